@@ -1,0 +1,1 @@
+"""Pure numpy/scipy maths of SG-PRT. Nothing under this package imports bpy."""
