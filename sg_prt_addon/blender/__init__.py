@@ -1,0 +1,1 @@
+"""bpy glue: properties, panels, operators, export of the scene to numpy."""

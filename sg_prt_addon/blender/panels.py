@@ -1,0 +1,88 @@
+"""Properties-editor panels of the SG-PRT engine."""
+import bpy
+
+from .properties import ANISOTROPIC_MODELS, MODEL_PARAMETERS
+
+ENGINE_ID = "SG_PRT"
+
+
+class SGPRT_PT_material(bpy.types.Panel):
+    bl_label = "SG-PRT Surface"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "material"
+    COMPAT_ENGINES = {ENGINE_ID}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and context.material is not None
+
+    def draw(self, context):
+        settings = context.material.sgprt
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(settings, "model")
+        textured = settings.show_textures
+        for name in ("diffuse_color", "specular_color") + MODEL_PARAMETERS[settings.model]:
+            row = layout.row(align=True)
+            row.prop(settings, name)
+            if textured and hasattr(settings, f"{name}_texture"):
+                row.template_ID(settings, f"{name}_texture", open="image.open")
+        layout.prop(settings, "show_textures")
+
+
+class SGPRT_PT_material_geometry(bpy.types.Panel):
+    bl_label = "Normal and Tangent"
+    bl_parent_id = "SGPRT_PT_material"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "material"
+    bl_options = {"DEFAULT_CLOSED"}
+    COMPAT_ENGINES = {ENGINE_ID}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and context.material is not None
+
+    def draw(self, context):
+        settings = context.material.sgprt
+        layout = self.layout
+        layout.use_property_split = True
+        layout.template_ID(settings, "normal_map", open="image.open")
+        layout.prop(settings, "normal_strength")
+        if settings.model in ANISOTROPIC_MODELS:
+            layout.prop(settings, "tangent_source")
+            if settings.tangent_source == "OBJECT_AXIS":
+                layout.prop(settings, "tangent_axis")
+            layout.prop(settings, "tangent_rotation")
+
+
+classes = (SGPRT_PT_material, SGPRT_PT_material_geometry)
+
+# Built-in panels that work unchanged with this engine.
+COMPATIBLE_BUILTIN_PANELS = (
+    "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_output", "RENDER_PT_color_management",
+    "DATA_PT_context_light", "DATA_PT_light", "DATA_PT_lens", "DATA_PT_camera", "DATA_PT_camera_display",
+    "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface", "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_context_material",
+)
+
+
+def _builtin_panels():
+    for name in COMPATIBLE_BUILTIN_PANELS:
+        panel = getattr(bpy.types, name, None)
+        if panel is not None and hasattr(panel, "COMPAT_ENGINES"):
+            yield panel
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    for panel in _builtin_panels():
+        panel.COMPAT_ENGINES.add(ENGINE_ID)
+
+
+def unregister():
+    for panel in _builtin_panels():
+        panel.COMPAT_ENGINES.discard(ENGINE_ID)
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,109 @@
+"""Material settings of the SG-PRT engine: `material.sgprt`.
+
+Every model parameter can be driven by an image over the active UV map: the
+shaded value is the property times the texture sample (RGB for colours, the
+red channel for scalars), like a factor next to a texture in Blender's nodes.
+"""
+import bpy
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty,
+                       PointerProperty)
+
+MODELS = (
+    ("GGX", "GGX", "Microfacet GGX matching Blender's Glossy BSDF (alpha = roughness^2, "
+                   "height-correlated Smith shadowing, no Fresnel)"),
+    ("COOK_TORRANCE", "Cook-Torrance", "Cook-Torrance with the Gaussian NDF of wang2009 eq. 10-12 "
+                                       "and dielectric Fresnel"),
+    ("BLINN_PHONG", "Blinn-Phong", "Blinn-Phong specular lobe"),
+    ("WARD_ISO", "Ward Isotropic", "Isotropic Ward"),
+    ("WARD_ANISO", "Ward Anisotropic", "Anisotropic Ward, fitted with several SG lobes"),
+    ("ASHIKHMIN_SHIRLEY", "Ashikhmin-Shirley", "Anisotropic Ashikhmin-Shirley, fitted with several SG lobes"),
+)
+
+# The parameters each model reads, in panel order (diffuse and specular colour are shared).
+MODEL_PARAMETERS = {
+    "GGX": ("roughness",),
+    "COOK_TORRANCE": ("roughness", "ior"),
+    "BLINN_PHONG": ("exponent",),
+    "WARD_ISO": ("alpha_x",),
+    "WARD_ANISO": ("alpha_x", "alpha_y", "lobe_count"),
+    "ASHIKHMIN_SHIRLEY": ("nu", "nv", "lobe_count"),
+}
+ANISOTROPIC_MODELS = {"WARD_ANISO", "ASHIKHMIN_SHIRLEY"}
+
+# Parameters that may be driven by an image texture: `<name>_texture`.
+TEXTURED_PARAMETERS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
+                       "alpha_x", "alpha_y", "nu", "nv")
+
+
+def _texture(name):
+    return PointerProperty(
+        type=bpy.types.Image, name=f"{name.replace('_', ' ').title()} Texture",
+        description=f"Image over the active UV map multiplying {name.replace('_', ' ')} "
+                    "(RGB for colours, red channel for scalars)")
+
+
+class SGPRT_PG_material(bpy.types.PropertyGroup):
+    model: EnumProperty(name="Model", items=MODELS, default="GGX",
+                        description="Specular reflectance model, rendered with spherical Gaussian NDF lobes")
+    diffuse_color: FloatVectorProperty(name="Diffuse", subtype="COLOR", size=3, default=(0.5, 0.5, 0.5),
+                                       min=0.0, soft_max=1.0, description="Lambertian albedo kd")
+    specular_color: FloatVectorProperty(name="Specular", subtype="COLOR", size=3, default=(0.25, 0.25, 0.25),
+                                        min=0.0, soft_max=1.0, description="Specular colour ks")
+    roughness: FloatProperty(name="Roughness", default=0.3, min=0.001, max=1.0,
+                             description="Cook-Torrance m; for GGX Blender's roughness (alpha = roughness^2)")
+    ior: FloatProperty(name="IOR", default=1.5, min=1.0, max=4.0,
+                       description="Relative index of refraction of the Cook-Torrance Fresnel term")
+    exponent: FloatProperty(name="Exponent", default=100.0, min=1.0, max=1e5,
+                            description="Blinn-Phong specular exponent")
+    alpha_x: FloatProperty(name="Alpha X", default=0.2, min=0.001, max=1.0,
+                           description="Ward roughness along the tangent (the isotropic model uses this only)")
+    alpha_y: FloatProperty(name="Alpha Y", default=0.05, min=0.001, max=1.0,
+                           description="Ward roughness along the bitangent")
+    nu: FloatProperty(name="Nu", default=100.0, min=1.0, max=1e5,
+                      description="Ashikhmin-Shirley exponent along the tangent")
+    nv: FloatProperty(name="Nv", default=1000.0, min=1.0, max=1e5,
+                      description="Ashikhmin-Shirley exponent along the bitangent")
+    lobe_count: IntProperty(name="Lobes", default=4, min=1, max=8,
+                            description="Spherical Gaussian lobes fitted to an anisotropic NDF")
+
+    diffuse_color_texture: _texture("diffuse_color")
+    specular_color_texture: _texture("specular_color")
+    roughness_texture: _texture("roughness")
+    ior_texture: _texture("ior")
+    exponent_texture: _texture("exponent")
+    alpha_x_texture: _texture("alpha_x")
+    alpha_y_texture: _texture("alpha_y")
+    nu_texture: _texture("nu")
+    nv_texture: _texture("nv")
+
+    normal_map: PointerProperty(type=bpy.types.Image, name="Normal Map",
+                                description="Tangent-space normal map (OpenGL convention, +Y up)")
+    normal_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=10.0,
+                                   description="Blend from the mesh normal (0) to the mapped normal (1) and beyond")
+    tangent_source: EnumProperty(
+        name="Tangent", default="UV_MAP",
+        items=(("UV_MAP", "UV Map", "Tangents from the active UV map"),
+               ("OBJECT_AXIS", "Object Axis", "A fixed object-space direction projected onto the surface")),
+        description="Where the anisotropy direction comes from")
+    tangent_axis: FloatVectorProperty(name="Axis", size=3, default=(1.0, 0.0, 0.0), subtype="XYZ",
+                                      description="Object-space tangent direction when the source is Object Axis")
+    tangent_rotation: FloatProperty(name="Rotation", default=0.0, subtype="ANGLE",
+                                    description="Rotation of the tangent about the normal")
+    show_textures: BoolProperty(name="Show Textures", default=True,
+                                description="Show the texture slot next to each parameter")
+
+
+classes = (SGPRT_PG_material,)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Material.sgprt = PointerProperty(type=SGPRT_PG_material, name="SG-PRT",
+                                               description="SG-PRT material settings")
+
+
+def unregister():
+    del bpy.types.Material.sgprt
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
