@@ -1,0 +1,104 @@
+"""Fixtures for GLSL tests on Mesa llvmpipe through a RenderEngine (see docs/DESIGN.md).
+
+- `blender`: session-wide; imports pip `bpy` (skips the tests if it is
+  missing) and resets it to empty factory settings once.
+- `glsl`: a callable `glsl(library, call, inputs, output_components=4,
+  textures=None)` around sg_prt_addon.engine.glsl_harness.run_glsl, where
+  `library` lists shaders/lib file names ("sg.glsl") and/or raw GLSL sources.
+"""
+import zlib
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture(scope="session")
+def blender():
+    bpy = pytest.importorskip("bpy")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    yield bpy
+
+
+@pytest.fixture(scope="session")
+def glsl(blender):
+    from sg_prt_addon.engine import glsl_harness
+
+    def run(library, call, inputs, output_components=4, textures=None):
+        sources = []
+        for item in library:
+            if item.endswith(".glsl") and "\n" not in item:
+                sources.extend(glsl_harness.load_library(item))
+            else:
+                sources.append(item)
+        return glsl_harness.run_glsl(sources, call, inputs, output_components, textures)
+
+    glsl_harness.register()
+    yield run
+
+
+class Fuzz:
+    """Random float32-representable inputs (numpy rng) shared by the GLSL tests.
+
+    Every generator returns float64 arrays whose values are exactly float32,
+    so the numpy reference sees the same inputs as the GLSL kernel.
+    """
+
+    def __init__(self, seed):
+        self.rng = np.random.default_rng(seed)
+
+    @staticmethod
+    def f32(values):
+        return np.asarray(values, np.float32).astype(np.float64)
+
+    def unit_vectors(self, count):
+        v = self.rng.normal(size=(count, 3))
+        return self.f32(v / np.linalg.norm(v, axis=1, keepdims=True))
+
+    def log_uniform(self, low, high, count):
+        return self.f32(np.exp(self.rng.uniform(np.log(low), np.log(high), count)))
+
+    def uniform(self, low, high, count):
+        return self.f32(self.rng.uniform(low, high, count))
+
+    def near(self, vectors, spread):
+        """Unit vectors within about `spread` radians of `vectors` (opposite axes: pass -v)."""
+        v = vectors + spread * self.rng.normal(size=vectors.shape)
+        return self.f32(v / np.linalg.norm(v, axis=1, keepdims=True))
+
+    def stress_vectors(self, count):
+        """Unit vectors, with 1/8 each exact poles, tiny, zero and huge (non-normalised) vectors."""
+        v = self.unit_vectors(count)
+        kind = self.rng.integers(0, 8, count)
+        v[kind == 1] = [0.0, 0.0, 1.0]
+        v[kind == 2] = [0.0, 0.0, -1.0]
+        v[kind == 3] *= 1e-30
+        v[kind == 4] = 0.0
+        v[kind == 5] *= 1e30
+        return self.f32(v)
+
+    def stress_sharpness(self, count):
+        """Log-uniform 1e-4..1e6, with exact 0, 1e-4 and 1e6 mixed in."""
+        s = self.log_uniform(1e-4, 1e6, count)
+        kind = self.rng.integers(0, 8, count)
+        s[kind == 1] = 0.0
+        s[kind == 2] = 1e-4
+        s[kind == 3] = 1e6
+        return self.f32(s)
+
+    def stress_amplitude(self, count):
+        a = self.log_uniform(1e-3, 1e3, count)
+        a[self.rng.integers(0, 4, count) == 0] = 0.0
+        return self.f32(a)
+
+    @staticmethod
+    def relative_error(actual, expected, floor):
+        """|actual - expected| / max(|expected|, floor), elementwise (floor: the absolute-error scale)."""
+        actual = np.asarray(actual, np.float64)
+        expected = np.asarray(expected, np.float64)
+        return np.abs(actual - expected) / np.maximum(np.abs(expected), floor)
+
+
+@pytest.fixture
+def fuzz(request):
+    """A Fuzz seeded from the test's name: reproducible, different per test."""
+    return Fuzz(zlib.crc32(request.node.name.encode()))
