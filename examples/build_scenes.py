@@ -1,0 +1,221 @@
+"""Build the example scenes from Blender's own primitives and bundled HDRIs.
+
+    .venv/bin/python examples/build_scenes.py out/scenes      # writes one .blend per scene
+
+Each builder starts from an empty file and returns the scene; `save_scene`
+writes it with every image packed, so the .blend is self-contained.
+"""
+import math
+import sys
+from pathlib import Path
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+ENGINE_ID = "SG_PRT"
+
+
+def bundled_hdri(name):
+    """Path of one of the HDRIs that ship inside Blender (courtyard, forest, city, interior, ...)."""
+    path = Path(bpy.utils.system_resource("DATAFILES", path="studiolights/world")) / f"{name}.exr"
+    if not path.is_file():
+        raise FileNotFoundError(f"Blender's bundled HDRI {path} is missing")
+    return path
+
+
+def _empty_file():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return bpy.context.scene
+
+
+def _apply_modifiers(obj):
+    """Bake the modifier stack into the mesh, so per-vertex bakes address the final vertices."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    mesh = bpy.data.meshes.new_from_object(obj.evaluated_get(depsgraph))
+    obj.modifiers.clear()
+    old, obj.data = obj.data, mesh
+    bpy.data.meshes.remove(old)
+
+
+def _add_camera(scene, location, target, lens=50.0):
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.data.lens = lens
+    camera.location = location
+    camera.rotation_euler = (Vector(target) - Vector(location)).to_track_quat("-Z", "Y").to_euler()
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    return camera
+
+
+def _world_with_hdri(scene, hdri_path, strength=1.0):
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    background = next(node for node in nodes if node.type == "BACKGROUND")
+    background.inputs["Strength"].default_value = strength
+    environment = nodes.new("ShaderNodeTexEnvironment")
+    environment.image = bpy.data.images.load(str(hdri_path), check_existing=True)
+    links.new(environment.outputs["Color"], background.inputs["Color"])
+    scene.world = world
+    return world
+
+
+def _world_with_colour(scene, colour):
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    background = next(node for node in world.node_tree.nodes if node.type == "BACKGROUND")
+    background.inputs["Color"].default_value = (*colour, 1.0)
+    world.color = colour
+    scene.world = world
+    return world
+
+
+def _image_from_array(name, rgb):
+    """A packed 8-bit image from an (H, W, 3) array in [0, 1], row 0 at the top."""
+    height, width = rgb.shape[:2]
+    image = bpy.data.images.new(name, width, height, alpha=False)
+    rgba = np.concatenate([rgb, np.ones((height, width, 1))], axis=-1)[::-1]  # Blender rows start at the bottom
+    image.pixels.foreach_set(np.ascontiguousarray(rgba, np.float32).ravel())
+    image.pack()
+    return image
+
+
+def _tile_pattern(size=256, tiles=8, seed=1):
+    """Deterministic tiles with per-tile colour and roughness, for a visibly spatially-varying material."""
+    rng = np.random.default_rng(seed)
+    tile_colour = rng.uniform(0.15, 0.85, (tiles, tiles, 3))
+    tile_roughness = rng.uniform(0.15, 1.0, (tiles, tiles))
+    index = (np.arange(size) * tiles) // size
+    colour = tile_colour[index[:, None], index[None, :]]
+    roughness = tile_roughness[index[:, None], index[None, :]]
+    grout = ((np.arange(size) * tiles) % size < size // (tiles * 8))
+    grout = grout[:, None] | grout[None, :]
+    colour[grout] = 0.05
+    roughness[grout] = 1.0
+    return colour, np.repeat(roughness[..., None], 3, axis=-1)
+
+
+def _link(scene, obj, material=None):
+    scene.collection.objects.link(obj)
+    if material is not None:
+        obj.data.materials.append(material)
+    return obj
+
+
+def _grid(name, size, subdivisions):
+    """A floor grid, tessellated finely enough to carry per-vertex visibility."""
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=subdivisions, y_subdivisions=subdivisions, size=size)
+    obj = bpy.context.active_object
+    obj.name = name
+    return obj
+
+
+def build_suzanne_courtyard(resolution=512):
+    """Subdivided Suzanne on a tiled floor under courtyard.exr, textured Cook-Torrance."""
+    scene = _empty_file()
+    scene.render.engine = ENGINE_ID
+    scene.render.resolution_x = scene.render.resolution_y = resolution
+    _world_with_hdri(scene, bundled_hdri("courtyard"))
+
+    floor_material = bpy.data.materials.new("Tiles")
+    colour, roughness = _tile_pattern()
+    floor_material.sgprt.model = "COOK_TORRANCE"
+    floor_material.sgprt.diffuse_color = (1.0, 1.0, 1.0)
+    floor_material.sgprt.diffuse_color_texture = _image_from_array("tiles_colour", colour)
+    floor_material.sgprt.specular_color = (0.3, 0.3, 0.3)
+    floor_material.sgprt.roughness = 0.5
+    floor_material.sgprt.roughness_texture = _image_from_array("tiles_roughness", roughness)
+
+    suzanne_material = bpy.data.materials.new("Glaze")
+    suzanne_material.sgprt.model = "COOK_TORRANCE"
+    suzanne_material.sgprt.diffuse_color = (0.6, 0.12, 0.05)
+    suzanne_material.sgprt.specular_color = (0.5, 0.5, 0.5)
+    suzanne_material.sgprt.roughness = 0.2
+
+    floor = _grid("Floor", size=6.0, subdivisions=64)
+    floor.data.materials.append(floor_material)
+
+    bpy.ops.mesh.primitive_monkey_add(size=2.0, location=(0.0, 0.0, 1.0))
+    suzanne = bpy.context.active_object
+    suzanne.name = "Suzanne"
+    suzanne.rotation_euler = (math.radians(-20), 0.0, math.radians(20))
+    suzanne.modifiers.new("Subdivision", "SUBSURF").levels = 2
+    _apply_modifiers(suzanne)
+    suzanne.data.shade_smooth()
+    suzanne.data.materials.append(suzanne_material)
+
+    _add_camera(scene, location=(4.5, -5.5, 3.2), target=(0.0, 0.0, 0.8))
+    return scene
+
+
+def build_brushed_metal(resolution=512):
+    """An anisotropic Ashikhmin-Shirley torus lit by a point light in a dark room."""
+    scene = _empty_file()
+    scene.render.engine = ENGINE_ID
+    scene.render.resolution_x = scene.render.resolution_y = resolution
+    _world_with_colour(scene, (0.02, 0.02, 0.025))
+
+    metal = bpy.data.materials.new("Brushed Metal")
+    metal.sgprt.model = "ASHIKHMIN_SHIRLEY"
+    metal.sgprt.diffuse_color = (0.02, 0.02, 0.02)
+    metal.sgprt.specular_color = (0.9, 0.85, 0.75)
+    metal.sgprt.nu, metal.sgprt.nv = 50.0, 800.0
+    metal.sgprt.lobe_count = 6
+    metal.sgprt.tangent_source = "OBJECT_AXIS"
+    metal.sgprt.tangent_axis = (0.0, 0.0, 1.0)
+
+    floor_material = bpy.data.materials.new("Floor")
+    floor_material.sgprt.model = "GGX"
+    floor_material.sgprt.diffuse_color = (0.4, 0.4, 0.4)
+    floor_material.sgprt.specular_color = (0.1, 0.1, 0.1)
+    floor_material.sgprt.roughness = 0.4
+
+    floor = _grid("Floor", size=8.0, subdivisions=64)
+    floor.data.materials.append(floor_material)
+
+    bpy.ops.mesh.primitive_torus_add(major_radius=1.2, minor_radius=0.45, major_segments=96, minor_segments=48,
+                                     location=(0.0, 0.0, 1.0), rotation=(math.radians(70), 0.0, 0.0))
+    torus = bpy.context.active_object
+    torus.name = "Torus"
+    torus.data.shade_smooth()
+    torus.data.materials.append(metal)
+
+    light = bpy.data.objects.new("Key Light", bpy.data.lights.new("Key Light", "POINT"))
+    light.data.energy = 1500.0
+    light.data.shadow_soft_size = 0.1
+    light.location = (2.5, -2.0, 4.0)
+    scene.collection.objects.link(light)
+
+    _add_camera(scene, location=(0.0, -6.5, 2.6), target=(0.0, 0.0, 0.9))
+    return scene
+
+
+SCENES = {
+    "suzanne_courtyard": build_suzanne_courtyard,
+    "brushed_metal": build_brushed_metal,
+}
+
+
+def save_scene(path):
+    """Save the current file with every image packed (the HDRI too), so it reopens anywhere."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    for image in bpy.data.images:
+        if image.packed_file is None and image.source == "FILE":
+            image.pack()
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=True)
+    return path
+
+
+def main(output_dir):
+    import sg_prt_addon
+    sg_prt_addon.register()
+    for name, build in SCENES.items():
+        build()
+        print(f"wrote {save_scene(Path(output_dir) / f'{name}.blend')}", flush=True)
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    main(sys.argv[1] if len(sys.argv) > 1 else "out/scenes")
