@@ -1,0 +1,59 @@
+"""The extension zip: built with its wheels, accepted by Blender's validator,
+installed into a clean user directory of the pip bpy, enabled, and rendering."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+INSTALL_AND_RENDER = r"""
+import json, sys
+import bpy
+zip_path, image_path = sys.argv[1], sys.argv[2]
+bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
+enabled = [name for name in bpy.context.preferences.addons.keys() if name.endswith("sg_prt")]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+scene.render.engine = "SG_PRT"
+scene.render.resolution_x = scene.render.resolution_y = 64
+bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0)
+material = bpy.data.materials.new("Probe")
+material.sgprt.diffuse_color = (0.8, 0.4, 0.2)
+bpy.context.active_object.data.materials.append(material)
+light = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+light.rotation_euler = (0.5, 0.3, 0.0)
+scene.collection.objects.link(light)
+camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+camera.location = (0.0, -5.0, 0.0)
+camera.rotation_euler = (1.5707963, 0.0, 0.0)
+scene.collection.objects.link(camera)
+scene.camera = camera
+scene.render.filepath = image_path
+scene.render.image_settings.file_format = "PNG"
+bpy.ops.render.render(write_still=True)
+image = bpy.data.images.load(image_path)
+pixels = list(image.pixels)
+print("RESULT " + json.dumps({"enabled": enabled, "max": max(pixels[0::4]), "size": list(image.size)}))
+"""
+
+
+def test_extension_builds_validates_installs_and_renders(tmp_path):
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        import build_extension
+    finally:
+        sys.path.pop(0)
+    zip_path = build_extension.build(local_only=True, output_dir=tmp_path / "dist")  # raises unless validated
+
+    environment = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
+    environment.pop("PYTHONPATH", None)
+    completed = subprocess.run([sys.executable, "-c", INSTALL_AND_RENDER, str(zip_path), str(tmp_path / "probe.png")],
+                               cwd=tmp_path, env=environment, capture_output=True, text=True, timeout=600)
+    lines = [line for line in completed.stdout.splitlines() if line.startswith("RESULT ")]
+    assert completed.returncode == 0 and lines, completed.stdout[-3000:] + completed.stderr[-3000:]
+    result = json.loads(lines[-1][len("RESULT "):])
+    assert result["enabled"] == ["bl_ext.user_default.sg_prt"]
+    assert result["size"] == [64, 64]
+    assert result["max"] > 0.05, "the installed engine rendered a black image"
