@@ -102,3 +102,22 @@ class Fuzz:
 def fuzz(request):
     """A Fuzz seeded from the test's name: reproducible, different per test."""
     return Fuzz(zlib.crc32(request.node.name.encode()))
+
+
+_measured_errors = {}
+
+
+@pytest.fixture
+def record_error():
+    """record_error(label, value): a measured max error, listed in the pytest summary."""
+    def record(label, value):
+        _measured_errors[label] = float(value)
+        return float(value)
+    return record
+
+
+def pytest_terminal_summary(terminalreporter):
+    if _measured_errors:
+        terminalreporter.section("GLSL (float32) vs numpy (float64): measured max errors")
+        for label, value in sorted(_measured_errors.items()):
+            terminalreporter.write_line(f"{label:60s} {value:.3g}")

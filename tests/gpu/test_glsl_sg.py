@@ -11,25 +11,25 @@ N = 20000
 LIB = ["sg.glsl"]
 
 
-def test_one_minus_exp_over_x(glsl, fuzz):
+def test_one_minus_exp_over_x(glsl, fuzz, record_error):
     x = np.concatenate([[0.0, 1e-30, 1e-8, 0.2499999, 0.25, 0.2500001],
                         fuzz.log_uniform(1e-8, 2e6, N)])
     x = fuzz.f32(x)
     out = glsl(LIB, "vec4(one_minus_exp_over_x(a.x))", {"a": x}, 1)
     error = fuzz.relative_error(out, sg.one_minus_exp_over_x(x), 1e-30)
-    assert error.max() <= 1e-6, x[np.argmax(error)]
+    assert record_error("sg one_minus_exp_over_x, relative", error.max()) <= 1e-6, x[np.argmax(error)]
 
 
-def test_safe_normalize(glsl, fuzz):
+def test_safe_normalize(glsl, fuzz, record_error):
     v = fuzz.f32(fuzz.rng.normal(size=(N, 3)) * fuzz.log_uniform(1e-30, 1e30, N)[:, None])
     v[:4] = [[0, 0, 0], [1e-36, 0, 0], [0, -3, 0], [3e38, -3e38, 0]]
     out = glsl(LIB, "vec4(safe_normalize(a.xyz), 0)", {"a": v}, 3)
     expected = sg.normalize(v)
-    assert np.abs(out - expected).max() <= 1e-6
+    assert record_error("sg safe_normalize, absolute", np.abs(out - expected).max()) <= 1e-6
     assert np.allclose(out[:4], [[0, 0, 1], [1, 0, 0], [0, -1, 0], [0.5 ** 0.5, -0.5 ** 0.5, 0]])
 
 
-def test_evaluate(glsl, fuzz):
+def test_evaluate(glsl, fuzz, record_error):
     axis = fuzz.unit_vectors(N)
     direction = fuzz.near(axis, 0.5)
     sharpness = fuzz.log_uniform(1e-4, 1e4, N)
@@ -41,7 +41,7 @@ def test_evaluate(glsl, fuzz):
     exponent = 0.5 * sharpness * np.sum((direction - axis) ** 2, axis=1)
     well_conditioned = exponent < 60
     error = fuzz.relative_error(out, expected, 1e-30)
-    assert error[well_conditioned].max() <= 2e-5
+    assert record_error("sg evaluate (exponent < 60), relative", error[well_conditioned].max()) <= 2e-5
     assert np.all(np.abs(out - expected)[~well_conditioned] <= 1e-20)
 
 
@@ -56,7 +56,7 @@ def _product_inputs(fuzz):
     return axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2
 
 
-def test_product(glsl, fuzz):
+def test_product(glsl, fuzz, record_error):
     axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2 = _product_inputs(fuzz)
     call = """
     vec3 axis; float sharpness, amplitude;
@@ -72,18 +72,20 @@ def test_product(glsl, fuzz):
     axis, sharpness, amplitude = sg.product(axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2)
     # l1 p1 + l2 p2 cancels when l1 ~ l2 and p1 ~ -p2: the summed vector carries
     # float32 rounding of the larger term, so errors are relative to l1 + l2.
-    assert (np.abs(out_scalars[:, 0] - sharpness) / (sharpness1 + sharpness2)).max() <= 1e-6
+    assert record_error("sg product sharpness, relative to l1 + l2",
+                        (np.abs(out_scalars[:, 0] - sharpness) / (sharpness1 + sharpness2)).max()) <= 1e-6
     well_separated = sharpness > 1e-2 * (sharpness1 + sharpness2)
-    assert np.abs(out_axis - axis)[well_separated].max() <= 1e-4
+    assert record_error("sg product axis (lambda_m > 0.01 (l1 + l2)), absolute",
+                        np.abs(out_axis - axis)[well_separated].max()) <= 1e-4
     log_amplitude = np.log(np.maximum(amplitude, 1e-300) / np.maximum(amplitude1 * amplitude2, 1e-300))
     well_conditioned = (log_amplitude > -60) & (amplitude1 * amplitude2 > 0)
     error = fuzz.relative_error(out_scalars[:, 1], amplitude, 1e-30)
     # relative error of exp(-E) grows like E * eps: 60 * 1.2e-7 * a few
-    assert error[well_conditioned].max() <= 3e-5
+    assert record_error("sg product amplitude (log > -60), relative", error[well_conditioned].max()) <= 3e-5
     assert np.all(np.abs(out_scalars[:, 1] - amplitude)[~well_conditioned] <= 1e-20)
 
 
-def test_inner_product(glsl, fuzz):
+def test_inner_product(glsl, fuzz, record_error):
     axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2 = _product_inputs(fuzz)
     out = glsl(LIB, "vec4(sg_inner_product(p1.xyz, p1.w, m.x, p2.xyz, p2.w, m.y))",
                {"p1": np.c_[axis1, sharpness1], "p2": np.c_[axis2, sharpness2],
@@ -93,11 +95,11 @@ def test_inner_product(glsl, fuzz):
     log_amplitude = np.log(np.maximum(product_amplitude, 1e-300) / np.maximum(amplitude1 * amplitude2, 1e-300))
     well_conditioned = (log_amplitude > -60) & (amplitude1 * amplitude2 > 0)
     error = fuzz.relative_error(out, expected, 1e-30)
-    assert error[well_conditioned].max() <= 3e-5
+    assert record_error("sg inner_product (log amplitude > -60), relative", error[well_conditioned].max()) <= 3e-5
     assert np.all(np.abs(out - expected)[~well_conditioned] <= 1e-20)
 
 
-def test_integrals(glsl, fuzz):
+def test_integrals(glsl, fuzz, record_error):
     sharpness = fuzz.f32(np.concatenate([[0.0, 1e-4, 0.125, 1e6], fuzz.log_uniform(1e-4, 1e6, N)]))
     amplitude = fuzz.uniform(0.0, 5.0, sharpness.size)
     out = glsl(LIB, "vec4(sg_sphere_integral(a.x, a.y), sg_axis_hemisphere_integral(a.x, a.y),"
@@ -106,10 +108,10 @@ def test_integrals(glsl, fuzz):
     shifted = fuzz.f32(sharpness + 1.0)
     expected = np.c_[sg.sphere_integral(sharpness, amplitude), sg.axis_hemisphere_integral(sharpness, amplitude),
                      sg.support_area(shifted), sg.sharpness_from_area(shifted)]
-    assert fuzz.relative_error(out, expected, 1e-30).max() <= 2e-6
+    assert record_error("sg integrals, support area, relative", fuzz.relative_error(out, expected, 1e-30).max()) <= 2e-6
 
 
-def test_rotate(glsl, fuzz):
+def test_rotate(glsl, fuzz, record_error):
     axis = fuzz.unit_vectors(N)
     angle = fuzz.uniform(-np.pi, np.pi, N)
     c, s = np.cos(angle), np.sin(angle)
@@ -120,4 +122,4 @@ def test_rotate(glsl, fuzz):
     call = "vec4(sg_rotate(p.xyz, mat3(c0.xyz, c1.xyz, c2.xyz)), 0.0)"
     out = glsl(LIB, call, {"p": axis, "c0": rotation[:, :, 0], "c1": rotation[:, :, 1],
                            "c2": rotation[:, :, 2]}, 3)
-    assert np.abs(out - sg.rotate(axis, rotation)).max() <= 1e-6
+    assert record_error("sg rotate, absolute", np.abs(out - sg.rotate(axis, rotation)).max()) <= 1e-6

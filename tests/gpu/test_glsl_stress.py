@@ -58,3 +58,21 @@ def test_safe_normalize_stress(glsl, fuzz):
     out = glsl(["sg.glsl"], "vec4(safe_normalize(a.xyz), 0.0)", {"a": v}, 3)
     _assert_finite(out, "safe_normalize")
     assert np.abs(np.linalg.norm(out, axis=1) - 1).max() <= 1e-6
+
+
+def test_hemisphere_stress(glsl, fuzz):
+    axis, normal = _axis_pairs(fuzz, ROWS)
+    sharpness = fuzz.stress_sharpness(ROWS)
+    amplitude = fuzz.stress_amplitude(ROWS)
+    # theta_d and sin(theta_d) beyond their ranges, and exactly at +-pi/2, +-1
+    theta = fuzz.uniform(-4.0, 4.0, ROWS)
+    kind = fuzz.rng.integers(0, 6, ROWS)
+    theta[kind == 1] = np.float32(np.pi / 2)
+    theta[kind == 2] = -np.float32(np.pi / 2)
+    theta[kind == 3] = 0.0
+    inputs = {"p": np.c_[axis, sharpness], "n": np.c_[normal, amplitude], "t": theta}
+    call = ("vec4(fh_normalized_from_sine(t.x, p.w), fh(t.x, p.w),"
+            " hemisphere_integral(p.xyz, p.w, n.w, n.xyz), visibility_product_amplitude(p.w, n.w, t.x))")
+    out = glsl(["sg.glsl", "hemisphere.glsl"], call, inputs, 4)
+    _assert_finite(out, "hemisphere.glsl")
+    assert out.min() >= 0 and out[:, 0].max() <= 1
