@@ -1,0 +1,403 @@
+"""Monte Carlo reference renderer: exact direct lighting with ray-traced visibility.
+
+Computes wang2009 eq. 1 at the first surface seen through each pixel:
+
+    R(o) = integral L(i) V(i) rho(o, i) max(0, n.i) di,  rho = kd / pi + ks rho_s(o, i)
+
+with V by ray casts against every triangle of the scene (core.raytrace).  No
+indirect light.  Every sample of a pixel takes a new uniformly jittered
+position inside the pixel (anti-aliasing) and traces its own camera ray, so a
+pixel's value is the average of R over its footprint.
+
+Estimators, one sample each per pixel sample:
+  - environment: multiple importance sampling of one environment sample
+    (core.env_sampling) and one BRDF sample, power heuristic;
+  - point lights (sphere of radius r, r = 0 a true point) and directional
+    lights (cone of angular radius a, a = 0 a delta): light sampling uniform
+    over the solid angle the light subtends.
+
+Conventions:
+  - Pixels whose camera ray misses the scene show the environment radiance
+    along the ray (the constant background colour, or 0 without either).
+  - Surfaces are two-sided: the geometric normal is turned towards the viewer
+    and the shading normal to the same side.  Where the interpolated shading
+    normal faces away from the viewer, the view direction is lifted just above
+    its horizon before the BRDF is evaluated.
+  - BRDF models work in the local frame (normal z+, tangent x+) with the
+    protocol specular(wo, wi) -> (N,), sample(wo, u) -> (wi, pdf), pdf(wo, wi)
+    (core.brdf); specular(wo, wi) is rho_s without the cosine.
+  - The standard error of a pixel is sqrt(sample variance / samples): the
+    samples of a pixel are independent, so it is calibrated.
+"""
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional, Sequence
+
+import numpy as np
+
+from .env_sampling import EnvironmentSampler, LUMINANCE_WEIGHTS
+from .raytrace import RayTracer, offset_origins
+
+INV_PI = 1.0 / np.pi
+# Lowest cosine of the view direction over the shading horizon (see module notes).
+_MIN_VIEW_COSINE = 1e-3
+
+
+@dataclass
+class Material:
+    diffuse_color: Any = (0.8, 0.8, 0.8)     # kd (3,), albedo of the Lambertian term kd / pi
+    specular_color: Any = (0.0, 0.0, 0.0)    # ks (3,), scales the specular model
+    specular_model: Any = None               # object with specular / sample / pdf, or None
+
+
+@dataclass
+class PointLight:
+    position: Any                             # (3,) world
+    intensity: Any                            # (3,) W/sr
+    radius: float = 0.0                       # > 0: a uniformly emitting sphere of the same intensity
+
+
+@dataclass
+class DirectionalLight:
+    direction: Any                            # (3,) world, from the surface TOWARDS the light
+    irradiance: Any                           # (3,) W/m^2 on a surface facing the light
+    angular_radius: float = 0.0               # radians; > 0: a uniform disc of directions (like a sun)
+
+
+@dataclass
+class Scene:
+    vertices: Any                             # (V, 3)
+    triangles: Any                            # (T, 3) int, counter-clockwise seen from the front
+    normals: Any                              # (V, 3) shading normals, interpolated
+    materials: Sequence[Material] = field(default_factory=lambda: [Material()])
+    material_index: Any = None                # (T,) int into materials; None: all 0
+    uvs: Any = None                           # (V, 2), unused for now (no textures yet)
+    tangents: Any = None                      # (V, 3) for anisotropic models; None: built from the normal
+    lights: Sequence[Any] = ()                # PointLight / DirectionalLight
+    environment: Any = None                   # equirect (H, W, 3) radiance, Blender world mapping
+    background: Any = None                    # (3,) constant radiance, used when environment is None
+
+
+def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optional[Callable] = None,
+                     batch_rays=1 << 15, tracer=None, threads=2):
+    """Render ``scene`` through ``camera`` (core.camera.Camera).
+
+    Returns (image, standard_error), both (H, W, 3) float64.  ``progress`` is
+    called after every batch as progress(samples_done, samples_total) with
+    counts of pixel samples; if it returns True rendering stops there and the
+    images average the samples taken so far (standard_error is inf where a
+    pixel has fewer than two).  ``tracer`` lets callers reuse a RayTracer of
+    the same mesh.  Batches of about ``batch_rays`` pixel samples run on
+    ``threads`` threads (numpy and Embree release the GIL); every batch has
+    its own random stream, so the result depends on ``seed`` only.
+    """
+    renderer = _Renderer(scene, tracer if tracer is not None else
+                         RayTracer(scene.vertices, scene.triangles, threads=threads))
+    height, width = camera.height, camera.width
+    pixel_count = height * width
+    samples_per_pixel = int(samples_per_pixel)
+    # Each batch takes `repeats` samples of a run of `pixels_per_batch` pixels.
+    pixels_per_batch = min(pixel_count, max(1, batch_rays))
+    repeats = max(1, min(samples_per_pixel, batch_rays // pixels_per_batch))
+    batches = [(first_sample, min(repeats, samples_per_pixel - first_sample), first_pixel,
+                min(first_pixel + pixels_per_batch, pixel_count))
+               for first_sample in range(0, samples_per_pixel, repeats)
+               for first_pixel in range(0, pixel_count, pixels_per_batch)]
+    streams = np.random.SeedSequence(seed).spawn(len(batches))
+
+    def run_batch(index):
+        _, batch_repeats, first_pixel, end_pixel = batches[index]
+        rng = np.random.default_rng(streams[index])
+        pixels = np.arange(first_pixel, end_pixel)
+        pixel_ids = np.tile(pixels, batch_repeats)
+        pixel_xy = np.stack([pixel_ids % width, pixel_ids // width], axis=-1).astype(np.float64)
+        pixel_xy += rng.random(pixel_xy.shape)
+        origins, directions = camera.rays_through(pixel_xy)
+        values = renderer.radiance(origins, directions, rng).reshape(batch_repeats, len(pixels), 3)
+        return pixels, values
+
+    count = np.zeros(pixel_count)
+    mean = np.zeros((pixel_count, 3))
+    squares = np.zeros((pixel_count, 3))   # sum of squared deviations from the mean
+    total = samples_per_pixel * pixel_count
+    done = 0
+    with ThreadPoolExecutor(max(1, int(threads))) as pool:
+        pending = deque()
+        next_batch = 0
+        while next_batch < len(batches) or pending:
+            # Keep a small window of batches in flight, merged in order (deterministic).
+            while next_batch < len(batches) and len(pending) < 2 * max(1, int(threads)):
+                pending.append(pool.submit(run_batch, next_batch))
+                next_batch += 1
+            pixels, values = pending.popleft().result()
+            # Chan et al.'s merge of the batch's mean and M2 into the running ones.
+            batch_repeats = values.shape[0]
+            batch_mean = values.mean(axis=0)
+            batch_squares = ((values - batch_mean) ** 2).sum(axis=0)
+            n_old = count[pixels][:, None]
+            n_new = n_old + batch_repeats
+            delta = batch_mean - mean[pixels]
+            mean[pixels] += delta * (batch_repeats / n_new)
+            squares[pixels] += batch_squares + delta ** 2 * (n_old * batch_repeats / n_new)
+            count[pixels] = n_new[:, 0]
+            done += values.shape[0] * values.shape[1]
+            if progress is not None and progress(done, total):
+                for future in pending:
+                    future.cancel()
+                break
+    n = count[:, None]
+    variance = squares / np.maximum(n - 1, 1)
+    standard_error = np.where(n > 1, np.sqrt(variance / np.maximum(n, 1)), np.inf)
+    return mean.reshape(height, width, 3), standard_error.reshape(height, width, 3)
+
+
+def _orthonormal_tangents(normals):
+    """A tangent perpendicular to each unit normal, continuous except on one
+    meridian (Duff et al. 2017 branchless construction)."""
+    sign = np.where(normals[:, 2] >= 0, 1.0, -1.0)
+    a = -1.0 / (sign + normals[:, 2])
+    b = normals[:, 0] * normals[:, 1] * a
+    return np.stack([1.0 + sign * normals[:, 0] ** 2 * a, sign * b, -sign * normals[:, 0]], axis=-1)
+
+
+def _normalize(v, fallback):
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    ok = length > 1e-12
+    return np.where(ok, v / np.where(ok, length, 1.0), fallback)
+
+
+def _cone_directions(axis, cos_max, uniforms):
+    """Uniform directions in the cone of half-angle acos(cos_max) around unit axes (N, 3)."""
+    cos_theta = 1.0 - uniforms[:, 0] * (1.0 - cos_max)
+    sin_theta = np.sqrt(np.maximum(0.0, 1.0 - cos_theta ** 2))
+    phi = 2.0 * np.pi * uniforms[:, 1]
+    tangent = _orthonormal_tangents(axis)
+    bitangent = np.cross(axis, tangent)
+    return (tangent * (sin_theta * np.cos(phi))[:, None] + bitangent * (sin_theta * np.sin(phi))[:, None]
+            + axis * cos_theta[:, None])
+
+
+def _one_minus_cos_from_sin(sin_value):
+    """1 - sqrt(1 - s^2) without cancellation for small s."""
+    s2 = np.minimum(sin_value ** 2, 1.0)
+    return s2 / (1.0 + np.sqrt(1.0 - s2))
+
+
+class _Renderer:
+    def __init__(self, scene, tracer):
+        self.tracer = tracer
+        self.triangles = np.asarray(scene.triangles, dtype=np.int64).reshape(-1, 3)
+        self.normals = np.asarray(scene.normals, dtype=np.float64).reshape(-1, 3)
+        self.corner_positions = np.asarray(scene.vertices, dtype=np.float64).reshape(-1, 3)[self.triangles]
+        self.face_normals = _normalize(np.cross(self.corner_positions[:, 1] - self.corner_positions[:, 0],
+                                                self.corner_positions[:, 2] - self.corner_positions[:, 0]),
+                                       np.array([0.0, 0.0, 1.0]))
+        self.tangents = None if scene.tangents is None else np.asarray(scene.tangents, np.float64).reshape(-1, 3)
+        self.material_index = (np.zeros(len(self.triangles), np.int64) if scene.material_index is None
+                               else np.asarray(scene.material_index, np.int64).reshape(-1))
+        materials = list(scene.materials) or [Material()]
+        self.material_index = np.clip(self.material_index, 0, len(materials) - 1)
+        self.diffuse = np.array([np.broadcast_to(np.asarray(m.diffuse_color, float), 3) for m in materials])
+        self.specular = np.array([np.broadcast_to(np.asarray(m.specular_color, float), 3)
+                                  if m.specular_model is not None else np.zeros(3) for m in materials])
+        self.models = [m.specular_model for m in materials]
+        # Probability of sampling the specular lobe: its share of the colour weight,
+        # kept in [0.1, 0.9] when both lobes exist so neither is starved.
+        diffuse_weight = self.diffuse @ LUMINANCE_WEIGHTS
+        specular_weight = self.specular @ LUMINANCE_WEIGHTS
+        share = specular_weight / np.maximum(diffuse_weight + specular_weight, 1e-300)
+        both = (diffuse_weight > 0) & (specular_weight > 0)
+        self.specular_probability = np.where(both, np.clip(share, 0.1, 0.9), np.where(specular_weight > 0, 1.0, 0.0))
+        self.lights = list(scene.lights)
+        environment = scene.environment
+        if environment is None and scene.background is not None:
+            # A constant background lights the scene like a constant environment.
+            environment = np.broadcast_to(np.asarray(scene.background, float).reshape(1, 1, -1)[..., :3], (4, 8, 3))
+        self.environment = None if environment is None else EnvironmentSampler(environment)
+
+    # -- per-point BRDF in the local frame ------------------------------------------------------
+    def _groups(self, material):
+        """(model, indices into the batch) for every material with a specular model present."""
+        groups = []
+        for m, model in enumerate(self.models):
+            if model is None:
+                continue
+            idx = np.flatnonzero(material == m)
+            if len(idx):
+                groups.append((model, idx))
+        return groups
+
+    def _brdf_cosine(self, points, wi_local):
+        """(kd/pi + ks rho_s) max(0, n.i): (N, 3); zero below the shading horizon."""
+        cosine = np.maximum(wi_local[:, 2], 0.0)
+        value = self.diffuse[points.material] * INV_PI
+        specular = np.zeros(len(wi_local))
+        for model, idx in points.groups:
+            above = idx[cosine[idx] > 0]
+            if len(above):
+                specular[above] = model.specular(points.wo_local[above], wi_local[above])
+        value = value + self.specular[points.material] * np.nan_to_num(specular, nan=0.0, posinf=0.0)[:, None]
+        return value * cosine[:, None]
+
+    def _brdf_pdf(self, points, wi_local):
+        q = self.specular_probability[points.material]
+        pdf = (1.0 - q) * np.maximum(wi_local[:, 2], 0.0) * INV_PI
+        for model, idx in points.groups:
+            pdf[idx] += q[idx] * np.nan_to_num(model.pdf(points.wo_local[idx], wi_local[idx]), nan=0.0, posinf=0.0)
+        return pdf
+
+    def _brdf_sample(self, points, uniforms):
+        """Mixture sample: cosine hemisphere or the specular model, chosen per point."""
+        radius = np.sqrt(uniforms[:, 1])
+        phi = 2.0 * np.pi * uniforms[:, 2]
+        wi_local = np.stack([radius * np.cos(phi), radius * np.sin(phi),
+                             np.sqrt(np.maximum(0.0, 1.0 - uniforms[:, 1]))], axis=-1)
+        choose_specular = uniforms[:, 0] < self.specular_probability[points.material]
+        for model, idx in points.groups:
+            chosen = idx[choose_specular[idx]]
+            if len(chosen):
+                # The choice used uniforms[:, 0]; the lobe gets the other two.
+                sampled, _ = model.sample(points.wo_local[chosen], uniforms[chosen, 1:3])
+                wi_local[chosen] = sampled
+        return wi_local, self._brdf_pdf(points, wi_local)
+
+    # -- estimator ---------------------------------------------------------------------------------
+    def radiance(self, origins, directions, rng):
+        """Estimate of the radiance along each camera ray: (N, 3)."""
+        result = np.zeros((len(origins), 3))
+        hits = self.tracer.intersect(origins, directions)
+        missed = ~hits.hit
+        if self.environment is not None and missed.any():
+            result[missed] = self.environment.radiance(directions[missed])
+        hit_rows = np.flatnonzero(hits.hit)
+        if len(hit_rows) == 0:
+            return result
+        points = self._surface_points(hits, hit_rows, directions[hit_rows])
+        shaded = np.zeros((len(hit_rows), 3))
+        for light in self.lights:
+            shaded += self._light_contribution(points, light, rng)
+        if self.environment is not None:
+            shaded += self._environment_contribution(points, rng)
+        result[hit_rows] = shaded
+        return result
+
+    def _surface_points(self, hits, rows, view_directions):
+        points = _Points()
+        triangle = hits.triangle[rows]
+        weights = np.stack([1.0 - hits.u[rows] - hits.v[rows], hits.u[rows], hits.v[rows]], axis=-1)
+        # Positions from barycentrics on the float64 mesh: closer to the surface than o + t d.
+        points.position = np.einsum("nk,nkc->nc", weights, self.corner_positions[triangle])
+        geometric = self.face_normals[triangle]
+        wo = -view_directions
+        # Two-sided surfaces: face the geometric normal to the viewer, the shading normal with it.
+        geometric *= np.where(np.sum(geometric * wo, axis=-1) < 0, -1.0, 1.0)[:, None]
+        corners = self.triangles[triangle]
+        shading = _normalize(np.einsum("nk,nkc->nc", weights, self.normals[corners]), geometric)
+        shading *= np.where(np.sum(shading * geometric, axis=-1) < 0, -1.0, 1.0)[:, None]
+        if self.tangents is not None:
+            tangent = np.einsum("nk,nkc->nc", weights, self.tangents[corners])
+            tangent -= shading * np.sum(tangent * shading, axis=-1, keepdims=True)
+            tangent = _normalize(tangent, _orthonormal_tangents(shading))
+        else:
+            tangent = _orthonormal_tangents(shading)
+        points.normal = shading
+        points.geometric_normal = geometric
+        points.frame = np.stack([tangent, np.cross(shading, tangent), shading], axis=1)   # rows: x, y, z
+        wo_local = np.einsum("nij,nj->ni", points.frame, wo)
+        wo_local[:, 2] = np.maximum(wo_local[:, 2], _MIN_VIEW_COSINE)
+        points.wo_local = _normalize(wo_local, np.array([0.0, 0.0, 1.0]))
+        points.material = self.material_index[triangle]
+        points.groups = self._groups(points.material)
+        points.origin_offset = self.tracer.offset
+        return points
+
+    def _visible(self, points, wi_world, max_distance, active):
+        """Visibility (N,) of each direction, tracing only where ``active``."""
+        visible = np.zeros(len(wi_world), bool)
+        rows = np.flatnonzero(active)
+        if len(rows):
+            origins = offset_origins(points.position[rows], points.geometric_normal[rows],
+                                     points.origin_offset, wi_world[rows])
+            distance = None if max_distance is None else np.maximum(max_distance[rows] - points.origin_offset, 0.0)
+            visible[rows] = ~self.tracer.occluded(origins, wi_world[rows], distance)
+        return visible
+
+    def _light_contribution(self, points, light, rng):
+        count = len(points.position)
+        uniforms = rng.random((count, 2))
+        if isinstance(light, PointLight):
+            to_centre = np.asarray(light.position, float)[None, :] - points.position
+            distance = np.linalg.norm(to_centre, axis=-1)
+            axis = _normalize(to_centre, np.array([0.0, 0.0, 1.0]))
+            intensity = np.asarray(light.intensity, float)
+            radius = float(light.radius)
+            if radius > 0:
+                outside = distance > radius
+                sin_max = np.where(outside, radius / np.maximum(distance, 1e-300), 1.0)
+                one_minus_cos = _one_minus_cos_from_sin(sin_max)
+                wi = _cone_directions(axis, 1.0 - one_minus_cos, uniforms)
+                # Radiance of a uniform sphere of this intensity: I / (pi r^2); times the cone's solid angle.
+                scale = np.where(outside, 2.0 * np.pi * one_minus_cos / (np.pi * radius ** 2), 0.0)
+                cos_to_centre = np.sum(wi * axis, axis=-1)
+                chord = np.maximum(radius ** 2 - distance ** 2 * (1.0 - cos_to_centre ** 2), 0.0)
+                max_distance = distance * cos_to_centre - np.sqrt(chord)
+            else:
+                wi = axis
+                scale = 1.0 / np.maximum(distance, 1e-300) ** 2
+                max_distance = distance
+            weight = scale[:, None] * intensity[None, :]
+        elif isinstance(light, DirectionalLight):
+            axis = _normalize(np.asarray(light.direction, float)[None, :], np.array([0.0, 0.0, 1.0]))
+            axis = np.broadcast_to(axis, (count, 3))
+            alpha = float(light.angular_radius)
+            irradiance = np.asarray(light.irradiance, float)
+            if alpha > 0:
+                one_minus_cos = float(_one_minus_cos_from_sin(np.sin(min(alpha, np.pi / 2))))
+                wi = _cone_directions(axis, np.full(count, 1.0 - one_minus_cos), uniforms)
+                # Radiance E / (pi sin^2 a) (irradiance of the disc facing it is E) times its solid angle.
+                scale = 2.0 * np.pi * one_minus_cos / (np.pi * np.sin(min(alpha, np.pi / 2)) ** 2)
+            else:
+                wi = np.array(axis)
+                scale = 1.0
+            weight = np.broadcast_to(scale * irradiance, (count, 3))
+            max_distance = None
+        else:
+            raise TypeError(f"unknown light type {type(light).__name__}")
+        wi_local = np.einsum("nij,nj->ni", points.frame, wi)
+        value = self._brdf_cosine(points, wi_local) * weight
+        active = np.any(value > 0, axis=-1)
+        visible = self._visible(points, wi, max_distance, active)
+        return value * visible[:, None]
+
+    def _environment_contribution(self, points, rng):
+        count = len(points.position)
+        to_world = np.swapaxes(points.frame, 1, 2)
+        # Environment sample.
+        wi_env, pdf_env, radiance_env = self.environment.sample_with_radiance(rng.random((count, 2)))
+        wi_env_local = np.einsum("nij,nj->ni", points.frame, wi_env)
+        value_env = self._brdf_cosine(points, wi_env_local) * radiance_env
+        pdf_brdf_at_env = self._brdf_pdf(points, wi_env_local)
+        # BRDF sample.
+        wi_brdf_local, pdf_brdf = self._brdf_sample(points, rng.random((count, 3)))
+        wi_brdf = _normalize(np.einsum("nij,nj->ni", to_world, wi_brdf_local), points.normal)
+        value_brdf = self._brdf_cosine(points, wi_brdf_local) * self.environment.radiance(wi_brdf)
+        pdf_env_at_brdf = self.environment.pdf(wi_brdf)
+        # Power heuristic, written as 1 / (1 + ratio^2) so huge pdfs do not overflow.
+        weight_env = _power_weight(pdf_env, pdf_brdf_at_env)
+        weight_brdf = _power_weight(pdf_brdf, pdf_env_at_brdf)
+        estimate_env = value_env * (weight_env / np.maximum(pdf_env, 1e-300))[:, None]
+        estimate_brdf = np.where((pdf_brdf > 0)[:, None],
+                                 value_brdf * (weight_brdf / np.where(pdf_brdf > 0, pdf_brdf, 1.0))[:, None], 0.0)
+        visible_env = self._visible(points, wi_env, None, np.any(estimate_env > 0, axis=-1))
+        visible_brdf = self._visible(points, wi_brdf, None, np.any(estimate_brdf > 0, axis=-1))
+        return estimate_env * visible_env[:, None] + estimate_brdf * visible_brdf[:, None]
+
+
+def _power_weight(pdf_own, pdf_other):
+    ratio = pdf_other / np.where(pdf_own > 0, pdf_own, 1.0)
+    return np.where(pdf_own > 0, 1.0 / (1.0 + np.minimum(ratio, 1e150) ** 2), 0.0)
+
+
+class _Points:
+    """Shading points of one batch (plain attribute bag)."""

@@ -1,0 +1,297 @@
+"""Reference renderer and environment sampling against closed-form answers."""
+import numpy as np
+import pytest
+
+from benchmarks.reference_speed import make_icosphere
+from sg_prt_addon.core import equirect
+from sg_prt_addon.core.camera import Camera
+from sg_prt_addon.core.env_sampling import EnvironmentSampler
+from sg_prt_addon.core.reference import DirectionalLight, Material, PointLight, Scene, render_reference
+
+
+# -- helpers ------------------------------------------------------------------------------------
+def orthographic_down(half_size, pixels, height_above=5.0):
+    """Camera above the origin looking down -z: pixel footprints are exact squares on z = 0."""
+    view = np.eye(4)
+    view[2, 3] = -height_above
+    near, far = 0.1, 100.0
+    projection = np.diag([1.0 / half_size, 1.0 / half_size, -2.0 / (far - near), 1.0])
+    projection[2, 3] = -(far + near) / (far - near)
+    return Camera(view, projection, pixels, pixels)
+
+
+def ground_plane(half_size=10.0, z=0.0):
+    vertices = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float) * half_size + [0, 0, z]
+    return vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.tile([0, 0, 1.0], (4, 1))
+
+
+def _reflect_frame(axis):
+    helper = np.where(np.abs(axis[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]])
+    tangent = np.cross(helper, axis)
+    tangent /= np.linalg.norm(tangent, axis=-1, keepdims=True)
+    return tangent, np.cross(axis, tangent)
+
+
+class PhongStandIn:
+    """Private glossy test model (not core.brdf): rho_s = (n + 2) / (2 pi) cos^n(angle to the mirror
+    direction), sampled exactly from its cos^n lobe, in the local frame (normal z+)."""
+
+    def __init__(self, exponent):
+        self.exponent = exponent
+
+    def _mirror(self, wo):
+        return wo * [-1.0, -1.0, 1.0]
+
+    def specular(self, wo, wi):
+        cosine = np.maximum(np.sum(self._mirror(wo) * wi, axis=-1), 0.0)
+        return (self.exponent + 2) / (2 * np.pi) * cosine ** self.exponent
+
+    def pdf(self, wo, wi):
+        cosine = np.maximum(np.sum(self._mirror(wo) * wi, axis=-1), 0.0)
+        return (self.exponent + 1) / (2 * np.pi) * cosine ** self.exponent
+
+    def sample(self, wo, u):
+        axis = self._mirror(wo)
+        cos_alpha = u[:, 0] ** (1.0 / (self.exponent + 1))
+        sin_alpha = np.sqrt(np.maximum(0.0, 1 - cos_alpha ** 2))
+        phi = 2 * np.pi * u[:, 1]
+        tangent, bitangent = _reflect_frame(axis)
+        wi = (tangent * (sin_alpha * np.cos(phi))[:, None] + bitangent * (sin_alpha * np.sin(phi))[:, None]
+              + axis * cos_alpha[:, None])
+        return wi, self.pdf(wo, wi)
+
+
+def rms(values):
+    return float(np.sqrt(np.mean(np.square(values))))
+
+
+# -- environment sampling -----------------------------------------------------------------------
+def test_environment_sampler_is_consistent_and_unbiased():
+    rng = np.random.default_rng(3)
+    image = rng.random((12, 24, 3)) ** 6 * 20     # high dynamic range
+    sampler = EnvironmentSampler(image)
+    directions, pdf = sampler.sample(rng.random((200000, 2)))
+    np.testing.assert_allclose(np.linalg.norm(directions, axis=-1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(pdf, sampler.pdf(directions), rtol=1e-12)
+    np.testing.assert_array_equal(sampler.radiance(directions), equirect.lookup_nearest(image, directions))
+    # Texel frequencies follow the texel probabilities (luminance x solid angle).
+    row, column = sampler.texel_index(directions)
+    frequency = np.bincount(row * 24 + column, minlength=12 * 24) / len(directions)
+    expected = sampler.texel_probability.ravel()
+    assert np.max(np.abs(frequency - expected) / np.sqrt(expected / len(directions))) < 5.5
+    # Probabilities / densities recover the texel solid angles: they sum to 4 pi.
+    assert abs(np.sum(sampler.texel_probability / sampler.texel_pdf) / (4 * np.pi) - 1) < 1e-12
+    # E[L / pdf] = the exact integral of the piecewise-constant map.
+    exact = np.sum(image * equirect.texel_solid_angles(12, 24)[..., None], axis=(0, 1))
+    np.testing.assert_allclose(np.mean(sampler.radiance(directions) / pdf[:, None], axis=0), exact, rtol=0.01)
+
+
+def test_environment_sampler_handles_black_and_constant_maps():
+    black = EnvironmentSampler(np.zeros((4, 8, 3)))
+    directions, pdf = black.sample(np.random.default_rng(0).random((1000, 2)))
+    assert np.all(np.isfinite(pdf)) and np.all(pdf > 0)
+    constant = EnvironmentSampler(np.ones((6, 12, 3)))
+    np.testing.assert_allclose(constant.pdf(directions), 1 / (4 * np.pi), rtol=1e-9)
+
+
+# -- (a) Lambertian plane under a constant environment: R = kd L ------------------------------------
+def _constant_sky_scene(albedo=0.6, sky=(1.0, 0.5, 2.0)):
+    vertices, triangles, normals = ground_plane()
+    environment = np.broadcast_to(np.asarray(sky), (8, 16, 3)).copy()
+    return Scene(vertices, triangles, normals, [Material((albedo,) * 3)], environment=environment)
+
+
+def test_constant_environment_on_lambertian_plane_is_unbiased_and_calibrated():
+    scene = _constant_sky_scene()
+    camera = orthographic_down(1.0, 24)
+    expected = 0.6 * np.array([1.0, 0.5, 2.0])
+    image, error = render_reference(scene, camera, 16, seed=1)
+    assert np.all(np.isfinite(image)) and np.all(np.isfinite(error)) and np.all(error > 0)
+    deviation = image - expected
+    # Standard error calibrated: actual RMS error / RMS reported error near 1 (1728 values).
+    ratio = rms(deviation) / rms(error)
+    assert 0.85 < ratio < 1.15, ratio
+    # Unbiased: the mean over pixels is within 4 standard errors of the mean.
+    error_of_mean = np.sqrt(np.sum(error ** 2, axis=(0, 1))) / (24 * 24)
+    assert np.all(np.abs(deviation.mean(axis=(0, 1))) < 4 * error_of_mean)
+
+
+def test_error_falls_as_one_over_sqrt_samples():
+    scene = _constant_sky_scene()
+    camera = orthographic_down(1.0, 16)
+    expected = 0.6 * np.array([1.0, 0.5, 2.0])
+    samples = np.array([4, 16, 64, 256])
+    errors = [rms(render_reference(scene, camera, int(n), seed=10 + k)[0] - expected) for k, n in enumerate(samples)]
+    slope = np.polyfit(np.log(samples), np.log(errors), 1)[0]
+    assert -0.6 < slope < -0.4, (slope, errors)
+
+
+def test_constant_background_lights_like_a_constant_environment_and_fills_misses():
+    vertices, triangles, normals = ground_plane(half_size=0.5)
+    scene = Scene(vertices, triangles, normals, [Material((0.5, 0.5, 0.5))], background=(0.2, 0.4, 0.8))
+    image, error = render_reference(scene, orthographic_down(1.0, 16), 32, seed=2)
+    # Plane covers the central 8x8 pixels; the rest shows the background exactly.
+    np.testing.assert_allclose(image[0, 0], [0.2, 0.4, 0.8], rtol=1e-12)
+    np.testing.assert_allclose(error[0, 0], 0.0, atol=1e-12)
+    centre = image[5:11, 5:11]
+    assert np.all(np.abs(centre - [0.1, 0.2, 0.4]) < 5 * error[5:11, 5:11] + 1e-12)
+
+
+# -- (b) directional light on a Lambertian sphere: kd / pi E max(0, n.l) ------------------------------
+def test_directional_light_on_lambertian_sphere_matches_closed_form():
+    vertices, triangles, normals = make_icosphere(4)
+    light = np.array([0.8, 0.3, 0.5]) / np.linalg.norm([0.8, 0.3, 0.5])
+    irradiance = np.array([3.0, 2.0, 1.0])
+    albedo = np.array([0.8, 0.6, 0.4])
+    scene = Scene(vertices, triangles, normals, [Material(albedo)],
+                  lights=[DirectionalLight(light, irradiance)])
+    camera = Camera.look_at((0, 0, 4.0), (0, 0, 0), (0, 1.0, 0), 40.0, 48, 48)
+    image, error = render_reference(scene, camera, 32, seed=3)
+    # Exact normal of the true sphere under each pixel centre.
+    origins, directions = camera.primary_rays()
+    b = np.sum(origins * directions, -1)
+    discriminant = b ** 2 - (np.sum(origins ** 2, -1) - 1)
+    hit = discriminant > 0
+    t = -b - np.sqrt(np.where(hit, discriminant, 0))
+    normal = origins + t[..., None] * directions
+    facing = np.sum(normal * -directions, -1)
+    cosine = normal @ light
+    expected = albedo / np.pi * irradiance * np.maximum(cosine, 0)[..., None]
+    interior = hit & (facing > 0.3)
+    lit = interior & (cosine > 0.15)
+    dark = interior & (cosine < -0.15)
+    assert lit.sum() > 200 and dark.sum() > 50
+    relative = np.abs(image[lit] - expected[lit]) / expected[lit]
+    assert np.all(relative < 0.01 + 4 * error[lit] / expected[lit]), relative.max()
+    assert rms(relative) < 0.01
+    np.testing.assert_array_equal(image[dark], 0.0)
+    np.testing.assert_array_equal(image[~hit & (discriminant < -0.05)], 0.0)   # misses, no environment
+
+
+# -- (c) a small occluder casts exactly the expected point-light shadow ---------------------------------
+def test_point_light_shadow_falls_on_exactly_the_expected_pixels():
+    vertices, triangles, normals = ground_plane(half_size=2.0)
+    occluder = np.array([[-0.3, -0.2, 1.0], [0.35, -0.25, 1.0], [0.0, 0.4, 1.0]])
+    scene = Scene(np.concatenate([vertices, occluder]), np.concatenate([triangles, [[4, 5, 6]]]),
+                  np.concatenate([normals, np.tile([0, 0, 1.0], (3, 1))]), [Material((0.5, 0.5, 0.5))],
+                  lights=[PointLight((0.05, 0.0, 2.0), (4.0, 4.0, 4.0))])
+    pixels = 40
+    camera = orthographic_down(1.0, pixels, height_above=0.9)   # below the occluder, above the plane
+    image, error = render_reference(scene, camera, 8, seed=4)
+    # Shadow on z = 0: the occluder scaled by 2 from the light (light at height 2, occluder at 1).
+    light = np.array([0.05, 0.0])
+    shadow = light + 2.0 * (occluder[:, :2] - light)
+
+    def inside(points):
+        sign = []
+        for k in range(3):
+            a, b = shadow[k], shadow[(k + 1) % 3]
+            sign.append((b[0] - a[0]) * (points[..., 1] - a[1]) - (b[1] - a[1]) * (points[..., 0] - a[0]))
+        sign = np.stack(sign)
+        return np.all(sign > 0, axis=0) | np.all(sign < 0, axis=0)
+
+    # Pixel (x, y) covers world [x0, x0 + s] x [y0 - s, y0] on the plane.
+    size = 2.0 / pixels
+    y, x = np.mgrid[0:pixels, 0:pixels]
+    corners = [np.stack([-1 + (x + dx) * size, 1 - (y + dy) * size], -1) for dx in (0, 1) for dy in (0, 1)]
+    corner_inside = np.stack([inside(c) for c in corners])
+    fully_shadowed = corner_inside.all(axis=0)        # the shadow is convex
+    touched = corner_inside.any(axis=0)
+    # Margin: pixels whose centre is farther than a pixel diagonal from the shadow are fully lit.
+    centre = np.stack([-1 + (x + 0.5) * size, 1 - (y + 0.5) * size], -1)
+    near = np.zeros_like(touched)
+    for dx in np.linspace(-1.5, 1.5, 7):
+        for dy in np.linspace(-1.5, 1.5, 7):
+            near |= inside(centre + size * np.array([dx, dy]))
+    assert fully_shadowed.sum() > 40
+    np.testing.assert_array_equal(image[fully_shadowed], 0.0)
+    zero = np.all(image == 0, axis=-1)
+    assert np.all(zero <= (touched | near))              # no shadow away from where it should be
+    lit = ~near
+    position = np.concatenate([centre, np.zeros(centre.shape[:-1] + (1,))], -1)
+    to_light = np.array([0.05, 0.0, 2.0]) - position
+    distance = np.linalg.norm(to_light, axis=-1)
+    expected = 0.5 / np.pi * 4.0 * (to_light[..., 2] / distance) / distance ** 2
+    # Lit pixels: kd / pi I cos / d^2 at the centre, up to the jitter noise of 8 samples
+    # (the value varies ~1% across a pixel); on average exact.
+    relative = image[lit][:, 0] / expected[lit] - 1
+    assert np.max(np.abs(relative)) < 0.03 and abs(np.mean(relative)) < 1e-3, (np.abs(relative).max(), relative.mean())
+
+
+# -- area lights: a uniform sphere / cone fully above the horizon gives the point-light answer -------------
+@pytest.mark.parametrize("light", [PointLight((0.4, -0.2, 1.5), (2.0, 3.0, 4.0), radius=0.5),
+                                   DirectionalLight((0.4, -0.2, 1.0), (1.0, 2.0, 3.0), angular_radius=0.3)])
+def test_sphere_and_cone_lights_keep_point_light_irradiance(light):
+    vertices, triangles, normals = ground_plane()
+    scene = Scene(vertices, triangles, normals, [Material((0.7, 0.7, 0.7))], lights=[light])
+    camera = orthographic_down(0.5, 12)
+    image, error = render_reference(scene, camera, 64, seed=5)
+    y, x = np.mgrid[0:12, 0:12]
+    position = np.stack([-0.5 + (x + 0.5) / 12, 0.5 - (y + 0.5) / 12, np.zeros((12, 12))], -1)
+    if isinstance(light, PointLight):
+        to_light = np.asarray(light.position) - position
+        distance = np.linalg.norm(to_light, axis=-1)
+        irradiance = np.asarray(light.intensity) * (to_light[..., 2] / distance ** 3)[..., None]
+    else:
+        direction = np.asarray(light.direction) / np.linalg.norm(light.direction)
+        irradiance = np.broadcast_to(np.asarray(light.irradiance) * direction[2], (12, 12, 3))
+    expected = 0.7 / np.pi * irradiance
+    assert rms(error / expected) > 1e-3                  # really sampled, not a delta
+    z = (image - expected) / error
+    assert rms(z) < 1.3 and abs(np.mean(z)) < 0.3, (rms(z), np.mean(z))
+
+
+# -- MIS with a glossy lobe under a non-constant environment vs quadrature ----------------------------
+def test_glossy_plane_under_environment_matches_quadrature():
+    rng = np.random.default_rng(6)
+    environment = rng.random((8, 16, 3)) ** 3 * 4
+    vertices, triangles, normals = ground_plane()
+    model = PhongStandIn(30.0)
+    material = Material((0.3, 0.2, 0.1), (0.6, 0.6, 0.6), model)
+    scene = Scene(vertices, triangles, normals, [material], environment=environment)
+    # Oblique orthographic view: every pixel sees the plane with the same wo.
+    wo = np.array([0.0, -np.sin(0.7), np.cos(0.7)])
+    view = Camera.look_at(4 * wo, (0, 0, 0), (0, 0, 1.0), 10.0, 24, 24).view_matrix
+    projection = np.diag([1.0, 1.0, -0.02, 1.0])
+    projection[2, 3] = -1.0
+    image, error = render_reference(scene, Camera(view, projection, 24, 24), 64, seed=7)
+    # Midpoint quadrature, uniform in solid angle over the upper hemisphere.
+    n_cos, n_phi = 600, 1200
+    cos_theta = (np.arange(n_cos) + 0.5) / n_cos
+    phi = (np.arange(n_phi) + 0.5) / n_phi * 2 * np.pi
+    c, p = np.meshgrid(cos_theta, phi, indexing="ij")
+    s = np.sqrt(1 - c ** 2)
+    wi = np.stack([s * np.cos(p), s * np.sin(p), c], -1).reshape(-1, 3)
+    brdf = np.asarray(material.diffuse_color) / np.pi + 0.6 * model.specular(np.broadcast_to(wo, wi.shape), wi)[:, None]
+    radiance = equirect.lookup_nearest(environment, wi)
+    expected = np.sum(radiance * brdf * wi[:, 2:3], axis=0) * (2 * np.pi / wi.shape[0])
+    mean = image.mean(axis=(0, 1))
+    error_of_mean = np.sqrt(np.sum(error ** 2, axis=(0, 1))) / 24 ** 2
+    assert np.all(error_of_mean < 0.008 * expected)
+    assert np.all(np.abs(mean - expected) < 4 * error_of_mean + 2e-3 * expected), (mean, expected, error_of_mean)
+
+
+# -- bookkeeping ---------------------------------------------------------------------------------------
+def test_seed_determinism_progress_and_early_stop():
+    scene = _constant_sky_scene()
+    camera = orthographic_down(1.0, 8)
+    first, _ = render_reference(scene, camera, 4, seed=9, batch_rays=32)
+    again, _ = render_reference(scene, camera, 4, seed=9, batch_rays=32)
+    np.testing.assert_array_equal(first, again)
+    calls = []
+    image, error = render_reference(scene, camera, 4, seed=9, batch_rays=32,
+                                    progress=lambda done, total: calls.append((done, total)) or len(calls) == 3)
+    assert calls == [(32, 256), (64, 256), (96, 256)]
+    assert np.all(np.isfinite(image))
+    assert np.isinf(error).any()                       # pixels with one sample have no error estimate
+
+
+def test_degenerate_geometry_stays_finite():
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], float)   # first triangle has zero area
+    triangles = np.array([[0, 1, 2], [0, 1, 3]])
+    normals = np.zeros((4, 3))                                                # no usable shading normals
+    scene = Scene(vertices, triangles, normals, [Material((0.5, 0.5, 0.5), (0.5, 0.5, 0.5), PhongStandIn(1e4))],
+                  lights=[PointLight((0.2, 0.2, 0.0), (1, 1, 1.0)), DirectionalLight((0, 0, 1.0), (1, 1, 1.0))],
+                  environment=np.zeros((4, 8, 3)))
+    image, error = render_reference(scene, Camera.look_at((0.3, 0.3, 2.0), (0.3, 0.3, 0), (0, 1.0, 0), 60, 8, 8), 2)
+    assert np.all(np.isfinite(image)) and np.all(np.isfinite(error))
