@@ -1,0 +1,442 @@
+"""SG-mixture fits of normal distribution functions (wang2009 section 4.1-4.2).
+
+* ``fit_isotropic``: 1-2 lobes around z+ fitted to an isotropic NDF D(theta) by
+  Levenberg-Marquardt (scipy least_squares, method 'lm') on the hemisphere L2
+  error, lobes sorted by increasing sharpness (the paper's order for texture
+  interpolation).  Batched over rows of a table.
+* ``fit_anisotropic``: K free-axis lobes fitted to any NDF sampled on a
+  hemisphere quadrature by L-BFGS-B with an analytic gradient, grown greedily
+  (each new lobe starts at the direction of largest residual).
+* ``anisotropy_table`` / ``anisotropic_lobes``: the fast per-pixel path for
+  spatially-varying anisotropic models.  In the small-angle limit both Ward
+  (exp(-(x^2/ax^2 + y^2/ay^2)), x, y the slopes) and Ashikhmin-Shirley
+  ((n.h)^e ~ exp(-(nu x^2 + nv y^2)/2), widths sqrt(2/nu), sqrt(2/nv)) are the
+  normalized target T(x, y) = exp(-(x^2 + y^2/r^2)) after dividing the slopes
+  by the long-axis width, with r = short width / long width <= 1.  T is fitted
+  once per r (a log-spaced grid of ANISOTROPY_RATIO_COUNT ratios from
+  ANISOTROPY_RATIO_MIN to 1) by a symmetric row of isotropic Gaussians along
+  the long axis, with the L2 error in closed form (Gaussian integrals) and
+  amplitudes by non-negative least squares.  The table is a float array
+  (R, K, 3): (offset along the long axis in widths, sharpness * width^2,
+  amplitude / D(n)), linear in log r.  Scaling back: sharpness = s / w^2,
+  axis = normalize(offset * w along the long axis, 1 along z), amplitude = a D(n).
+  The scale step is exact only for narrow lobes; its error at real parameters
+  is measured (tests and benchmarks/accuracy/ndf_fit.py).
+* ``ggx_two_lobe_table``: 2-lobe L2 fits of GGX over log alpha (alpha-normalized).
+* ``derive_isotropic_mapping``: the L2-optimal 1-lobe fit over a width grid and
+  a polynomial through it (the frozen coefficients of brdf.ISOTROPIC_MAPPINGS).
+"""
+import functools
+
+import numpy as np
+from scipy.optimize import least_squares, minimize, nnls
+
+HALF_PI = 0.5 * np.pi
+ANISOTROPY_RATIO_MIN = 1.0 / 64.0
+ANISOTROPY_RATIO_COUNT = 25
+MAX_LOBES = 8
+
+
+# ----------------------------------------------------------------------------- quadrature
+
+def polar_quadrature(widths, nodes_per_segment=48, theta_max=HALF_PI):
+    """Gauss-Legendre nodes in theta on [0, theta_max], with segment breaks at
+    multiples of the lobe widths so peaks of any sharpness are resolved.
+
+    Returns (theta (M,), weight (M,)) with weight = sin(theta) dtheta (multiply by
+    2 pi for an isotropic integrand, or by the phi step).
+    """
+    widths = np.atleast_1d(np.asarray(widths, np.float64))
+    breaks = {0.0, float(theta_max)}
+    for w in widths:
+        for multiple in (0.5, 1, 2, 4, 8, 16):
+            if 0 < multiple * w < theta_max:
+                breaks.add(float(multiple * w))
+    breaks = np.array(sorted(breaks))
+    x, w = np.polynomial.legendre.leggauss(nodes_per_segment)
+    lo, hi = breaks[:-1, None], breaks[1:, None]
+    theta = (0.5 * (hi - lo) * x + 0.5 * (hi + lo)).ravel()
+    weight = (0.5 * (hi - lo) * w).ravel() * np.sin(theta)
+    return theta, weight
+
+
+def hemisphere_quadrature(widths, nodes_per_segment=32, phi_count=192):
+    """Directions (M, 3) and solid-angle weights (M,) on the upper hemisphere."""
+    theta, weight = polar_quadrature(widths, nodes_per_segment)
+    phi = (np.arange(phi_count) + 0.5) * (2 * np.pi / phi_count)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    directions = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1).reshape(-1, 3)
+    weights = np.repeat(weight * (2 * np.pi / phi_count), phi_count)
+    return directions, weights
+
+
+def relative_l2(exact, approximation, weights):
+    """sqrt(sum w (approx - exact)^2 / sum w exact^2) along the last axis."""
+    return np.sqrt(np.sum(weights * (approximation - exact) ** 2, axis=-1)
+                   / np.maximum(np.sum(weights * exact ** 2, axis=-1), 1e-300))
+
+
+# ----------------------------------------------------------------------------- isotropic fits
+
+def _isotropic_model(params, one_minus_cos):
+    # clipped logs: a redundant lobe may drift towards 0 or infinite sharpness
+    log_sharpness, log_amplitude = np.split(np.clip(params, -40, 40), 2)
+    sharpness, amplitude = np.exp(log_sharpness), np.exp(log_amplitude)
+    lobes = amplitude[:, None] * np.exp(-sharpness[:, None] * one_minus_cos[None, :])
+    return sharpness, amplitude, lobes
+
+
+def _initial_isotropic(values, theta, lobe_count):
+    """Peak height and the curvature at half maximum: a Gaussian exp(-theta^2/s^2) guess."""
+    peak = max(values[0], 1e-30)
+    below = np.nonzero(values < 0.5 * peak)[0]
+    half_width = theta[below[0]] if len(below) else theta[-1]
+    sharpness = 2 * np.log(2) / max(half_width * half_width, 1e-12)  # exp(-lambda theta^2/2)
+    if lobe_count == 1:
+        return np.log([sharpness, peak])
+    return np.log([sharpness / 3, 3 * sharpness, 0.3 * peak, 0.7 * peak])
+
+
+def fit_isotropic(ndf_values, theta, weights, lobe_count=1, initial=None):
+    """L2 fit of 1-2 SG lobes around z+ to an isotropic NDF (wang2009 section 4.2).
+
+    ndf_values (M,) or (B, M) sampled at polar angles theta (M,) with solid-angle
+    weights (from polar_quadrature).  Minimizes sum w (sum_k mu_k exp(lambda_k
+    (cos theta - 1)) - D)^2 by Levenberg-Marquardt over log lambda, log mu.
+    initial (2K,) or (B, 2K) of (sharpness..., amplitude...) warm-starts the fit.
+
+    Returns (sharpness (..., K), amplitude (..., K), relative_l2 (...)), lobes sorted
+    by increasing sharpness.
+    """
+    values = np.asarray(ndf_values, np.float64)
+    batched = values.ndim == 2
+    values = np.atleast_2d(values)
+    theta = np.asarray(theta, np.float64)
+    one_minus_cos = 2 * np.sin(0.5 * theta) ** 2  # 1 - cos without cancellation
+    root_w = np.sqrt(np.asarray(weights, np.float64))
+    out_sharpness = np.empty((len(values), lobe_count))
+    out_amplitude = np.empty((len(values), lobe_count))
+    out_error = np.empty(len(values))
+    if initial is not None:
+        initial = np.atleast_2d(np.asarray(initial, np.float64))
+    for row, target in enumerate(values):
+        scale = max(np.sqrt(np.sum(root_w ** 2 * target ** 2)), 1e-300)
+        if initial is not None:
+            start = np.log(np.maximum(initial[min(row, len(initial) - 1)], 1e-12))
+        else:
+            start = _initial_isotropic(target, theta, lobe_count)
+
+        def residual(params):
+            return root_w * (_isotropic_model(params, one_minus_cos)[2].sum(0) - target) / scale
+
+        def jacobian(params):
+            sharpness, _, lobes = _isotropic_model(params, one_minus_cos)
+            d_log_sharpness = -(lobes * sharpness[:, None] * one_minus_cos[None, :])
+            return (root_w[:, None] * np.concatenate([d_log_sharpness, lobes]).T) / scale
+
+        result = least_squares(residual, start, jac=jacobian, method="lm", xtol=1e-12, ftol=1e-12)
+        sharpness, amplitude, _ = _isotropic_model(result.x, one_minus_cos)
+        order = np.argsort(sharpness)
+        out_sharpness[row], out_amplitude[row] = sharpness[order], amplitude[order]
+        out_error[row] = np.sqrt(np.sum(result.fun ** 2))
+    if not batched:
+        return out_sharpness[0], out_amplitude[0], out_error[0]
+    return out_sharpness, out_amplitude, out_error
+
+
+def derive_isotropic_mapping(ndf_of_width, peak_of_width, widths, degree=5):
+    """L2-optimal single lobe over a width grid and polynomials through it.
+
+    ndf_of_width(theta, width) -> D; peak_of_width(width) -> D(n).  The fitted
+    quantities are sharpness * width^2 and amplitude / D(n), polynomials in width
+    (lowest order first), as stored in brdf.ISOTROPIC_MAPPINGS.
+    Returns (sharpness_coefficients, amplitude_coefficients, table (W, 3) of
+    width, scaled sharpness, relative amplitude).
+    """
+    rows = []
+    previous = None
+    for width in np.asarray(widths, np.float64):
+        theta, weights = polar_quadrature([width])
+        peak = peak_of_width(width)
+        sharpness, amplitude, _ = fit_isotropic(ndf_of_width(theta, width) / peak, theta, weights, 1,
+                                                initial=previous)
+        previous = np.concatenate([sharpness, amplitude])
+        rows.append((width, sharpness[0] * width * width, amplitude[0]))
+    table = np.array(rows)
+    sharpness_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 1], degree)
+    amplitude_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 2], degree)
+    return sharpness_coefficients, amplitude_coefficients, table
+
+
+def _ggx_normalized(theta, alpha):
+    """GGX D / D(n) = 1 / (sin^2/alpha^2 + cos^2)^2."""
+    scaled = (np.sin(theta) / alpha) ** 2 + np.cos(theta) ** 2
+    return 1 / (scaled * scaled)
+
+
+GGX_TABLE_ALPHAS = np.geomspace(1e-3, 1.0, 31)
+
+
+@functools.lru_cache(maxsize=None)
+def ggx_two_lobe_table():
+    """(alpha (A,), table (A, 2, 2)): per alpha, lobes (sharpness * alpha^2, amplitude / D(n)),
+    sorted by increasing sharpness.  Fitted from the smoothest alpha (where GGX is
+    scale-invariant) up to alpha = 1, warm-started from the previous row."""
+    table = np.empty((len(GGX_TABLE_ALPHAS), 2, 2))
+    previous = None
+    for index, alpha in enumerate(GGX_TABLE_ALPHAS):
+        theta, weights = polar_quadrature([alpha])
+        if previous is not None:
+            previous = previous * np.array([(alpha / GGX_TABLE_ALPHAS[index - 1]) ** -2] * 2 + [1, 1])
+        sharpness, amplitude, _ = fit_isotropic(_ggx_normalized(theta, alpha), theta, weights, 2,
+                                                initial=previous)
+        previous = np.concatenate([sharpness, amplitude])
+        table[index, :, 0] = sharpness * alpha * alpha
+        table[index, :, 1] = amplitude
+    table.setflags(write=False)
+    return GGX_TABLE_ALPHAS, table
+
+
+def ggx_two_lobes(alpha):
+    """Two SG lobes around z+ for GGX of any (array) alpha, by linear interpolation in log alpha."""
+    alphas, table = ggx_two_lobe_table()
+    alpha = np.asarray(alpha)
+    dtype = np.result_type(alpha, np.float32)
+    position = np.interp(np.log(np.clip(alpha, alphas[0], alphas[-1])), np.log(alphas), np.arange(len(alphas)))
+    low = np.clip(np.floor(position).astype(int), 0, len(alphas) - 2)
+    fraction = (position - low)[..., None, None]
+    entry = (1 - fraction) * table[low] + fraction * table[low + 1]
+    alpha = alpha.astype(dtype)
+    sharpness = (entry[..., 0] / (alpha * alpha)[..., None]).astype(dtype)
+    amplitude = (entry[..., 1] / (np.pi * alpha * alpha)[..., None]).astype(dtype)
+    axis = np.zeros(sharpness.shape + (3,), dtype)
+    axis[..., 2] = 1
+    return axis, sharpness, amplitude
+
+
+# ----------------------------------------------------------------------------- anisotropic free-axis fit
+
+def _unpack_anisotropic(params, lobe_count):
+    params = params.reshape(lobe_count, 5)
+    raw_axis = params[:, :3]
+    length = np.maximum(np.linalg.norm(raw_axis, axis=1, keepdims=True), 1e-12)
+    return raw_axis / length, length, np.exp(params[:, 3]), np.exp(params[:, 4])
+
+
+def _anisotropic_objective(params, lobe_count, directions, weights, target, scale2):
+    axis, length, sharpness, amplitude = _unpack_anisotropic(params, lobe_count)
+    cosine = directions @ axis.T  # (M, K)
+    lobes = amplitude * np.exp(sharpness * np.minimum(cosine - 1, 0))
+    residual = lobes.sum(1) - target
+    weighted = 2 * weights * residual / scale2
+    d_log_amplitude = weighted @ lobes
+    d_log_sharpness = weighted @ (lobes * sharpness * (cosine - 1))
+    d_axis = (weighted[:, None] * lobes * sharpness).T @ directions  # (K, 3)
+    # gradient through axis = raw / |raw|
+    d_raw = (d_axis - np.sum(d_axis * axis, 1, keepdims=True) * axis) / length
+    gradient = np.concatenate([d_raw, d_log_sharpness[:, None], d_log_amplitude[:, None]], axis=1)
+    return np.sum(weights * residual ** 2) / scale2, gradient.ravel()
+
+
+def fit_anisotropic(ndf_values, directions, weights, lobe_count, initial=None, max_iterations=400):
+    """K free-axis SG lobes fitted to an NDF on a hemisphere quadrature (wang2009 section 4.2,
+    L-BFGS-B as in the paper).
+
+    ndf_values (M,) at directions (M, 3) with solid-angle weights (M,).  Without
+    ``initial`` (axis (K,3), sharpness (K,), amplitude (K,)) the mixture is grown
+    one lobe at a time, each new lobe placed at the largest residual and all
+    lobes refitted.  Returns (axis (K, 3), sharpness (K,), amplitude (K,),
+    relative_l2), lobes sorted by increasing sharpness.
+    """
+    target = np.asarray(ndf_values, np.float64)
+    directions = np.asarray(directions, np.float64)
+    weights = np.asarray(weights, np.float64)
+    scale2 = max(np.sum(weights * target ** 2), 1e-300)
+
+    def optimize(start, count):
+        result = minimize(_anisotropic_objective, start.ravel(), jac=True, method="L-BFGS-B",
+                          args=(count, directions, weights, target, scale2),
+                          bounds=([(None, None)] * 3 + [(-10, 16), (-60, 60)]) * count,
+                          options={"maxiter": max_iterations})
+        return result.x.reshape(count, 5), result.fun
+
+    if initial is not None:
+        axis, sharpness, amplitude = (np.asarray(a, np.float64) for a in initial)
+        start = np.concatenate([axis, np.log(np.maximum(sharpness, 1e-4))[:, None],
+                                np.log(np.maximum(amplitude, 1e-30))[:, None]], axis=1)
+        params, value = optimize(start, lobe_count)
+    else:
+        peak_index = np.argmax(target)
+        mean_sharpness = 1 / max(np.sum(weights * target * 2 * (1 - directions[:, 2])) / np.sum(weights * target), 1e-6)
+        params = np.array([[*directions[peak_index], np.log(mean_sharpness), np.log(max(target[peak_index], 1e-30))]])
+        params, value = optimize(params, 1)
+        for count in range(2, lobe_count + 1):
+            axis, _, sharpness, amplitude = _unpack_anisotropic(params.ravel(), count - 1)
+            current = (amplitude * np.exp(sharpness * (directions @ axis.T - 1))).sum(1)
+            worst = np.argmax(target - current)
+            new = [*directions[worst], np.log(np.max(sharpness)), np.log(max(target[worst] - current[worst], 1e-30))]
+            params, value = optimize(np.vstack([params, new]), count)
+    axis, _, sharpness, amplitude = _unpack_anisotropic(params.ravel(), lobe_count)
+    order = np.argsort(sharpness)
+    return axis[order], sharpness[order], amplitude[order], float(np.sqrt(value))
+
+
+# ----------------------------------------------------------------------------- normalized anisotropy table
+
+def _row_layout(lobe_count):
+    """Symmetric row: pairs at +-offset (one shared sharpness and amplitude) and a centre lobe if K is odd."""
+    pairs = lobe_count // 2
+    group = np.concatenate([np.repeat(np.arange(pairs), 2), [pairs] if lobe_count % 2 else []]).astype(int)
+    sign = np.concatenate([np.tile([1.0, -1.0], pairs), [0.0] if lobe_count % 2 else []])
+    return pairs, pairs + lobe_count % 2, group, sign
+
+
+def _plane_fit(params, ratio, lobe_count):
+    """Closed-form L2 of a row of Gaussians mu exp(-b ((x - p)^2 + y^2)) against
+    T = exp(-(x^2 + y^2/r^2)) over the plane, amplitudes by NNLS.
+
+    Returns (E / |T|^2, its gradient w.r.t. params, p (K,), b (K,), mu (K,)).  The
+    gradient holds the amplitudes fixed: at the NNLS optimum that is exact
+    (envelope theorem).
+    """
+    pairs, unique, group, sign = _row_layout(lobe_count)
+    offsets = np.concatenate([params[:pairs], [0.0] * (unique - pairs)])
+    b_unique = np.exp(params[pairs:pairs + unique])
+    p, b = sign * offsets[group], b_unique[group]
+    target_norm = np.pi * ratio / 2  # integral of T^2
+    y_precision = 1 / (ratio * ratio) + b
+    overlap = np.pi / np.sqrt((1 + b) * y_precision) * np.exp(-b * p * p / (1 + b))
+    b_sum = b[:, None] + b[None, :]
+    separation = p[:, None] - p[None, :]
+    gram = np.pi / b_sum * np.exp(-b[:, None] * b[None, :] * separation ** 2 / b_sum)
+    membership = np.zeros((unique, lobe_count))
+    membership[group, np.arange(lobe_count)] = 1
+    overlap_u = membership @ overlap
+    gram_u = membership @ gram @ membership.T + 1e-12 * np.eye(unique) * np.trace(gram) / lobe_count
+    cholesky = np.linalg.cholesky(gram_u)
+    mu_u, _ = nnls(cholesky.T, np.linalg.solve(cholesky, overlap_u))
+    mu = mu_u[group]
+    error2 = target_norm - 2 * mu @ overlap + mu @ gram @ mu
+    # derivatives of E = |T|^2 - 2 mu.I + mu' J mu with respect to each lobe's p and b
+    d_p = (-2 * mu * overlap * (-2 * b * p / (1 + b))
+           + 2 * mu * ((gram * (-2 * b[:, None] * b[None, :] * separation / b_sum)) @ mu))
+    d_log_overlap_b = -0.5 / (1 + b) - p * p / (1 + b) ** 2 - 0.5 / y_precision
+    d_log_gram_b = -1 / b_sum - separation ** 2 * b[None, :] ** 2 / b_sum ** 2
+    d_b = -2 * mu * overlap * d_log_overlap_b + 2 * mu * ((gram * d_log_gram_b) @ mu)
+    gradient = np.concatenate([(membership @ (sign * d_p))[:pairs], membership @ (b * d_b)])
+    return max(error2, 0) / target_norm, gradient / target_norm, p, b, mu
+
+
+def _fit_row(ratio, lobe_count, start):
+    pairs, unique, _, _ = _row_layout(lobe_count)
+    bounds = [(0.0, 4.0)] * pairs + [(-8.0, 14.0)] * unique
+    result = minimize(lambda x: _plane_fit(x, ratio, lobe_count)[:2], start, jac=True, method="L-BFGS-B",
+                      bounds=bounds, options={"maxiter": 1000})
+    return result.x, np.sqrt(result.fun)
+
+
+@functools.lru_cache(maxsize=None)
+def anisotropy_table(lobe_count):
+    """(ratios (R,), table (R, K, 3)) for K = lobe_count lobes; table[..., :] =
+    (offset along the long axis / width, sharpness * width^2, amplitude / D(n)).
+
+    Fitted at the most anisotropic ratio from several starts, then continued
+    (warm-started) towards r = 1 so neighbouring rows interpolate smoothly.
+    """
+    if not 1 <= lobe_count <= MAX_LOBES:
+        raise ValueError(f"lobe_count must be in 1..{MAX_LOBES}")
+    ratios = np.geomspace(ANISOTROPY_RATIO_MIN, 1.0, ANISOTROPY_RATIO_COUNT)
+    pairs, unique, _, _ = _row_layout(lobe_count)
+    best = None
+    # a symmetric pair at offset 0 is a saddle the optimizer cannot leave: start spread out
+    for spread, sharpness in ((0.8, 1 / ratios[0] ** 2), (1.2, lobe_count ** 2), (2.0, 1 / ratios[0] ** 2)):
+        offsets = spread * np.linspace(1, 0, pairs + 1)[:-1] if pairs else np.array([])
+        start = np.concatenate([offsets, np.full(unique, np.log(sharpness))])
+        candidate = _fit_row(ratios[0], lobe_count, start)
+        if best is None or candidate[1] < best[1]:
+            best = candidate
+    params = best[0]
+    table = np.empty((len(ratios), lobe_count, 3))
+    for index, ratio in enumerate(ratios):
+        params, _ = _fit_row(ratio, lobe_count, params)
+        _, _, p, b, amplitude = _plane_fit(params, ratio, lobe_count)
+        # exp(-b |x - p|^2) = exp(-(lambda/2) |x - p|^2): sharpness = 2 b
+        table[index] = np.stack([p, 2 * b, amplitude], axis=-1)
+    table.setflags(write=False)
+    return ratios, table
+
+
+def anisotropy_table_array(lobe_count, dtype=np.float32):
+    """The table as one contiguous array (R, K, 4) for GPU upload:
+    (log ratio, offset, sharpness * width^2, amplitude / D(n)) per row and lobe."""
+    ratios, table = anisotropy_table(lobe_count)
+    log_ratio = np.broadcast_to(np.log(ratios)[:, None, None], table.shape[:2] + (1,))
+    return np.ascontiguousarray(np.concatenate([log_ratio, table], axis=-1), dtype)
+
+
+def anisotropic_lobes(width_x, width_y, peak, lobe_count):
+    """K SG lobes of an anisotropic NDF with small-angle Gaussian widths (width_x, width_y)
+    (slopes) and peak value D(n), from the normalized table; arrays broadcast.
+
+    Returns axis (..., K, 3), sharpness (..., K), amplitude (..., K).
+    """
+    width_x, width_y, peak = np.broadcast_arrays(np.asarray(width_x), np.asarray(width_y), np.asarray(peak))
+    dtype = np.result_type(width_x, width_y, peak, np.float32)
+    ratios, table = anisotropy_table(lobe_count)
+    long_is_x = width_x >= width_y
+    long_width = np.maximum(np.where(long_is_x, width_x, width_y), 1e-12)
+    ratio = np.clip(np.where(long_is_x, width_y, width_x) / long_width, ratios[0], 1.0)
+    position = np.interp(np.log(ratio), np.log(ratios), np.arange(len(ratios)))
+    low = np.clip(np.floor(position).astype(int), 0, len(ratios) - 2)
+    fraction = (position - low)[..., None, None]
+    entry = (1 - fraction) * table[low] + fraction * table[low + 1]
+    slope = entry[..., 0] * long_width[..., None]
+    zeros = np.zeros_like(slope)
+    axis = np.where(long_is_x[..., None, None],
+                    np.stack([slope, zeros, np.ones_like(slope)], axis=-1),
+                    np.stack([zeros, slope, np.ones_like(slope)], axis=-1))
+    axis = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+    sharpness = entry[..., 1] / (long_width * long_width)[..., None]
+    amplitude = entry[..., 2] * peak[..., None]
+    return axis.astype(dtype), sharpness.astype(dtype), amplitude.astype(dtype)
+
+
+def isotropic_model_of_width(kind, width):
+    """The brdf model whose 1-lobe mapping ``kind`` (a key of brdf.ISOTROPIC_MAPPINGS) is
+    parametrized by ``width``, and its peak D(n)."""
+    from . import brdf
+    if kind == "BECKMANN":
+        return brdf.CookTorranceBeckmann(roughness=width), 1 / (np.pi * width * width)
+    if kind == "BLINN_PHONG":
+        exponent = 2 / (width * width)
+        return brdf.BlinnPhong(exponent=exponent), (exponent + 2) / (2 * np.pi)
+    if kind == "WARD_ISO":
+        return brdf.WardIsotropic(alpha_x=width), 1 / (np.pi * width * width)
+    if kind == "GGX":
+        return brdf.GGX(roughness=np.sqrt(width)), 1 / (np.pi * width * width)
+    raise ValueError(kind)
+
+
+def isotropic_ndf_of_width(kind):
+    """ndf_of_width(theta, width) -> D(theta) / D(n) for derive_isotropic_mapping."""
+    def ndf_of_width(theta, width):
+        model, peak = isotropic_model_of_width(kind, width)
+        h = np.stack([np.sin(theta), np.zeros_like(theta), np.cos(theta)], axis=-1)
+        return model.ndf(h) / peak
+    return ndf_of_width
+
+
+def isotropic_mapping_errors(kind, widths):
+    """Relative L2 (hemisphere) of the frozen brdf mapping and of the L2-optimal
+    single lobe, per width: (mapping_error (W,), optimal_error (W,))."""
+    from . import brdf
+    mapping_errors, optimal_errors = [], []
+    ndf_of_width = isotropic_ndf_of_width(kind)
+    for width in np.asarray(widths, np.float64):
+        theta, weights = polar_quadrature([width])
+        target = ndf_of_width(theta, width)
+        scaled_sharpness, relative_amplitude = brdf.isotropic_mapping(kind, np.float64(width))
+        lobe = relative_amplitude * np.exp(-scaled_sharpness / width ** 2 * 2 * np.sin(0.5 * theta) ** 2)
+        mapping_errors.append(relative_l2(target, lobe, weights))
+        optimal_errors.append(fit_isotropic(target, theta, weights, 1)[2])
+    return np.array(mapping_errors), np.array(optimal_errors)
