@@ -25,7 +25,8 @@ def _axis_pairs(fuzz, count):
 
 def _assert_finite(out, what):
     bad = ~np.isfinite(out)
-    assert not bad.any(), f"{what}: {int(bad.any(axis=-1).sum()) if out.ndim > 1 else int(bad.sum())} non-finite rows"
+    columns = np.flatnonzero(bad.reshape(len(out), -1).any(axis=0))
+    assert not bad.any(), f"{what}: {int(bad.reshape(len(out), -1).any(axis=1).sum())} non-finite rows, columns {columns}"
 
 
 def test_sg_stress(glsl, fuzz):
@@ -76,3 +77,46 @@ def test_hemisphere_stress(glsl, fuzz):
     out = glsl(["sg.glsl", "hemisphere.glsl"], call, inputs, 4)
     _assert_finite(out, "hemisphere.glsl")
     assert out.min() >= 0 and out[:, 0].max() <= 1
+
+
+def test_brdf_stress(glsl, fuzz):
+    wo, wi = fuzz.stress_vectors(ROWS), fuzz.stress_vectors(ROWS)
+    h = fuzz.stress_vectors(ROWS)
+    huge = np.abs(h).max(axis=1) > 1e10  # ndf(h) takes unit (or zero) h; m_factor normalises
+    h[huge] = fuzz.unit_vectors(int(huge.sum()))
+    for v in (wo, wi, h):  # grazing: z in [-1e-6, 1e-6]
+        grazing = fuzz.rng.integers(0, 8, ROWS) == 0
+        v[grazing, 2] = fuzz.uniform(-1e-6, 1e-6, int(grazing.sum()))
+    wi[fuzz.rng.integers(0, 8, ROWS) == 0] *= -1  # some exactly opposite pairs through reflection
+    roughness = fuzz.f32(np.where(fuzz.rng.integers(0, 4, ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 1.0, ROWS)))
+    ior = fuzz.uniform(0.0, 4.0, ROWS)
+    exponent = fuzz.f32(np.where(fuzz.rng.integers(0, 4, ROWS) == 0, 0.0, fuzz.log_uniform(1e-3, 1e6, ROWS)))
+    rf0 = fuzz.uniform(0.0, 1.0, ROWS)
+    inputs = {"wo": np.c_[wo, roughness], "wi": np.c_[wi, ior], "h": np.c_[h, exponent], "e": rf0}
+    ndfs = """
+    float r = wo.w, n = h.w;
+    result = vec4(cook_torrance_ndf(h.xyz, r) + cook_torrance_beckmann_ndf(h.xyz, r) + ggx_ndf(h.xyz, r),
+                  blinn_phong_ndf(h.xyz, n) + ashikhmin_shirley_ndf(h.xyz, n, n * 7.0 + 1.0),
+                  ward_isotropic_ndf(h.xyz, r) + ward_anisotropic_ndf(h.xyz, r, 1.0 - r),
+                  fresnel_dielectric(h.z, wi.w) + fresnel_schlick(h.z, e.x));
+    """
+    out = glsl(["sg.glsl", "brdf.glsl"], ndfs, inputs, 4)
+    _assert_finite(out, "brdf ndfs / fresnel")
+    assert out.min() >= 0
+    m_factors = """
+    float r = wo.w, n = h.w;
+    result = vec4(cook_torrance_m_factor(wo.xyz, wi.xyz, r, wi.w) + cook_torrance_beckmann_m_factor(wo.xyz, wi.xyz, r, wi.w),
+                  blinn_phong_m_factor(wo.xyz, wi.xyz, n) + ward_anisotropic_m_factor(wo.xyz, wi.xyz),
+                  ashikhmin_shirley_m_factor(wo.xyz, wi.xyz, n, 1.0, e.x) + ggx_m_factor(wo.xyz, wi.xyz, r),
+                  lambert_m_factor(wo.xyz, wi.xyz, e.x));
+    """
+    out = glsl(["sg.glsl", "brdf.glsl"], m_factors, inputs, 4)
+    _assert_finite(out, "brdf m_factors")
+    assert out.min() >= 0
+    lobes = """
+    float r = wo.w, n = h.w;
+    result = vec4(cook_torrance_ndf_lobe(r) + cook_torrance_beckmann_ndf_lobe(r),
+                  blinn_phong_ndf_lobe(n) + ward_isotropic_ndf_lobe(r) + ggx_ndf_lobe(r));
+    """
+    out = glsl(["sg.glsl", "brdf.glsl"], lobes, inputs, 4)
+    _assert_finite(out, "brdf ndf lobes")
