@@ -120,3 +120,27 @@ def test_brdf_stress(glsl, fuzz):
     """
     out = glsl(["sg.glsl", "brdf.glsl"], lobes, inputs, 4)
     _assert_finite(out, "brdf ndf lobes")
+
+
+def test_lights_stress(glsl, fuzz):
+    position = fuzz.stress_vectors(ROWS)  # includes 1e30-sized positions and the origin
+    light = fuzz.stress_vectors(ROWS)
+    same = fuzz.rng.integers(0, 8, ROWS) == 0
+    light[same] = position[same]  # shading point at the light's centre
+    radius = fuzz.f32(np.where(fuzz.rng.integers(0, 4, ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 1e6, ROWS)))
+    intensity = fuzz.stress_amplitude(ROWS)
+    spot = fuzz.stress_vectors(ROWS)
+    angle = fuzz.uniform(-1.0, 4.0, ROWS)
+    inputs = {"x": np.c_[position, angle], "l": np.c_[light, radius], "s": np.c_[spot, intensity]}
+    calls = {
+        "sphere_light_sg": "sphere_light_sg(x.xyz, l.xyz, l.w, s.w, axis, sharpness, amplitude)",
+        "sphere_light_sg_paper": "sphere_light_sg_paper(x.xyz, l.xyz, l.w, s.w, axis, sharpness, amplitude)",
+        "spot_light_sg": "spot_light_sg(x.xyz, l.xyz, s.xyz, x.w, fract(x.w), s.w, l.w, axis, sharpness, amplitude)",
+        "directional_light_sg": "directional_light_sg(s.xyz, x.w, s.w, axis, sharpness, amplitude)",
+    }
+    for name, call in calls.items():
+        body = ("vec3 axis; float sharpness, amplitude; " + call +
+                "; result = vec4(axis.x + axis.y + axis.z, sharpness, amplitude, 0.0);")
+        out = glsl(["sg.glsl", "lights.glsl"], body, inputs, 3)
+        _assert_finite(out, name)
+        assert out[:, 1].min() > 0 and out[:, 2].min() >= 0, name

@@ -1,0 +1,101 @@
+/* Local and distant lights as single SGs (wang2009 section 6, eq. 32-33):
+ * GLSL mirror of sg_prt_addon/core/lights.py.  Depends on sg.glsl.
+ *
+ *   blender_point_light_intensity <- lights.blender_point_light_intensity
+ *   sphere_light_sg               <- lights.sphere_light_sg(model="energy")
+ *   sphere_light_sg_paper         <- lights.sphere_light_sg(model="paper")
+ *   point_light_sg                <- lights.point_light_sg (energy model)
+ *   spot_light_sg                 <- lights.spot_light_sg (energy model)
+ *   directional_light_sg          <- lights.directional_light_sg(model="energy")
+ *
+ * Lobes come back in out parameters (axis, sharpness, amplitude); intensity
+ * and irradiance are scalars: for a colour pass 1 and multiply.  lights.py
+ * works in float64 internally; here float32 positions limit the accuracy of
+ * the light direction to ~1e-7 of the scene scale over the distance.
+ */
+
+const float LIGHT_MAX_SHARPNESS = 1.0e6;
+const float LIGHT_LN10 = 2.302585092994046;
+/* lights._finite: amplitudes saturate at float32 max * 1e-6 instead of overflowing */
+const float LIGHT_MAX_AMPLITUDE = 3.4028235e32;
+
+float blender_point_light_intensity(float power)
+{
+  return power / SG_FOUR_PI;
+}
+
+/* Cap of sin^2(theta) = sin2 (0 = a point): sharpness fa^-1(2 pi sin^2) = ln(10)/sin^2,
+ * capped at LIGHT_MAX_SHARPNESS; amplitude so that the sphere integral is energy. */
+void light_cap_energy_lobe(float sin2, float energy, out float sharpness, out float amplitude)
+{
+  sharpness = sin2 > 0.0 ? min(LIGHT_LN10 / sin2, LIGHT_MAX_SHARPNESS) : LIGHT_MAX_SHARPNESS;
+  amplitude = min(energy / sg_sphere_integral(sharpness, 1.0), LIGHT_MAX_AMPLITUDE);
+}
+
+/* Geometry shared by both sphere-light models: returns sin^2 of the cap and
+ * writes effective2 = max(d^2, r^2, 1e-12 max(r^2, 1)) and the axis. */
+float sphere_light_cap(vec3 shading_position, vec3 light_position, float radius,
+                       out float effective2, out vec3 axis)
+{
+  vec3 to_light = light_position - shading_position;
+  float distance2 = dot(to_light, to_light);
+  float radius2 = radius * radius;
+  effective2 = max(max(distance2, radius2), 1.0e-12 * max(radius2, 1.0));
+  axis = safe_normalize(to_light);
+  return radius2 / effective2;
+}
+
+/* Sphere light of radius r and intensity I [W/sr] (use blender_point_light_intensity),
+ * energy model: sphere integral = cap radiance integral 2 I / (max(d, r)^2 (1 + cos)). */
+void sphere_light_sg(vec3 shading_position, vec3 light_position, float radius, float intensity,
+                     out vec3 axis, out float sharpness, out float amplitude)
+{
+  float effective2;
+  float sin2 = sphere_light_cap(shading_position, light_position, radius, effective2, axis);
+  float cos_half = sqrt(max(1.0 - sin2, 0.0));
+  float energy = 2.0 / (effective2 * (1.0 + cos_half));
+  light_cap_energy_lobe(sin2, energy, sharpness, amplitude);
+  amplitude = clamp(amplitude * intensity, -LIGHT_MAX_AMPLITUDE, LIGHT_MAX_AMPLITUDE);
+}
+
+/* eq. 32 as printed: sharpness ln(10) d^2 / r^2, amplitude I / d^2 (comparison only). */
+void sphere_light_sg_paper(vec3 shading_position, vec3 light_position, float radius, float intensity,
+                           out vec3 axis, out float sharpness, out float amplitude)
+{
+  float effective2;
+  float sin2 = sphere_light_cap(shading_position, light_position, radius, effective2, axis);
+  sharpness = sin2 > 0.0 ? min(LIGHT_LN10 / sin2, LIGHT_MAX_SHARPNESS) : LIGHT_MAX_SHARPNESS;
+  amplitude = clamp(intensity / effective2, -LIGHT_MAX_AMPLITUDE, LIGHT_MAX_AMPLITUDE);
+}
+
+void point_light_sg(vec3 shading_position, vec3 light_position, float intensity, float radius,
+                    out vec3 axis, out float sharpness, out float amplitude)
+{
+  sphere_light_sg(shading_position, light_position, radius, intensity, axis, sharpness, amplitude);
+}
+
+/* Point light times the cone falloff smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) blend)). */
+void spot_light_sg(vec3 shading_position, vec3 light_position, vec3 spot_direction, float spot_size,
+                   float spot_blend, float intensity, float radius,
+                   out vec3 axis, out float sharpness, out float amplitude)
+{
+  sphere_light_sg(shading_position, light_position, radius, intensity, axis, sharpness, amplitude);
+  float cos_angle = dot(-axis, safe_normalize(spot_direction));
+  float cos_half = cos(0.5 * spot_size);
+  float width = max((1.0 - cos_half) * spot_blend, 1.0e-12);
+  float t = clamp((cos_angle - cos_half) / width, 0.0, 1.0);
+  amplitude *= t * t * (3.0 - 2.0 * t);
+}
+
+/* Distant disc light (eq. 33), e.g. Blender's sun: angular_radius = sun.angle / 2,
+ * irradiance = sun strength; energy 2 S / (1 + cos(angular_radius)). */
+void directional_light_sg(vec3 direction, float angular_radius, float irradiance,
+                          out vec3 axis, out float sharpness, out float amplitude)
+{
+  float half_angle = clamp(angular_radius, 0.0, 0.5 * SG_PI);
+  float sine = sin(half_angle);
+  float energy = 2.0 / (1.0 + cos(half_angle));
+  light_cap_energy_lobe(sine * sine, energy, sharpness, amplitude);
+  amplitude = clamp(amplitude * irradiance, -LIGHT_MAX_AMPLITUDE, LIGHT_MAX_AMPLITUDE);
+  axis = safe_normalize(direction);
+}

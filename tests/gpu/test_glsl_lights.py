@@ -1,0 +1,90 @@
+"""shaders/lib/lights.glsl (float32) against sg_prt_addon/core/lights.py (float64)."""
+import numpy as np
+
+from sg_prt_addon.core import lights
+
+N = 20000
+LIB = ["sg.glsl", "lights.glsl"]
+
+LOBE_OUT = """
+    vec3 axis; float sharpness, amplitude;
+    {call};
+    result = m.w > 0.5 ? vec4(sharpness, amplitude, 0.0, 0.0) : vec4(axis, 0.0);
+"""
+
+
+def _run(glsl, call, inputs):
+    """(axis (N, 3), sharpness (N,), amplitude (N,)) of a lobe-returning GLSL call; `m.w` selects."""
+    inputs = dict(inputs)
+    m = np.array(inputs["m"], np.float64)
+    m[:, 3] = 0.0
+    inputs["m"] = m
+    axis = glsl(LIB, LOBE_OUT.format(call=call), inputs, 3)
+    m = m.copy()
+    m[:, 3] = 1.0
+    inputs["m"] = m
+    scalars = glsl(LIB, LOBE_OUT.format(call=call), inputs, 2)
+    return axis, scalars[:, 0], scalars[:, 1]
+
+
+def _check(record_error, label, got, expected, direction_bound=1e-6, bound=5e-6):
+    axis, sharpness, amplitude = got
+    axis_expected, sharpness_expected, amplitude_expected = (np.asarray(a, np.float64) for a in expected)
+    assert record_error(f"lights {label} axis, absolute", np.abs(axis - axis_expected).max()) <= direction_bound
+    for what, value, reference in (("sharpness", sharpness, sharpness_expected),
+                                   ("amplitude", amplitude, amplitude_expected)):
+        error = np.abs(value - reference) / np.maximum(np.abs(reference), 1e-30)
+        assert record_error(f"lights {label} {what}, relative", error.max()) <= bound
+
+
+def _scene(fuzz):
+    position = fuzz.uniform(-1.0, 1.0, (N * 3)).reshape(N, 3)
+    # lights 0.01..10 away, radius from 0 (points) to beyond the distance (inside the light)
+    light = fuzz.f32(position + fuzz.unit_vectors(N) * fuzz.log_uniform(1e-2, 10.0, N)[:, None])
+    radius = fuzz.f32(np.where(fuzz.rng.integers(0, 5, N) == 0, 0.0, fuzz.log_uniform(1e-4, 3.0, N)))
+    intensity = fuzz.log_uniform(1e-2, 1e3, N)
+    return position, light, radius, intensity
+
+
+def test_sphere_light(glsl, fuzz, record_error):
+    position, light, radius, intensity = _scene(fuzz)
+    inputs = {"x": position, "l": np.c_[light, radius], "m": np.c_[intensity, np.zeros((N, 3))]}
+    got = _run(glsl, "sphere_light_sg(x.xyz, l.xyz, l.w, m.x, axis, sharpness, amplitude)", inputs)
+    _check(record_error, "sphere_light_sg", got, lights.sphere_light_sg(position, light, radius, intensity))
+    got = _run(glsl, "sphere_light_sg_paper(x.xyz, l.xyz, l.w, m.x, axis, sharpness, amplitude)", inputs)
+    _check(record_error, "sphere_light_sg_paper", got,
+           lights.sphere_light_sg(position, light, radius, intensity, model="paper"))
+    got = _run(glsl, "point_light_sg(x.xyz, l.xyz, m.x, l.w, axis, sharpness, amplitude)", inputs)
+    _check(record_error, "point_light_sg", got, lights.point_light_sg(position, light, intensity, radius))
+
+
+def test_spot_light(glsl, fuzz, record_error):
+    position, light, radius, intensity = _scene(fuzz)
+    spot_direction = fuzz.near(position - light, 0.5)
+    size = fuzz.uniform(0.1, 3.0, N)
+    blend = fuzz.uniform(0.0, 1.0, N)
+    inputs = {"x": np.c_[position, size], "l": np.c_[light, radius], "s": np.c_[spot_direction, blend],
+              "m": np.c_[intensity, np.zeros((N, 3))]}
+    got = _run(glsl, "spot_light_sg(x.xyz, l.xyz, s.xyz, x.w, s.w, m.x, l.w, axis, sharpness, amplitude)", inputs)
+    expected = lights.spot_light_sg(position, light, spot_direction, size, blend, intensity, radius)
+    # the smoothstep edge amplifies float32 cosines by 1/width: compare amplitudes to the unfalloffed lobe
+    unfalloffed = lights.sphere_light_sg(position, light, radius, intensity)[2]
+    assert np.abs(got[0] - expected[0]).max() <= 2e-6
+    assert fuzz.relative_error(got[1], expected[1], 1e-30).max() <= 2e-5
+    error = np.abs(got[2] - expected[2]) / unfalloffed
+    wide = (1 - np.cos(0.5 * size)) * blend > 1e-3
+    assert record_error("lights spot_light_sg amplitude (blend width > 1e-3), relative to no falloff",
+                        error[wide].max()) <= 1e-3
+
+
+def test_directional_light(glsl, fuzz, record_error):
+    direction = fuzz.f32(fuzz.unit_vectors(N) * fuzz.log_uniform(1e-3, 1e3, N)[:, None])
+    angular_radius = fuzz.f32(np.where(fuzz.rng.integers(0, 5, N) == 0, 0.0, fuzz.uniform(0.0, 2.0, N)))
+    irradiance = fuzz.log_uniform(1e-2, 1e3, N)
+    inputs = {"d": np.c_[direction, angular_radius], "m": np.c_[irradiance, np.zeros((N, 3))]}
+    got = _run(glsl, "directional_light_sg(d.xyz, d.w, m.x, axis, sharpness, amplitude)", inputs)
+    _check(record_error, "directional_light_sg", got,
+           lights.directional_light_sg(direction, angular_radius, irradiance))
+    power = fuzz.log_uniform(1e-2, 1e4, N)
+    out = glsl(LIB, "vec4(blender_point_light_intensity(p.x))", {"p": power}, 1)
+    assert fuzz.relative_error(out, lights.blender_point_light_intensity(power), 1e-30).max() <= 1e-6
