@@ -1,0 +1,209 @@
+"""Spherical warp of NDF lobes into the lighting domain (wang2009 section 4.3, eq. 15-22).
+
+The NDF D(h) is an SG mixture in the half-vector domain.  For a fixed view
+``wo`` the BRDF slice needs D(h(wi)) with h = normalize(wo + wi), i.e. the
+NDF pushed through the warp wi = psi(h) = 2 (wo.h) h - wo (eq. 17).
+
+Two modes, both returning ISOTROPIC SGs so that every downstream consumer
+(SG x clamped cosine, SSDF visibility fh, the SG-prefiltered environment,
+point lights as SGs) takes them unchanged:
+
+``'paper'``  one lobe per NDF lobe, eq. 18-21: axis psi(p), sharpness
+             lambda / tau with tau = 4 |p.wo|, amplitude kept.
+``'split2'`` (default) two lobes per NDF lobe.  The true warped lobe is
+             anisotropic: sharpness lambda/4 in the plane of (p, wo) and
+             lambda / (4 c^2) across it (c = p.wo), and it fans out (wider
+             where h.wo is larger, i.e. towards the normal).  The paper's
+             single lobe has the geometric-mean sharpness lambda / (4 c): too
+             narrow in the plane, so at grazing views it sits at the horizon
+             and loses most of its cosine-weighted energy.  split2 first
+             splits the NDF lobe into two half-amplitude lobes offset by
+             +-delta along the plane of incidence, delta = sqrt((1 - c) /
+             lambda) (the two-point Gauss-Hermite rule, shrunk so that the
+             in-plane variance of the pair after warping, 4c/lambda +
+             4 delta^2, equals the true 4/lambda), then warps each with the
+             paper's rule at its own centre, so each half gets its own
+             Jacobian: the fan shape and the energy near the horizon come
+             back.  At normal incidence delta = 0 and split2 equals 'paper'.
+             Sub-lobes whose centre is not a valid half vector (h.wo <= 0) get
+             zero amplitude: no wi reflects wo about them.  delta is capped at
+             MAX_SPLIT_OFFSET, and the cap fades to 0 below lambda =
+             FULL_SPLIT_SHARPNESS: for broad lobes the split overshoots the
+             planar model it comes from, so they stay (nearly) 'paper'.
+
+Measured (benchmarks/accuracy/warp.py, quadrature of D(h(wi))): cosine-
+weighted energy ratio at 85 deg, alpha 0.05 / 0.1 / 0.3 / 0.5 (lambda =
+2/alpha^2): paper 0.75 / 0.46 / 0.15 / 0.11, split2 0.98 / 1.03 / 1.05 / 0.56;
+relative L2 at 60 deg for lambda >= 100: paper 0.34, split2 0.30.  Never
+worse than 'paper' by more than 0.05 in energy or 0.01 in L2 (grid lambda
+0.3..1e4, views 0..85 deg; worst at lambda 8, 45 deg).  Costs twice the lobes downstream.  End to end with eq. 22 (Mo at
+each lobe centre) on GGX, roughness 0.2-0.9, the gain shrinks: Mo carries
+1/(n.wi), which at the paper lobe's near-horizon centre partly compensates
+its lost cosine energy (see the accuracy table).
+
+Grazing clamp: tau = 4 max(|h.wo|, COS_FLOOR) and the warped sharpness is
+capped at MAX_WARPED_SHARPNESS, so grazing views (wo.z = 0, wo in the tangent
+plane) give large but finite sharpness.  The cap (angular width ~1e-3 rad)
+is below any environment texel and only bites for mirror-like lobes within
+a fraction of a degree of grazing.
+
+Everything is elementwise (dot products, sqrt, cos/sin, one normalize) so the
+GLSL port is line by line.  Reference helpers at the end (``true_slice``,
+``lighting_quadrature``) are for tests and accuracy tables, not for shading.
+"""
+import numpy as np
+
+from . import sg
+
+MODES = ("paper", "split2")
+DEFAULT_MODE = "split2"
+COS_FLOOR = 1e-3                # floor of |h.wo| in tau = 4 |h.wo| (eq. 21)
+MAX_WARPED_SHARPNESS = 1e6      # cap of lambda / tau
+MAX_SPLIT_OFFSET = 0.2          # cap of delta (rad): the split overshoots for wide lobes (lambda < ~25)
+FULL_SPLIT_SHARPNESS = 8.0      # below this lambda the cap shrinks linearly to 0 (alpha 0.5 is lambda 8)
+
+
+def _dot(a, b):
+    return np.sum(a * b, axis=-1)
+
+
+def _warp_at(half, sharpness, wo, signed_cos):
+    """Paper's per-lobe warp (eq. 18-21) of lobes centred at ``half``.
+
+    Returns the reflected axis psi(half) and the sharpness lambda / tau with
+    tau = 4 |half.wo| clamped below by 4 COS_FLOOR.
+    """
+    axis = sg.normalize(2 * signed_cos[..., None] * half - wo)
+    tau = 4 * np.maximum(np.abs(signed_cos), COS_FLOOR)
+    warped_sharpness = np.minimum(sharpness / tau, MAX_WARPED_SHARPNESS)
+    return axis, warped_sharpness
+
+
+def warp_lobes(axis, sharpness, amplitude, wo, mode=DEFAULT_MODE):
+    """Warp NDF lobes (half-vector domain) to slice lobes (lighting domain).
+
+    axis (..., K, 3), sharpness (..., K), amplitude (..., K); wo (..., 3)
+    broadcast over K.  Returns (axis, sharpness, amplitude) with K lobes for
+    mode 'paper' (wang2009 eq. 18-21) and 2K for 'split2' (the two halves of
+    NDF lobe k at indices 2k, 2k+1).  dtype follows the inputs.
+    """
+    if mode not in MODES:
+        raise ValueError(f"unknown warp mode {mode!r}, expected one of {MODES}")
+    axis = sg.normalize(axis)
+    dtype = axis.dtype
+    sharpness = np.asarray(sharpness).astype(dtype, copy=False)
+    amplitude = np.asarray(amplitude).astype(dtype, copy=False)
+    wo = sg.normalize(np.asarray(wo).astype(dtype, copy=False))[..., None, :]
+    wo = np.broadcast_to(wo, np.broadcast_shapes(wo.shape, axis.shape))
+    sharpness, amplitude = np.broadcast_arrays(sharpness, amplitude)
+    signed_cos = np.clip(_dot(axis, wo), -1, 1)
+
+    if mode == "paper":
+        warped_axis, warped_sharpness = _warp_at(axis, sharpness, wo, signed_cos)
+        return warped_axis, warped_sharpness, np.broadcast_to(amplitude, warped_sharpness.shape).copy()
+
+    # split2: offset the lobe centre by +-delta in the plane of (axis, wo).
+    in_plane = sg.normalize(wo - signed_cos[..., None] * axis, fallback=(1.0, 0.0, 0.0))
+    in_plane = in_plane - _dot(in_plane, axis)[..., None] * axis   # fallback may not be orthogonal
+    in_plane = sg.normalize(in_plane, fallback=(0.0, 1.0, 0.0))
+    safe_sharpness = np.where(sharpness > 0, sharpness, 1)
+    offset_squared = np.where(sharpness > 0, (1 - signed_cos) / safe_sharpness, np.inf)
+    # broad lobes: the split overshoots the planar model it is derived from, fade back to 'paper'
+    offset_cap = MAX_SPLIT_OFFSET * np.minimum(sharpness * (1 / FULL_SPLIT_SHARPNESS), 1)
+    offset = np.minimum(np.sqrt(offset_squared), offset_cap)
+    sign = np.array([1, -1], dtype)                          # +: towards wo
+    cos_offset = np.cos(offset)[..., None, None]
+    sin_offset = (np.sin(offset)[..., None] * sign)[..., None]
+    half = cos_offset * axis[..., None, :] + sin_offset * in_plane[..., None, :]   # (..., K, 2, 3)
+    half_cos = _dot(half, wo[..., None, :])
+    warped_axis, warped_sharpness = _warp_at(half, sharpness[..., None], wo[..., None, :], half_cos)
+    warped_amplitude = np.where(half_cos > 0, 0.5 * amplitude[..., None], 0).astype(dtype)
+    shape = warped_sharpness.shape[:-2] + (2 * warped_sharpness.shape[-2],)
+    return (warped_axis.reshape(shape + (3,)), warped_sharpness.reshape(shape),
+            warped_amplitude.reshape(shape))
+
+
+def brdf_slice_lobes(axis, sharpness, amplitude, wo, m_factor, mode=DEFAULT_MODE):
+    """BRDF view slice as SG lobes in the lighting domain (wang2009 eq. 22).
+
+    Warped lobes (warp_lobes) with amplitude multiplied by Mo(psi(p)), the
+    smooth factor of the BRDF evaluated at each warped lobe centre (eq. 22
+    assumes it constant over the lobe).  ``m_factor(wo, wi)`` takes
+    broadcastable (..., 3) directions.  Non-finite Mo (e.g. 1/(n.wi) at a
+    centre on the horizon) is replaced by 0.
+    """
+    warped_axis, warped_sharpness, warped_amplitude = warp_lobes(axis, sharpness, amplitude, wo, mode)
+    wo_lobes = np.broadcast_to(sg.normalize(np.asarray(wo).astype(warped_axis.dtype, copy=False))[..., None, :],
+                               warped_axis.shape)
+    with np.errstate(all="ignore"):
+        mo = np.asarray(m_factor(wo_lobes, warped_axis))
+    mo = np.where(np.isfinite(mo), mo, 0).astype(warped_axis.dtype, copy=False)
+    return warped_axis, warped_sharpness, warped_amplitude * mo
+
+
+# ---------------------------------------------------------------- reference
+
+
+def true_slice(direction, wo, ndf_axis, ndf_sharpness, ndf_amplitude=1.0):
+    """Exact slice D(h(wi)) of an SG-mixture NDF, h = normalize(wo + wi).
+
+    direction (..., 3); NDF lobes along the last axis of ndf_sharpness.
+    """
+    half = sg.normalize(np.asarray(direction) + np.asarray(wo))
+    return sg.mixture_evaluate(half, ndf_axis, ndf_sharpness, ndf_amplitude)
+
+
+def _frame(centre):
+    helper = np.array([1.0, 0.0, 0.0]) if abs(centre[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    first = np.cross(centre, helper)
+    first /= np.linalg.norm(first)
+    return first, np.cross(centre, first)
+
+
+def lighting_quadrature(centre, finest_scale, azimuths=1024, panels=30, nodes=10):
+    """Quadrature over the whole sphere in polar coordinates around ``centre``.
+
+    Returns directions (T, P, 3) and solid-angle weights (T, P).  The polar
+    angle uses Gauss-Legendre panels with geometrically growing widths from
+    ``finest_scale`` / 1000 to pi (resolves a lobe of angular width
+    ``finest_scale`` at the centre and the whole sphere); the azimuth is
+    uniform (trapezoid, spectrally accurate for periodic integrands).
+    """
+    centre = np.asarray(centre, float) / np.linalg.norm(centre)
+    edges = np.concatenate([[0.0], np.geomspace(finest_scale * 1e-3, np.pi, panels)])
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    widths = (edges[1:] - edges[:-1])[:, None]
+    polar = (widths * (x + 1) / 2 + edges[:-1, None]).ravel()
+    polar_weight = (widths * w / 2).ravel() * np.sin(polar)
+    azimuth = np.arange(azimuths) * (2 * np.pi / azimuths)
+    first, second = _frame(centre)
+    ring = np.cos(azimuth)[:, None] * first + np.sin(azimuth)[:, None] * second       # (P, 3)
+    directions = np.cos(polar)[:, None, None] * centre + np.sin(polar)[:, None, None] * ring
+    weights = polar_weight[:, None] * np.full(azimuths, 2 * np.pi / azimuths)
+    return directions, weights
+
+
+def slice_errors(wo, ndf_axis, ndf_sharpness, mode, azimuths=1024, panels=30, nodes=10):
+    """Errors of the warped slice of one SG NDF lobe (amplitude 1) for view wo.
+
+    Returns dict: energy_sphere (integral ratio approx / true over the
+    sphere), energy_cosine (same, weighted by max(0, wi.z)), l2 (relative L2
+    error over the sphere), l2_cosine (relative L2 error weighted by the
+    clamped cosine).
+    """
+    wo = np.asarray(wo, float) / np.linalg.norm(wo)
+    ndf_axis = np.asarray(ndf_axis, float) / np.linalg.norm(ndf_axis)
+    centre = 2 * (wo @ ndf_axis) * ndf_axis - wo
+    # finest feature: the across-plane width of the true lobe, 2 c / sqrt(lambda)
+    finest = 2 * max(abs(wo @ ndf_axis), 0.02) / np.sqrt(max(ndf_sharpness, 1.0))
+    directions, weights = lighting_quadrature(centre, finest, azimuths, panels, nodes)
+    exact = true_slice(directions, wo, ndf_axis[None], np.array([ndf_sharpness]))
+    lobes = warp_lobes(ndf_axis[None], np.array([ndf_sharpness]), np.array([1.0]), wo, mode)
+    approx = sg.mixture_evaluate(directions, *lobes)
+    cosine = np.maximum(directions[..., 2], 0)
+    out = {}
+    for name, w in (("sphere", weights), ("cosine", weights * cosine)):
+        out["energy_" + name] = float(np.sum(approx * w) / np.sum(exact * w))
+        l2 = np.sqrt(np.sum((approx - exact) ** 2 * w) / np.sum(exact ** 2 * w))
+        out["l2" if name == "sphere" else "l2_cosine"] = float(l2)
+    return out
