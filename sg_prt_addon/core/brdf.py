@@ -49,8 +49,11 @@ def _dtype(*arrays):
     return np.dtype(np.float64) if dtype is None else dtype
 
 
-def _param(value, dtype):
-    return np.asarray(value).astype(dtype, copy=False)
+def _param(value, dtype, floor=None):
+    """Parameter as an array of ``dtype``, clamped below at ``floor`` (a typed constant, so
+    numpy scalars do not promote to float64)."""
+    value = np.asarray(value).astype(dtype, copy=False)
+    return value if floor is None else np.maximum(value, np.asarray(floor, dtype))
 
 
 def _dot(a, b):
@@ -140,9 +143,10 @@ def _cosines(wo, wi):
     return np.maximum(no, COSINE_EPSILON), np.maximum(ni, COSINE_EPSILON), visible
 
 
-def _frame_lobes(axis_shape, sharpness, amplitude):
-    """Single lobe around z+ with shapes (..., 1, 3), (..., 1), (..., 1)."""
-    sharpness, amplitude = np.broadcast_arrays(sharpness, amplitude)
+def _frame_lobes(parameter, sharpness, amplitude):
+    """Single lobe around z+ with shapes (..., 1, 3), (..., 1), (..., 1), in the parameter's dtype."""
+    dtype = _dtype(parameter)
+    sharpness, amplitude = np.broadcast_arrays(np.asarray(sharpness, dtype), np.asarray(amplitude, dtype))
     axis = np.zeros(sharpness.shape + (1, 3), sharpness.dtype)
     axis[..., 2] = 1
     return axis, sharpness[..., None].copy(), amplitude[..., None].copy()
@@ -266,7 +270,7 @@ class CookTorrance(_Microfacet):
     ior: object = 1.5
 
     def _m(self, dtype):
-        return np.maximum(_param(self.roughness, dtype), 1e-6)
+        return _param(self.roughness, dtype, 1e-6)
 
     def ndf(self, h):
         h = np.asarray(h)
@@ -284,7 +288,7 @@ class CookTorrance(_Microfacet):
     def ndf_lobes(self):
         """wang2009 eq. 12: G(h; n, 2/m^2, 1)."""
         m = self._m(_dtype(self.roughness))
-        return _frame_lobes(m.shape, 2 / (m * m), np.ones_like(m))
+        return _frame_lobes(m, 2 / (m * m), np.ones_like(m))
 
     def half_vector_pdf(self, h):
         m = self._m(h.dtype)
@@ -313,7 +317,7 @@ class CookTorranceBeckmann(CookTorrance):
     def ndf_lobes(self):
         m = self._m(_dtype(self.roughness))
         scaled_sharpness, relative_amplitude = isotropic_mapping("BECKMANN", m)
-        return _frame_lobes(m.shape, scaled_sharpness / (m * m), relative_amplitude / (np.pi * m * m))
+        return _frame_lobes(m, scaled_sharpness / (m * m), relative_amplitude / (np.pi * m * m))
 
 
 @dataclass(frozen=True, eq=False)
@@ -325,7 +329,7 @@ class BlinnPhong(_Microfacet):
     exponent: object = 100.0
 
     def _n(self, dtype):
-        return np.maximum(_param(self.exponent, dtype), 0)
+        return _param(self.exponent, dtype, 0)
 
     def ndf(self, h):
         h = np.asarray(h)
@@ -342,10 +346,10 @@ class BlinnPhong(_Microfacet):
 
     def ndf_lobes(self):
         n = self._n(_dtype(self.exponent))
-        width = np.sqrt(2 / np.maximum(n, 1e-6))
+        width = np.sqrt(2 / np.maximum(n, np.asarray(1e-6, n.dtype)))
         scaled_sharpness, relative_amplitude = isotropic_mapping("BLINN_PHONG", width)
         sharpness = scaled_sharpness / np.square(np.clip(width, *ISOTROPIC_MAPPINGS["BLINN_PHONG"]["width_range"]))
-        return _frame_lobes(n.shape, sharpness, relative_amplitude * (n + 2) / (2 * np.pi))
+        return _frame_lobes(n, sharpness, relative_amplitude * (n + 2) / (2 * np.pi))
 
     def half_vector_pdf(self, h):
         return self.ndf(h) * np.maximum(h[..., 2], 0)
@@ -367,7 +371,7 @@ class WardAnisotropic(_Microfacet):
     alpha_y: object = 0.05
 
     def _alphas(self, dtype):
-        return (np.maximum(_param(self.alpha_x, dtype), 1e-6), np.maximum(_param(self.alpha_y, dtype), 1e-6))
+        return (_param(self.alpha_x, dtype, 1e-6), _param(self.alpha_y, dtype, 1e-6))
 
     def ndf(self, h):
         h = np.asarray(h)
@@ -404,13 +408,13 @@ class WardIsotropic(WardAnisotropic):
     alpha_y: object = None
 
     def _alphas(self, dtype):
-        alpha = np.maximum(_param(self.alpha_x, dtype), 1e-6)
+        alpha = _param(self.alpha_x, dtype, 1e-6)
         return alpha, alpha
 
     def ndf_lobes(self):
         alpha, _ = self._alphas(_dtype(self.alpha_x))
         scaled_sharpness, relative_amplitude = isotropic_mapping("WARD_ISO", alpha)
-        return _frame_lobes(alpha.shape, scaled_sharpness / (alpha * alpha),
+        return _frame_lobes(alpha, scaled_sharpness / (alpha * alpha),
                             relative_amplitude / (np.pi * alpha * alpha))
 
 
@@ -427,7 +431,7 @@ class AshikhminShirley(_Microfacet):
     rf0: object = 0.05
 
     def _exponents(self, dtype):
-        return np.maximum(_param(self.nu, dtype), 0), np.maximum(_param(self.nv, dtype), 0)
+        return _param(self.nu, dtype, 0), _param(self.nv, dtype, 0)
 
     def ndf(self, h):
         h = np.asarray(h)
@@ -452,8 +456,9 @@ class AshikhminShirley(_Microfacet):
         (the small-angle Gaussian of (n.h)^e)."""
         from . import ndf_fit
         nu, nv = self._exponents(_dtype(self.nu, self.nv))
-        width_x = np.sqrt(2 / np.maximum(nu, 1e-6))
-        width_y = np.sqrt(2 / np.maximum(nv, 1e-6))
+        floor = np.asarray(1e-6, nu.dtype)
+        width_x = np.sqrt(2 / np.maximum(nu, floor))
+        width_y = np.sqrt(2 / np.maximum(nv, floor))
         return ndf_fit.anisotropic_lobes(width_x, width_y, np.sqrt((nu + 1) * (nv + 1)) / (2 * np.pi), lobe_count)
 
     def half_vector_pdf(self, h):
@@ -481,7 +486,7 @@ class GGX(_Microfacet):
 
     def _alpha(self, dtype):
         # alpha >= 1e-9 keeps 1/(pi alpha^2) and (sin^2/alpha^2)^2 finite in float32
-        return np.maximum(np.square(_param(self.roughness, dtype)), 1e-9)
+        return np.maximum(np.square(_param(self.roughness, dtype)), np.asarray(1e-9, dtype))
 
     def ndf(self, h):
         h = np.asarray(h)
@@ -511,7 +516,7 @@ class GGX(_Microfacet):
         peak = 1 / (np.pi * alpha * alpha)
         if lobe_count == 1:
             scaled_sharpness, relative_amplitude = isotropic_mapping("GGX", alpha)
-            return _frame_lobes(alpha.shape, scaled_sharpness / (alpha * alpha), relative_amplitude * peak)
+            return _frame_lobes(alpha, scaled_sharpness / (alpha * alpha), relative_amplitude * peak)
         if lobe_count != 2:
             raise ValueError("GGX has 1- and 2-lobe fits")
         from . import ndf_fit
@@ -571,7 +576,7 @@ class Lambert(_Microfacet):
 
     def ndf_lobes(self):
         kd = np.asarray(self.kd, dtype=_dtype(self.kd))
-        return _frame_lobes(kd.shape, np.zeros_like(kd), np.ones_like(kd))
+        return _frame_lobes(kd, np.zeros_like(kd), np.ones_like(kd))
 
     def sample(self, wo, u):
         """Cosine-weighted hemisphere."""

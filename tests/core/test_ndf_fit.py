@@ -1,0 +1,131 @@
+"""SG fits of NDFs (core.ndf_fit and the models' ndf_lobes) against the exact NDFs."""
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+from scipy.optimize import approx_fprime
+
+from sg_prt_addon.core import brdf, ndf_fit, sg
+
+
+@pytest.mark.parametrize("roughness, bound", [(0.045, 3e-4), (0.2, 5e-3), (0.5, 0.03), (0.8, 0.07)])
+def test_cook_torrance_eq12_single_lobe(roughness, bound):
+    """wang2009 eq. 12: G(h; n, 2/m^2, 1) against exp(-(theta/m)^2), relative L2 over the hemisphere."""
+    model = brdf.CookTorrance(roughness=roughness)
+    axis, sharpness, amplitude = model.ndf_lobes()
+    assert sharpness[0] == pytest.approx(2 / roughness ** 2) and amplitude[0] == 1
+    assert ndf_fit.ndf_l2_error(model, (axis, sharpness, amplitude)) < bound
+
+
+@pytest.mark.parametrize("kind", sorted(brdf.ISOTROPIC_MAPPINGS))
+def test_isotropic_mappings_are_near_l2_optimal(kind):
+    low, high = brdf.ISOTROPIC_MAPPINGS[kind]["width_range"]
+    widths = np.linspace(0.01, high, 7)
+    mapping_error, optimal_error = ndf_fit.isotropic_mapping_errors(kind, widths)
+    assert np.all(mapping_error <= optimal_error + 0.005), (mapping_error - optimal_error)
+
+
+@pytest.mark.parametrize("roughness", [0.05, 0.2, 0.45, 0.7, 0.9, 1.0])
+def test_ggx_one_and_two_lobes(roughness):
+    model = brdf.GGX(roughness=roughness)
+    one = ndf_fit.ndf_l2_error(model, model.ndf_lobes(1))
+    two = ndf_fit.ndf_l2_error(model, model.ndf_lobes(2))
+    assert one < 0.21 and two < 0.05
+    assert two <= 0.7 * one + 1e-5
+
+
+@pytest.mark.parametrize("model, bound", [
+    (brdf.CookTorranceBeckmann(roughness=0.1), 0.005), (brdf.CookTorranceBeckmann(roughness=0.3), 0.045),
+    (brdf.CookTorranceBeckmann(roughness=0.6), 0.2), (brdf.BlinnPhong(exponent=300.0), 0.0011),
+    (brdf.BlinnPhong(exponent=30.0), 0.01), (brdf.BlinnPhong(exponent=3.0), 0.09),
+    (brdf.WardIsotropic(alpha_x=0.1), 0.0045), (brdf.WardIsotropic(alpha_x=0.3), 0.035),
+    (brdf.WardIsotropic(alpha_x=0.6), 0.1)], ids=str)
+def test_models_single_lobe_errors(model, bound):
+    """Measured 1-lobe errors of the other isotropic models (the bounds are the measured values + ~20%)."""
+    assert ndf_fit.ndf_l2_error(model, model.ndf_lobes()) < bound
+
+
+@settings(max_examples=8, deadline=None)
+@given(st.floats(5.0, 500.0), st.floats(0.1, 0.9), st.floats(1.5, 8.0))
+def test_fit_isotropic_recovers_a_two_lobe_mixture(sharpness, share, ratio):
+    theta, weights = ndf_fit.polar_quadrature([1 / np.sqrt(sharpness)])
+    truth_sharpness = np.array([sharpness, sharpness * ratio])
+    truth_amplitude = np.array([share, 1 - share]) * 3.0
+    values = np.sum(truth_amplitude[:, None] * np.exp(truth_sharpness[:, None] * (np.cos(theta) - 1)), 0)
+    fitted_sharpness, fitted_amplitude, error = ndf_fit.fit_isotropic(values, theta, weights, 2)
+    assert error < 1e-3
+    assert np.all(np.diff(fitted_sharpness) >= 0)  # sorted for texture interpolation
+
+
+def test_fit_isotropic_batched():
+    theta, weights = ndf_fit.polar_quadrature([0.1])
+    values = np.stack([np.exp(s * (np.cos(theta) - 1)) for s in (50.0, 200.0)])
+    sharpness, amplitude, error = ndf_fit.fit_isotropic(values, theta, weights, 1)
+    np.testing.assert_allclose(sharpness[:, 0], [50, 200], rtol=1e-6)
+    np.testing.assert_allclose(amplitude[:, 0], 1, rtol=1e-6)
+    assert np.all(error < 1e-8)
+
+
+def test_fit_anisotropic_recovers_free_axes():
+    axes = sg.normalize(np.array([[0.2, 0.0, 1.0], [-0.1, 0.15, 1.0]]))
+    sharpness, amplitude = np.array([80.0, 300.0]), np.array([1.0, 2.0])
+    directions, weights = ndf_fit.hemisphere_quadrature([0.05, 0.2], 20, 128)
+    values = sg.mixture_evaluate(directions, axes, sharpness, amplitude)
+    fitted_axes, fitted_sharpness, fitted_amplitude, error = ndf_fit.fit_anisotropic(values, directions, weights, 2)
+    assert error < 1e-3
+    np.testing.assert_allclose(fitted_sharpness, sharpness, rtol=1e-2)
+    np.testing.assert_allclose(np.abs(np.sum(fitted_axes * axes, -1)), 1, atol=1e-4)
+
+
+def test_plane_fit_gradient_is_exact():
+    rng = np.random.default_rng(0)
+    for lobe_count in (1, 2, 5, 8):
+        pairs, unique, _, _ = ndf_fit._row_layout(lobe_count)
+        params = np.concatenate([rng.uniform(0.1, 1, pairs), rng.uniform(0, 3, unique)])
+        analytic = ndf_fit._plane_fit(params, 0.2, lobe_count)[1]
+        numeric = approx_fprime(params, lambda x: ndf_fit._plane_fit(x, 0.2, lobe_count)[0], 1e-7)
+        np.testing.assert_allclose(analytic, numeric, atol=1e-5)
+
+
+def test_anisotropic_table_errors_fall_with_lobe_count():
+    """Table path at real parameters: A-S (75, 1200) as in wang2009 Fig. 2, and Ward (0.3, 0.05)."""
+    ashikhmin = brdf.AshikhminShirley(nu=75.0, nv=1200.0)
+    ward = brdf.WardAnisotropic(alpha_x=0.3, alpha_y=0.05)
+    errors = {}
+    for name, model in (("as", ashikhmin), ("ward", ward)):
+        errors[name] = [ndf_fit.ndf_l2_error(model, model.ndf_lobes(k), 16, 128) for k in (1, 2, 4)]
+        assert np.all(np.diff(errors[name]) < 0), errors
+    # measured: A-S 0.60, 0.40, 0.18; Ward 0.71, 0.53, 0.30
+    assert errors["as"][2] < 0.19 and errors["ward"][2] < 0.32, errors
+
+
+def test_table_is_close_to_a_direct_fit():
+    """The normalized table loses little against L-BFGS-B on the exact sphere NDF."""
+    model = brdf.AshikhminShirley(nu=75.0, nv=1200.0)
+    lobes = model.ndf_lobes(2)
+    directions, weights = ndf_fit.hemisphere_quadrature(ndf_fit.model_widths(model), 16, 128)
+    table_error = ndf_fit.relative_l2(model.ndf(directions), sg.mixture_evaluate(directions, *lobes), weights)
+    *_, direct_error = ndf_fit.fit_anisotropic(model.ndf(directions), directions, weights, 2, initial=lobes,
+                                               max_iterations=100)
+    assert direct_error <= table_error + 1e-9 and table_error - direct_error < 0.01
+
+
+def test_anisotropic_lobes_swap_axes_and_broadcast():
+    across = brdf.WardAnisotropic(alpha_x=0.05, alpha_y=0.3).ndf_lobes(4)
+    along = brdf.WardAnisotropic(alpha_x=0.3, alpha_y=0.05).ndf_lobes(4)
+    np.testing.assert_allclose(across[0][..., [1, 0, 2]], along[0], atol=1e-12)
+    np.testing.assert_allclose(across[1], along[1])
+    alpha_x = np.array([0.1, 0.3, 0.02], np.float32)
+    batch = brdf.WardAnisotropic(alpha_x=alpha_x, alpha_y=np.float32(0.05)).ndf_lobes(4)
+    assert batch[0].dtype == np.float32 and batch[0].shape == (3, 4, 3)
+    for i in range(3):
+        single = brdf.WardAnisotropic(alpha_x=float(alpha_x[i]), alpha_y=0.05).ndf_lobes(4)
+        np.testing.assert_allclose(batch[1][i], single[1], rtol=1e-5)
+        np.testing.assert_allclose(batch[2][i], single[2], rtol=1e-5)
+    table = ndf_fit.anisotropy_table_array(4)
+    assert table.dtype == np.float32 and table.shape == (ndf_fit.ANISOTROPY_RATIO_COUNT, 4, 4)
+    assert table.flags.c_contiguous and np.all(np.isfinite(table))
+
+
+def test_brdf_rmse_of_cook_torrance_eq12():
+    model = brdf.CookTorrance(roughness=0.2)
+    assert ndf_fit.brdf_relative_rmse(model, model.ndf_lobes(), count=40_000) < 0.005
