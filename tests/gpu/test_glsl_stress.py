@@ -144,3 +144,20 @@ def test_lights_stress(glsl, fuzz):
         out = glsl(["sg.glsl", "lights.glsl"], body, inputs, 3)
         _assert_finite(out, name)
         assert out[:, 1].min() > 0 and out[:, 2].min() >= 0, name
+
+
+def test_clamped_cosine_stress(glsl, fuzz):
+    axis, normal = _axis_pairs(fuzz, ROWS)
+    sharpness = fuzz.stress_sharpness(ROWS)
+    tiny = fuzz.rng.integers(0, 8, ROWS) == 0
+    sharpness[tiny] = fuzz.log_uniform(1e-38, 1e-4, int(tiny.sum()))  # below the contract's range too
+    amplitude = fuzz.stress_amplitude(ROWS)
+    cosine = fuzz.uniform(-1.5, 1.5, ROWS)
+    inputs = {"p": np.c_[axis, sharpness], "n": np.c_[normal, amplitude], "c": cosine}
+    call = ("vec4(sg_clamped_cosine_integral(p.xyz, p.w, n.w, n.xyz), sg_clamped_cosine_integral_paper(p.xyz, p.w, n.w, n.xyz),"
+            " clamped_cosine_from_cosine(clamp(c.x, -1.0, 1.0), p.w), clamped_cosine_lobe_evaluate(p.xyz, n.xyz))")
+    out = glsl(["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl"], call, inputs, 4)
+    _assert_finite(out, "clamped_cosine.glsl")
+    assert out.min() >= 0
+    # never above the cosine's own integral pi times the amplitude (its sharpness-0 limit)
+    assert np.all(out[:, 0] <= np.pi * amplitude * (1 + 1e-5) + 1e-30)

@@ -1,0 +1,62 @@
+"""shaders/lib/clamped_cosine.glsl (float32) against sg_prt_addon/core/clamped_cosine.py (float64)."""
+import numpy as np
+import pytest
+
+from sg_prt_addon.core import clamped_cosine
+
+# the numpy closed form evaluates both sides of its np.where (e.g. c / tiny squared)
+pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
+
+N = 20000
+LIB = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl"]
+
+
+def test_pole_integrals(glsl, fuzz, record_error):
+    sharpness = fuzz.f32(np.concatenate([[1e-6, 0.0099999, 0.01, 0.2499999, 0.25, 1e6],
+                                         fuzz.log_uniform(1e-6, 1e6, N)]))
+    out = glsl(LIB, "vec4(clamped_cosine_pole_integrals(a.x), 0.0, 0.0)", {"a": sharpness}, 2)
+    upper, lower = clamped_cosine._pole_integrals(sharpness)
+    # lower = e^-l (...) reaches float32 denormals for l > ~80: absolute floor there
+    error = fuzz.relative_error(out, np.c_[upper, lower], 1e-30)
+    # e^-l carries ~l * 6e-8 relative float32 error (l up to ~70 above the floor)
+    assert record_error("clamped_cosine pole_integrals, relative", error.max()) <= 1e-5
+
+
+def test_clamped_cosine_integral(glsl, fuzz, record_error):
+    axis = fuzz.unit_vectors(N)
+    normal = fuzz.f32(fuzz.near(axis, 2.0) * fuzz.log_uniform(1e-2, 1e2, N)[:, None])
+    normal[:100] = -axis[:100]
+    normal[100:200] = axis[100:200]
+    sharpness = fuzz.f32(np.concatenate([[0.0, 1e-7], fuzz.log_uniform(1e-4, 1e6, N - 2)]))
+    amplitude = fuzz.uniform(0.0, 3.0, N)
+    out = glsl(LIB, "vec4(sg_clamped_cosine_integral(p.xyz, p.w, n.w, n.xyz),"
+                    " sg_clamped_cosine_integral_paper(p.xyz, p.w, n.w, n.xyz), 0.0, 0.0)",
+               {"p": np.c_[axis, sharpness], "n": np.c_[normal, amplitude]}, 2)
+    expected = clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, amplitude, normal)
+    # scale: the integral with the normal on the axis, mu (2 pi / lambda) I_up
+    scale = amplitude * clamped_cosine._clamped_cosine_from_cosine(np.ones(N), sharpness) + 1e-30
+    assert record_error("clamped_cosine sg_clamped_cosine_integral, relative to I(c = 1)",
+                        (np.abs(out[:, 0] - expected) / scale).max()) <= 1e-5
+    paper = clamped_cosine.sg_clamped_cosine_integral_paper(axis, sharpness, amplitude, normal)
+    error = fuzz.relative_error(out[:, 1], paper, 1e-30)
+    log_amplitude = np.log(np.maximum(paper, 1e-300) / np.maximum(amplitude, 1e-300))
+    well_conditioned = (log_amplitude > -60) & (amplitude > 0)
+    assert record_error("clamped_cosine sg_clamped_cosine_integral_paper (log > -60), relative",
+                        error[well_conditioned].max()) <= 3e-5
+
+
+def test_from_cosine_and_lobe(glsl, fuzz, record_error):
+    cosine = fuzz.f32(np.concatenate([[-1.0, 1.0, 0.0], fuzz.uniform(-1.0, 1.0, N)]))
+    sharpness = fuzz.log_uniform(1e-4, 1e6, cosine.size)
+    direction = fuzz.unit_vectors(cosine.size)
+    normal = fuzz.near(direction, 1.0)
+    out = glsl(LIB, "vec4(clamped_cosine_from_cosine(a.x, a.y), clamped_cosine_lobe_evaluate(d.xyz, n.xyz),"
+                    " clamped_cosine_lobe())",
+               {"a": np.c_[cosine, sharpness], "d": direction, "n": normal}, 4)
+    expected = clamped_cosine._clamped_cosine_from_cosine(cosine, sharpness)
+    scale = clamped_cosine._clamped_cosine_from_cosine(np.ones_like(cosine), sharpness)
+    assert record_error("clamped_cosine from_cosine, relative to I(c = 1)",
+                        (np.abs(out[:, 0] - expected) / scale).max()) <= 1e-5
+    lobe = clamped_cosine.clamped_cosine_lobe_evaluate(direction, normal)
+    assert fuzz.relative_error(out[:, 1], lobe, 1e-30).max() <= 2e-6
+    assert np.allclose(out[:, 2:], clamped_cosine.clamped_cosine_lobe(), rtol=1e-7)
