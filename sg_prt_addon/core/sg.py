@@ -16,14 +16,19 @@ TWO_PI = 2.0 * np.pi
 
 
 def _float_dtype(*arrays):
-    return np.result_type(*[np.asarray(a) for a in arrays], np.float32)
+    """Floating dtype of the inputs; 0-d inputs (Python scalars) only decide when all inputs are 0-d."""
+    arrays = [np.asarray(a) for a in arrays]
+    shaped = [a.dtype for a in arrays if a.ndim > 0]
+    return np.result_type(*(shaped or [a.dtype for a in arrays]), np.float32)
 
 
 def one_minus_exp_over_x(x):
     """(1 - exp(-x)) / x for x >= 0, exact to rounding near 0 (limit 1)."""
     x = np.asarray(x)
+    dtype = _float_dtype(x)
     safe = np.where(x > 0, x, 1)
-    return np.where(x > 1e-12, -np.expm1(-safe) / safe, 1 - 0.5 * x)
+    # np.where on 0-d inputs promotes to float64: restore the input's precision.
+    return np.where(x > 1e-12, -np.expm1(-safe) / safe, 1 - 0.5 * x).astype(dtype, copy=False)
 
 
 def normalize(v, fallback=(0.0, 0.0, 1.0)):
@@ -40,8 +45,10 @@ def normalize(v, fallback=(0.0, 0.0, 1.0)):
 def evaluate(direction, axis, sharpness, amplitude=1.0):
     """G(v) = mu exp(-lambda/2 |v - p|^2): same as mu exp(lambda (v.p - 1)) for
     unit vectors, without cancellation of v.p - 1 near the axis."""
-    d = np.asarray(direction) - np.asarray(axis)
-    return np.asarray(amplitude) * np.exp(-0.5 * np.asarray(sharpness) * np.sum(d * d, axis=-1))
+    dtype = _float_dtype(direction, axis, sharpness, amplitude)
+    d = np.asarray(direction, dtype) - np.asarray(axis, dtype)
+    value = np.asarray(amplitude) * np.exp(-0.5 * np.asarray(sharpness, dtype) * np.sum(d * d, axis=-1))
+    return value.astype(dtype, copy=False)
 
 
 def product(axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2):
@@ -60,14 +67,18 @@ def product(axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2):
     denominator = sharpness + l1 + l2
     log_amplitude = -l1 * l2 * np.sum(diff * diff, axis=-1) / np.where(denominator > 0, denominator, 1)
     amplitude = np.asarray(amplitude1) * np.asarray(amplitude2) * np.exp(log_amplitude)
-    nonzero = sharpness > np.finfo(_float_dtype(summed)).tiny * 1e4
+    dtype = _float_dtype(summed)
+    nonzero = sharpness > np.finfo(dtype).tiny * 1e4
     axis = np.where(nonzero[..., None], summed / np.where(nonzero, sharpness, 1)[..., None], axis1)
-    return axis, sharpness, amplitude
+    # np.where on 0-d inputs promotes to float64: restore the inputs' precision.
+    return axis.astype(dtype, copy=False), sharpness.astype(dtype, copy=False), amplitude.astype(dtype, copy=False)
 
 
 def sphere_integral(sharpness, amplitude=1.0):
     """Integral of G over the sphere: 4 pi mu (1 - exp(-2 lambda)) / (2 lambda)."""
-    return FOUR_PI * np.asarray(amplitude) * one_minus_exp_over_x(2 * np.asarray(sharpness))
+    dtype = _float_dtype(sharpness, amplitude)  # Python scalars times 0-d float32 promote to float64
+    sharpness = np.asarray(sharpness, dtype)
+    return (FOUR_PI * np.asarray(amplitude) * one_minus_exp_over_x(2 * sharpness)).astype(dtype, copy=False)
 
 
 def axis_hemisphere_integral(sharpness, amplitude=1.0):
@@ -76,7 +87,9 @@ def axis_hemisphere_integral(sharpness, amplitude=1.0):
     This is fh(pi/2, lambda) of wang2009 eq. 31; do not confuse it with the
     full-sphere integral above.
     """
-    return TWO_PI * np.asarray(amplitude) * one_minus_exp_over_x(np.asarray(sharpness))
+    dtype = _float_dtype(sharpness, amplitude)
+    sharpness = np.asarray(sharpness, dtype)
+    return (TWO_PI * np.asarray(amplitude) * one_minus_exp_over_x(sharpness)).astype(dtype, copy=False)
 
 
 def inner_product(axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2):
