@@ -95,6 +95,11 @@ class EnvironmentSampler:
         row, column = self.texel_index(directions)
         return self.texel_pdf[row, column]
 
+    def lookup(self, directions):
+        """(radiance (..., C), pdf (...)) of each direction from one texel lookup."""
+        row, column = self.texel_index(directions)
+        return self.image[row, column], self.texel_pdf[row, column]
+
     def radiance(self, directions):
         """Radiance (..., C) of the texel containing each direction."""
         row, column = self.texel_index(directions)

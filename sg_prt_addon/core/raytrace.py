@@ -39,8 +39,8 @@ def offset_origins(points, normals, scale, directions=None):
     """
     normals = np.asarray(normals, dtype=np.float64)
     if directions is not None:
-        side = np.sign(np.sum(normals * np.asarray(directions), axis=-1, keepdims=True))
-        normals = normals * np.where(side == 0, 1.0, side)
+        backwards = np.einsum("...i,...i->...", normals, np.asarray(directions, dtype=np.float64)) < 0
+        normals = np.where(backwards[..., None], -normals, normals)
     return np.asarray(points, dtype=np.float64) + scale * normals
 
 

@@ -80,7 +80,7 @@ class Scene:
 
 
 def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optional[Callable] = None,
-                     batch_rays=1 << 15, tracer=None, threads=2):
+                     batch_rays=1 << 15, tracer=None, threads=2, environment_samples=4):
     """Render ``scene`` through ``camera`` (core.camera.Camera).
 
     Returns (image, standard_error), both (H, W, 3) float64.  ``progress`` is
@@ -91,9 +91,14 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
     the same mesh.  Batches of about ``batch_rays`` pixel samples run on
     ``threads`` threads (numpy and Embree release the GIL); every batch has
     its own random stream, so the result depends on ``seed`` only.
+
+    A pixel sample is one camera ray, one sample of each light, and
+    ``environment_samples`` stratified pairs of environment and BRDF samples
+    (the environment dominates the noise; sharing the camera ray and the
+    surface set-up makes extra pairs cheap).
     """
     renderer = _Renderer(scene, tracer if tracer is not None else
-                         RayTracer(scene.vertices, scene.triangles, threads=threads))
+                         RayTracer(scene.vertices, scene.triangles, threads=threads), environment_samples)
     height, width = camera.height, camera.width
     pixel_count = height * width
     samples_per_pixel = int(samples_per_pixel)
@@ -162,7 +167,7 @@ def _orthonormal_tangents(normals):
 
 
 def _normalize(v, fallback):
-    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    length = np.sqrt(np.einsum("...i,...i->...", v, v))[..., None]
     ok = length > 1e-12
     return np.where(ok, v / np.where(ok, length, 1.0), fallback)
 
@@ -185,8 +190,9 @@ def _one_minus_cos_from_sin(sin_value):
 
 
 class _Renderer:
-    def __init__(self, scene, tracer):
+    def __init__(self, scene, tracer, environment_samples=1):
         self.tracer = tracer
+        self.environment_samples = max(1, int(environment_samples))
         self.triangles = np.asarray(scene.triangles, dtype=np.int64).reshape(-1, 3)
         self.normals = np.asarray(scene.normals, dtype=np.float64).reshape(-1, 3)
         self.corner_positions = np.asarray(scene.vertices, dtype=np.float64).reshape(-1, 3)[self.triangles]
@@ -231,20 +237,22 @@ class _Renderer:
     def _brdf_cosine(self, points, wi_local):
         """(kd/pi + ks rho_s) max(0, n.i): (N, 3); zero below the shading horizon."""
         cosine = np.maximum(wi_local[:, 2], 0.0)
-        value = self.diffuse[points.material] * INV_PI
+        if not points.groups:
+            return points.diffuse_over_pi * cosine[:, None]
         specular = np.zeros(len(wi_local))
         for model, idx in points.groups:
             above = idx[cosine[idx] > 0]
             if len(above):
-                specular[above] = model.specular(points.wo_local[above], wi_local[above])
-        value = value + self.specular[points.material] * np.nan_to_num(specular, nan=0.0, posinf=0.0)[:, None]
-        return value * cosine[:, None]
+                value = model.specular(points.wo_local[above], wi_local[above])
+                specular[above] = np.nan_to_num(value, nan=0.0, posinf=0.0, neginf=0.0)
+        return (points.diffuse_over_pi + points.specular_color * specular[:, None]) * cosine[:, None]
 
     def _brdf_pdf(self, points, wi_local):
-        q = self.specular_probability[points.material]
+        q = points.specular_probability
         pdf = (1.0 - q) * np.maximum(wi_local[:, 2], 0.0) * INV_PI
         for model, idx in points.groups:
-            pdf[idx] += q[idx] * np.nan_to_num(model.pdf(points.wo_local[idx], wi_local[idx]), nan=0.0, posinf=0.0)
+            pdf[idx] += q[idx] * np.nan_to_num(model.pdf(points.wo_local[idx], wi_local[idx]),
+                                               nan=0.0, posinf=0.0, neginf=0.0)
         return pdf
 
     def _brdf_sample(self, points, uniforms):
@@ -253,13 +261,14 @@ class _Renderer:
         phi = 2.0 * np.pi * uniforms[:, 2]
         wi_local = np.stack([radius * np.cos(phi), radius * np.sin(phi),
                              np.sqrt(np.maximum(0.0, 1.0 - uniforms[:, 1]))], axis=-1)
-        choose_specular = uniforms[:, 0] < self.specular_probability[points.material]
+        choose_specular = uniforms[:, 0] < points.specular_probability
         for model, idx in points.groups:
             chosen = idx[choose_specular[idx]]
             if len(chosen):
                 # The choice used uniforms[:, 0]; the lobe gets the other two.
                 sampled, _ = model.sample(points.wo_local[chosen], uniforms[chosen, 1:3])
-                wi_local[chosen] = sampled
+                # A model that fails to sample (non-finite) gives a direction below the horizon: no light.
+                wi_local[chosen] = np.where(np.isfinite(sampled).all(axis=-1, keepdims=True), sampled, [0.0, 0.0, -1.0])
         return wi_local, self._brdf_pdf(points, wi_local)
 
     # -- estimator ---------------------------------------------------------------------------------
@@ -309,18 +318,28 @@ class _Renderer:
         points.wo_local = _normalize(wo_local, np.array([0.0, 0.0, 1.0]))
         points.material = self.material_index[triangle]
         points.groups = self._groups(points.material)
+        points.diffuse_over_pi = self.diffuse[points.material] * INV_PI
+        points.specular_color = self.specular[points.material]
+        points.specular_probability = self.specular_probability[points.material]
         points.origin_offset = self.tracer.offset
         return points
 
     def _visible(self, points, wi_world, max_distance, active):
         """Visibility (N,) of each direction, tracing only where ``active``."""
+        active_count = np.count_nonzero(active)
+        if active_count == 0:
+            return np.zeros(len(wi_world), bool)
+        if active_count > 0.6 * len(active):
+            # Mostly active: tracing the few idle rays is cheaper than gathering the rest.
+            origins = offset_origins(points.position, points.geometric_normal, points.origin_offset, wi_world)
+            distance = None if max_distance is None else np.maximum(max_distance - points.origin_offset, 0.0)
+            return active & ~self.tracer.occluded(origins, wi_world, distance)
         visible = np.zeros(len(wi_world), bool)
         rows = np.flatnonzero(active)
-        if len(rows):
-            origins = offset_origins(points.position[rows], points.geometric_normal[rows],
-                                     points.origin_offset, wi_world[rows])
-            distance = None if max_distance is None else np.maximum(max_distance[rows] - points.origin_offset, 0.0)
-            visible[rows] = ~self.tracer.occluded(origins, wi_world[rows], distance)
+        origins = offset_origins(points.position[rows], points.geometric_normal[rows],
+                                 points.origin_offset, wi_world[rows])
+        distance = None if max_distance is None else np.maximum(max_distance[rows] - points.origin_offset, 0.0)
+        visible[rows] = ~self.tracer.occluded(origins, wi_world[rows], distance)
         return visible
 
     def _light_contribution(self, points, light, rng):
@@ -371,27 +390,51 @@ class _Renderer:
         return value * visible[:, None]
 
     def _environment_contribution(self, points, rng):
+        """MIS of `environment_samples` environment samples and as many BRDF samples, stratified
+        over the pixel sample's own uniforms (so pixel samples stay independent), averaged."""
+        per_point = self.environment_samples
+        if per_point > 1:
+            points = points.repeat(per_point, self)
         count = len(points.position)
         to_world = np.swapaxes(points.frame, 1, 2)
         # Environment sample.
-        wi_env, pdf_env, radiance_env = self.environment.sample_with_radiance(rng.random((count, 2)))
+        wi_env, pdf_env, radiance_env = self.environment.sample_with_radiance(
+            _stratified_uniforms(rng, count, per_point, 2))
         wi_env_local = np.einsum("nij,nj->ni", points.frame, wi_env)
         value_env = self._brdf_cosine(points, wi_env_local) * radiance_env
         pdf_brdf_at_env = self._brdf_pdf(points, wi_env_local)
-        # BRDF sample.
-        wi_brdf_local, pdf_brdf = self._brdf_sample(points, rng.random((count, 3)))
+        # BRDF sample: the lobe choice gets its own uniform, the direction a stratified pair.
+        brdf_uniforms = np.concatenate([rng.random((count, 1)), _stratified_uniforms(rng, count, per_point, 2)], 1)
+        wi_brdf_local, pdf_brdf = self._brdf_sample(points, brdf_uniforms)
         wi_brdf = _normalize(np.einsum("nij,nj->ni", to_world, wi_brdf_local), points.normal)
-        value_brdf = self._brdf_cosine(points, wi_brdf_local) * self.environment.radiance(wi_brdf)
-        pdf_env_at_brdf = self.environment.pdf(wi_brdf)
+        radiance_brdf, pdf_env_at_brdf = self.environment.lookup(wi_brdf)
+        value_brdf = self._brdf_cosine(points, wi_brdf_local) * radiance_brdf
         # Power heuristic, written as 1 / (1 + ratio^2) so huge pdfs do not overflow.
         weight_env = _power_weight(pdf_env, pdf_brdf_at_env)
         weight_brdf = _power_weight(pdf_brdf, pdf_env_at_brdf)
         estimate_env = value_env * (weight_env / np.maximum(pdf_env, 1e-300))[:, None]
-        estimate_brdf = np.where((pdf_brdf > 0)[:, None],
-                                 value_brdf * (weight_brdf / np.where(pdf_brdf > 0, pdf_brdf, 1.0))[:, None], 0.0)
+        estimate_brdf = value_brdf * (weight_brdf / np.where(pdf_brdf > 0, pdf_brdf, 1.0))[:, None]
         visible_env = self._visible(points, wi_env, None, np.any(estimate_env > 0, axis=-1))
         visible_brdf = self._visible(points, wi_brdf, None, np.any(estimate_brdf > 0, axis=-1))
-        return estimate_env * visible_env[:, None] + estimate_brdf * visible_brdf[:, None]
+        total = estimate_env * visible_env[:, None] + estimate_brdf * visible_brdf[:, None]
+        return total.reshape(-1, per_point, 3).mean(axis=1)
+
+
+def _stratified_uniforms(rng, count, per_point, dimensions):
+    """(count, dimensions) uniforms; each run of ``per_point`` rows is stratified: a square
+    number of rows gets a jittered grid over the first two dimensions, other counts strata
+    along the first dimension only."""
+    uniforms = rng.random((count, dimensions))
+    if per_point <= 1:
+        return uniforms
+    stratum = np.arange(count) % per_point
+    side = int(round(per_point ** 0.5))
+    if side * side == per_point and dimensions >= 2:
+        uniforms[:, 0] = (stratum // side + uniforms[:, 0]) / side
+        uniforms[:, 1] = (stratum % side + uniforms[:, 1]) / side
+    else:
+        uniforms[:, 0] = (stratum + uniforms[:, 0]) / per_point
+    return uniforms
 
 
 def _power_weight(pdf_own, pdf_other):
@@ -401,3 +444,13 @@ def _power_weight(pdf_own, pdf_other):
 
 class _Points:
     """Shading points of one batch (plain attribute bag)."""
+
+    def repeat(self, times, renderer):
+        """Every point ``times`` times in a row (point i -> rows i * times ... i * times + times - 1)."""
+        out = _Points()
+        for name, value in vars(self).items():
+            if isinstance(value, np.ndarray):
+                setattr(out, name, np.repeat(value, times, axis=0))
+        out.origin_offset = self.origin_offset
+        out.groups = renderer._groups(out.material)
+        return out

@@ -101,11 +101,12 @@ def _constant_sky_scene(albedo=0.6, sky=(1.0, 0.5, 2.0)):
     return Scene(vertices, triangles, normals, [Material((albedo,) * 3)], environment=environment)
 
 
-def test_constant_environment_on_lambertian_plane_is_unbiased_and_calibrated():
+@pytest.mark.parametrize("environment_samples", [1, 4, 3])
+def test_constant_environment_on_lambertian_plane_is_unbiased_and_calibrated(environment_samples):
     scene = _constant_sky_scene()
     camera = orthographic_down(1.0, 24)
     expected = 0.6 * np.array([1.0, 0.5, 2.0])
-    image, error = render_reference(scene, camera, 16, seed=1)
+    image, error = render_reference(scene, camera, 16, seed=1, environment_samples=environment_samples)
     assert np.all(np.isfinite(image)) and np.all(np.isfinite(error)) and np.all(error > 0)
     deviation = image - expected
     # Standard error calibrated: actual RMS error / RMS reported error near 1 (1728 values).
@@ -295,3 +296,36 @@ def test_degenerate_geometry_stays_finite():
                   environment=np.zeros((4, 8, 3)))
     image, error = render_reference(scene, Camera.look_at((0.3, 0.3, 2.0), (0.3, 0.3, 0), (0, 1.0, 0), 60, 8, 8), 2)
     assert np.all(np.isfinite(image)) and np.all(np.isfinite(error))
+
+
+class TangentProbe:
+    """Private test model whose value depends on the tangent: rho_s = max(0, wi.x)."""
+
+    def specular(self, wo, wi):
+        return np.maximum(wi[:, 0], 0.0)
+
+    def pdf(self, wo, wi):
+        return np.maximum(wi[:, 2], 0.0) / np.pi
+
+    def sample(self, wo, u):
+        r, phi = np.sqrt(u[:, 0]), 2 * np.pi * u[:, 1]
+        wi = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1 - u[:, 0])], -1)
+        return wi, self.pdf(wo, wi)
+
+
+@pytest.mark.parametrize("tangent, expected_x", [((1.0, 0, 0), 0.6), ((0, 1.0, 0), 0.0), ((-1.0, 0, 0), 0.0),
+                                                 (None, None)])
+def test_tangents_orient_the_local_frame(tangent, expected_x):
+    vertices, triangles, normals = ground_plane()
+    light = np.array([0.6, 0.0, 0.8])
+    material = Material((0.0, 0.0, 0.0), (1.0, 1.0, 1.0), TangentProbe())
+    tangents = None if tangent is None else np.tile(tangent, (4, 1))
+    scene = Scene(vertices, triangles, normals, [material], tangents=tangents,
+                  lights=[DirectionalLight(light, (2.0, 2.0, 2.0))])
+    image, _ = render_reference(scene, orthographic_down(1.0, 4), 2, seed=0)
+    if tangent is None:
+        # Built frame: some tangent perpendicular to z; the value is 2 * 0.8 * max(0, t.l) <= 2 * 0.8 * 0.6.
+        assert np.all(image >= 0) and np.all(image <= 2 * 0.8 * 0.6 + 1e-12)
+        assert np.ptp(image) < 1e-12
+    else:
+        np.testing.assert_allclose(image, 2.0 * 0.8 * expected_x, atol=1e-12)
