@@ -161,3 +161,28 @@ def test_clamped_cosine_stress(glsl, fuzz):
     assert out.min() >= 0
     # never above the cosine's own integral pi times the amplitude (its sharpness-0 limit)
     assert np.all(out[:, 0] <= np.pi * amplitude * (1 + 1e-5) + 1e-30)
+
+
+def test_warp_stress(glsl, fuzz):
+    axis, wo = _axis_pairs(fuzz, ROWS)  # includes wo = axis, wo = -axis, zero axes
+    grazing = fuzz.rng.integers(0, 4, ROWS) == 0
+    wo[grazing, 2] = fuzz.uniform(-1e-6, 1e-6, int(grazing.sum()))
+    sharpness = fuzz.stress_sharpness(ROWS)
+    amplitude = fuzz.stress_amplitude(ROWS)
+    roughness = fuzz.uniform(0.0, 1.0, ROWS)
+    inputs = {"p": np.c_[axis, sharpness], "wo": np.c_[wo, roughness], "m": amplitude}
+    body = """
+    vec3 axes[2]; float sharpnesses[2], amplitudes[2];
+    warp_lobes_split2(p.xyz, p.w, m.x, wo.xyz, axes, sharpnesses, amplitudes);
+    vec3 paper_axis; float paper_sharpness, paper_amplitude;
+    warp_lobes_paper(p.xyz, p.w, m.x, wo.xyz, paper_axis, paper_sharpness, paper_amplitude);
+    float slice = brdf_slice_amplitude(amplitudes[0], ggx_m_factor(wo.xyz, axes[0], wo.w))
+                + brdf_slice_amplitude(amplitudes[1], ggx_m_factor(wo.xyz, axes[1], wo.w));
+    result = vec4(dot(axes[0] + axes[1] + paper_axis, vec3(1.0)),
+                  sharpnesses[0] + sharpnesses[1] + paper_sharpness,
+                  amplitudes[0] + amplitudes[1] + paper_amplitude, slice);
+    """
+    out = glsl(["sg.glsl", "brdf.glsl", "warp.glsl"], body, inputs, 4)
+    _assert_finite(out, "warp.glsl")
+    assert out[:, 1:].min() >= 0
+    assert out[:, 1].max() <= 3 * 1e6 * (1 + 1e-6)  # each warped sharpness capped at 1e6
