@@ -1,0 +1,144 @@
+"""fh (wang2009 eq. 25-31): exact quadrature against closed forms and an
+independent ring-fraction quadrature; the fast form against the exact one."""
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+from scipy import integrate, special
+
+from sg_prt_addon.core import hemisphere, sg
+
+SETTINGS = settings(max_examples=15, deadline=None)
+log_sharpness = st.floats(np.log(1e-4), np.log(1e6)).map(np.exp)
+theta_st = st.floats(-np.pi / 2, np.pi / 2)
+
+
+def sphere_minus_upper(lam):
+    """Integral over the hemisphere opposite the axis, (2 pi / lambda) e^-lambda (1 - e^-lambda), no cancellation."""
+    return sg.TWO_PI * np.exp(-lam) * sg.one_minus_exp_over_x(lam)
+
+
+def fh_ring_fraction(theta_d, lam):
+    """Independent reference: rings around the lobe axis, t = lambda (1 - cos theta).
+
+    The ring at polar angle theta lies in the hemisphere for the fraction
+    arccos(-cot(theta) tan(theta_d)) / pi of its length.
+    """
+    def fraction(t):
+        x = t / lam
+        cos_t, sin_t = 1 - x, np.sqrt(max(x * (2 - x), 0.0))
+        if sin_t == 0:
+            return 1.0 if theta_d > 0 else 0.0
+        return np.arccos(np.clip(-cos_t / sin_t * np.tan(theta_d), -1, 1)) / np.pi
+
+    t_inner = lam * 2 * np.sin(theta_d / 2) ** 2  # rings closer than |theta_d|: all in or all out
+    t_outer = lam * (1 + np.cos(theta_d))
+    stop = min(t_outer, t_inner + 60)
+    middle, _ = integrate.quad(lambda s: np.exp(-s) * fraction(t_inner + s), 0, stop - t_inner,
+                               epsabs=0, epsrel=1e-12, limit=200)
+    total = np.exp(-t_inner) * middle
+    if theta_d > 0:
+        total += -np.expm1(-t_inner)
+    elif t_outer < 2 * lam:
+        total += np.exp(-t_outer) - np.exp(-2 * lam)
+    return sg.TWO_PI / lam * total
+
+
+@pytest.mark.parametrize("lam", [1e-4, 0.1, 1.0, 10.0, 300.0, 1e4, 1e6])
+def test_exact_anchors(lam):
+    upper = sg.axis_hemisphere_integral(lam)
+    sphere = sg.sphere_integral(lam)
+    assert np.isclose(hemisphere.fh_exact(np.pi / 2, lam), upper, rtol=1e-10)
+    assert np.isclose(hemisphere.fh_exact(0.0, lam), 0.5 * sphere, rtol=1e-10)
+    assert np.isclose(hemisphere.fh_exact(-np.pi / 2, lam), sphere_minus_upper(lam), rtol=1e-9, atol=0)
+    # beyond +-pi/2 the hemispherical reconstruction saturates
+    assert hemisphere.fh_exact(2.5, lam) == hemisphere.fh_exact(np.pi / 2, lam)
+    assert np.isclose(hemisphere.fh_normalized_exact(np.pi / 2, lam), 1.0, rtol=1e-10)
+
+
+@SETTINGS
+@given(theta_st, log_sharpness)
+def test_exact_complement_and_ring_fraction(theta_d, lam):
+    a, b = hemisphere.fh_exact(theta_d, lam), hemisphere.fh_exact(-theta_d, lam)
+    assert np.isclose(a + b, sg.sphere_integral(lam), rtol=1e-9)
+    reference = fh_ring_fraction(theta_d, lam)
+    assert np.isclose(a, reference, rtol=1e-8, atol=1e-290)
+
+
+def test_erf_approx():
+    y = np.linspace(-8, 8, 20001)
+    error = np.abs(hemisphere.erf_approx(y) - special.erf(y))
+    assert error.max() < 1.1e-4
+    assert hemisphere.erf_approx(np.float32(0.3)).dtype == np.float32
+    assert np.all(hemisphere.erf_approx(-y) == -hemisphere.erf_approx(y))
+
+
+def random_theta_lambda(rng, n, lam_low, lam_high):
+    lam = np.exp(rng.uniform(np.log(lam_low), np.log(lam_high), n))
+    theta = rng.uniform(-np.pi, np.pi, n)
+    # half of them inside the transition band, |theta_d| of a few 1/sqrt(lambda)
+    theta[: n // 2] = rng.normal(0, 2 / np.sqrt(lam[: n // 2]))
+    return theta, lam
+
+
+@pytest.mark.parametrize("lam_low, lam_high, bound", [(0.1, 1e5, 0.002), (1e-4, 0.1, 0.002), (1e5, 1e6, 0.002)])
+def test_fast_normalized_against_exact(lam_low, lam_high, bound):
+    rng = np.random.default_rng(7)
+    theta, lam = random_theta_lambda(rng, 600, lam_low, lam_high)
+    exact = hemisphere.fh_normalized_exact(theta, lam)
+    fast = hemisphere.fh_normalized(theta, lam)
+    assert np.max(np.abs(fast - exact)) <= bound  # measured 0.00144 over [0.1, 1e5]
+    fast32 = hemisphere.fh_normalized(theta.astype(np.float32), lam.astype(np.float32))
+    assert fast32.dtype == np.float32
+    assert np.max(np.abs(fast32 - exact)) <= bound + 1e-5
+
+
+def test_paper_sigmoid_is_far_off():
+    """DESIGN.md: the printed appendix sigmoid is off by 0.2-0.5 for lambda <= 100."""
+    theta = np.linspace(-np.pi / 2, np.pi / 2, 41)
+    lam = np.array([0.5, 5.0, 50.0])[:, None]
+    error = np.abs(hemisphere.fh_normalized_paper(theta, lam) - hemisphere.fh_normalized_exact(theta, lam))
+    assert 0.2 < error.max() < 0.7
+
+
+@SETTINGS
+@given(log_sharpness, st.floats(0, np.pi / 2))
+def test_fast_structure(lam, theta_d):
+    """fh_hat(t) + fh_hat(-t) = 1 + e^-lambda (complementary hemispheres), endpoints exact, monotone."""
+    a, b = hemisphere.fh_normalized(theta_d, lam), hemisphere.fh_normalized(-theta_d, lam)
+    assert np.isclose(a + b, 1 + np.exp(-lam), rtol=0, atol=1e-12)
+    assert np.isclose(hemisphere.fh_normalized(np.pi / 2, lam), 1.0, atol=1e-12)
+    assert np.isclose(hemisphere.fh_normalized(-np.pi / 2, lam), np.exp(-lam), atol=1e-12)
+    grid = hemisphere.fh_normalized(np.linspace(-np.pi / 2, np.pi / 2, 401), lam)
+    assert np.all(np.diff(grid) >= -1e-15)
+
+
+def test_hemisphere_integral_any_normal():
+    rng = np.random.default_rng(11)
+    n = 200
+    axis = sg.normalize(rng.normal(size=(n, 3)))
+    lam = np.exp(rng.uniform(np.log(1e-3), np.log(1e5), n))
+    # normals near the lobe's horizon, where the integral changes fastest
+    normal = sg.normalize(rng.normal(size=(n, 3)))
+    normal -= np.sum(normal * axis, -1, keepdims=True) * axis * rng.uniform(0.9, 1.0, (n, 1))
+    amplitude = rng.uniform(0, 3, n)
+    exact = hemisphere.hemisphere_integral_exact(axis, lam, amplitude, normal)
+    fast = hemisphere.hemisphere_integral(axis, lam, amplitude, normal)
+    scale = amplitude * sg.axis_hemisphere_integral(lam)
+    assert np.max(np.abs(fast - exact) / np.maximum(scale, 1e-300)) <= 0.002
+    # the hemisphere around the axis itself, and the normal reversed
+    assert np.allclose(hemisphere.hemisphere_integral_exact(axis, lam, amplitude, axis), scale, rtol=1e-9)
+    assert np.allclose(hemisphere.hemisphere_integral(axis, lam, amplitude, axis), scale, rtol=1e-6)
+
+
+def test_visibility_product_eq31():
+    axis = np.array([0.0, 0.6, 0.8])
+    lam, mu = np.array([0.5, 20.0, 4000.0]), np.array([1.0, 2.0, 0.5])
+    theta = np.array([0.3, -0.1, 0.01])
+    out_axis, out_lam, out_mu = hemisphere.visibility_product(axis, lam, mu, theta)
+    assert np.all(out_axis == axis) and np.all(out_lam == lam)
+    # the product lobe integrates over its axis hemisphere to mu fh(theta_d)
+    integral = sg.axis_hemisphere_integral(out_lam, out_mu)
+    assert np.allclose(integral, mu * hemisphere.fh(theta, lam), rtol=1e-12)
+    assert np.allclose(integral, mu * hemisphere.fh_exact(theta, lam), rtol=0.01)
+    saturated = hemisphere.visibility_product(axis, lam, mu, np.array([3.0, -3.0, 2.0]))[2]
+    assert np.allclose(saturated, mu * hemisphere.fh_normalized(np.array([1, -1, 1]) * np.pi / 2, lam))
