@@ -160,8 +160,8 @@ def _upload_texture(array):
         size = (data.shape[1], data.shape[0])
         return gpu.types.GPUTexture(size, format="RGBA32F",
                                     data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
-    size = (data.shape[2], data.shape[1], data.shape[0])
-    return gpu.types.GPUTexture(size, layered=True, format="RGBA32F",
+    size = (data.shape[2], data.shape[1])
+    return gpu.types.GPUTexture(size, layers=data.shape[0], format="RGBA32F",
                                 data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
 
 

@@ -186,3 +186,18 @@ def test_warp_stress(glsl, fuzz):
     _assert_finite(out, "warp.glsl")
     assert out[:, 1:].min() >= 0
     assert out[:, 1].max() <= 3 * 1e6 * (1 + 1e-6)  # each warped sharpness capped at 1e6
+
+
+def test_env_prefilter_stress(glsl, fuzz):
+    """Lookups with degenerate axes and any sharpness in a 2-layer 8x8 array of random radiance."""
+    layers = np.random.default_rng(1).random((2, 8, 8, 4)).astype(np.float32) * 1e3
+    axis = fuzz.stress_vectors(ROWS)
+    sharpness = fuzz.stress_sharpness(ROWS)
+    amplitude = fuzz.stress_amplitude(ROWS)
+    transforms = "const vec2 TRANSFORMS[32] = vec2[32](vec2(0.375, 0.5), vec2(0.375, 0.5)" + ", vec2(0.0)" * 30 + ");"
+    call = ("env_prefilter_lookup(environment, p.xyz, p.w, -3.0, 2.0, 2, TRANSFORMS)"
+            " + env_prefilter_lookup_integral(environment, p.xyz, p.w, a.x, -3.0, 2.0, 2, TRANSFORMS)")
+    out = glsl(["sg.glsl", "env_prefilter.glsl", transforms], call, {"p": np.c_[axis, sharpness], "a": amplitude},
+               4, {"environment": layers})
+    _assert_finite(out, "env_prefilter.glsl")
+    assert out.min() >= 0
