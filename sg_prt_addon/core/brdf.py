@@ -57,14 +57,25 @@ def _param(value, dtype, floor=None):
 
 
 def _dot(a, b):
-    return np.sum(a * b, axis=-1)
+    # explicit components: much faster than a reduction over a length-3 axis
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 def _unit(v):
-    """Unit vectors; zero or non-finite vectors become z+ (their BRDF is 0 anyway)."""
-    length = np.sqrt(_dot(v, v))[..., None]
-    ok = np.isfinite(length) & (length > 1e-30)
-    return np.where(ok, v / np.where(ok, length, 1), np.asarray((0.0, 0.0, 1.0), v.dtype))
+    """Unit vectors; zero or non-finite vectors become z+ (their BRDF is 0 anyway).
+    Scaled by the largest component first, so tiny vectors do not underflow when squared;
+    written per component (reductions over a length-3 axis are slow in numpy)."""
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    largest = np.maximum(np.maximum(np.abs(x), np.abs(y)), np.abs(z))
+    ok = np.isfinite(largest) & (largest > 0)
+    inverse_scale = 1 / np.where(ok, largest, 1)
+    x, y, z = x * inverse_scale, y * inverse_scale, z * inverse_scale
+    inverse_length = np.where(ok, 1 / np.sqrt(np.where(ok, x * x + y * y + z * z, 1)), 0)
+    out = np.empty(v.shape, v.dtype)
+    out[..., 0] = x * inverse_length
+    out[..., 1] = y * inverse_length
+    out[..., 2] = np.where(ok, z * inverse_length, 1)
+    return out
 
 
 def _directions(*vectors):
@@ -114,13 +125,16 @@ def fresnel_dielectric(cos_theta, eta):
     c = c.astype(dtype, copy=False)
     eta = _param(eta, dtype)
     g2 = eta * eta + c * c - 1
-    g = np.sqrt(np.maximum(g2, 0))
+    total = (g2 <= 0) | (c <= 0)  # total internal reflection, or grazing: F = 1
+    # evaluate the masked entries at a harmless point so nothing overflows
+    c = np.where(total, 1, c)
+    eta = np.where(total, 2, eta)
+    g = np.sqrt(np.where(total, 4, g2))
     g_plus_c = g + c
-    safe_sum = np.where(g_plus_c > 0, g_plus_c, 1)
-    g_minus_c = (eta * eta - 1) / safe_sum
+    g_minus_c = (eta * eta - 1) / g_plus_c
     ratio = (c * g_plus_c - 1) / (c * g_minus_c + 1)
-    f = 0.5 * (g_minus_c / safe_sum) ** 2 * (1 + ratio * ratio)
-    return np.where((g2 <= 0) | (g_plus_c <= 0), np.ones_like(f), np.minimum(f, 1)).astype(dtype, copy=False)
+    f = 0.5 * (g_minus_c / g_plus_c) ** 2 * (1 + ratio * ratio)
+    return np.where(total, np.ones_like(f), np.minimum(f, 1)).astype(dtype, copy=False)
 
 
 def fresnel_schlick(cos_theta, rf0):
@@ -190,7 +204,9 @@ def isotropic_mapping(kind, width):
     """(sharpness * width^2, amplitude / D(n)) of the frozen L2 mapping for ``kind``."""
     mapping = ISOTROPIC_MAPPINGS[kind]
     w = np.clip(width, *mapping["width_range"])
-    return _polynomial(mapping["sharpness"], w), _polynomial(mapping["amplitude"], w)
+    # the GGX polynomial dips to -1e-3 at alpha = 1, where the fit is a constant (sharpness 0)
+    zero = np.zeros_like(w)
+    return np.maximum(_polynomial(mapping["sharpness"], w), zero), np.maximum(_polynomial(mapping["amplitude"], w), zero)
 
 
 # ----------------------------------------------------------------------------- sampling helpers
@@ -213,7 +229,13 @@ class _Microfacet:
     def specular(self, wo, wi):
         """rho_s(o, i) = M_o(i) D(h) (eq. 9); 0 below the horizon of either direction."""
         wo, wi = _directions(wo, wi)
-        return self.m_factor(wo, wi) * self.ndf(_unit(wo + wi))
+        h = _unit(wo + wi)
+        return self._m_factor(wo, wi, h) * self.ndf(h)
+
+    def m_factor(self, wo, wi):
+        """M_o(i) of eq. 9: everything but the NDF (shadowing, Fresnel, cosines)."""
+        wo, wi = _directions(wo, wi)
+        return self._m_factor(wo, wi, _unit(wo + wi))
 
     __call__ = specular
 
@@ -277,9 +299,7 @@ class CookTorrance(_Microfacet):
         theta = _theta(h)
         return np.where(h[..., 2] > 0, np.exp(-(theta / self._m(h.dtype)) ** 2), 0)
 
-    def m_factor(self, wo, wi):
-        wo, wi = _directions(wo, wi)
-        h = _unit(wo + wi)
+    def _m_factor(self, wo, wi, h):
         no, ni, visible = _cosines(wo, wi)
         fresnel = fresnel_dielectric(_dot(wi, h), _param(self.ior, wo.dtype))
         value = fresnel * shadowing_cook_torrance(wo, wi, h) / (np.pi * ni * no)
@@ -311,8 +331,8 @@ class CookTorranceBeckmann(CookTorrance):
         m = self._m(h.dtype)
         return _beckmann_ndf(h, m, m)
 
-    def m_factor(self, wo, wi):
-        return CookTorrance.m_factor(self, wo, wi) * (np.pi / 4)
+    def _m_factor(self, wo, wi, h):
+        return CookTorrance._m_factor(self, wo, wi, h) * (np.pi / 4)
 
     def ndf_lobes(self):
         m = self._m(_dtype(self.roughness))
@@ -338,9 +358,7 @@ class BlinnPhong(_Microfacet):
         value = (n + 2) / (2 * np.pi) * np.exp(n * np.log(np.maximum(hz, np.finfo(h.dtype).tiny)))
         return np.where(hz > 0, value, 0)
 
-    def m_factor(self, wo, wi):
-        wo, wi = _directions(wo, wi)
-        h = _unit(wo + wi)
+    def _m_factor(self, wo, wi, h):
         no, ni, visible = _cosines(wo, wi)
         return np.where(visible, shadowing_cook_torrance(wo, wi, h) / (4 * ni * no), 0)
 
@@ -381,8 +399,7 @@ class WardAnisotropic(_Microfacet):
         exponent = -((h[..., 0] / ax) ** 2 + (h[..., 1] / ay) ** 2) / (z * z)
         return np.where(h[..., 2] > 0, np.exp(exponent) / (np.pi * ax * ay), 0)
 
-    def m_factor(self, wo, wi):
-        wo, wi = _directions(wo, wi)
+    def _m_factor(self, wo, wi, h):
         no, ni, visible = _cosines(wo, wi)
         return np.where(visible, 0.25 / np.sqrt(ni * no), 0)
 
@@ -443,9 +460,7 @@ class AshikhminShirley(_Microfacet):
         value = np.sqrt((nu + 1) * (nv + 1)) / (2 * np.pi) * np.exp(exponent * log_hz)
         return np.where(hz > 0, value, 0)
 
-    def m_factor(self, wo, wi):
-        wo, wi = _directions(wo, wi)
-        h = _unit(wo + wi)
+    def _m_factor(self, wo, wi, h):
         no, ni, visible = _cosines(wo, wi)
         kh = np.maximum(np.abs(_dot(wi, h)), COSINE_EPSILON)
         fresnel = fresnel_schlick(kh, _param(self.rf0, wo.dtype))
@@ -503,8 +518,7 @@ class GGX(_Microfacet):
         a = alpha * alpha * (w[..., 0] ** 2 + w[..., 1] ** 2) / (z * z)
         return a / (2 * (1 + np.sqrt(1 + a)))
 
-    def m_factor(self, wo, wi):
-        wo, wi = _directions(wo, wi)
+    def _m_factor(self, wo, wi, h):
         alpha = self._alpha(wo.dtype)
         no, ni, visible = _cosines(wo, wi)
         shadowing = 1 / (1 + self.smith_lambda(wo, alpha) + self.smith_lambda(wi, alpha))
@@ -569,8 +583,7 @@ class Lambert(_Microfacet):
         h = np.asarray(h)
         return np.ones_like(h[..., 2])
 
-    def m_factor(self, wo, wi):
-        wo, wi = _directions(wo, wi)
+    def _m_factor(self, wo, wi, h):
         _, _, visible = _cosines(wo, wi)
         return np.where(visible, _param(self.kd, wo.dtype) * INV_PI, 0)
 
