@@ -226,3 +226,7 @@ def clamped_cosine_exact_from_cosine(cosine, sharpness):
     edge = sin_alpha[..., 0]
     integral = ring_quadrature(ring_positive_mean, sharpness, [sharpness * (1 - edge), sharpness, sharpness * (1 + edge)])
     return np.where(sharpness > 0, sg.TWO_PI * integral / np.where(sharpness > 0, sharpness, 1), np.pi)
+
+
+# Former private name, still imported by tests/gpu/test_glsl_clamped_cosine.py.
+_clamped_cosine_from_cosine = clamped_cosine_from_cosine
