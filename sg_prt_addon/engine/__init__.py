@@ -1,0 +1,7 @@
+"""SG-PRT render engine: RenderEngine (render_engine.py), CPU scene state and update logic
+(scene_state.py), GPU upload and drawing (renderer.py), shader variants (shader_variants.py).
+
+`classes` is what the add-on registers (blender/registration.py)."""
+from .render_engine import SGPRT_RenderEngine
+
+classes = (SGPRT_RenderEngine,)

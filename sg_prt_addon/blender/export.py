@@ -1,0 +1,333 @@
+"""Blender scene -> plain numpy arrays and small dataclasses (no `gpu` here).
+
+Everything the engine draws goes through this module, so the GPU side and the
+numpy mirror (core/shading.py) see exactly the same numbers:
+
+- meshes: one vertex per face corner (loop), so split normals, UV seams and
+  tangent sign flips need no vertex splitting logic; triangles index corners;
+  positions/normals/tangents are in object space, with the object's
+  matrix_world alongside (a transform edit then needs no re-export);
+- materials: `material.sgprt` read into `MaterialParams` (defaults when the
+  material has no settings or the slot is empty);
+- lights in Blender units, converted to the quantities core/lights.py takes;
+- the world: an Environment Texture's equirect pixels, else the world colour.
+
+`export_counter` counts mesh exports: the viewport's update logic is tested
+with it (a material edit must not re-export meshes).
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+# Mesh exports since import; tests read it to check what an update re-exported.
+export_counter = {"meshes": 0}
+
+MODELS = ("COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX")
+ANISOTROPIC_MODELS = ("WARD_ANISO", "ASHIKHMIN_SHIRLEY")
+SCALAR_PARAMETERS = ("roughness", "ior", "exponent", "alpha_x", "alpha_y", "nu", "nv")
+COLOUR_PARAMETERS = ("diffuse_color", "specular_color")
+TEXTURED_PARAMETERS = COLOUR_PARAMETERS + SCALAR_PARAMETERS
+
+
+@dataclass
+class MeshExport:
+    """Triangles over face corners, object space, float32/uint32 arrays."""
+    positions: np.ndarray          # (V, 3) corner positions
+    normals: np.ndarray            # (V, 3) split (corner) normals, unit
+    tangents: np.ndarray           # (V, 4) unit tangent xyz, bitangent sign w (+-1)
+    uvs: np.ndarray                # (V, 2) active UV map (zeros without one)
+    triangles: np.ndarray          # (T, 3) uint32 corner indices, sorted by material index
+    material_ranges: list          # [(material_index, first_triangle, triangle_count)]
+    has_uv: bool = False
+
+
+@dataclass
+class MaterialParams:
+    """material.sgprt as plain values; textures as (name, (H, W, 4) float32 array, row 0 at the bottom)."""
+    name: str = ""
+    model: str = "GGX"
+    diffuse_color: tuple = (0.5, 0.5, 0.5)
+    specular_color: tuple = (0.25, 0.25, 0.25)
+    roughness: float = 0.3
+    ior: float = 1.5
+    exponent: float = 100.0
+    alpha_x: float = 0.2
+    alpha_y: float = 0.05
+    nu: float = 100.0
+    nv: float = 1000.0
+    lobe_count: int = 4
+    normal_strength: float = 1.0
+    tangent_source: str = "UV_MAP"
+    tangent_axis: tuple = (1.0, 0.0, 0.0)
+    tangent_rotation: float = 0.0
+    textures: dict = field(default_factory=dict)     # parameter name or "normal_map" -> image name
+
+    def values_key(self):
+        """Everything but textures, hashable: the material UBO is rebuilt when this changes."""
+        return tuple((k, v) for k, v in self.__dict__.items() if k != "textures")
+
+
+@dataclass
+class LightExport:
+    """One light: kind 'POINT' (point, spot, area as sphere) or 'SUN'."""
+    name: str
+    kind: str
+    position: tuple                # world position (POINT)
+    direction: tuple               # world direction the light points along (-Z of the object)
+    colour_intensity: tuple        # POINT: radiant intensity W/sr per channel; SUN: irradiance per channel
+    radius: float = 0.0            # POINT sphere radius
+    angle: float = 0.0             # SUN full angular diameter
+    spot_size: float = np.pi       # >= pi: no cone
+    spot_blend: float = 0.0
+    is_spot: bool = False
+
+
+@dataclass
+class WorldExport:
+    """A constant colour, or an equirect image (H, W, 3) float32 in numpy orientation (row 0 at the top)."""
+    colour: tuple = (0.05, 0.05, 0.05)
+    image_name: str = ""
+    equirect: np.ndarray = None
+    strength: float = 1.0
+
+
+# --------------------------------------------------------------------------- meshes
+
+def _tangents_from_uv(positions, normals, uvs, triangles):
+    """Per-corner tangents by accumulating each triangle's UV gradient at the vertices it shares
+    position with; for meshes calc_tangents refuses (n-gons).  Sign from the UV handedness."""
+    p = positions[triangles]                       # (T, 3, 3)
+    t = uvs[triangles]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    d1, d2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    safe = np.where(np.abs(det) > 1e-20, det, 1.0)
+    tangent = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) / safe[:, None]
+    bitangent = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) / safe[:, None]
+    per_corner = np.zeros_like(positions)
+    per_corner_b = np.zeros_like(positions)
+    for k in range(3):
+        np.add.at(per_corner, triangles[:, k], tangent)
+        np.add.at(per_corner_b, triangles[:, k], bitangent)
+    tangent = per_corner - normals * np.sum(per_corner * normals, axis=1, keepdims=True)
+    length = np.linalg.norm(tangent, axis=1, keepdims=True)
+    fallback = _any_perpendicular(normals)
+    tangent = np.where(length > 1e-12, tangent / np.maximum(length, 1e-30), fallback)
+    sign = np.where(np.sum(np.cross(normals, tangent) * per_corner_b, axis=1) < 0, -1.0, 1.0)
+    return np.concatenate([tangent, sign[:, None]], axis=1)
+
+
+def _any_perpendicular(normals):
+    helper = np.where(np.abs(normals[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    t = np.cross(normals, helper)
+    return t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-30)
+
+
+def export_mesh_data(mesh):
+    """MeshExport of a bpy Mesh (already evaluated), object space."""
+    export_counter["meshes"] += 1
+    mesh.calc_loop_triangles()
+    loop_count = len(mesh.loops)
+    triangle_count = len(mesh.loop_triangles)
+    vertex_co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", vertex_co)
+    vertex_index = np.empty(loop_count, np.int64)
+    mesh.loops.foreach_get("vertex_index", vertex_index)
+    positions = vertex_co.reshape(-1, 3)[vertex_index] if loop_count else np.zeros((0, 3), np.float32)
+
+    normals = np.empty(loop_count * 3, np.float32)
+    if hasattr(mesh, "corner_normals"):            # Blender 4.1+
+        mesh.corner_normals.foreach_get("vector", normals)
+    else:
+        mesh.calc_normals_split()
+        mesh.loops.foreach_get("normal", normals)
+    normals = normals.reshape(-1, 3)
+
+    triangles = np.empty(triangle_count * 3, np.int64)
+    mesh.loop_triangles.foreach_get("loops", triangles)
+    triangles = triangles.reshape(-1, 3)
+    material_index = np.empty(triangle_count, np.int64)
+    mesh.loop_triangles.foreach_get("material_index", material_index)
+
+    uv_layer = mesh.uv_layers.active
+    uvs = np.zeros((loop_count, 2), np.float32)
+    tangents = None
+    if uv_layer is not None and loop_count:
+        flat = np.empty(loop_count * 2, np.float32)
+        uv_layer.data.foreach_get("uv", flat)
+        uvs = flat.reshape(-1, 2)
+        try:
+            mesh.calc_tangents(uvmap=uv_layer.name)
+            tangent = np.empty(loop_count * 3, np.float32)
+            sign = np.empty(loop_count, np.float32)
+            mesh.loops.foreach_get("tangent", tangent)
+            mesh.loops.foreach_get("bitangent_sign", sign)
+            tangents = np.concatenate([tangent.reshape(-1, 3), sign[:, None]], axis=1)
+            mesh.free_tangents()
+        except RuntimeError:                        # n-gons: compute our own
+            tangents = None
+        if tangents is None:
+            tangents = _tangents_from_uv(positions.astype(np.float64), normals.astype(np.float64),
+                                         uvs.astype(np.float64), triangles)
+    if tangents is None:
+        tangents = np.concatenate([_any_perpendicular(normals.astype(np.float64)),
+                                   np.ones((loop_count, 1))], axis=1)
+
+    order = np.argsort(material_index, kind="stable")
+    triangles = triangles[order]
+    material_index = material_index[order]
+    ranges = []
+    if triangle_count:
+        starts = np.flatnonzero(np.diff(material_index, prepend=-1))
+        ends = np.append(starts[1:], triangle_count)
+        ranges = [(int(material_index[s]), int(s), int(e - s)) for s, e in zip(starts, ends)]
+    return MeshExport(
+        positions=np.ascontiguousarray(positions, np.float32),
+        normals=np.ascontiguousarray(normals, np.float32),
+        tangents=np.ascontiguousarray(tangents, np.float32),
+        uvs=np.ascontiguousarray(uvs, np.float32),
+        triangles=np.ascontiguousarray(triangles, np.uint32),
+        material_ranges=ranges,
+        has_uv=uv_layer is not None,
+    )
+
+
+def export_object_mesh(object_eval):
+    """MeshExport of an evaluated object (mesh, curve, text... anything with to_mesh)."""
+    mesh = object_eval.to_mesh()
+    try:
+        return export_mesh_data(mesh)
+    finally:
+        object_eval.to_mesh_clear()
+
+
+def matrix_to_numpy(matrix):
+    return np.array([list(row) for row in matrix], np.float64)
+
+
+# --------------------------------------------------------------------------- materials
+
+def export_material(material):
+    """MaterialParams of a bpy Material (None, or without `sgprt`: the defaults)."""
+    params = MaterialParams()
+    if material is None:
+        return params
+    params.name = material.name
+    settings = getattr(material, "sgprt", None)
+    if settings is None:
+        return params
+    params.model = settings.model
+    params.diffuse_color = tuple(settings.diffuse_color)
+    params.specular_color = tuple(settings.specular_color)
+    for name in SCALAR_PARAMETERS:
+        setattr(params, name, float(getattr(settings, name)))
+    params.lobe_count = int(settings.lobe_count)
+    params.normal_strength = float(settings.normal_strength)
+    params.tangent_source = settings.tangent_source
+    params.tangent_axis = tuple(settings.tangent_axis)
+    params.tangent_rotation = float(settings.tangent_rotation)
+    for name in TEXTURED_PARAMETERS:
+        image = getattr(settings, name + "_texture", None)
+        if image is not None:
+            params.textures[name] = image.name
+    if settings.normal_map is not None:
+        params.textures["normal_map"] = settings.normal_map.name
+    return params
+
+
+def image_pixels(image):
+    """(H, W, 4) float32 pixels of a bpy Image, Blender's orientation (row 0 at the bottom).
+    Colour images come as Blender stores them in float (linear for float buffers, else the
+    byte values / 255: data textures such as normal maps stay as authored)."""
+    width, height = image.size
+    pixels = np.empty(width * height * image.channels, np.float32)
+    image.pixels.foreach_get(pixels)
+    pixels = pixels.reshape(height, width, image.channels)
+    if image.channels == 4:
+        return pixels
+    out = np.ones((height, width, 4), np.float32)
+    out[..., :min(3, image.channels)] = pixels[..., :3]
+    if image.channels == 1:
+        out[..., 1] = out[..., 2] = pixels[..., 0]
+    return out
+
+
+# --------------------------------------------------------------------------- lights
+
+def export_light(object_eval):
+    """LightExport of an evaluated light object in Blender's units; None for unsupported types."""
+    from ..core import lights as core_lights
+
+    light = object_eval.data
+    matrix = matrix_to_numpy(object_eval.matrix_world)
+    position = tuple(matrix[:3, 3])
+    direction = -matrix[:3, 2]
+    direction = tuple(direction / max(np.linalg.norm(direction), 1e-30))
+    colour = np.asarray(light.color, np.float64)
+    if light.type == "SUN":
+        return LightExport(object_eval.name, "SUN", position, direction,
+                           tuple(colour * float(core_lights.blender_sun_irradiance(light.energy))),
+                           angle=float(light.angle))
+    intensity = colour * float(core_lights.blender_point_light_intensity(light.energy))
+    if light.type in ("POINT", "SPOT"):
+        radius = float(getattr(light, "shadow_soft_size", 0.0))
+        export = LightExport(object_eval.name, "POINT", position, direction, tuple(intensity), radius=radius)
+        if light.type == "SPOT":
+            export.is_spot = True
+            export.spot_size = float(light.spot_size)
+            export.spot_blend = float(light.spot_blend)
+        return export
+    if light.type == "AREA":
+        # An area light becomes a sphere of the same area (4 pi r^2 = A) and power.
+        size_x = float(light.size)
+        size_y = float(light.size_y) if light.shape in ("RECTANGLE", "ELLIPSE") else size_x
+        area = size_x * size_y * (np.pi / 4 if light.shape in ("DISK", "ELLIPSE") else 1.0)
+        return LightExport(object_eval.name, "POINT", position, direction, tuple(intensity),
+                           radius=float(np.sqrt(area / (4 * np.pi))))
+    return None
+
+
+# --------------------------------------------------------------------------- world
+
+def export_world(world):
+    """WorldExport of a bpy World: the first Environment Texture node's image, else its colour."""
+    if world is None:
+        return WorldExport(colour=(0.0, 0.0, 0.0))
+    colour = tuple(world.color)
+    strength = 1.0
+    if world.use_nodes and world.node_tree is not None:
+        for node in world.node_tree.nodes:
+            if node.type == "BACKGROUND":
+                if not node.inputs["Color"].is_linked:
+                    colour = tuple(node.inputs["Color"].default_value)[:3]
+                strength = float(node.inputs["Strength"].default_value)
+        for node in world.node_tree.nodes:
+            if node.type == "TEX_ENVIRONMENT" and node.image is not None:
+                pixels = image_pixels(node.image)[::-1, :, :3]      # numpy orientation, row 0 at the top
+                return WorldExport(colour=colour, image_name=node.image.name,
+                                   equirect=np.ascontiguousarray(pixels * strength, np.float32),
+                                   strength=strength)
+    return WorldExport(colour=tuple(float(c) * strength for c in colour[:3]), strength=strength)
+
+
+# --------------------------------------------------------------------------- camera
+
+@dataclass
+class CameraExport:
+    view: np.ndarray               # 4x4 world -> camera
+    projection: np.ndarray         # 4x4 camera -> clip
+    position: tuple
+    forward: tuple                 # camera -Z in world
+    is_perspective: bool = True
+
+
+def export_camera(camera_object, depsgraph, width, height, scale_x=1.0, scale_y=1.0):
+    """Render camera of the scene: view = matrix_world^-1, projection from calc_matrix_camera."""
+    matrix_world = camera_object.matrix_world
+    projection = camera_object.calc_matrix_camera(depsgraph, x=width, y=height, scale_x=scale_x, scale_y=scale_y)
+    world = matrix_to_numpy(matrix_world)
+    forward = -world[:3, 2]
+    return CameraExport(view=matrix_to_numpy(matrix_world.inverted()), projection=matrix_to_numpy(projection),
+                        position=tuple(world[:3, 3]),
+                        forward=tuple(forward / max(np.linalg.norm(forward), 1e-30)),
+                        is_perspective=camera_object.data.type != "ORTHO")

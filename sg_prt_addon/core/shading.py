@@ -1,0 +1,264 @@
+"""Numpy mirror of the engine's fragment shader (shaders/surface.frag.glsl): the same
+equations, per pixel, from plain arrays (a G-buffer, sampled material parameters,
+lights and environment data).  wang2009 eq. 36-43 without visibility:
+
+    R(o) = kd/pi * Rd + ks * Rs(o)
+
+    Rd    = sum_lights  I(light SG, n)  +  sum_env_lobes I(L*_k, n)       (eq. 39, 42)
+    Rs(o) = sum_j [ sum_lights I(light SG (x) rho*_j, n)                  (eq. 43)
+                    + Gamma_L(p_j, lambda_j)/integral * mu_j I(p_j, lambda_j, n) ]   (eq. 41, 35)
+
+I(G, n) is the integral of an SG times the clamped cosine (clamped_cosine.py's
+closed form, more accurate than the paper's single-lobe C*); rho*_j are the
+model's NDF lobes warped to the view slice (warp.brdf_slice_lobes: 2 lobes per
+NDF lobe in the default 'split2' mode) with the smooth factor M_o at each lobe
+centre.  For the environment, the cosine is folded in as the ratio
+I(p_j, lambda_j, n) / integral G_j (the clamped cosine averaged over the lobe),
+which keeps the horizon behaviour of the accurate integral; a constant world
+colour c stands for Gamma / integral = c.
+
+Everything is computed in float32 like the GPU.  Directions: world space, all
+pointing away from the surface.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import brdf, env_prefilter, lights, sg, warp
+
+FLOAT = np.float32
+# Local frame fallback when a tangent is parallel to the normal.
+_FALLBACK_TANGENT = np.array([1.0, 0.0, 0.0], FLOAT)
+
+
+def _clamped_cosine_integral(axis, sharpness, amplitude, normal):
+    from . import clamped_cosine
+    return clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, amplitude, normal)
+
+
+@dataclass
+class LightData:
+    """Lights as the shader gets them (float32).
+
+    point: position (P, 3), radius (P,), intensity (P, 3) W/sr, spot: direction (P, 3),
+    spot_size (P,) full cone angle (negative: a point light), spot_blend (P,).
+    sun: axis (S, 3), sharpness (S,), amplitude (S, 3) (precomputed SGs).
+    """
+    point_position: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+    point_radius: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
+    point_intensity: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+    spot_direction: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+    spot_size: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
+    spot_blend: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
+    sun_axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+    sun_sharpness: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
+    sun_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+
+    @property
+    def count(self):
+        return len(self.point_radius) + len(self.sun_sharpness)
+
+
+@dataclass
+class EnvironmentData:
+    """Constant colour, or SG mixture (diffuse) + prefiltered pyramid (specular)."""
+    colour: np.ndarray = field(default_factory=lambda: np.zeros(3, FLOAT))
+    lobe_axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+    lobe_sharpness: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
+    lobe_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+    prefiltered: object = None          # env_prefilter.PrefilteredEnvironment or None
+
+    @property
+    def has_texture(self):
+        return self.prefiltered is not None
+
+
+def point_light_sgs(position, light_data):
+    """(axis (N, P, 3), sharpness (N, P), amplitude (N, P, 3)) of every point/spot light at every pixel
+    (lights.sphere_light_sg / spot_light_sg with unit intensity, times the colour intensity)."""
+    position = np.asarray(position, FLOAT)[:, None, :]
+    axis, sharpness, amplitude = lights.sphere_light_sg(
+        position, light_data.point_position[None], light_data.point_radius[None], FLOAT(1))
+    is_spot = light_data.spot_size >= 0
+    if np.any(is_spot):
+        _, _, spot_amplitude = lights.spot_light_sg(
+            position, light_data.point_position[None], light_data.spot_direction[None],
+            np.maximum(light_data.spot_size, 0)[None], light_data.spot_blend[None], FLOAT(1),
+            light_data.point_radius[None])
+        amplitude = np.where(is_spot[None], spot_amplitude, amplitude)
+    amplitude = amplitude[..., None] * light_data.point_intensity[None]
+    return axis.astype(FLOAT), sharpness.astype(FLOAT), amplitude.astype(FLOAT)
+
+
+def shading_frame(normal, tangent):
+    """Unit normal, tangent (Gram-Schmidt; fallback if parallel), bitangent = n x t."""
+    n = sg.normalize(np.asarray(normal, FLOAT))
+    t = np.asarray(tangent, FLOAT)[..., :3]
+    t = t - n * np.sum(n * t, axis=-1, keepdims=True)
+    fallback = np.cross(n, np.where(np.abs(n[..., :1]) < 0.9, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])).astype(FLOAT)
+    t = sg.normalize(t, fallback=(0.0, 0.0, 0.0))
+    degenerate = np.sum(t * t, axis=-1, keepdims=True) < 0.5
+    t = np.where(degenerate, sg.normalize(fallback), t)
+    return n, t, np.cross(n, t).astype(FLOAT)
+
+
+def apply_normal_map(normal, tangent, sample, strength):
+    """Mapped normal: tangent-space (OpenGL +Y) sample in [0, 1], mixed with the mesh normal by strength."""
+    n = sg.normalize(np.asarray(normal, FLOAT))
+    t = np.asarray(tangent, FLOAT)
+    b = t[..., 3:4] * np.cross(n, t[..., :3])
+    m = 2 * np.asarray(sample, FLOAT)[..., :3] - 1
+    mapped = sg.normalize(t[..., :3] * m[..., 0:1] + b * m[..., 1:2] + n * m[..., 2:3])
+    return sg.normalize(n + (mapped - n) * np.asarray(strength, FLOAT))
+
+
+def rotate_tangent(normal, tangent, rotation):
+    """Tangent rotated about the normal by ``rotation`` radians (after projection)."""
+    n, t, b = shading_frame(normal, tangent)
+    c, s = np.cos(np.float32(rotation)), np.sin(np.float32(rotation))
+    return (c * t + s * b).astype(FLOAT)
+
+
+def ndf_lobes(model, params, lobe_count=1):
+    """The model's SG NDF lobes in the local frame: axis (N, K, 3), sharpness (N, K), amplitude (N, K)."""
+    instance = brdf.model_from_name(model, **params)
+    if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY"):
+        return instance.ndf_lobes(lobe_count)
+    return instance.ndf_lobes()
+
+
+def specular_slice(model, params, lobe_count, view_local):
+    """BRDF slice lobes (local frame) for the view: warped NDF lobes times M_o at their centres."""
+    axis, sharpness, amplitude = ndf_lobes(model, params, lobe_count)
+    # m_factor takes per-pixel parameters broadcast over the lobe axis
+    broadcast = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[..., None] for k, v in params.items()})
+    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, broadcast.m_factor)
+
+
+def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
+          light_data, environment, lobe_count=1):
+    """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
+    ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
+    applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
+
+    view_origin: camera position (perspective) or the camera's forward direction (orthographic).
+    """
+    position = np.asarray(position, FLOAT)
+    n, t, b = shading_frame(normal, tangent)
+    if is_perspective:
+        view = sg.normalize(np.asarray(view_origin, FLOAT)[None] - position)
+    else:
+        view = np.broadcast_to(-sg.normalize(np.asarray(view_origin, FLOAT)), position.shape)
+    frame = np.stack([t, b, n], axis=-1)                          # local -> world: columns t, b, n
+    view_local = np.einsum("nji,nj->ni", frame, view).astype(FLOAT)
+
+    slice_axis, slice_sharpness, slice_amplitude = specular_slice(model, params, lobe_count, view_local)
+    slice_axis = np.einsum("nij,nkj->nki", frame, slice_axis).astype(FLOAT)    # to world
+    slice_sharpness = slice_sharpness.astype(FLOAT)
+    slice_amplitude = slice_amplitude.astype(FLOAT)
+
+    irradiance = np.zeros(position.shape, FLOAT)
+    specular = np.zeros(position.shape, FLOAT)
+    n_lobe = n[:, None, :]
+
+    light_sets = []
+    if len(light_data.point_radius):
+        light_sets.append(point_light_sgs(position, light_data))
+    if len(light_data.sun_sharpness):
+        count = len(light_data.sun_sharpness)
+        light_sets.append((np.broadcast_to(light_data.sun_axis[None], (len(position), count, 3)),
+                           np.broadcast_to(light_data.sun_sharpness[None], (len(position), count)),
+                           np.broadcast_to(light_data.sun_amplitude[None], (len(position), count, 3))))
+    for light_axis, light_sharpness, light_amplitude in light_sets:
+        irradiance += np.sum(light_amplitude * _clamped_cosine_integral(
+            light_axis, light_sharpness, FLOAT(1), n_lobe)[..., None], axis=1)
+        # (N, P, 1) x (N, 1, J): every light against every slice lobe
+        axis_m, sharpness_m, amplitude_m = sg.product(
+            light_axis[:, :, None, :], light_sharpness[:, :, None], FLOAT(1),
+            slice_axis[:, None, :, :], slice_sharpness[:, None, :], slice_amplitude[:, None, :])
+        weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :])
+        specular += np.sum(light_amplitude * np.sum(weight, axis=2)[..., None], axis=1)
+
+    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)   # (N, J)
+    if environment.has_texture:
+        if len(environment.lobe_sharpness):
+            irradiance += np.sum(environment.lobe_amplitude[None] * _clamped_cosine_integral(
+                environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe)[..., None], axis=1)
+        radiance = env_prefilter.lookup(environment.prefiltered, slice_axis, slice_sharpness)        # (N, J, 3)
+        specular += np.sum(radiance * slice_cosine[..., None], axis=1)
+    else:
+        colour = np.asarray(environment.colour, FLOAT)
+        irradiance += np.pi * colour
+        specular += np.sum(slice_cosine, axis=1)[:, None] * colour
+
+    diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
+    return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * specular).astype(FLOAT)
+
+
+# --------------------------------------------------------------------------- texture sampling
+
+def sample_bilinear(image, uv):
+    """GPU-style bilinear fetch with clamp-to-edge: image (H, W, C) with row 0 at t = 0
+    (Blender's pixel order), uv (N, 2) -> (N, C) float32."""
+    height, width = image.shape[:2]
+    x = np.asarray(uv[..., 0], FLOAT) * width - FLOAT(0.5)
+    y = np.asarray(uv[..., 1], FLOAT) * height - FLOAT(0.5)
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    x0, y0 = x0.astype(np.int64), y0.astype(np.int64)
+    xa, xb = np.clip(x0, 0, width - 1), np.clip(x0 + 1, 0, width - 1)
+    ya, yb = np.clip(y0, 0, height - 1), np.clip(y0 + 1, 0, height - 1)
+    low = image[ya, xa] * (1 - fx) + image[ya, xb] * fx
+    high = image[yb, xa] * (1 - fx) + image[yb, xb] * fx
+    return (low * (1 - fy) + high * fy).astype(FLOAT)
+
+
+SCALAR_SLOTS = {"roughness": "roughness", "ior": "ior", "exponent": "exponent", "alpha_x": "alpha_x",
+                "alpha_y": "alpha_y", "nu": "nu", "nv": "nv"}
+
+
+def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,
+                    is_perspective, light_data, environment):
+    """Mirror of surface.frag.glsl's main(): per-fragment inputs as the G-buffer holds them.
+
+    material: an object with export.MaterialParams' fields; textures: slot name -> (H, W, 4)
+    float32 image (Blender's row order) for the slots the material uses; normal: interpolated
+    world normal (already flipped for back faces); tangent (N, 4): the tangent input (the UV
+    map's world tangent and sign, or the object axis in world space); uv (N, 2).
+    Returns (diffuse, specular), each (N, 3) float32.
+    """
+    count = len(position)
+    diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
+    specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
+    if "diffuse_color" in textures:
+        diffuse_color = diffuse_color * sample_bilinear(textures["diffuse_color"], uv)[:, :3]
+    if "specular_color" in textures:
+        specular_color = specular_color * sample_bilinear(textures["specular_color"], uv)[:, :3]
+    params = {}
+    for name in SCALAR_SLOTS:
+        value = np.full(count, getattr(material, name), FLOAT)
+        if name in textures:
+            value = value * sample_bilinear(textures[name], uv)[:, 0]
+        params[name] = value
+    shading_normal = np.asarray(normal, FLOAT)
+    tangent = np.asarray(tangent, FLOAT)
+    if "normal_map" in textures:
+        shading_normal = apply_normal_map(shading_normal, tangent, sample_bilinear(textures["normal_map"], uv)[:, :3],
+                                          FLOAT(material.normal_strength))
+    shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+    model = material.model
+    model_params = {key: params[key] for key in _MODEL_PARAMETERS[model]}
+    return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
+                 diffuse_color, specular_color, light_data, environment,
+                 lobe_count=material.lobe_count if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY") else 1)
+
+
+# The material fields each model reads (names as brdf.model_from_name takes them).
+_MODEL_PARAMETERS = {
+    "GGX": ("roughness",),
+    "COOK_TORRANCE": ("roughness", "ior"),
+    "BLINN_PHONG": ("exponent",),
+    "WARD_ISO": ("alpha_x",),
+    "WARD_ANISO": ("alpha_x", "alpha_y"),
+    "ASHIKHMIN_SHIRLEY": ("nu", "nv"),
+}

@@ -1,0 +1,164 @@
+"""The SG-PRT RenderEngine: final renders and the viewport share scene_state + renderer."""
+import time
+
+import bpy
+import numpy as np
+
+from ..blender import export
+from . import renderer as renderer_module
+from . import scene_state
+from . import shader_variants
+from .shader_variants import ShaderCompileError
+
+# Debug hooks for tests and benchmarks (no UI): when `capture_gbuffer` is True the next
+# final render also writes the shading inputs; every final render leaves its float
+# passes, the G-buffer and the SceneState in `last_render`.
+debug = {"capture_gbuffer": False, "environment_layer_size": None}
+last_render = {}
+
+
+class SGPRT_RenderEngine(bpy.types.RenderEngine):
+    bl_idname = "SG_PRT"
+    bl_label = "SG-PRT"
+    bl_use_gpu_context = True
+    bl_use_preview = False
+    bl_use_eevee_viewport = False
+    bl_use_shading_nodes_custom = False
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.viewport_state = None
+        self.viewport_renderer = None
+        self.viewport_error = None
+
+    def __del__(self):
+        # GPU objects are freed with their Python owners; nothing to release explicitly
+        pass
+
+    # ----------------------------------------------------------------- passes
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        self.register_pass(scene, renderlayer, "Diffuse", 3, "RGB", "COLOR")
+        self.register_pass(scene, renderlayer, "Specular", 3, "RGB", "COLOR")
+
+    # ----------------------------------------------------------------- final render
+
+    def render(self, depsgraph):
+        scene = depsgraph.scene
+        scale = scene.render.resolution_percentage / 100.0
+        width = int(scene.render.resolution_x * scale)
+        height = int(scene.render.resolution_y * scale)
+        if scene.camera is None:
+            self.report({"ERROR"}, "SG-PRT: the scene has no camera")
+            return
+        try:
+            passes, state, timings = render_frame(depsgraph, width, height, gbuffer=debug["capture_gbuffer"])
+        except ShaderCompileError as error:
+            print(error)
+            self.report({"ERROR"}, str(error).split("\n", 1)[0])
+            last_render.clear()
+            last_render["error"] = str(error)
+            return
+        finally:
+            if bpy.app.background:
+                # GPU shaders still alive at interpreter exit crash Blender's teardown (no context
+                # then): batch renders drop them while the render's context is current.
+                shader_variants.clear_cache()
+        result = self.begin_result(0, 0, width, height)
+        layer = result.layers[0]
+        for name in renderer_module.PASS_NAMES:
+            render_pass = layer.passes.get(name)
+            if render_pass is None:
+                continue
+            channels = render_pass.channels
+            render_pass.rect.foreach_set(np.ascontiguousarray(passes[name][..., :channels]).ravel())
+        self.end_result(result)
+        last_render.clear()
+        last_render.update(passes=passes, state=state, timings=timings, size=(width, height))
+
+    # ----------------------------------------------------------------- viewport
+
+    def view_update(self, context, depsgraph):
+        if self.viewport_state is None:
+            self.viewport_state = scene_state.SceneState()
+            self.viewport_state.sync(depsgraph)
+        else:
+            self.viewport_state.update(depsgraph)
+
+    def view_draw(self, context, depsgraph):
+        import gpu
+
+        region = context.region
+        width, height = region.width, region.height
+        if self.viewport_state is None:
+            self.view_update(context, depsgraph)
+        if self.viewport_renderer is None:
+            self.viewport_renderer = renderer_module.Renderer()
+        region_3d = context.region_data
+        camera = export.CameraExport(
+            view=export.matrix_to_numpy(region_3d.view_matrix),
+            projection=export.matrix_to_numpy(region_3d.window_matrix),
+            position=tuple(region_3d.view_matrix.inverted().translation),
+            forward=tuple(-np.asarray(region_3d.view_matrix.inverted().col[2][:3])),
+            is_perspective=region_3d.is_perspective)
+        try:
+            self.viewport_renderer.upload(self.viewport_state, self.viewport_state.consume_dirty(), camera)
+            self.viewport_renderer.ensure_targets(width, height)
+            self.viewport_renderer.draw(self.viewport_state, camera, background=background_colour(
+                self.viewport_state))
+        except ShaderCompileError as error:
+            if str(error) != self.viewport_error:
+                print(error)
+                self.viewport_error = str(error)
+            return
+        gpu.state.blend_set("ALPHA_PREMULT")
+        self.bind_display_space_shader(depsgraph.scene)
+        draw_texture_2d(self.viewport_renderer.targets[0], width, height)
+        self.unbind_display_space_shader()
+        gpu.state.blend_set("NONE")
+
+
+def background_colour(state):
+    colour = state.environment.colour if state.environment.prefiltered is None else (0.0, 0.0, 0.0)
+    return tuple(float(c) for c in colour[:3]) + (1.0,)
+
+
+def draw_texture_2d(texture, width, height):
+    """Draw a texture over the region with the bound display-space shader."""
+    from gpu_extras.presets import draw_texture_2d as preset
+    preset(texture, (0, 0), width, height)
+
+
+def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None):
+    """Export, upload, draw and read back one frame.
+
+    Returns (passes: name -> (H, W, 4) float32 with row 0 at the bottom, the SceneState, timings).
+    """
+    timings = {}
+    start = time.perf_counter()
+    scene = depsgraph.scene
+    if state is None:
+        state = scene_state.SceneState()
+        if debug.get("environment_layer_size"):
+            scene_state.ENVIRONMENT_LAYER_SIZE = debug["environment_layer_size"]
+        state.sync(depsgraph)
+    camera_object = scene.camera.evaluated_get(depsgraph)
+    camera = export.export_camera(camera_object, depsgraph, width, height,
+                                  scene.render.pixel_aspect_x, scene.render.pixel_aspect_y)
+    timings["export"] = time.perf_counter() - start
+    renderer = renderer or renderer_module.Renderer(gbuffer=gbuffer)
+    start = time.perf_counter()
+    renderer.upload(state, state.consume_dirty(), camera)
+    renderer.ensure_targets(width, height)
+    timings["upload"] = time.perf_counter() - start
+    start = time.perf_counter()
+    renderer.draw(state, camera, background=(0.0, 0.0, 0.0, 0.0))
+    passes = {name: renderer.read_output(name.lower()) for name in renderer_module.PASS_NAMES}
+    if gbuffer:
+        for name in renderer_module.GBUFFER_OUTPUTS:
+            passes["gbuffer_" + name] = renderer.read_output(name)
+    timings["draw_and_read"] = time.perf_counter() - start
+    passes["camera"] = camera
+    passes["material_ids"] = dict(renderer.material_ids)
+    return passes, state, timings

@@ -1,0 +1,273 @@
+"""GPU side: uploads a SceneState and draws it with the SG surface shaders.
+
+Used by both the final render (into our float offscreen framebuffer) and the
+viewport (view_draw draws the same framebuffer's Combined texture).  Only
+what SceneState marks dirty is re-uploaded.  Must run where the `gpu` module
+works: inside render() with bl_use_gpu_context, or in view_update/view_draw.
+"""
+import struct
+
+import numpy as np
+
+from . import shader_variants
+from .shader_variants import GBUFFER_OUTPUTS, MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
+
+PASS_NAMES = ("Combined", "Diffuse", "Specular")
+
+
+def _column_major(matrix):
+    return np.asarray(matrix, np.float32).T.ravel().tolist()
+
+
+def _texture_2d(pixels):
+    import gpu
+    data = np.ascontiguousarray(pixels, np.float32)
+    return gpu.types.GPUTexture((data.shape[1], data.shape[0]), format="RGBA32F",
+                                data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
+
+
+def _texture_2d_array(layers):
+    import gpu
+    data = np.ascontiguousarray(layers, np.float32)
+    return gpu.types.GPUTexture((data.shape[2], data.shape[1], data.shape[0]), layered=True, format="RGBA32F",
+                                data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
+
+
+def _uniform_buffer(data):
+    import gpu
+    data = np.ascontiguousarray(data, np.float32)
+    return gpu.types.GPUUniformBuf(gpu.types.Buffer("FLOAT", data.size, data.ravel()))
+
+
+def scene_block(camera, light_data, environment):
+    """SceneData (resources/scene_data.glsl) as float32 words, std140 (all vec4)."""
+    def vec4_array(count, rows):
+        block = np.zeros((count, 4), np.float32)
+        rows = np.asarray(rows, np.float32).reshape(-1, 4) if len(rows) else np.zeros((0, 4), np.float32)
+        block[:len(rows)] = rows[:count]
+        return block
+
+    points = len(light_data.point_radius)
+    suns = len(light_data.sun_sharpness)
+    if points > MAX_POINT_LIGHTS or suns > MAX_SUNS:
+        raise ValueError(f"SG-PRT draws at most {MAX_POINT_LIGHTS} point/spot/area and {MAX_SUNS} sun lights")
+    camera_vec = (list(camera.position) + [1.0]) if camera.is_perspective else (list(camera.forward) + [0.0])
+    prefiltered = environment.prefiltered
+    env_lobes = min(len(environment.lobe_sharpness), MAX_ENV_LOBES) if prefiltered is not None else 0
+    layer_count = len(prefiltered.sharpness) if prefiltered is not None else 0
+    if layer_count > MAX_LAYERS:
+        raise ValueError(f"the prefiltered environment has {layer_count} layers, at most {MAX_LAYERS}")
+    counts = np.array([points, suns, env_lobes, layer_count], np.int32).view(np.float32)
+    info = [prefiltered.log2_min_sharpness, prefiltered.levels_per_octave, layer_count - 1, 0.0] \
+        if prefiltered is not None else [0.0, 1.0, 0.0, 0.0]
+    scale_offset = np.stack([prefiltered.texcoord_scale, prefiltered.texcoord_offset,
+                             np.zeros(layer_count), np.zeros(layer_count)], axis=1) if layer_count else []
+    parts = [
+        np.array([camera_vec], np.float32),
+        np.array([list(environment.colour[:3]) + [1.0]], np.float32),
+        counts[None],
+        np.array([info], np.float32),
+        vec4_array(MAX_LAYERS, scale_offset),
+        vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.point_position, light_data.point_radius[:, None]], 1)
+                   if points else []),
+        vec4_array(MAX_POINT_LIGHTS, np.pad(light_data.point_intensity, ((0, 0), (0, 1))) if points else []),
+        vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.spot_direction,
+                                                     light_data.spot_size[:, None]], 1) if points else []),
+        vec4_array(MAX_POINT_LIGHTS, np.pad(light_data.spot_blend[:, None], ((0, 0), (0, 3)))
+                   if points else []),
+        vec4_array(MAX_SUNS, np.concatenate([light_data.sun_axis, light_data.sun_sharpness[:, None]], 1)
+                   if suns else []),
+        vec4_array(MAX_SUNS, np.pad(light_data.sun_amplitude, ((0, 0), (0, 1))) if suns else []),
+        vec4_array(MAX_ENV_LOBES, np.concatenate([environment.lobe_axis, environment.lobe_sharpness[:, None]], 1)
+                   [:env_lobes] if env_lobes else []),
+        vec4_array(MAX_ENV_LOBES, np.pad(environment.lobe_amplitude, ((0, 0), (0, 1)))[:env_lobes]
+                   if env_lobes else []),
+    ]
+    return np.concatenate(parts, axis=0)
+
+
+def material_block(params, material_id=0):
+    """MaterialData of an export.MaterialParams as (6, 4) float32; material_id goes to the G-buffer."""
+    return np.array([
+        list(params.diffuse_color) + [1.0],
+        list(params.specular_color) + [1.0],
+        [params.roughness, params.ior, params.exponent, params.alpha_x],
+        [params.alpha_y, params.nu, params.nv, params.normal_strength],
+        list(params.tangent_axis) + [params.tangent_rotation],
+        [1.0 if params.tangent_source == "OBJECT_AXIS" else 0.0, float(material_id), 0.0, 0.0],
+    ], np.float32)
+
+
+class MeshBuffers:
+    """Vertex buffer + one index buffer per material range of a MeshExport."""
+
+    def __init__(self, mesh):
+        import gpu
+
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
+        fmt.attr_add(id="normal", comp_type="F32", len=3, fetch_mode="FLOAT")
+        fmt.attr_add(id="tangent", comp_type="F32", len=4, fetch_mode="FLOAT")
+        fmt.attr_add(id="uv", comp_type="F32", len=2, fetch_mode="FLOAT")
+        vertices = gpu.types.GPUVertBuf(fmt, len(mesh.positions))
+        vertices.attr_fill("position", mesh.positions)
+        vertices.attr_fill("normal", mesh.normals)
+        vertices.attr_fill("tangent", mesh.tangents)
+        vertices.attr_fill("uv", mesh.uvs)
+        self.batches = []               # (material slot index, GPUBatch)
+        for material_index, first, count in mesh.material_ranges:
+            indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])
+            self.batches.append((material_index, gpu.types.GPUBatch(type="TRIS", buf=vertices, elem=indices)))
+        self.vertices = vertices
+
+
+class Renderer:
+    """Owns the GPU resources of one SceneState and draws it."""
+
+    def __init__(self, gbuffer=False):
+        self.gbuffer = gbuffer
+        self.mesh_buffers = {}          # mesh key -> MeshBuffers
+        self.material_buffers = {}      # material name -> GPUUniformBuf
+        self.material_ids = {}          # material name -> id written to the G-buffer (uv.z)
+        self.textures = {}              # image name -> GPUTexture
+        self.scene_buffer = None
+        self.environment_texture = None
+        self.environment_source = None
+        self.anisotropy_tables = {}     # lobe count -> GPUTexture
+        self.framebuffer = None
+        self.targets = []
+        self.size = None
+        self.uploads = {"meshes": 0, "materials": 0}
+
+    # ----------------------------------------------------------------- uploads
+
+    def upload(self, state, dirty, camera):
+        import bpy
+
+        for key in dirty.meshes:
+            if key in state.meshes:
+                self.mesh_buffers[key] = MeshBuffers(state.meshes[key])
+                self.uploads["meshes"] += 1
+        for key in list(self.mesh_buffers):
+            if key not in state.meshes:
+                del self.mesh_buffers[key]
+        for name in dirty.materials:
+            params = state.materials.get(name)
+            if params is None:
+                continue
+            material_id = self.material_ids.setdefault(name, len(self.material_ids))
+            self.material_buffers[name] = _uniform_buffer(material_block(params, material_id))
+            self.uploads["materials"] += 1
+            for image_name in params.textures.values():
+                if image_name not in self.textures and image_name in bpy.data.images:
+                    from ..blender import export
+                    self.textures[image_name] = _texture_2d(export.image_pixels(bpy.data.images[image_name]))
+        if state.environment.prefiltered is not None and self.environment_source is not state.environment:
+            layers = state.environment.prefiltered.layers
+            padded = np.ones(layers.shape[:3] + (4,), np.float32)
+            padded[..., :layers.shape[3]] = layers
+            self.environment_texture = _texture_2d_array(padded)
+            self.environment_source = state.environment
+        block = scene_block(camera, state.light_data(), state.environment)
+        if self.scene_buffer is None:
+            self.scene_buffer = _uniform_buffer(block)
+        else:
+            self.scene_buffer.update(gpu_buffer(block))
+
+    def _anisotropy_texture(self, lobe_count):
+        texture = self.anisotropy_tables.get(lobe_count)
+        if texture is None:
+            texture = _texture_2d(shader_variants.anisotropy_table(lobe_count))
+            self.anisotropy_tables[lobe_count] = texture
+        return texture
+
+    # ----------------------------------------------------------------- targets
+
+    def ensure_targets(self, width, height):
+        import gpu
+
+        if self.size == (width, height):
+            return
+        count = len(shader_variants.output_names(self.gbuffer))
+        self.targets = [gpu.types.GPUTexture((width, height), format="RGBA32F") for _ in range(count)]
+        self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
+        self.framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.targets)
+        self.size = (width, height)
+
+    # ----------------------------------------------------------------- drawing
+
+    def draw(self, state, camera, background=(0.0, 0.0, 0.0, 0.0)):
+        """Draw every object into our framebuffer (call ensure_targets first)."""
+        import gpu
+
+        has_lights = state.light_data().count > 0
+        has_environment = state.environment.prefiltered is not None
+        view_projection = _column_major(camera.projection @ camera.view)
+        with self.framebuffer.bind():
+            self.framebuffer.clear(color=tuple(background), depth=1.0)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            gpu.state.face_culling_set("NONE")
+            gpu.state.blend_set("NONE")
+            for entry in state.objects.values():
+                buffers = self.mesh_buffers.get(entry.mesh_key)
+                if buffers is None:
+                    continue
+                model = _column_major(entry.matrix_world)
+                for slot, batch in buffers.batches:
+                    name = entry.material_names[slot] if slot < len(entry.material_names) else ""
+                    params = state.materials.get(name) or state.materials[""]
+                    if name not in self.material_buffers:
+                        name = ""
+                    key = shader_variants.variant_key(params, has_lights, has_environment, self.gbuffer)
+                    shader = shader_variants.get_shader(key)
+                    shader.bind()
+                    shader.uniform_float("model_matrix", model)
+                    shader.uniform_float("view_projection", view_projection)
+                    shader.uniform_block("scene", self.scene_buffer)
+                    shader.uniform_block("material", self.material_buffers[name])
+                    if has_environment:
+                        shader.uniform_sampler("environment_texture", self.environment_texture)
+                    if key.model in shader_variants.ANISOTROPIC_MODELS:
+                        shader.uniform_sampler("anisotropy_table", self._anisotropy_texture(key.ndf_lobes))
+                    for texture_name in key.textures:
+                        shader.uniform_sampler("texture_" + texture_name,
+                                               self.textures[params.textures[texture_name]])
+                    batch.draw(shader)
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+
+    def read_output(self, name):
+        """(H, W, 4) float32 of output `name` ("combined", "diffuse", "position"...), row 0 at the bottom."""
+        names = shader_variants.output_names(self.gbuffer)
+        if name == "combined" and name not in names:
+            combined = self.read(names.index("diffuse")) + self.read(names.index("specular"))
+            combined[..., 3] = np.minimum(combined[..., 3], 1.0)
+            return combined
+        return self.read(names.index(name))
+
+    def read(self, slot):
+        """(H, W, 4) float32 of colour target `slot`, row 0 at the bottom (Blender's order)."""
+        import gpu
+
+        width, height = self.size
+        out = np.empty((height, width, 4), np.float32)
+        with self.framebuffer.bind():
+            # our own array: np.asarray of read_color's multi-dimensional Buffer has wrong strides
+            self.framebuffer.read_color(0, 0, width, height, 4, slot, "FLOAT",
+                                        data=gpu.types.Buffer("FLOAT", (height, width, 4), out))
+        return out
+
+    def free(self):
+        self.mesh_buffers.clear()
+        self.material_buffers.clear()
+        self.textures.clear()
+        self.targets = []
+        self.framebuffer = None
+        self.size = None
+
+
+def gpu_buffer(block):
+    import gpu
+    data = np.ascontiguousarray(block, np.float32)
+    return gpu.types.Buffer("FLOAT", data.size, data.ravel())

@@ -1,0 +1,214 @@
+"""CPU side of the engine: what the scene looks like as numpy data, and what changed.
+
+No `gpu` here, so the update logic runs (and is tested) in background mode.
+`SceneState.sync(depsgraph)` builds everything; `SceneState.update(depsgraph)`
+applies `depsgraph.updates`: a geometry update re-exports that object's mesh,
+a transform update only replaces its matrix, a material edit only re-reads the
+material, lights and world are re-read when they changed.  `dirty` tells the
+GPU side (renderer.py) what to re-upload.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..blender import export
+from ..core import shading
+
+# Prefiltered environments and SG fits by (image name, pixel checksum): prefiltering takes seconds.
+_environment_cache = {}
+ENVIRONMENT_LAYER_SIZE = 128
+ENVIRONMENT_FIT_LOBES = 8
+
+
+@dataclass
+class ObjectEntry:
+    name: str
+    mesh_key: str                   # name of the mesh datablock (objects sharing a mesh share the export)
+    matrix_world: np.ndarray
+    material_names: list            # material name (or "") per slot
+
+
+@dataclass
+class Dirty:
+    meshes: set = field(default_factory=set)        # mesh keys to (re-)upload
+    materials: set = field(default_factory=set)     # material names to rebuild
+    lights: bool = False
+    world: bool = False
+    objects: bool = False                          # object list or matrices changed
+
+    def any(self):
+        return bool(self.meshes or self.materials or self.lights or self.world or self.objects)
+
+
+class SceneState:
+    def __init__(self):
+        self.objects = {}           # object name -> ObjectEntry
+        self.meshes = {}            # mesh key -> export.MeshExport
+        self.materials = {}         # material name ("" = default) -> export.MaterialParams
+        self.lights = []            # export.LightExport
+        self.world = export.WorldExport()
+        self.environment = shading.EnvironmentData()
+        self.dirty = Dirty()
+
+    # ----------------------------------------------------------------- full sync
+
+    def sync(self, depsgraph):
+        """Re-read everything visible in the evaluated scene."""
+        self.objects.clear()
+        self.meshes.clear()
+        self.materials = {"": export.MaterialParams()}
+        self.lights = []
+        seen_meshes = set()
+        for instance in depsgraph.object_instances:
+            obj = instance.object
+            if obj.type == "LIGHT":
+                light = export.export_light(obj)
+                if light is not None:
+                    light.position = tuple(np.asarray(instance.matrix_world)[:3, 3])
+                    self.lights.append(light)
+                continue
+            if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
+                continue        # object_instances already lists only what is visible
+            name = obj.name if not instance.is_instance else f"{obj.name}#{len(self.objects)}"
+            mesh_key = self._mesh_key(obj)
+            if mesh_key not in seen_meshes:
+                self.meshes[mesh_key] = export.export_object_mesh(obj)
+                seen_meshes.add(mesh_key)
+            self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(instance.matrix_world),
+                                             self._read_materials(obj))
+        self.world = export.export_world(depsgraph.scene.world)
+        self.environment = environment_data(self.world)
+        self.dirty = Dirty(meshes=set(self.meshes), materials=set(self.materials), lights=True, world=True,
+                           objects=True)
+
+    @staticmethod
+    def _mesh_key(obj):
+        # evaluated data of modified objects is per object; plain meshes can be shared
+        data = obj.data
+        return f"{obj.name}:{data.name if data is not None else ''}"
+
+    def _read_materials(self, obj):
+        names = []
+        for slot in obj.material_slots:
+            material = slot.material
+            key = material.name if material is not None else ""
+            if key not in self.materials:
+                self.materials[key] = export.export_material(material)
+            names.append(key)
+        return names or [""]
+
+    # ----------------------------------------------------------------- incremental
+
+    def update(self, depsgraph):
+        """Apply depsgraph.updates; returns the Dirty set (also kept in self.dirty until consumed)."""
+        import bpy
+
+        dirty = self.dirty
+        for update in depsgraph.updates:
+            datablock = update.id
+            if isinstance(datablock, bpy.types.Material):
+                self.materials[datablock.name] = export.export_material(datablock)
+                dirty.materials.add(datablock.name)
+            elif isinstance(datablock, bpy.types.World):
+                self.world = export.export_world(datablock)
+                self.environment = environment_data(self.world)
+                dirty.world = True
+            elif isinstance(datablock, bpy.types.Scene):
+                continue        # the scene itself updates on any edit; its objects report their own
+            elif isinstance(datablock, bpy.types.Object):
+                self._update_object(depsgraph, datablock.evaluated_get(depsgraph), update, dirty)
+            elif isinstance(datablock, bpy.types.Light):
+                dirty.lights = True
+        if dirty.lights:
+            self.lights = [export.export_light(obj) for obj in depsgraph.objects if obj.type == "LIGHT"]
+            self.lights = [light for light in self.lights if light is not None]
+        return dirty
+
+    def _update_object(self, depsgraph, obj, update, dirty):
+        if obj.type == "LIGHT":
+            dirty.lights = True
+            return
+        if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
+            return
+        entry = self.objects.get(obj.name)
+        if not _visible(obj):
+            if entry is not None:
+                del self.objects[obj.name]
+                dirty.objects = True
+            return
+        mesh_key = self._mesh_key(obj)
+        if entry is None or update.is_updated_geometry or mesh_key not in self.meshes:
+            self.meshes[mesh_key] = export.export_object_mesh(obj)
+            dirty.meshes.add(mesh_key)
+        self.objects[obj.name] = ObjectEntry(obj.name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
+                                             self._read_materials(obj))
+        dirty.objects = True
+
+    def consume_dirty(self):
+        dirty, self.dirty = self.dirty, Dirty()
+        return dirty
+
+    # ----------------------------------------------------------------- shader-side data
+
+    def light_data(self):
+        return light_data(self.lights)
+
+
+def _visible(obj):
+    """Visibility in the view layer (asked of the original: evaluated copies report False)."""
+    original = getattr(obj, "original", obj)
+    try:
+        return original.visible_get()
+    except RuntimeError:
+        return True
+
+
+def light_data(light_exports):
+    """shading.LightData (float32) from export.LightExport records."""
+    from ..core import lights as core_lights
+
+    points = [light for light in light_exports if light.kind == "POINT"]
+    suns = [light for light in light_exports if light.kind == "SUN"]
+    data = shading.LightData()
+    f = np.float32
+    if points:
+        data.point_position = np.array([light.position for light in points], f)
+        data.point_radius = np.array([light.radius for light in points], f)
+        data.point_intensity = np.array([light.colour_intensity for light in points], f)
+        data.spot_direction = np.array([light.direction for light in points], f)
+        data.spot_size = np.array([light.spot_size if light.is_spot else -1.0 for light in points], f)
+        data.spot_blend = np.array([light.spot_blend if light.is_spot else 0.0 for light in points], f)
+    if suns:
+        axis, sharpness, amplitude = core_lights.directional_light_sg(
+            -np.array([light.direction for light in suns], np.float64),
+            0.5 * np.array([light.angle for light in suns]), np.array([light.colour_intensity for light in suns]))
+        data.sun_axis, data.sun_sharpness, data.sun_amplitude = (
+            np.asarray(axis, f), np.asarray(sharpness, f), np.asarray(amplitude, f))
+    return data
+
+
+def environment_data(world, layer_size=None):
+    """shading.EnvironmentData of an export.WorldExport (cached per image and pixels)."""
+    colour = np.asarray(world.colour[:3], np.float32)
+    if world.equirect is None:
+        return shading.EnvironmentData(colour=colour)
+    layer_size = layer_size or ENVIRONMENT_LAYER_SIZE
+    image = world.equirect
+    key = (world.image_name, image.shape, float(np.sum(image, dtype=np.float64)), layer_size)
+    cached = _environment_cache.get(key)
+    if cached is None:
+        from ..core import env_prefilter
+        prefiltered = env_prefilter.prefilter_environment(image, size=layer_size)
+        lobes = _fit_environment(image)
+        cached = shading.EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
+                                         lobe_sharpness=lobes[1], lobe_amplitude=lobes[2])
+        _environment_cache[key] = cached
+    return cached
+
+
+def _fit_environment(image):
+    """Diffuse SG mixture of the environment by core.env_fit (wang2009 eq. 39)."""
+    from ..core import env_fit
+    axis, sharpness, amplitude = env_fit.fit_environment(image, ENVIRONMENT_FIT_LOBES)[:3]
+    return (np.asarray(axis, np.float32), np.asarray(sharpness, np.float32),
+            np.asarray(amplitude, np.float32).reshape(len(sharpness), -1)[:, :3])

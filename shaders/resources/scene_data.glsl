@@ -1,0 +1,41 @@
+/* Uniform buffer layouts (std140, vec4 slots only).  Filled by
+ * sg_prt_addon/engine/gpu_resources.py; sizes come from the SGPRT_MAX_* defines. */
+
+struct SceneData {
+  /* xyz: camera position (perspective) or camera forward (orthographic); w: 1 perspective, 0 ortho */
+  vec4 camera;
+  vec4 world_colour;
+  /* x point/spot lights, y suns, z environment SG lobes, w prefiltered layers */
+  ivec4 counts;
+  /* x log2 of the first layer's sharpness, y levels per octave, z last layer index */
+  vec4 prefilter_info;
+  /* per layer: x texcoord scale, y texcoord offset */
+  vec4 prefilter_scale_offset[SGPRT_MAX_LAYERS];
+  /* xyz position, w radius */
+  vec4 point_position_radius[SGPRT_MAX_POINT_LIGHTS];
+  /* rgb radiant intensity (W/sr) */
+  vec4 point_intensity[SGPRT_MAX_POINT_LIGHTS];
+  /* xyz spot axis, w spot size (full cone angle; negative: a point light) */
+  vec4 spot_direction_size[SGPRT_MAX_POINT_LIGHTS];
+  /* x spot blend */
+  vec4 spot_blend[SGPRT_MAX_POINT_LIGHTS];
+  /* suns as ready SGs: xyz axis, w sharpness; rgb amplitude */
+  vec4 sun_axis_sharpness[SGPRT_MAX_SUNS];
+  vec4 sun_amplitude[SGPRT_MAX_SUNS];
+  /* diffuse environment SG mixture (env_fit) */
+  vec4 env_axis_sharpness[SGPRT_MAX_ENV_LOBES];
+  vec4 env_amplitude[SGPRT_MAX_ENV_LOBES];
+};
+
+struct MaterialData {
+  vec4 diffuse_color;
+  vec4 specular_color;
+  /* roughness, ior, exponent, alpha_x */
+  vec4 parameters0;
+  /* alpha_y, nu, nv, normal_strength */
+  vec4 parameters1;
+  /* xyz object-space tangent axis, w tangent rotation (radians) */
+  vec4 tangent_axis_rotation;
+  /* x tangent source: 0 UV map, 1 object axis */
+  vec4 options;
+};

@@ -1,0 +1,188 @@
+/* Per-pixel SG shading (wang2009 eq. 36-43 without visibility); mirrored line by line by
+ * sg_prt_addon/core/shading.py.  Needs sg.glsl, brdf.glsl, warp.glsl, clamped_cosine.glsl,
+ * lights.glsl and (HAS_ENVIRONMENT) env_prefilter.glsl, plus the `scene` uniform block. */
+
+/* Unit normal, tangent by Gram-Schmidt (fallback if parallel), bitangent n x t. */
+void shading_frame(vec3 normal, vec3 tangent, out vec3 n, out vec3 t, out vec3 b)
+{
+  n = safe_normalize(normal);
+  t = tangent - n * dot(n, tangent);
+  vec3 fallback = cross(n, abs(n.x) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0));
+  t = safe_normalize(t, vec3(0.0));
+  if (dot(t, t) < 0.5) {
+    t = safe_normalize(fallback);
+  }
+  b = cross(n, t);
+}
+
+vec3 apply_normal_map(vec3 normal, vec4 tangent, vec3 sample_value, float strength)
+{
+  vec3 n = safe_normalize(normal);
+  vec3 b = tangent.w * cross(n, tangent.xyz);
+  vec3 m = 2.0 * sample_value - 1.0;
+  vec3 mapped = safe_normalize(tangent.xyz * m.x + b * m.y + n * m.z);
+  return safe_normalize(n + (mapped - n) * strength);
+}
+
+vec3 rotate_tangent(vec3 normal, vec3 tangent, float rotation)
+{
+  vec3 n, t, b;
+  shading_frame(normal, tangent, n, t, b);
+  return cos(rotation) * t + sin(rotation) * b;
+}
+
+/* NDF lobe k of the model (brdf.glsl's <model>_ndf_lobe, or the anisotropy table), local
+ * frame.  p = (roughness, ior, exponent, alpha_x), q = (alpha_y, nu, nv, rf0). */
+void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude)
+{
+  axis = vec3(0.0, 0.0, 1.0);
+  vec2 lobe = vec2(0.0, 0.0);
+#if defined(MODEL_GGX)
+  lobe = ggx_ndf_lobe(p.x);
+#elif defined(MODEL_COOK_TORRANCE)
+  lobe = cook_torrance_ndf_lobe(p.x);
+#elif defined(MODEL_BLINN_PHONG)
+  lobe = blinn_phong_ndf_lobe(p.z);
+#elif defined(MODEL_WARD_ISO)
+  lobe = ward_isotropic_ndf_lobe(p.w);
+#endif
+  sharpness = lobe.x;
+  amplitude = lobe.y;
+#if defined(MODEL_WARD_ANISO)
+  float ax = max(p.w, 1.0e-6);
+  float ay = max(q.x, 1.0e-6);
+  anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
+#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
+  float nu = max(q.y, 0.0);
+  float nv = max(q.z, 0.0);
+  anisotropic_lobes(anisotropy_table, sqrt(2.0 / max(nu, 1.0e-6)), sqrt(2.0 / max(nv, 1.0e-6)),
+                    sqrt((nu + 1.0) * (nv + 1.0)) / (2.0 * SG_PI), k, axis, sharpness, amplitude);
+#endif
+}
+
+/* M_o(i) of the model (brdf.glsl's <model>_m_factor). */
+float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
+{
+#if defined(MODEL_GGX)
+  return ggx_m_factor(wo, wi, p.x);
+#elif defined(MODEL_COOK_TORRANCE)
+  return cook_torrance_m_factor(wo, wi, p.x, p.y);
+#elif defined(MODEL_BLINN_PHONG)
+  return blinn_phong_m_factor(wo, wi, p.z);
+#elif defined(MODEL_WARD_ISO)
+  return ward_isotropic_m_factor(wo, wi);
+#elif defined(MODEL_WARD_ANISO)
+  return ward_anisotropic_m_factor(wo, wi);
+#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
+  return ashikhmin_shirley_m_factor(wo, wi, q.y, q.z, q.w);
+#endif
+}
+
+/* Light l (point/spot first, then suns) as an SG at the shading position. */
+void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, out vec3 amplitude)
+{
+  if (l < scene.counts.x) {
+    float scalar_amplitude;
+    if (scene.spot_direction_size[l].w >= 0.0) {
+      spot_light_sg(position, scene.point_position_radius[l].xyz, scene.spot_direction_size[l].xyz,
+                    scene.spot_direction_size[l].w, scene.spot_blend[l].x, 1.0, scene.point_position_radius[l].w,
+                    axis, sharpness, scalar_amplitude);
+    }
+    else {
+      sphere_light_sg(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w, 1.0,
+                      axis, sharpness, scalar_amplitude);
+    }
+    amplitude = scalar_amplitude * scene.point_intensity[l].rgb;
+  }
+  else {
+    int s = l - scene.counts.x;
+    axis = scene.sun_axis_sharpness[s].xyz;
+    sharpness = scene.sun_axis_sharpness[s].w;
+    amplitude = scene.sun_amplitude[s].rgb;
+  }
+}
+
+#define SLICE_LOBES (2 * NDF_LOBES)
+
+/* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer. */
+void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
+                   vec3 diffuse_color, vec3 specular_color,
+                   out vec3 diffuse, out vec3 specular)
+{
+  vec3 n, t, b;
+  shading_frame(normal, tangent, n, t, b);
+  vec3 view = scene.camera.w > 0.5 ? safe_normalize(scene.camera.xyz - position)
+                                   : -safe_normalize(scene.camera.xyz);
+  mat3 frame = mat3(t, b, n);                    /* local -> world */
+  vec3 view_local = view * frame;                /* transpose(frame) * view */
+
+  /* BRDF slice: NDF lobes warped to the view (2 per NDF lobe) times M_o at their centres, in world space */
+  vec3 slice_axis[SLICE_LOBES];
+  float slice_sharpness[SLICE_LOBES];
+  float slice_amplitude[SLICE_LOBES];
+  for (int k = 0; k < NDF_LOBES; k++) {
+    vec3 ndf_axis;
+    float ndf_sharpness, ndf_amplitude;
+    model_ndf_lobe(p, q, k, ndf_axis, ndf_sharpness, ndf_amplitude);
+    vec3 warped_axis[2];
+    float warped_sharpness[2], warped_amplitude[2];
+    warp_lobes_split2(ndf_axis, ndf_sharpness, ndf_amplitude, view_local,
+                      warped_axis, warped_sharpness, warped_amplitude);
+    for (int side = 0; side < 2; side++) {
+      int j = 2 * k + side;
+      slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[side],
+                                                model_m_factor(view_local, warped_axis[side], p, q));
+      slice_axis[j] = frame * warped_axis[side];
+      slice_sharpness[j] = warped_sharpness[side];
+    }
+  }
+
+  vec3 irradiance = vec3(0.0);
+  vec3 radiance = vec3(0.0);
+
+#ifdef HAS_LIGHTS
+  for (int l = 0; l < scene.counts.x + scene.counts.y; l++) {
+    vec3 light_axis;
+    float light_sharpness;
+    vec3 light_amplitude;
+    scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
+    irradiance += light_amplitude * sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n);
+    float weight = 0.0;
+    for (int j = 0; j < SLICE_LOBES; j++) {
+      vec3 product_axis;
+      float product_sharpness, product_amplitude;
+      sg_product(light_axis, light_sharpness, 1.0, slice_axis[j], slice_sharpness[j], slice_amplitude[j],
+                 product_axis, product_sharpness, product_amplitude);
+      weight += sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n);
+    }
+    radiance += light_amplitude * weight;
+  }
+#endif
+
+  for (int j = 0; j < SLICE_LOBES; j++) {
+    float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n);
+#ifdef HAS_ENVIRONMENT
+    int lower, upper;
+    float fraction;
+    environment_layers(slice_sharpness[j], scene.prefilter_info.x, scene.prefilter_info.y,
+                       int(scene.prefilter_info.z), lower, upper, fraction);
+    radiance += slice_cosine * environment_fetch(environment_texture, slice_axis[j], lower, upper, fraction,
+                                                 scene.prefilter_scale_offset[lower].xy,
+                                                 scene.prefilter_scale_offset[upper].xy);
+#else
+    radiance += slice_cosine * scene.world_colour.rgb;
+#endif
+  }
+
+#ifdef HAS_ENVIRONMENT
+  for (int e = 0; e < scene.counts.z; e++) {
+    irradiance += scene.env_amplitude[e].rgb *
+                  sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, 1.0, n);
+  }
+#else
+  irradiance += SG_PI * scene.world_colour.rgb;
+#endif
+
+  diffuse = diffuse_color * (1.0 / SG_PI) * irradiance;
+  specular = specular_color * radiance;
+}

@@ -1,0 +1,64 @@
+/* Material parameters (property x texture over the active UV map), normal map, tangent
+ * frame, then shade_surface (resources/sg_shading.glsl).  Writes Combined, Diffuse and
+ * Specular; the GBUFFER variant writes Diffuse, Specular and the shading inputs for the
+ * numpy mirror (framebuffers take 6 attachments: Combined is summed on the CPU). */
+void main()
+{
+  vec3 normal = gl_FrontFacing ? world_normal : -world_normal;
+  vec3 diffuse_color = material.diffuse_color.rgb;
+  vec3 specular_color = material.specular_color.rgb;
+  vec4 p = material.parameters0;                  /* roughness, ior, exponent, alpha_x */
+  vec4 q = vec4(material.parameters1.xyz, BRDF_AS_RF0);   /* alpha_y, nu, nv, rf0 */
+#ifdef HAS_TEXTURE_DIFFUSE_COLOR
+  diffuse_color *= texture(texture_diffuse_color, texcoord).rgb;
+#endif
+#ifdef HAS_TEXTURE_SPECULAR_COLOR
+  specular_color *= texture(texture_specular_color, texcoord).rgb;
+#endif
+#ifdef HAS_TEXTURE_ROUGHNESS
+  p.x *= texture(texture_roughness, texcoord).r;
+#endif
+#ifdef HAS_TEXTURE_IOR
+  p.y *= texture(texture_ior, texcoord).r;
+#endif
+#ifdef HAS_TEXTURE_EXPONENT
+  p.z *= texture(texture_exponent, texcoord).r;
+#endif
+#ifdef HAS_TEXTURE_ALPHA_X
+  p.w *= texture(texture_alpha_x, texcoord).r;
+#endif
+#ifdef HAS_TEXTURE_ALPHA_Y
+  q.x *= texture(texture_alpha_y, texcoord).r;
+#endif
+#ifdef HAS_TEXTURE_NU
+  q.y *= texture(texture_nu, texcoord).r;
+#endif
+#ifdef HAS_TEXTURE_NV
+  q.z *= texture(texture_nv, texcoord).r;
+#endif
+
+  /* tangent input: the UV map's, or the object axis in world space */
+  vec4 tangent = material.options.x > 0.5 ?
+                     vec4(mat3(model_matrix) * material.tangent_axis_rotation.xyz, 1.0) : world_tangent;
+  vec3 shading_normal = normal;
+#ifdef HAS_NORMAL_MAP
+  shading_normal = apply_normal_map(normal, tangent, texture(texture_normal_map, texcoord).rgb,
+                                    material.parameters1.w);
+#endif
+  vec3 shading_tangent = rotate_tangent(shading_normal, tangent.xyz, material.tangent_axis_rotation.w);
+
+  vec3 diffuse, specular;
+  shade_surface(world_position, shading_normal, shading_tangent, p, q, diffuse_color, specular_color,
+                diffuse, specular);
+#ifndef GBUFFER
+  out_combined = vec4(diffuse + specular, 1.0);
+#endif
+  out_diffuse = vec4(diffuse, 1.0);
+  out_specular = vec4(specular, 1.0);
+#ifdef GBUFFER
+  out_position = vec4(world_position, 1.0);
+  out_normal = vec4(normal, 1.0);
+  out_tangent = tangent;
+  out_uv = vec4(texcoord, material.options.y, 1.0);
+#endif
+}

@@ -1,0 +1,128 @@
+"""The engine's GLSL against its numpy mirror (core/shading.py) on the same pixels.
+
+One render per scene writes the G-buffer (position, normal, tangent input, uv, material id);
+core.shading.shade_fragments shades those pixels from the same material, lights and
+environment data, and the two must agree to float32 round-off (max relative error 1e-3).
+"""
+import numpy as np
+import pytest
+
+import engine_fixtures as fx
+
+TOLERANCE = 1e-3
+
+
+@pytest.fixture(scope="module")
+def engine(blender):
+    fx.ensure_registered()
+    return blender
+
+
+def _mirror(result, textures_by_material=None):
+    """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask."""
+    from sg_prt_addon.core import shading
+
+    passes, state = result["passes"], result["state"]
+    camera = passes["camera"]
+    uv = passes["gbuffer_uv"]
+    covered = uv[..., 3] > 0.5
+    material_of_id = {i: name for name, i in passes["material_ids"].items()}
+    expected = {"Diffuse": np.zeros(uv.shape[:2] + (3,), np.float32),
+                "Specular": np.zeros(uv.shape[:2] + (3,), np.float32)}
+    light_data = state.light_data()
+    for material_id in np.unique(uv[covered][:, 2]).astype(int):
+        name = material_of_id[material_id]
+        mask = covered & (np.abs(uv[..., 2] - material_id) < 0.25)
+        view_origin = camera.position if camera.is_perspective else camera.forward
+        diffuse, specular = shading.shade_fragments(
+            state.materials[name], (textures_by_material or {}).get(name, {}),
+            passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
+            passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
+            light_data, state.environment)
+        expected["Diffuse"][mask] = diffuse
+        expected["Specular"][mask] = specular
+    return expected, covered
+
+
+def _check(result, textures_by_material=None, minimum_coverage=0.2):
+    assert "error" not in result, result.get("error")
+    expected, covered = _mirror(result, textures_by_material)
+    assert covered.mean() > minimum_coverage
+    errors = {}
+    for name in ("Diffuse", "Specular"):
+        actual = result["passes"][name][..., :3][covered]
+        reference = expected[name][covered]
+        assert np.all(np.isfinite(actual))
+        assert reference.max() > 0, f"{name}: the scene must light the pixels"
+        errors[name] = float(fx.relative_error(actual, reference).max())
+    combined = result["passes"]["Combined"][..., :3][covered]
+    np.testing.assert_allclose(combined, (result["passes"]["Diffuse"] + result["passes"]["Specular"])[..., :3][covered],
+                               rtol=1e-6, atol=1e-6)
+    print("max relative error", errors)
+    for name, error in errors.items():
+        assert error <= TOLERANCE, f"{name}: max relative error {error:.2e} > {TOLERANCE}"
+    return errors
+
+
+def test_isotropic_models_lights_and_world_colour(engine):
+    """GGX, Cook-Torrance, Blinn-Phong and Ward on four spheres, point + spot + sun + area lights."""
+    scene = fx.new_scene("mirror_isotropic", 256, 256)
+    fx.world_colour(scene, (0.05, 0.07, 0.1))
+    models = [("GGX", dict(roughness=0.35)), ("COOK_TORRANCE", dict(roughness=0.25, ior=1.6)),
+              ("BLINN_PHONG", dict(exponent=60.0)), ("WARD_ISO", dict(alpha_x=0.15))]
+    for index, (model, settings) in enumerate(models):
+        x = -2.25 + 1.5 * index
+        sphere = fx.uv_sphere(scene, f"sphere_{model}", (x, 0.0, 1.0), radius=0.7)
+        sphere.data.materials.append(fx.material(f"mat_{model}", model=model, diffuse_color=(0.6, 0.4, 0.3),
+                                                 specular_color=(0.5, 0.5, 0.5), **settings))
+    fx.plane(scene, "floor", (0.0, 0.0, 0.3))      # no material: the defaults
+    fx.point_light(scene, "point", (2.0, -3.0, 3.0), 800.0, radius=0.1)
+    spot = fx.point_light(scene, "spot", (-2.0, -3.0, 4.0), 1500.0, radius=0.2, colour=(1.0, 0.8, 0.6), kind="SPOT")
+    spot.rotation_euler = (0.6, -0.4, 0.0)
+    spot.data.spot_size = 1.0
+    spot.data.spot_blend = 0.3
+    sun = fx.point_light(scene, "sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
+    sun.rotation_euler = (0.5, 0.3, 0.0)
+    sun.data.angle = 0.1
+    area = fx.point_light(scene, "area", (0.0, -2.0, 3.0), 300.0, kind="AREA")
+    area.data.size = 0.5
+    result = fx.render(scene, gbuffer=True)
+    _check(result)
+
+
+def test_anisotropic_models_textures_and_normal_map(engine):
+    """Ward anisotropic and Ashikhmin-Shirley with textured parameters, a normal map and both tangent sources."""
+    rng = np.random.default_rng(3)
+    scene = fx.new_scene("mirror_textures", 192, 192)
+    fx.world_colour(scene, (0.2, 0.2, 0.25))
+    colour = np.ones((16, 16, 4), np.float32)
+    colour[..., :3] = rng.uniform(0.2, 1.0, (16, 16, 3))
+    scalar = np.ones((8, 8, 4), np.float32)
+    scalar[..., 0] = rng.uniform(0.5, 1.5, (8, 8))
+    bumps = np.ones((16, 16, 4), np.float32)
+    bumps[..., :2] = rng.uniform(0.35, 0.65, (16, 16, 2))
+    bumps[..., 2] = 0.9
+    images = {"colour": fx.image("tex_colour", colour), "scalar": fx.image("tex_scalar", scalar),
+              "bumps": fx.image("tex_bumps", bumps)}
+    ward = fx.material("mat_ward", model="WARD_ANISO", alpha_x=0.3, alpha_y=0.08, lobe_count=4,
+                       diffuse_color=(0.5, 0.5, 0.5), specular_color=(0.6, 0.6, 0.6), tangent_rotation=0.4)
+    ward.sgprt.diffuse_color_texture = images["colour"]
+    ward.sgprt.alpha_x_texture = images["scalar"]
+    ward.sgprt.normal_map = images["bumps"]
+    ward.sgprt.normal_strength = 0.8
+    shirley = fx.material("mat_as", model="ASHIKHMIN_SHIRLEY", nu=50.0, nv=800.0, lobe_count=3,
+                          tangent_source="OBJECT_AXIS", tangent_axis=(0.0, 0.0, 1.0))
+    shirley.sgprt.specular_color_texture = images["colour"]
+    shirley.sgprt.nv_texture = images["scalar"]
+    fx.uv_sphere(scene, "ward", (-1.1, 0.0, 1.0), radius=0.9).data.materials.append(ward)
+    fx.uv_sphere(scene, "shirley", (1.1, 0.0, 1.0), radius=0.9).data.materials.append(shirley)
+    fx.point_light(scene, "point", (1.0, -3.0, 3.0), 1000.0, radius=0.05)
+    result = fx.render(scene, gbuffer=True)
+    from sg_prt_addon.blender import export
+    textures = {
+        "mat_ward": {"diffuse_color": colour, "alpha_x": scalar, "normal_map": bumps},
+        "mat_as": {"specular_color": colour, "nv": scalar},
+    }
+    # the engine uploads exactly what export.image_pixels reads
+    np.testing.assert_array_equal(export.image_pixels(images["colour"]), colour)
+    _check(result, textures)
