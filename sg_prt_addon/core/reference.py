@@ -53,16 +53,35 @@ class Material:
 
 @dataclass
 class PointLight:
+    """Point / sphere light, optionally a spot.  Blender: intensity = power / (4 pi)
+    (core.lights.blender_point_light_intensity), radius = shadow_soft_size."""
     position: Any                             # (3,) world
     intensity: Any                            # (3,) W/sr
     radius: float = 0.0                       # > 0: a uniformly emitting sphere of the same intensity
+    spot_direction: Any = None                # (3,) world axis of a spot cone; None: no cone
+    spot_size: float = np.pi                  # full cone angle (Blender spot_size)
+    spot_blend: float = 0.0                   # Blender spot_blend: smoothstep over this fraction of 1 - cos(size/2)
+
+    def spot_falloff(self, to_light):
+        """Intensity factor (N,) for unit directions (N, 3) from shading points to the light centre:
+        smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) blend)), a the angle off the spot axis
+        (Cycles' round spot at unit scale, like core.lights.spot_light_sg)."""
+        if self.spot_direction is None:
+            return np.ones(len(to_light))
+        axis = np.asarray(self.spot_direction, float)
+        axis = axis / max(np.linalg.norm(axis), 1e-300)
+        cos_half = np.cos(0.5 * self.spot_size)
+        width = max((1.0 - cos_half) * self.spot_blend, 1e-12)
+        t = np.clip((-(to_light @ axis) - cos_half) / width, 0.0, 1.0)
+        return t * t * (3.0 - 2.0 * t)
 
 
 @dataclass
 class DirectionalLight:
+    """Distant light (Blender sun: irradiance = strength, angular_radius = angle / 2)."""
     direction: Any                            # (3,) world, from the surface TOWARDS the light
     irradiance: Any                           # (3,) W/m^2 on a surface facing the light
-    angular_radius: float = 0.0               # radians; > 0: a uniform disc of directions (like a sun)
+    angular_radius: float = 0.0               # radians; > 0: a uniform cap of directions, radiance E / (pi sin^2)
 
 
 @dataclass
@@ -365,7 +384,7 @@ class _Renderer:
                 wi = axis
                 scale = 1.0 / np.maximum(distance, 1e-300) ** 2
                 max_distance = distance
-            weight = scale[:, None] * intensity[None, :]
+            weight = (scale * light.spot_falloff(axis))[:, None] * intensity[None, :]
         elif isinstance(light, DirectionalLight):
             axis = _normalize(np.asarray(light.direction, float)[None, :], np.array([0.0, 0.0, 1.0]))
             axis = np.broadcast_to(axis, (count, 3))

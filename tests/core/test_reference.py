@@ -242,34 +242,82 @@ def test_sphere_and_cone_lights_keep_point_light_irradiance(light):
     assert rms(z) < 1.3 and abs(np.mean(z)) < 0.3, (rms(z), np.mean(z))
 
 
-# -- MIS with a glossy lobe under a non-constant environment vs quadrature ----------------------------
-def test_glossy_plane_under_environment_matches_quadrature():
+# -- MIS with glossy lobes under a non-constant environment vs quadrature ------------------------------
+def _oblique_plane_mean_vs_quadrature(model, pixels, samples, seed, tangents=None):
+    """Mean of an orthographic oblique view of a plane (the same wo at every pixel), its standard
+    error, and the midpoint quadrature of the same integral."""
     rng = np.random.default_rng(6)
     environment = rng.random((8, 16, 3)) ** 3 * 4
     vertices, triangles, normals = ground_plane()
-    model = PhongStandIn(30.0)
     material = Material((0.3, 0.2, 0.1), (0.6, 0.6, 0.6), model)
-    scene = Scene(vertices, triangles, normals, [material], environment=environment)
-    # Oblique orthographic view: every pixel sees the plane with the same wo.
+    scene = Scene(vertices, triangles, normals, [material], environment=environment,
+                  tangents=None if tangents is None else np.tile(tangents, (4, 1)))
     wo = np.array([0.0, -np.sin(0.7), np.cos(0.7)])
-    view = Camera.look_at(4 * wo, (0, 0, 0), (0, 0, 1.0), 10.0, 24, 24).view_matrix
+    view = Camera.look_at(4 * wo, (0, 0, 0), (0, 0, 1.0), 10.0, pixels, pixels).view_matrix
     projection = np.diag([1.0, 1.0, -0.02, 1.0])
     projection[2, 3] = -1.0
-    image, error = render_reference(scene, Camera(view, projection, 24, 24), 64, seed=7)
-    # Midpoint quadrature, uniform in solid angle over the upper hemisphere.
-    n_cos, n_phi = 600, 1200
-    cos_theta = (np.arange(n_cos) + 0.5) / n_cos
-    phi = (np.arange(n_phi) + 0.5) / n_phi * 2 * np.pi
-    c, p = np.meshgrid(cos_theta, phi, indexing="ij")
-    s = np.sqrt(1 - c ** 2)
-    wi = np.stack([s * np.cos(p), s * np.sin(p), c], -1).reshape(-1, 3)
+    image, error = render_reference(scene, Camera(view, projection, pixels, pixels), samples, seed=seed)
+    # The plane's frame is the world frame (tangent x, normal z) for the built frame at n = z and
+    # for tangents = x.  Midpoint quadrature on cells aligned with the texel edges (uniform in
+    # sin(elevation) and azimuth inside each texel of the upper half), so the integrand is smooth
+    # in every cell: relative error below 1e-4 (measured against 25x finer cells).
+    height, width, cells = environment.shape[0], environment.shape[1], 40
+    top = np.pi / 2 - np.arange(height // 2) * np.pi / height
+    z_top, z_bottom = np.sin(top), np.sin(top - np.pi / height)
+    z = (z_bottom[:, None] + (np.arange(cells) + 0.5)[None, :] / cells * (z_top - z_bottom)[:, None]).ravel()
+    dz = np.repeat((z_top - z_bottom) / cells, cells)
+    u = (np.arange(width * cells) + 0.5) / (width * cells)
+    u_grid, z_grid = np.meshgrid(u, z)
+    wi = equirect.uv_to_direction(u_grid, 0.5 + np.arcsin(z_grid) / np.pi).reshape(-1, 3)
+    solid_angle = (np.broadcast_to(dz[:, None], z_grid.shape) * (2 * np.pi / (width * cells))).ravel()
     brdf = np.asarray(material.diffuse_color) / np.pi + 0.6 * model.specular(np.broadcast_to(wo, wi.shape), wi)[:, None]
-    radiance = equirect.lookup_nearest(environment, wi)
-    expected = np.sum(radiance * brdf * wi[:, 2:3], axis=0) * (2 * np.pi / wi.shape[0])
+    expected = np.sum(equirect.lookup_nearest(environment, wi) * brdf * (wi[:, 2] * solid_angle)[:, None], axis=0)
     mean = image.mean(axis=(0, 1))
-    error_of_mean = np.sqrt(np.sum(error ** 2, axis=(0, 1))) / 24 ** 2
+    error_of_mean = np.sqrt(np.sum(error ** 2, axis=(0, 1))) / pixels ** 2
+    return mean, error_of_mean, expected
+
+
+def test_glossy_plane_under_environment_matches_quadrature():
+    mean, error_of_mean, expected = _oblique_plane_mean_vs_quadrature(PhongStandIn(30.0), 24, 64, seed=7)
     assert np.all(error_of_mean < 0.008 * expected)
-    assert np.all(np.abs(mean - expected) < 4 * error_of_mean + 2e-3 * expected), (mean, expected, error_of_mean)
+    assert np.all(np.abs(mean - expected) < 4 * error_of_mean + 5e-4 * expected), (mean, expected, error_of_mean)
+
+
+def _core_brdf_models():
+    brdf = pytest.importorskip("sg_prt_addon.core.brdf")
+    return [("ggx", lambda: brdf.GGX(roughness=0.5)), ("cook_torrance", lambda: brdf.CookTorrance(roughness=0.3)),
+            ("ward_anisotropic", lambda: brdf.WardAnisotropic(alpha_x=0.35, alpha_y=0.15))]
+
+
+@pytest.mark.parametrize("name", ["ggx", "cook_torrance", "ward_anisotropic"])
+def test_core_brdf_models_under_environment_match_quadrature(name):
+    model = dict(_core_brdf_models())[name]()
+    mean, error_of_mean, expected = _oblique_plane_mean_vs_quadrature(model, 16, 48, seed=8,
+                                                                      tangents=(1.0, 0.0, 0.0))
+    assert np.all(error_of_mean < 0.015 * expected)
+    assert np.all(np.abs(mean - expected) < 4 * error_of_mean + 5e-4 * expected), (mean, expected, error_of_mean)
+
+
+def test_spot_light_cone_edge_falls_on_the_expected_pixels():
+    vertices, triangles, normals = ground_plane()
+    radius_on_plane = 0.5
+    light = PointLight((0.0, 0.0, 2.0), (3.0, 3.0, 3.0), spot_direction=(0, 0, -1.0),
+                       spot_size=2 * np.arctan(radius_on_plane / 2.0))
+    scene = Scene(vertices, triangles, normals, [Material((0.5, 0.5, 0.5))], lights=[light])
+    pixels = 32
+    image, _ = render_reference(scene, orthographic_down(1.0, pixels), 4, seed=11)
+    size = 2.0 / pixels
+    y, x = np.mgrid[0:pixels, 0:pixels]
+    corner_radius = np.stack([np.hypot(-1 + (x + dx) * size, 1 - (y + dy) * size) for dx in (0, 1) for dy in (0, 1)])
+    inside, outside = corner_radius.max(axis=0) < radius_on_plane, corner_radius.min(axis=0) > radius_on_plane
+    assert inside.sum() > 100 and outside.sum() > 500
+    np.testing.assert_array_equal(image[outside], 0.0)
+    assert np.all(image[inside] > 0)
+    # Inside the cone: the plain point light, kd / pi I cos / d^2 (within the jitter across a pixel).
+    centre = np.stack([-1 + (x + 0.5) * size, 1 - (y + 0.5) * size], -1)
+    distance2 = np.sum(centre ** 2, -1) + 4.0
+    expected = 0.5 / np.pi * 3.0 * 2.0 / distance2 ** 1.5
+    np.testing.assert_allclose(image[inside][:, 0], expected[inside], rtol=0.01)
 
 
 # -- bookkeeping ---------------------------------------------------------------------------------------
