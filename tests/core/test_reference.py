@@ -101,7 +101,7 @@ def _constant_sky_scene(albedo=0.6, sky=(1.0, 0.5, 2.0)):
     return Scene(vertices, triangles, normals, [Material((albedo,) * 3)], environment=environment)
 
 
-@pytest.mark.parametrize("environment_samples", [1, 4, 3])
+@pytest.mark.parametrize("environment_samples", [1, 3, 16])
 def test_constant_environment_on_lambertian_plane_is_unbiased_and_calibrated(environment_samples):
     scene = _constant_sky_scene()
     camera = orthographic_down(1.0, 24)
@@ -122,7 +122,8 @@ def test_error_falls_as_one_over_sqrt_samples():
     camera = orthographic_down(1.0, 16)
     expected = 0.6 * np.array([1.0, 0.5, 2.0])
     samples = np.array([4, 16, 64, 256])
-    errors = [rms(render_reference(scene, camera, int(n), seed=10 + k)[0] - expected) for k, n in enumerate(samples)]
+    errors = [rms(render_reference(scene, camera, int(n), seed=10 + k, environment_samples=1)[0] - expected)
+              for k, n in enumerate(samples)]
     slope = np.polyfit(np.log(samples), np.log(errors), 1)[0]
     assert -0.6 < slope < -0.4, (slope, errors)
 
@@ -166,7 +167,7 @@ def test_directional_light_on_lambertian_sphere_matches_closed_form():
     assert np.all(relative < 0.01 + 4 * error[lit] / expected[lit]), relative.max()
     assert rms(relative) < 0.01
     np.testing.assert_array_equal(image[dark], 0.0)
-    np.testing.assert_array_equal(image[~hit & (discriminant < -0.05)], 0.0)   # misses, no environment
+    np.testing.assert_array_equal(image[discriminant < -0.2], 0.0)   # misses (a pixel away), no environment
 
 
 # -- (c) a small occluder casts exactly the expected point-light shadow ---------------------------------
@@ -278,7 +279,7 @@ def _oblique_plane_mean_vs_quadrature(model, pixels, samples, seed, tangents=Non
 
 
 def test_glossy_plane_under_environment_matches_quadrature():
-    mean, error_of_mean, expected = _oblique_plane_mean_vs_quadrature(PhongStandIn(30.0), 24, 64, seed=7)
+    mean, error_of_mean, expected = _oblique_plane_mean_vs_quadrature(PhongStandIn(30.0), 24, 16, seed=7)
     assert np.all(error_of_mean < 0.008 * expected)
     assert np.all(np.abs(mean - expected) < 4 * error_of_mean + 5e-4 * expected), (mean, expected, error_of_mean)
 
@@ -292,7 +293,7 @@ def _core_brdf_models():
 @pytest.mark.parametrize("name", ["ggx", "cook_torrance", "ward_anisotropic"])
 def test_core_brdf_models_under_environment_match_quadrature(name):
     model = dict(_core_brdf_models())[name]()
-    mean, error_of_mean, expected = _oblique_plane_mean_vs_quadrature(model, 16, 48, seed=8,
+    mean, error_of_mean, expected = _oblique_plane_mean_vs_quadrature(model, 16, 12, seed=8,
                                                                       tangents=(1.0, 0.0, 0.0))
     assert np.all(error_of_mean < 0.015 * expected)
     assert np.all(np.abs(mean - expected) < 4 * error_of_mean + 5e-4 * expected), (mean, expected, error_of_mean)
@@ -324,11 +325,13 @@ def test_spot_light_cone_edge_falls_on_the_expected_pixels():
 def test_seed_determinism_progress_and_early_stop():
     scene = _constant_sky_scene()
     camera = orthographic_down(1.0, 8)
-    first, _ = render_reference(scene, camera, 4, seed=9, batch_rays=32)
-    again, _ = render_reference(scene, camera, 4, seed=9, batch_rays=32)
+    first, _ = render_reference(scene, camera, 4, seed=9, batch_rays=32, environment_samples=1)
+    again, _ = render_reference(scene, camera, 4, seed=9, batch_rays=32, environment_samples=1)
+    other, _ = render_reference(scene, camera, 4, seed=10, batch_rays=32, environment_samples=1)
+    assert np.any(first != other)
     np.testing.assert_array_equal(first, again)
     calls = []
-    image, error = render_reference(scene, camera, 4, seed=9, batch_rays=32,
+    image, error = render_reference(scene, camera, 4, seed=9, batch_rays=32, environment_samples=1,
                                     progress=lambda done, total: calls.append((done, total)) or len(calls) == 3)
     assert calls == [(32, 256), (64, 256), (96, 256)]
     assert np.all(np.isfinite(image))
