@@ -4,13 +4,13 @@ The NDF D(h) is an SG mixture in the half-vector domain.  For a fixed view
 ``wo`` the BRDF slice needs D(h(wi)) with h = normalize(wo + wi), i.e. the
 NDF pushed through the warp wi = psi(h) = 2 (wo.h) h - wo (eq. 17).
 
-Two modes, both returning ISOTROPIC SGs so that every downstream consumer
+Three modes, all returning ISOTROPIC SGs so that every downstream consumer
 (SG x clamped cosine, SSDF visibility fh, the SG-prefiltered environment,
 point lights as SGs) takes them unchanged:
 
 ``'paper'``  one lobe per NDF lobe, eq. 18-21: axis psi(p), sharpness
              lambda / tau with tau = 4 |p.wo|, amplitude kept.
-``'split2'`` (default) two lobes per NDF lobe.  The true warped lobe is
+``'split2'`` two lobes per NDF lobe.  The true warped lobe is
              anisotropic: sharpness lambda/4 in the plane of (p, wo) and
              lambda / (4 c^2) across it (c = p.wo), and it fans out (wider
              where h.wo is larger, i.e. towards the normal).  The paper's
@@ -31,15 +31,26 @@ point lights as SGs) takes them unchanged:
              FULL_SPLIT_SHARPNESS: for broad lobes the split overshoots the
              planar model it comes from, so they stay (nearly) 'paper'.
 
-Measured (benchmarks/accuracy/warp.py, quadrature of D(h(wi))): cosine-
-weighted energy ratio at 85 deg, alpha 0.05 / 0.1 / 0.3 / 0.5 (lambda =
-2/alpha^2): paper 0.75 / 0.46 / 0.15 / 0.11, split2 0.98 / 1.03 / 1.05 / 0.56;
-relative L2 at 60 deg for lambda >= 100: paper 0.34, split2 0.30.  Never
-worse than 'paper' by more than 0.05 in energy or 0.01 in L2 (grid lambda
-0.3..1e4, views 0..85 deg; worst at lambda 8, 45 deg).  Costs twice the lobes downstream.  End to end with eq. 22 (Mo at
-each lobe centre) on GGX, roughness 0.2-0.9, the gain shrinks: Mo carries
-1/(n.wi), which at the paper lobe's near-horizon centre partly compensates
-its lost cosine energy (see the accuracy table).
+``'split3'`` (default) the same with the three-point rule (nodes 0,
+             +-sqrt(3) delta, weights 2/3, 1/6, 1/6), three lobes.
+
+Measured (benchmarks/accuracy/warp.py, quadrature of D(h(wi)), lambda =
+2/alpha^2): cosine-weighted energy ratio at 85 deg for alpha 0.05 / 0.1 /
+0.3 / 0.5: paper 0.75 / 0.46 / 0.15 / 0.11, split2 0.98 / 1.03 / 1.05 / 0.56,
+split3 0.99 / 0.95 / 0.86 / 0.45.  Relative L2 over lambda 1..1e4 (mean) at
+60 / 75 / 85 deg: paper 0.34 / 0.61 / 0.94, split2 0.31 / 0.54 / 0.74,
+split3 0.28 / 0.49 / 0.77.  On the grid lambda 0.3..1e4 x views 0..85 deg
+split2 is never worse than 'paper' by more than 0.05 in energy or 0.01 in L2.
+
+End to end, eq. 22 with GGX's own SG lobe and Mo (roughness 0.2-0.9), mean
+|energy ratio - 1| at 60 / 75 / 85 / 89 deg: paper 0.031 / 0.080 / 0.198 /
+0.638, split2 0.021 / 0.152 / 0.130 / 0.336, split3 0.021 / 0.090 / 0.122 /
+0.315.  split2 loses at 75 deg because a sub-lobe whose centre falls below
+the horizon gets Mo = 0 while part of it is above (split3 gives that node
+only 1/6 of the weight).  Evaluating Mo at a lifted centre (the lobe's mean
+upper-hemisphere cosine) was measured and is worse.  So split3 is the
+default: as good as 'paper' up to 75 deg (mean within 0.01), better beyond,
+for 3x the lobes; split2 is the cheaper middle ground.
 
 Grazing clamp: tau = 4 max(|h.wo|, COS_FLOOR) and the warped sharpness is
 capped at MAX_WARPED_SHARPNESS, so grazing views (wo.z = 0, wo in the tangent
@@ -55,8 +66,13 @@ import numpy as np
 
 from . import sg
 
-MODES = ("paper", "split2")
-DEFAULT_MODE = "split2"
+# Gauss-Hermite rules (nodes in units of the offset delta, weights) for the split modes
+SPLIT_RULES = {
+    "split2": ((1.0, -1.0), (0.5, 0.5)),
+    "split3": ((np.sqrt(3.0), 0.0, -np.sqrt(3.0)), (1 / 6, 2 / 3, 1 / 6)),
+}
+MODES = ("paper",) + tuple(SPLIT_RULES)
+DEFAULT_MODE = "split3"
 COS_FLOOR = 1e-3                # floor of |h.wo| in tau = 4 |h.wo| (eq. 21)
 MAX_WARPED_SHARPNESS = 1e6      # cap of lambda / tau
 MAX_SPLIT_OFFSET = 0.2          # cap of delta (rad): the split overshoots for wide lobes (lambda < ~25)
@@ -84,8 +100,9 @@ def warp_lobes(axis, sharpness, amplitude, wo, mode=DEFAULT_MODE):
 
     axis (..., K, 3), sharpness (..., K), amplitude (..., K); wo (..., 3)
     broadcast over K.  Returns (axis, sharpness, amplitude) with K lobes for
-    mode 'paper' (wang2009 eq. 18-21) and 2K for 'split2' (the two halves of
-    NDF lobe k at indices 2k, 2k+1).  dtype follows the inputs.
+    mode 'paper' (wang2009 eq. 18-21), n K for the split modes (n = 2, 3; the
+    parts of NDF lobe k at indices n k ... n k + n - 1, in the order of
+    SPLIT_RULES' nodes).  dtype follows the inputs.
     """
     if mode not in MODES:
         raise ValueError(f"unknown warp mode {mode!r}, expected one of {MODES}")
@@ -102,7 +119,7 @@ def warp_lobes(axis, sharpness, amplitude, wo, mode=DEFAULT_MODE):
         warped_axis, warped_sharpness = _warp_at(axis, sharpness, wo, signed_cos)
         return warped_axis, warped_sharpness, np.broadcast_to(amplitude, warped_sharpness.shape).copy()
 
-    # split2: offset the lobe centre by +-delta in the plane of (axis, wo).
+    # split modes: Gauss-Hermite nodes along the plane of (axis, wo), spaced by delta
     in_plane = sg.normalize(wo - signed_cos[..., None] * axis, fallback=(1.0, 0.0, 0.0))
     in_plane = in_plane - _dot(in_plane, axis)[..., None] * axis   # fallback may not be orthogonal
     in_plane = sg.normalize(in_plane, fallback=(0.0, 1.0, 0.0))
@@ -111,14 +128,14 @@ def warp_lobes(axis, sharpness, amplitude, wo, mode=DEFAULT_MODE):
     # broad lobes: the split overshoots the planar model it is derived from, fade back to 'paper'
     offset_cap = MAX_SPLIT_OFFSET * np.minimum(sharpness * (1 / FULL_SPLIT_SHARPNESS), 1)
     offset = np.minimum(np.sqrt(offset_squared), offset_cap)
-    sign = np.array([1, -1], dtype)                          # +: towards wo
-    cos_offset = np.cos(offset)[..., None, None]
-    sin_offset = (np.sin(offset)[..., None] * sign)[..., None]
-    half = cos_offset * axis[..., None, :] + sin_offset * in_plane[..., None, :]   # (..., K, 2, 3)
+    nodes, weights = (np.array(r, dtype) for r in SPLIT_RULES[mode])   # node > 0: towards wo
+    node_offset = offset[..., None] * nodes                               # (..., K, n)
+    half = (np.cos(node_offset)[..., None] * axis[..., None, :]
+            + np.sin(node_offset)[..., None] * in_plane[..., None, :])    # (..., K, n, 3)
     half_cos = _dot(half, wo[..., None, :])
     warped_axis, warped_sharpness = _warp_at(half, sharpness[..., None], wo[..., None, :], half_cos)
-    warped_amplitude = np.where(half_cos > 0, 0.5 * amplitude[..., None], 0).astype(dtype)
-    shape = warped_sharpness.shape[:-2] + (2 * warped_sharpness.shape[-2],)
+    warped_amplitude = np.where(half_cos > 0, weights * amplitude[..., None], 0).astype(dtype)
+    shape = warped_sharpness.shape[:-2] + (len(nodes) * warped_sharpness.shape[-2],)
     return (warped_axis.reshape(shape + (3,)), warped_sharpness.reshape(shape),
             warped_amplitude.reshape(shape))
 
