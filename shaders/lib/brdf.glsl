@@ -67,8 +67,8 @@ float fresnel_dielectric(float cos_theta, float eta)
   float g2 = eta * eta + c * c - 1.0;
   float g = sqrt(max(g2, 0.0));
   float g_plus_c = g + c;
-  if (g2 <= 0.0 || g_plus_c <= 0.0) {
-    return 1.0;  /* total internal reflection, or c = 0 with eta <= 1 */
+  if (g2 <= 0.0 || c <= 0.0) {
+    return 1.0;  /* total internal reflection, or grazing */
   }
   float g_minus_c = (eta * eta - 1.0) / g_plus_c;
   float ratio = (c * g_plus_c - 1.0) / (c * g_minus_c + 1.0);
@@ -91,7 +91,7 @@ float shadowing_cook_torrance(vec3 wo, vec3 wi, vec3 h)
   return clamp(min(2.0 * nh * wo.z / oh, 2.0 * nh * wi.z / oh), 0.0, 1.0);
 }
 
-/* ---- frozen L2 single-lobe mappings: vec2(sharpness * w^2, amplitude / D(n)) ---- */
+/* ---- frozen L2 single-lobe mappings: vec2(sharpness * w^2, amplitude / D(n)), clamped at 0 ---- */
 
 const float BECKMANN_SHARPNESS[8] = float[8](2.0002526198839767, -0.018562042324853516, -0.7087810352685576, -1.780493452401246, 7.795476534850792, -5.224441602950464, -1.8573600001154729, 1.8313186768538343);
 const float BECKMANN_AMPLITUDE[8] = float[8](1.0000788099487423, -0.00562487537421968, 0.45936658759780197, -0.4782415853046627, 1.8768790206320416, -0.723505986830146, -1.093140907789823, 0.6774600689844926);
@@ -109,7 +109,7 @@ vec2 isotropic_mapping_beckmann(float width)
   for (int k = 6; k >= 0; k--) {
     r = r * w + vec2(BECKMANN_SHARPNESS[k], BECKMANN_AMPLITUDE[k]);
   }
-  return r;
+  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
 }
 
 vec2 isotropic_mapping_blinn_phong(float width)
@@ -119,7 +119,7 @@ vec2 isotropic_mapping_blinn_phong(float width)
   for (int k = 6; k >= 0; k--) {
     r = r * w + vec2(BLINN_PHONG_SHARPNESS[k], BLINN_PHONG_AMPLITUDE[k]);
   }
-  return r;
+  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
 }
 
 vec2 isotropic_mapping_ward_iso(float width)
@@ -129,7 +129,7 @@ vec2 isotropic_mapping_ward_iso(float width)
   for (int k = 5; k >= 0; k--) {
     r = r * w + vec2(WARD_ISO_SHARPNESS[k], WARD_ISO_AMPLITUDE[k]);
   }
-  return r;
+  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
 }
 
 vec2 isotropic_mapping_ggx(float width)
@@ -139,7 +139,7 @@ vec2 isotropic_mapping_ggx(float width)
   for (int k = 5; k >= 0; k--) {
     r = r * w + vec2(GGX_SHARPNESS[k], GGX_AMPLITUDE[k]);
   }
-  return r;
+  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
 }
 
 /* ---- shared pieces ---- */

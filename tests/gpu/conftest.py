@@ -5,6 +5,10 @@
 - `glsl`: a callable `glsl(library, call, inputs, output_components=4,
   textures=None)` around sg_prt_addon.engine.glsl_harness.run_glsl, where
   `library` lists shaders/lib file names ("sg.glsl") and/or raw GLSL sources.
+- `fuzz`: a `Fuzz` (numpy rng seeded from the test name) generating
+  float32-exact inputs, including the degenerate ones of the stress tests.
+- `record_error`: `record_error(label, value)` returns value and lists it
+  under "measured max errors" in the pytest summary.
 """
 import zlib
 

@@ -20,6 +20,11 @@ def test_pole_integrals(glsl, fuzz, record_error):
     error = fuzz.relative_error(out, np.c_[upper, lower], 1e-30)
     # e^-l carries ~l * 6e-8 relative float32 error (l up to ~70 above the floor)
     assert record_error("clamped_cosine pole_integrals, relative", error.max()) <= 1e-5
+    moments = glsl(LIB, "vec4(clamped_cosine_langevin_moments(a.x), 0.0, 0.0)", {"a": sharpness}, 2)
+    mean, variance = clamped_cosine._langevin_moments(sharpness)
+    # coth(l) - 1/l and 1/l^2 - 1/sinh^2 cancel by ~5/L just above the series cutoff 0.2
+    error = np.abs(moments - np.c_[mean, variance]) / np.c_[np.maximum(mean, 1e-30), np.full(mean.size, 1 / 3)]
+    assert record_error("clamped_cosine langevin_moments, L relative, V relative to 1/3", error.max()) <= 2e-5
 
 
 def test_clamped_cosine_integral(glsl, fuzz, record_error):
@@ -34,7 +39,7 @@ def test_clamped_cosine_integral(glsl, fuzz, record_error):
                {"p": np.c_[axis, sharpness], "n": np.c_[normal, amplitude]}, 2)
     expected = clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, amplitude, normal)
     # scale: the integral with the normal on the axis, mu (2 pi / lambda) I_up
-    scale = amplitude * clamped_cosine._clamped_cosine_from_cosine(np.ones(N), sharpness) + 1e-30
+    scale = amplitude * clamped_cosine.clamped_cosine_from_cosine(np.ones(N), sharpness) + 1e-30
     assert record_error("clamped_cosine sg_clamped_cosine_integral, relative to I(c = 1)",
                         (np.abs(out[:, 0] - expected) / scale).max()) <= 1e-5
     paper = clamped_cosine.sg_clamped_cosine_integral_paper(axis, sharpness, amplitude, normal)
@@ -53,8 +58,8 @@ def test_from_cosine_and_lobe(glsl, fuzz, record_error):
     out = glsl(LIB, "vec4(clamped_cosine_from_cosine(a.x, a.y), clamped_cosine_lobe_evaluate(d.xyz, n.xyz),"
                     " clamped_cosine_lobe())",
                {"a": np.c_[cosine, sharpness], "d": direction, "n": normal}, 4)
-    expected = clamped_cosine._clamped_cosine_from_cosine(cosine, sharpness)
-    scale = clamped_cosine._clamped_cosine_from_cosine(np.ones_like(cosine), sharpness)
+    expected = clamped_cosine.clamped_cosine_from_cosine(cosine, sharpness)
+    scale = clamped_cosine.clamped_cosine_from_cosine(np.ones_like(cosine), sharpness)
     assert record_error("clamped_cosine from_cosine, relative to I(c = 1)",
                         (np.abs(out[:, 0] - expected) / scale).max()) <= 1e-5
     lobe = clamped_cosine.clamped_cosine_lobe_evaluate(direction, normal)
