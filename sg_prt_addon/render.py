@@ -40,7 +40,7 @@ def ensure_registered():
     """Register the add-on once per process (the pip module has no add-on preferences)."""
     import bpy
     import sg_prt_addon
-    if ENGINE_ID not in {engine.bl_idname for engine in bpy.types.RenderEngine.__subclasses__()}:
+    if not hasattr(bpy.types.Material, "sgprt"):
         sg_prt_addon.register()
 
 
