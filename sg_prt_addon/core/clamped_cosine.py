@@ -115,12 +115,13 @@ def sg_clamped_cosine_integral_paper(axis, sharpness, amplitude, normal):
 def _pole_integrals(sharpness):
     """(I_up, I_low) / (2 pi / lambda): the normal on the lobe axis, and opposite to it."""
     lam = sharpness
-    small = lam < 1e-2
+    small = lam < 0.25  # below, 1 - (1 - e^-l)/l loses float32 digits: Taylor series (truncation < 1e-11)
     safe = np.where(small, 1, lam)
-    # 1 - (1 - e^-l)/l and (1 - e^-l)/l - e^-l, with series where they cancel
-    upper = np.where(small, 0.5 * lam * (1 - lam / 3 + lam * lam / 12 - lam ** 3 / 60),
+    x = np.where(small, lam, 0)  # series argument, kept small so no branch can overflow
+    # 1 - (1 - e^-l)/l = sum (-1)^(k+1) l^k / (k+1)!,  (1 - e^-l)/l - e^-l = sum (-1)^(k+1) k l^k / (k+1)!
+    upper = np.where(small, 0.5 * x * (1 - x * (1 / 3 - x * (1 / 12 - x * (1 / 60 - x * (1 / 360 - x * (1 / 2520 - x * (1 / 20160 - x / 181440))))))),
                      1 - sg.one_minus_exp_over_x(safe))
-    lower_moment = np.where(small, 0.5 * lam * (1 - 2 * lam / 3 + lam * lam / 4 - lam ** 3 / 15),
+    lower_moment = np.where(small, 0.5 * x * (1 - x * (2 / 3 - x * (1 / 4 - x * (1 / 15 - x * (1 / 72 - x * (1 / 420 - x * (1 / 2880 - x / 22680))))))),
                             sg.one_minus_exp_over_x(safe) - np.exp(-safe))
     return upper, np.exp(-lam) * lower_moment
 
@@ -133,7 +134,7 @@ def _langevin_moments(sharpness):
     safe = np.where(small, 1, lam)
     decay = np.exp(-2 * safe)
     one_minus_decay = -np.expm1(-2 * safe)
-    square = lam * lam
+    square = np.where(small, lam * lam, 0)  # series argument, kept small so no branch can overflow
     mean = np.where(small, lam * (1 / 3 - square / 45 + 2 * square ** 2 / 945 - square ** 3 / 4725),
                     (1 + decay) / one_minus_decay - 1 / safe)
     variance = np.where(small, 1 / 3 - square / 15 + 2 * square ** 2 / 189 - square ** 3 / 675 + 2 * square ** 4 / 10395,
