@@ -145,7 +145,63 @@ def fit_isotropic(ndf_values, theta, weights, lobe_count=1, initial=None):
     return out_sharpness, out_amplitude, out_error
 
 
-def derive_isotropic_mapping(ndf_of_width, peak_of_width, widths, degree=5):
+def fit_isotropic_batch(ndf_values, theta, weights, lobe_count=1, iterations=60, chunk=2048):
+    """Vectorized Levenberg-Marquardt version of fit_isotropic for many rows at once
+    (per-pixel NDFs of a measured SVBRDF tabulated on one shared theta grid).
+
+    Same model and objective as fit_isotropic (log-parametrized lobes around z+),
+    every row damped independently; rows are processed ``chunk`` at a time to bound
+    memory.  Returns (sharpness (B, K), amplitude (B, K), relative_l2 (B,)), lobes
+    sorted by increasing sharpness.
+    """
+    values = np.atleast_2d(np.asarray(ndf_values, np.float64))
+    theta = np.asarray(theta, np.float64)
+    one_minus_cos = 2 * np.sin(0.5 * theta) ** 2
+    root_w = np.sqrt(np.asarray(weights, np.float64))
+    sharpness_out = np.empty((len(values), lobe_count))
+    amplitude_out = np.empty((len(values), lobe_count))
+    error_out = np.empty(len(values))
+    for start in range(0, len(values), chunk):
+        target = values[start:start + chunk]
+        scale = np.maximum(np.sqrt(np.sum(root_w ** 2 * target ** 2, axis=1)), 1e-300)[:, None]
+        params = np.stack([_initial_isotropic(row, theta, lobe_count) for row in target])
+
+        def residual_and_jacobian(params):
+            clipped = np.clip(params, -40, 40)
+            sharpness = np.exp(clipped[:, :lobe_count])[:, :, None]
+            lobes = np.exp(clipped[:, lobe_count:])[:, :, None] * np.exp(-sharpness * one_minus_cos)  # (B, K, M)
+            residual = root_w * (lobes.sum(1) - target) / scale
+            jacobian = np.concatenate([-lobes * sharpness * one_minus_cos, lobes], axis=1)  # (B, P, M)
+            return residual, jacobian * (root_w / scale)[:, None, :]
+
+        residual, jacobian = residual_and_jacobian(params)
+        cost = np.sum(residual ** 2, axis=1)
+        damping = np.full(len(target), 1e-3)
+        identity = np.eye(2 * lobe_count)
+        for _ in range(iterations):
+            normal = jacobian @ jacobian.transpose(0, 2, 1)
+            gradient = np.einsum("bpm,bm->bp", jacobian, residual)
+            diagonal = np.einsum("bpp->bp", normal)[:, :, None] * identity + 1e-30 * identity
+            step = np.linalg.solve(normal + damping[:, None, None] * diagonal, -gradient[:, :, None])[:, :, 0]
+            trial = params + step
+            trial_residual, trial_jacobian = residual_and_jacobian(trial)
+            trial_cost = np.sum(trial_residual ** 2, axis=1)
+            better = np.isfinite(trial_cost) & (trial_cost < cost)
+            params = np.where(better[:, None], trial, params)
+            residual = np.where(better[:, None], trial_residual, residual)
+            jacobian = np.where(better[:, None, None], trial_jacobian, jacobian)
+            cost = np.where(better, trial_cost, cost)
+            damping = np.clip(np.where(better, damping / 3, damping * 4), 1e-12, 1e12)
+        sharpness = np.exp(np.clip(params[:, :lobe_count], -40, 40))
+        amplitude = np.exp(np.clip(params[:, lobe_count:], -40, 40))
+        order = np.argsort(sharpness, axis=1)
+        sharpness_out[start:start + chunk] = np.take_along_axis(sharpness, order, 1)
+        amplitude_out[start:start + chunk] = np.take_along_axis(amplitude, order, 1)
+        error_out[start:start + chunk] = np.sqrt(cost)
+    return sharpness_out, amplitude_out, error_out
+
+
+def derive_isotropic_mapping(ndf_of_width, peak_of_width, widths, degree=5, endpoint_weight=1.0):
     """L2-optimal single lobe over a width grid and polynomials through it.
 
     ndf_of_width(theta, width) -> D; peak_of_width(width) -> D(n).  The fitted
@@ -164,8 +220,11 @@ def derive_isotropic_mapping(ndf_of_width, peak_of_width, widths, degree=5):
         previous = np.concatenate([sharpness, amplitude])
         rows.append((width, sharpness[0] * width * width, amplitude[0]))
     table = np.array(rows)
-    sharpness_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 1], degree)
-    amplitude_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 2], degree)
+    # endpoint_weight pins the ends of the range (GGX at alpha = 1 is a constant: sharpness 0)
+    fit_weights = np.ones(len(table))
+    fit_weights[[0, -1]] = endpoint_weight
+    sharpness_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 1], degree, w=fit_weights)
+    amplitude_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 2], degree, w=fit_weights)
     return sharpness_coefficients, amplitude_coefficients, table
 
 
@@ -393,15 +452,18 @@ def anisotropic_lobes(width_x, width_y, peak, lobe_count):
     low = np.clip(np.floor(position).astype(int), 0, len(ratios) - 2)
     fraction = (position - low)[..., None, None]
     entry = (1 - fraction) * table[low] + fraction * table[low + 1]
+    # axis = normalize(slope along the long axis, 0 across, 1), written per component
     slope = entry[..., 0] * long_width[..., None]
-    zeros = np.zeros_like(slope)
-    axis = np.where(long_is_x[..., None, None],
-                    np.stack([slope, zeros, np.ones_like(slope)], axis=-1),
-                    np.stack([zeros, slope, np.ones_like(slope)], axis=-1))
-    axis = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+    inverse_length = 1 / np.sqrt(1 + slope * slope)
+    tilt = slope * inverse_length
+    axis = np.zeros(slope.shape + (3,), dtype)
+    long_x = np.broadcast_to(long_is_x[..., None], slope.shape)
+    axis[..., 0] = np.where(long_x, tilt, 0)
+    axis[..., 1] = np.where(long_x, 0, tilt)
+    axis[..., 2] = inverse_length
     sharpness = entry[..., 1] / (long_width * long_width)[..., None]
     amplitude = entry[..., 2] * peak[..., None]
-    return axis.astype(dtype), sharpness.astype(dtype), amplitude.astype(dtype)
+    return axis, sharpness.astype(dtype), amplitude.astype(dtype)
 
 
 def isotropic_model_of_width(kind, width):

@@ -19,9 +19,9 @@ def test_cook_torrance_eq12_single_lobe(roughness, bound):
 @pytest.mark.parametrize("kind", sorted(brdf.ISOTROPIC_MAPPINGS))
 def test_isotropic_mappings_are_near_l2_optimal(kind):
     low, high = brdf.ISOTROPIC_MAPPINGS[kind]["width_range"]
-    widths = np.linspace(0.01, high, 7)
+    widths = np.r_[np.linspace(0.01, high, 7), 0.99 * high]
     mapping_error, optimal_error = ndf_fit.isotropic_mapping_errors(kind, widths)
-    assert np.all(mapping_error <= optimal_error + 0.005), (mapping_error - optimal_error)
+    assert np.all(mapping_error <= optimal_error + 0.002), (mapping_error - optimal_error)
 
 
 @pytest.mark.parametrize("roughness", [0.05, 0.2, 0.45, 0.7, 0.9, 1.0])
@@ -129,3 +129,14 @@ def test_anisotropic_lobes_swap_axes_and_broadcast():
 def test_brdf_rmse_of_cook_torrance_eq12():
     model = brdf.CookTorrance(roughness=0.2)
     assert ndf_fit.brdf_relative_rmse(model, model.ndf_lobes(), count=40_000) < 0.005
+
+
+def test_batched_fit_matches_scipy_levenberg_marquardt():
+    theta, weights = ndf_fit.polar_quadrature([0.05, 0.3], 16)
+    alphas = np.array([0.05, 0.1, 0.25, 0.4, 0.6])
+    values = np.stack([1 / ((np.sin(theta) / a) ** 2 + np.cos(theta) ** 2) ** 2 for a in alphas])  # GGX / D(n)
+    for lobe_count in (1, 2):
+        batch = ndf_fit.fit_isotropic_batch(values, theta, weights, lobe_count)
+        single = ndf_fit.fit_isotropic(values, theta, weights, lobe_count)
+        np.testing.assert_allclose(batch[2], single[2], rtol=1e-6, atol=1e-9)
+        np.testing.assert_allclose(batch[0], single[0], rtol=1e-4)
