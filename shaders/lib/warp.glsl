@@ -3,9 +3,11 @@
  *
  *   warp_at             <- warp._warp_at (eq. 18-21 at one lobe centre, grazing clamp)
  *   warp_lobes_paper    <- warp.warp_lobes(mode="paper"): one lobe per NDF lobe
- *   warp_lobes_split2   <- warp.warp_lobes(mode="split2") (warp.DEFAULT_MODE): two
- *                          half-amplitude lobes per NDF lobe, index 0 = warp.py's 2k
- *                          (offset towards wo), index 1 = 2k + 1
+ *   warp_split_frame, warp_split_node <- the split branch of warp.warp_lobes
+ *   warp_lobes_split2   <- warp.warp_lobes(mode="split2"): two lobes per NDF lobe
+ *   warp_lobes_split3   <- warp.warp_lobes(mode="split3") (warp.DEFAULT_MODE): three
+ *                          lobes; index j = warp.py's n k + j, in SPLIT_RULES' node
+ *                          order (first node offset towards wo)
  *   brdf_slice_amplitude <- the end of warp.brdf_slice_lobes: warped amplitude
  *                          times Mo at the warped axis, 0 where Mo is not finite
  *                          (the caller evaluates Mo with a brdf.glsl *_m_factor)
@@ -38,30 +40,62 @@ void warp_lobes_paper(vec3 axis, float sharpness, float amplitude, vec3 wo,
   warped_amplitude = amplitude;
 }
 
-/* Split the NDF lobe into two half-amplitude lobes offset by +-delta in the
- * plane of (axis, wo), delta = sqrt((1 - c)/lambda) capped (the cap fades to 0
- * below lambda = WARP_FULL_SPLIT_SHARPNESS), then warp each at its own centre.
- * A sub-lobe whose centre is not a valid half vector (h.wo <= 0) gets amplitude 0. */
+/* Split modes: Gauss-Hermite nodes along the plane of (axis, wo), spaced by
+ * delta = sqrt((1 - c)/lambda) capped (the cap fades to 0 below lambda =
+ * WARP_FULL_SPLIT_SHARPNESS), each warped at its own centre.  This prepares the
+ * normalised axis and wo, the in-plane direction and delta. */
+void warp_split_frame(vec3 axis, float sharpness, vec3 wo,
+                      out vec3 unit_axis, out vec3 unit_wo, out vec3 in_plane, out float offset)
+{
+  unit_axis = safe_normalize(axis);
+  unit_wo = safe_normalize(wo);
+  float signed_cos = clamp(dot(unit_axis, unit_wo), -1.0, 1.0);
+  in_plane = safe_normalize(unit_wo - signed_cos * unit_axis, vec3(1.0, 0.0, 0.0));
+  in_plane = in_plane - dot(in_plane, unit_axis) * unit_axis;  /* the fallback may not be orthogonal */
+  in_plane = safe_normalize(in_plane, vec3(0.0, 1.0, 0.0));
+  float offset_cap = WARP_MAX_SPLIT_OFFSET * min(sharpness * (1.0 / WARP_FULL_SPLIT_SHARPNESS), 1.0);
+  offset = sharpness > 0.0 ? min(sqrt((1.0 - signed_cos) / sharpness), offset_cap) : offset_cap;
+}
+
+/* One node (in units of delta, > 0 towards wo) of weight `weight`; a node whose
+ * centre is not a valid half vector (h.wo <= 0) gets amplitude 0. */
+void warp_split_node(vec3 unit_axis, vec3 in_plane, vec3 unit_wo, float offset, float node, float weight,
+                     float sharpness, float amplitude,
+                     out vec3 warped_axis, out float warped_sharpness, out float warped_amplitude)
+{
+  float node_offset = offset * node;
+  vec3 half_vector = cos(node_offset) * unit_axis + sin(node_offset) * in_plane;
+  float half_cos = dot(half_vector, unit_wo);
+  warp_at(half_vector, sharpness, unit_wo, half_cos, warped_axis, warped_sharpness);
+  warped_amplitude = half_cos > 0.0 ? weight * amplitude : 0.0;
+}
+
+/* Two-point rule: nodes +-1, weights 1/2 (index 0 = warp.py's n k, towards wo). */
 void warp_lobes_split2(vec3 axis, float sharpness, float amplitude, vec3 wo,
                        out vec3 warped_axis[2], out float warped_sharpness[2], out float warped_amplitude[2])
 {
-  axis = safe_normalize(axis);
-  wo = safe_normalize(wo);
-  float signed_cos = clamp(dot(axis, wo), -1.0, 1.0);
-  vec3 in_plane = safe_normalize(wo - signed_cos * axis, vec3(1.0, 0.0, 0.0));
-  in_plane = in_plane - dot(in_plane, axis) * axis;  /* the fallback may not be orthogonal */
-  in_plane = safe_normalize(in_plane, vec3(0.0, 1.0, 0.0));
-  float offset_cap = WARP_MAX_SPLIT_OFFSET * min(sharpness * (1.0 / WARP_FULL_SPLIT_SHARPNESS), 1.0);
-  float offset = sharpness > 0.0 ? min(sqrt((1.0 - signed_cos) / sharpness), offset_cap) : offset_cap;
-  float cos_offset = cos(offset);
-  float sin_offset = sin(offset);
-  for (int k = 0; k < 2; k++) {
-    float sign_k = k == 0 ? 1.0 : -1.0;  /* +: towards wo */
-    vec3 half_vector = cos_offset * axis + (sign_k * sin_offset) * in_plane;
-    float half_cos = dot(half_vector, wo);
-    warp_at(half_vector, sharpness, wo, half_cos, warped_axis[k], warped_sharpness[k]);
-    warped_amplitude[k] = half_cos > 0.0 ? 0.5 * amplitude : 0.0;
-  }
+  vec3 unit_axis, unit_wo, in_plane;
+  float offset;
+  warp_split_frame(axis, sharpness, wo, unit_axis, unit_wo, in_plane, offset);
+  warp_split_node(unit_axis, in_plane, unit_wo, offset, 1.0, 0.5, sharpness, amplitude,
+                  warped_axis[0], warped_sharpness[0], warped_amplitude[0]);
+  warp_split_node(unit_axis, in_plane, unit_wo, offset, -1.0, 0.5, sharpness, amplitude,
+                  warped_axis[1], warped_sharpness[1], warped_amplitude[1]);
+}
+
+/* Three-point rule (warp.DEFAULT_MODE): nodes sqrt(3), 0, -sqrt(3), weights 1/6, 2/3, 1/6. */
+void warp_lobes_split3(vec3 axis, float sharpness, float amplitude, vec3 wo,
+                       out vec3 warped_axis[3], out float warped_sharpness[3], out float warped_amplitude[3])
+{
+  vec3 unit_axis, unit_wo, in_plane;
+  float offset;
+  warp_split_frame(axis, sharpness, wo, unit_axis, unit_wo, in_plane, offset);
+  warp_split_node(unit_axis, in_plane, unit_wo, offset, 1.7320508075688772, 1.0 / 6.0, sharpness, amplitude,
+                  warped_axis[0], warped_sharpness[0], warped_amplitude[0]);
+  warp_split_node(unit_axis, in_plane, unit_wo, offset, 0.0, 2.0 / 3.0, sharpness, amplitude,
+                  warped_axis[1], warped_sharpness[1], warped_amplitude[1]);
+  warp_split_node(unit_axis, in_plane, unit_wo, offset, -1.7320508075688772, 1.0 / 6.0, sharpness, amplitude,
+                  warped_axis[2], warped_sharpness[2], warped_amplitude[2]);
 }
 
 /* eq. 22: Mo evaluated at the warped lobe centre scales the amplitude; non-finite Mo -> 0. */

@@ -7,9 +7,9 @@ from sg_prt_addon.core import brdf, warp
 N = 20000
 LIB = ["sg.glsl", "brdf.glsl", "warp.glsl"]
 
-SPLIT2 = """
-    vec3 axes[2]; float sharpnesses[2], amplitudes[2];
-    warp_lobes_split2(p.xyz, p.w, m.x, wo.xyz, axes, sharpnesses, amplitudes);
+SPLIT = """
+    vec3 axes[{n}]; float sharpnesses[{n}], amplitudes[{n}];
+    warp_lobes_split{n}(p.xyz, p.w, m.x, wo.xyz, axes, sharpnesses, amplitudes);
     int k = int(m.y);
     result = m.z > 0.5 ? vec4(sharpnesses[k], amplitudes[k], 0.0, 0.0) : vec4(axes[k], 0.0);
 """
@@ -66,33 +66,35 @@ def test_warp_paper(glsl, fuzz, record_error):
     _compare(record_error, "paper", got, [a[:, 0] for a in expected], sharpness)
 
 
-@pytest.mark.parametrize("index", [0, 1])
-def test_warp_split2(glsl, fuzz, record_error, index):
+@pytest.mark.parametrize("mode, index", [("split2", 0), ("split2", 1), ("split3", 0), ("split3", 1), ("split3", 2)])
+def test_warp_split(glsl, fuzz, record_error, mode, index):
     axis, sharpness, amplitude, wo = _inputs(fuzz)
-    got = _glsl_lobes(glsl, SPLIT2, axis, sharpness, amplitude, wo, index)
-    expected = warp.warp_lobes(axis[:, None], sharpness[:, None], amplitude[:, None], wo, mode="split2")
-    _compare(record_error, f"split2[{index}]", got, [a[:, index] for a in expected], sharpness)
+    body = SPLIT.format(n=len(warp.SPLIT_RULES[mode][0]))
+    got = _glsl_lobes(glsl, body, axis, sharpness, amplitude, wo, index)
+    expected = warp.warp_lobes(axis[:, None], sharpness[:, None], amplitude[:, None], wo, mode=mode)
+    _compare(record_error, f"{mode}[{index}]", got, [a[:, index] for a in expected], sharpness)
 
 
 def test_brdf_slice_ggx(glsl, fuzz, record_error):
-    """eq. 22 end to end for one GGX lobe: warp_lobes_split2 then ggx_m_factor at each warped axis."""
+    """eq. 22 end to end for one GGX lobe: warp_lobes_split3 (the default) then ggx_m_factor at each warped axis."""
     roughness = fuzz.uniform(0.1, 1.0, N)
     _, lobe_sharpness, lobe_amplitude = brdf.GGX(roughness=roughness).ndf_lobes()
     axis = np.tile([0.0, 0.0, 1.0], (N, 1))
     _, _, _, wo = _inputs(fuzz)
     body = """
-    vec2 lobe = ggx_ndf_lobe(m.w);
-    vec3 axes[2]; float sharpnesses[2], amplitudes[2];
-    warp_lobes_split2(vec3(0.0, 0.0, 1.0), lobe.x, lobe.y, wo.xyz, axes, sharpnesses, amplitudes);
+    vec2 lobe = m.xy;  /* numpy's lobe: the mapping's own float32 error is tested in test_glsl_brdf */
+    vec3 axes[3]; float sharpnesses[3], amplitudes[3];
+    warp_lobes_split3(vec3(0.0, 0.0, 1.0), lobe.x, lobe.y, wo.xyz, axes, sharpnesses, amplitudes);
     result = vec4(brdf_slice_amplitude(amplitudes[0], ggx_m_factor(wo.xyz, axes[0], m.w)),
-                  brdf_slice_amplitude(amplitudes[1], ggx_m_factor(wo.xyz, axes[1], m.w)), axes[0].z, axes[1].z);
+                  brdf_slice_amplitude(amplitudes[1], ggx_m_factor(wo.xyz, axes[1], m.w)),
+                  brdf_slice_amplitude(amplitudes[2], ggx_m_factor(wo.xyz, axes[2], m.w)), 0.0);
     """
-    out = glsl(LIB, body, {"wo": wo, "m": np.c_[np.zeros((N, 3)), roughness]}, 4)
+    out = glsl(LIB, body, {"wo": wo, "m": np.c_[lobe_sharpness, lobe_amplitude, np.zeros(N), roughness]}, 3)
     model = brdf.GGX(roughness=roughness[:, None])
     warped_axis, _, expected = warp.brdf_slice_lobes(axis[:, None], lobe_sharpness, lobe_amplitude, wo,
-                                                     model.m_factor, mode="split2")
+                                                     model.m_factor, mode="split3")
     # Mo ~ 1/(n.wi (n.o)): relative error ~ 1e-7 / (n.wi) near the horizon; compare above 0.05
     clear = (warped_axis[..., 2] > 0.05) & (wo[:, 2:3] > 0.05)
-    error = np.abs(out[:, :2] - expected) / np.maximum(np.abs(expected), 1e-30)
-    assert record_error("warp brdf_slice (split2, GGX, n.wi and n.o > 0.05) amplitude, relative",
+    error = np.abs(out - expected) / np.maximum(np.abs(expected), 1e-30)
+    assert record_error("warp brdf_slice (split3, GGX, n.wi and n.o > 0.05) amplitude, relative",
                         error[clear].max()) <= 1e-4
