@@ -211,7 +211,29 @@ def visibility_product(axis, sharpness, amplitude, theta_d):
     The product with the SSDF-reconstructed hemispherical visibility keeps the
     axis and sharpness and rescales the amplitude so that the integral matches.
     Returns (axis, sharpness, amplitude).
+
+    Exact (up to fh) only for the lobe that is integrated last, i.e. the
+    product of all SG factors (wang2009 eq. 39 forms C* (x) L* first).  Applied
+    to one factor before multiplying by a second SG H, the error reaches 100%
+    of the integral of G H when H is as sharp as G or sharper (measured in
+    benchmarks/accuracy/hemisphere.py); it stays small only for H much broader.
     """
     normalized = fh_normalized(theta_d, sharpness)
     return axis, sharpness, (np.asarray(amplitude) * normalized).astype(normalized.dtype, copy=False)
+
+
+def visibility_product_integral_preserving(axis, sharpness, amplitude, theta_d):
+    """eq. 31 with the normalization its text asks for: the returned lobe's integral over
+    the whole sphere equals mu fh(theta_d) (fast fh).
+
+    The printed eq. 31 divides by fh(pi/2) = (2 pi / lambda)(1 - e^-lambda), the
+    integral over the lobe's own hemisphere, while the lobe is then integrated
+    over the sphere, (2 pi / lambda)(1 - e^-2 lambda): that over-counts by the
+    factor 1 + e^-lambda (12% for the eq. 40 cosine lobe, lambda = 2.133; 37% at
+    lambda = 1; negligible above lambda ~ 10).  Here amplitude * fh_hat / (1 + e^-lambda).
+    """
+    normalized = fh_normalized(theta_d, sharpness)
+    lam = np.maximum(np.asarray(sharpness, normalized.dtype), 0)
+    scale = normalized / (1 + np.exp(-lam))
+    return axis, sharpness, (np.asarray(amplitude) * scale).astype(normalized.dtype, copy=False)
 

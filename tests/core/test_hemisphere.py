@@ -142,3 +142,42 @@ def test_visibility_product_eq31():
     assert np.allclose(integral, mu * hemisphere.fh_exact(theta, lam), rtol=0.01)
     saturated = hemisphere.visibility_product(axis, lam, mu, np.array([3.0, -3.0, 2.0]))[2]
     assert np.allclose(saturated, mu * hemisphere.fh_normalized(np.array([1, -1, 1]) * np.pi / 2, lam))
+
+
+def _triple_product_case(n, seed):
+    """Lobe G, second lobe H, visibility hemisphere m with m.p = sin(theta_d) near G's horizon."""
+    rng = np.random.default_rng(seed)
+    p = sg.normalize(rng.normal(size=(n, 3)))
+    q = sg.normalize(p + rng.normal(size=(n, 3)) * rng.uniform(0, 1, (n, 1)))
+    lam_g = np.exp(rng.uniform(np.log(0.1), np.log(1e4), n))
+    lam_h = np.exp(rng.uniform(np.log(1e-3), np.log(1e4), n))
+    theta = np.clip(rng.normal(0, 1.5 / np.sqrt(lam_g)), -np.pi / 2, np.pi / 2)
+    tangent = sg.normalize(np.cross(p, rng.normal(size=(n, 3))))
+    m = np.sin(theta)[:, None] * p + np.cos(theta)[:, None] * tangent
+    return p, q, lam_g, lam_h, theta, m
+
+
+def test_visibility_product_needs_the_final_lobe():
+    """eq. 31 on the lobe integrated last (G (x) H) is exact up to fh and to the printed
+    normalization's 1 + e^-lambda; applied to G before multiplying by H it is not."""
+    p, q, lam_g, lam_h, theta, m = _triple_product_case(400, 21)
+    axis, lam, mu = sg.product(p, lam_g, 1.0, q, lam_h, 1.0)
+    full = sg.inner_product(p, lam_g, 1.0, q, lam_h, 1.0)
+    keep = full > 1e-250
+    exact = hemisphere.hemisphere_integral_exact(axis, lam, mu, m)[keep]
+    theta_final = np.arcsin(np.clip(np.sum(axis * m, -1), -1, 1))
+    # integral-preserving eq. 31 on the final lobe: only the fast fh's error remains
+    _, lam_v, mu_v = hemisphere.visibility_product_integral_preserving(axis, lam, mu, theta_final)
+    preserving = sg.sphere_integral(lam_v, mu_v)[keep]
+    assert np.max(np.abs(preserving - exact) / full[keep]) <= 0.002
+    # printed eq. 31: over-counts by 1 + e^-lambda
+    _, lam_p, mu_p = hemisphere.visibility_product(axis, lam, mu, theta_final)
+    printed = sg.sphere_integral(lam_p, mu_p)[keep]
+    assert np.allclose(printed, preserving * (1 + np.exp(-lam[keep])), rtol=1e-9)
+    # eq. 31 on G alone, then the inner product with H: fine only if H is nearly constant
+    _, _, mu_g = hemisphere.visibility_product_integral_preserving(p, lam_g, 1.0, theta)
+    early = sg.inner_product(p, lam_g, mu_g, q, lam_h, 1.0)[keep]
+    error = np.abs(early - exact) / full[keep]
+    broad = lam_h[keep] < 0.01  # H varies by < 2% over the sphere
+    assert broad.sum() > 20 and error[broad].max() <= 0.03
+    assert error[~broad].max() > 0.5

@@ -144,6 +144,8 @@ def test_hemisphere_kernels(inputs):
     axis, sharp, scaled = hemisphere.visibility_product(x["axis1"], lam, amplitude, theta_d)
     assert np.array_equal(sharp, lam) and axis is x["axis1"]
     _check(scaled, dtype, 0, amplitude, eps)
+    preserved = hemisphere.visibility_product_integral_preserving(x["axis1"], lam, amplitude, theta_d)[2]
+    _check(preserved, dtype, 0, amplitude, eps)
 
     _check(hemisphere.erf_approx(theta_d * lam), dtype, -1, 1)
 
