@@ -86,10 +86,11 @@ def _dot(a, b):
 def _warp_at(half, sharpness, wo, signed_cos):
     """Paper's per-lobe warp (eq. 18-21) of lobes centred at ``half``.
 
-    Returns the reflected axis psi(half) and the sharpness lambda / tau with
-    tau = 4 |half.wo| clamped below by 4 COS_FLOOR.
+    Returns the reflected axis psi(half) = 2 (wo.h) h - wo (unit for unit h and
+    wo: |psi|^2 = 4 c^2 - 4 c^2 + 1, so no normalize) and the sharpness
+    lambda / tau with tau = 4 |half.wo| clamped below by 4 COS_FLOOR.
     """
-    axis = sg.normalize(2 * signed_cos[..., None] * half - wo)
+    axis = 2 * signed_cos[..., None] * half - wo
     tau = 4 * np.maximum(np.abs(signed_cos), COS_FLOOR)
     warped_sharpness = np.minimum(sharpness / tau, MAX_WARPED_SHARPNESS)
     return axis, warped_sharpness
@@ -120,9 +121,13 @@ def warp_lobes(axis, sharpness, amplitude, wo, mode=DEFAULT_MODE):
         return warped_axis, warped_sharpness, np.broadcast_to(amplitude, warped_sharpness.shape).copy()
 
     # split modes: Gauss-Hermite nodes along the plane of (axis, wo), spaced by delta
-    in_plane = sg.normalize(wo - signed_cos[..., None] * axis, fallback=(1.0, 0.0, 0.0))
-    in_plane = in_plane - _dot(in_plane, axis)[..., None] * axis   # fallback may not be orthogonal
-    in_plane = sg.normalize(in_plane, fallback=(0.0, 1.0, 0.0))
+    in_plane = wo - signed_cos[..., None] * axis
+    # wo along the axis: no plane of incidence (delta = 0 there anyway), take any perpendicular
+    helper = np.where(np.abs(axis[..., :1]) < 0.9, np.array([1, 0, 0], dtype), np.array([0, 1, 0], dtype))
+    degenerate = _dot(in_plane, in_plane)[..., None] < 1e-12
+    in_plane = sg.normalize(np.where(degenerate, np.cross(axis, helper), in_plane))
+    # wo near -axis: wo - c axis cancels, so restore orthogonality (the error left is second order)
+    in_plane = in_plane - _dot(in_plane, axis)[..., None] * axis
     safe_sharpness = np.where(sharpness > 0, sharpness, 1)
     offset_squared = np.where(sharpness > 0, (1 - signed_cos) / safe_sharpness, np.inf)
     # broad lobes: the split overshoots the planar model it is derived from, fade back to 'paper'
