@@ -10,8 +10,8 @@ lights and environment data).  wang2009 eq. 36-43 without visibility:
 
 I(G, n) is the integral of an SG times the clamped cosine (clamped_cosine.py's
 closed form, more accurate than the paper's single-lobe C*); rho*_j are the
-model's NDF lobes warped to the view slice (warp.brdf_slice_lobes: 2 lobes per
-NDF lobe in the default 'split2' mode) with the smooth factor M_o at each lobe
+model's NDF lobes warped to the view slice (warp.brdf_slice_lobes in
+warp.DEFAULT_MODE: one to three lobes per NDF lobe) with the smooth factor M_o at each lobe
 centre.  For the environment, the cosine is folded in as the ratio
 I(p_j, lambda_j, n) / integral G_j (the clamped cosine averaged over the lobe),
 which keeps the horizon behaviour of the accurate integral; a constant world
@@ -132,7 +132,7 @@ def specular_slice(model, params, lobe_count, view_local):
     axis, sharpness, amplitude = ndf_lobes(model, params, lobe_count)
     # m_factor takes per-pixel parameters broadcast over the lobe axis
     broadcast = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[..., None] for k, v in params.items()})
-    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, broadcast.m_factor)
+    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, broadcast.m_factor, mode=warp.DEFAULT_MODE)
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,

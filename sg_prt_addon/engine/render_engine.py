@@ -1,5 +1,6 @@
 """The SG-PRT RenderEngine: final renders and the viewport share scene_state + renderer."""
 import time
+import traceback
 
 import bpy
 import numpy as np
@@ -59,6 +60,12 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             self.report({"ERROR"}, str(error).split("\n", 1)[0])
             last_render.clear()
             last_render["error"] = str(error)
+            return
+        except Exception as error:
+            traceback.print_exc()
+            self.report({"ERROR"}, f"SG-PRT render failed: {type(error).__name__}: {error}")
+            last_render.clear()
+            last_render["error"] = traceback.format_exc()
             return
         finally:
             if bpy.app.background:

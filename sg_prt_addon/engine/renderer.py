@@ -29,7 +29,7 @@ def _texture_2d(pixels):
 def _texture_2d_array(layers):
     import gpu
     data = np.ascontiguousarray(layers, np.float32)
-    return gpu.types.GPUTexture((data.shape[2], data.shape[1], data.shape[0]), layered=True, format="RGBA32F",
+    return gpu.types.GPUTexture((data.shape[2], data.shape[1]), layers=data.shape[0], format="RGBA32F",
                                 data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
 
 

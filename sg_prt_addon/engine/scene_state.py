@@ -207,8 +207,33 @@ def environment_data(world, layer_size=None):
 
 
 def _fit_environment(image):
-    """Diffuse SG mixture of the environment by core.env_fit (wang2009 eq. 39)."""
-    from ..core import env_fit
+    """Diffuse SG mixture of the environment (wang2009 eq. 39): core.env_fit when present,
+    else a fixed-axis least-squares mixture (_fit_environment_fixed_axes)."""
+    try:
+        from ..core import env_fit
+    except ImportError:
+        return _fit_environment_fixed_axes(image)
     axis, sharpness, amplitude = env_fit.fit_environment(image, ENVIRONMENT_FIT_LOBES)[:3]
     return (np.asarray(axis, np.float32), np.asarray(sharpness, np.float32),
             np.asarray(amplitude, np.float32).reshape(len(sharpness), -1)[:, :3])
+
+
+def _fit_environment_fixed_axes(image, lobe_count=12, sharpness=3.0, rows=32):
+    """SG mixture with Fibonacci-sphere axes and one sharpness; non-negative amplitudes per
+    channel by least squares, weighted by texel solid angle, on a downsampled map."""
+    from scipy.optimize import nnls
+    from ..core import equirect
+
+    height, width = image.shape[:2]
+    row_index = (np.arange(rows) + 0.5) * height / rows
+    col_index = (np.arange(2 * rows) + 0.5) * width / (2 * rows)
+    small = image[row_index.astype(int)][:, col_index.astype(int), :3].reshape(-1, 3)
+    directions = equirect.texel_directions(rows, 2 * rows).reshape(-1, 3)
+    weights = np.sqrt(np.broadcast_to(equirect.texel_solid_angles(rows, 2 * rows), (rows, 2 * rows)).ravel())
+    k = np.arange(lobe_count) + 0.5
+    z = 1 - 2 * k / lobe_count
+    phi = np.pi * (1 + 5 ** 0.5) * k
+    axes = np.stack([np.sqrt(1 - z * z) * np.cos(phi), np.sqrt(1 - z * z) * np.sin(phi), z], axis=1)
+    basis = np.exp(sharpness * (directions @ axes.T - 1)) * weights[:, None]
+    amplitude = np.stack([nnls(basis, small[:, c] * weights)[0] for c in range(3)], axis=1)
+    return (axes.astype(np.float32), np.full(lobe_count, sharpness, np.float32), amplitude.astype(np.float32))

@@ -4,9 +4,9 @@ A variant is keyed by what changes the code (not the values): the BRDF model,
 its NDF lobe count, whether lights / an environment texture are present, which
 material textures are bound, and whether the debug G-buffer is written.
 
-Fragment source = generated header (constants from core/) + shared GLSL
-(shaders/lib/<name>.glsl when it exists, else our port in
-shaders/resources/fallback/) + resources/sg_shading.glsl + surface.frag.glsl.
+Fragment source = generated header (constants from core/) + the GLSL mirrors
+of core/ (shaders/lib/<name>.glsl) + our resources (anisotropic_lobes.glsl,
+sg_shading.glsl) + surface.frag.glsl.
 A compile error raises ShaderCompileError naming the variant and quoting the
 offending lines of the numbered assembled source.
 """
@@ -21,7 +21,6 @@ import numpy as np
 SHADER_DIR = os.path.normpath(os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders"))
 LIB_DIR = os.path.join(SHADER_DIR, "lib")
 RESOURCE_DIR = os.path.join(SHADER_DIR, "resources")
-FALLBACK_DIR = os.path.join(RESOURCE_DIR, "fallback")
 
 MAX_POINT_LIGHTS = 32
 MAX_SUNS = 8
@@ -83,9 +82,7 @@ def _read(path):
 
 
 def library_source(file_name):
-    """shaders/lib/<file_name> when another part of the project provides it, else our port."""
-    lib_path = os.path.join(LIB_DIR, file_name)
-    return _read(lib_path if os.path.exists(lib_path) else os.path.join(FALLBACK_DIR, file_name))
+    return _read(os.path.join(LIB_DIR, file_name))
 
 
 def _float_literal(value):
@@ -101,14 +98,24 @@ def _constants_source(key):
     return f"const float BRDF_AS_RF0 = {_float_literal(rf0)};\n"
 
 
+def warp_mode():
+    """(GLSL function, lobes per NDF lobe) of core.warp's default mode, which the mirror uses."""
+    from ..core import warp
+    mode = warp.DEFAULT_MODE
+    nodes = 1 if mode == "paper" else len(warp.SPLIT_RULES[mode][0])
+    return f"warp_lobes_{mode}", nodes
+
+
 def defines(key):
     out = dict(LIMITS)
+    out["WARP_FUNCTION"], out["WARP_NODES"] = warp_mode()
     out["MODEL_" + key.model] = 1
     out["NDF_LOBES"] = key.ndf_lobes
     if key.has_lights:
         out["HAS_LIGHTS"] = 1
     if key.has_environment:
         out["HAS_ENVIRONMENT"] = 1
+        out["ENV_PREFILTER_MAX_LAYERS"] = MAX_LAYERS
     for name in key.textures:
         out["HAS_NORMAL_MAP" if name == "normal_map" else "HAS_TEXTURE_" + name.upper()] = 1
     if key.gbuffer:

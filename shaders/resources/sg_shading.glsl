@@ -102,7 +102,7 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
   }
 }
 
-#define SLICE_LOBES (2 * NDF_LOBES)
+#define SLICE_LOBES (WARP_NODES * NDF_LOBES)
 
 /* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer. */
 void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
@@ -116,7 +116,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   mat3 frame = mat3(t, b, n);                    /* local -> world */
   vec3 view_local = view * frame;                /* transpose(frame) * view */
 
-  /* BRDF slice: NDF lobes warped to the view (2 per NDF lobe) times M_o at their centres, in world space */
+  /* BRDF slice: NDF lobes warped to the view (WARP_NODES per NDF lobe) times M_o at their centres, in world space */
   vec3 slice_axis[SLICE_LOBES];
   float slice_sharpness[SLICE_LOBES];
   float slice_amplitude[SLICE_LOBES];
@@ -124,16 +124,22 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     vec3 ndf_axis;
     float ndf_sharpness, ndf_amplitude;
     model_ndf_lobe(p, q, k, ndf_axis, ndf_sharpness, ndf_amplitude);
-    vec3 warped_axis[2];
-    float warped_sharpness[2], warped_amplitude[2];
-    warp_lobes_split2(ndf_axis, ndf_sharpness, ndf_amplitude, view_local,
-                      warped_axis, warped_sharpness, warped_amplitude);
-    for (int side = 0; side < 2; side++) {
-      int j = 2 * k + side;
-      slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[side],
-                                                model_m_factor(view_local, warped_axis[side], p, q));
-      slice_axis[j] = frame * warped_axis[side];
-      slice_sharpness[j] = warped_sharpness[side];
+    /* warp.DEFAULT_MODE: WARP_FUNCTION with WARP_NODES lobes per NDF lobe (defines from the variant) */
+    vec3 warped_axis[WARP_NODES];
+    float warped_sharpness[WARP_NODES], warped_amplitude[WARP_NODES];
+#if WARP_NODES == 1
+    WARP_FUNCTION(ndf_axis, ndf_sharpness, ndf_amplitude, view_local,
+                  warped_axis[0], warped_sharpness[0], warped_amplitude[0]);
+#else
+    WARP_FUNCTION(ndf_axis, ndf_sharpness, ndf_amplitude, view_local,
+                  warped_axis, warped_sharpness, warped_amplitude);
+#endif
+    for (int node = 0; node < WARP_NODES; node++) {
+      int j = WARP_NODES * k + node;
+      slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
+                                                model_m_factor(view_local, warped_axis[node], p, q));
+      slice_axis[j] = frame * warped_axis[node];
+      slice_sharpness[j] = warped_sharpness[node];
     }
   }
 
@@ -159,16 +165,18 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
 #endif
 
+#ifdef HAS_ENVIRONMENT
+  vec2 scale_offset[ENV_PREFILTER_MAX_LAYERS];
+  for (int k = 0; k < ENV_PREFILTER_MAX_LAYERS; k++) {
+    scale_offset[k] = scene.prefilter_scale_offset[k].xy;
+  }
+#endif
   for (int j = 0; j < SLICE_LOBES; j++) {
     float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n);
 #ifdef HAS_ENVIRONMENT
-    int lower, upper;
-    float fraction;
-    environment_layers(slice_sharpness[j], scene.prefilter_info.x, scene.prefilter_info.y,
-                       int(scene.prefilter_info.z), lower, upper, fraction);
-    radiance += slice_cosine * environment_fetch(environment_texture, slice_axis[j], lower, upper, fraction,
-                                                 scene.prefilter_scale_offset[lower].xy,
-                                                 scene.prefilter_scale_offset[upper].xy);
+    radiance += slice_cosine * env_prefilter_lookup(environment_texture, slice_axis[j], slice_sharpness[j],
+                                                    scene.prefilter_info.x, scene.prefilter_info.y,
+                                                    scene.counts.w, scale_offset).rgb;
 #else
     radiance += slice_cosine * scene.world_colour.rgb;
 #endif

@@ -4,13 +4,9 @@ import os
 
 import numpy as np
 
-STUDIO_WORLDS = None
-
-
 def studio_world_path(name="courtyard.exr"):
     import bpy
-    return os.path.join(os.path.dirname(bpy.__file__), f"{bpy.app.version[0]}.{bpy.app.version[1]}",
-                        "datafiles", "studiolights", "world", name)
+    return os.path.join(bpy.utils.system_resource("DATAFILES"), "studiolights", "world", name)
 
 
 def ensure_registered():

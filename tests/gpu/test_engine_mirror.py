@@ -126,3 +126,31 @@ def test_anisotropic_models_textures_and_normal_map(engine):
     # the engine uploads exactly what export.image_pixels reads
     np.testing.assert_array_equal(export.image_pixels(images["colour"]), colour)
     _check(result, textures)
+
+
+def test_environment_texture(engine):
+    """Prefiltered environment (specular) and SG mixture (diffuse) from a world Environment Texture."""
+    import bpy
+    from sg_prt_addon.engine import render_engine
+
+    # Blender's courtyard, box-filtered to 128 x 64 so the prefilter takes a moment, as a float image
+    source = bpy.data.images.load(fx.studio_world_path("courtyard.exr"), check_existing=True)
+    width, height = source.size
+    pixels = np.empty(width * height * 4, np.float32)
+    source.pixels.foreach_get(pixels)
+    small = pixels.reshape(64, height // 64, 128, width // 128, 4).mean(axis=(1, 3))
+    scene = fx.new_scene("mirror_environment", 160, 160)
+    world = fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    world.node_tree.nodes["Environment Texture"].image = fx.image("courtyard_small", small)
+    glossy = fx.material("mat_env_ggx", model="GGX", roughness=0.25, diffuse_color=(0.3, 0.3, 0.3),
+                         specular_color=(0.8, 0.8, 0.8))
+    shirley = fx.material("mat_env_as", model="ASHIKHMIN_SHIRLEY", nu=30.0, nv=300.0, lobe_count=2)
+    fx.uv_sphere(scene, "glossy", (-1.0, 0.0, 1.0), radius=0.9).data.materials.append(glossy)
+    fx.uv_sphere(scene, "brushed", (1.0, 0.0, 1.0), radius=0.9).data.materials.append(shirley)
+    render_engine.debug["environment_layer_size"] = 32
+    try:
+        result = fx.render(scene, gbuffer=True)
+    finally:
+        render_engine.debug["environment_layer_size"] = None
+    assert result["state"].environment.prefiltered is not None
+    _check(result)
