@@ -181,3 +181,27 @@ def test_visibility_product_needs_the_final_lobe():
     broad = lam_h[keep] < 0.01  # H varies by < 2% over the sphere
     assert broad.sum() > 20 and error[broad].max() <= 0.03
     assert error[~broad].max() > 0.5
+
+
+@pytest.mark.parametrize("lam", [0.05, 2.0, 40.0])
+def test_clamped_cosine_identity(lam):
+    """An exact link between fh and the SG x clamped-cosine integral I(c) (ours): with
+    F(x, lambda) = fh(asin x, lambda), differentiating exp(v.i) along n gives
+        I(c) = c (F + dF/dlambda) + (1 - c^2) / lambda dF/dx   at x = c = n.p.
+    Checked with finite differences of fh_exact against the cosine-weighted quadrature
+    and clamped_cosine's own (ring) quadrature."""
+    from sg_prt_addon.core import clamped_cosine
+
+    c = np.array([-0.8, -0.2, 0.0, 0.3, 0.9])
+
+    def F(x, sharpness):
+        return hemisphere.fh_exact(np.arcsin(x), sharpness)
+
+    dx, dl = 1e-5, 1e-5 * lam
+    by_identity = (c * (F(c, lam) + (F(c, lam + dl) - F(c, lam - dl)) / (2 * dl))
+                   + (1 - c * c) / lam * (F(c + dx, lam) - F(c - dx, lam)) / (2 * dx))
+    weighted = hemisphere._quadrature_array(c, lam, True)
+    axis = np.stack([np.sqrt(1 - c * c), 0 * c, c], -1)
+    ring = clamped_cosine.sg_clamped_cosine_integral_exact(axis, lam, 1.0, [0, 0, 1.0])
+    assert np.allclose(by_identity, weighted, rtol=1e-6)
+    assert np.allclose(weighted, ring, rtol=1e-9)
