@@ -43,8 +43,9 @@ def normalize(v, fallback=(0.0, 0.0, 1.0)):
 
 
 def evaluate(direction, axis, sharpness, amplitude=1.0):
-    """G(v) = mu exp(-lambda/2 |v - p|^2): same as mu exp(lambda (v.p - 1)) for
-    unit vectors, without cancellation of v.p - 1 near the axis."""
+    """G(v; p, lambda, mu) = mu exp(lambda (v.p - 1)) (wang2009 eq. 2), evaluated as
+    mu exp(-lambda/2 |v - p|^2): equal for unit vectors, without cancellation of
+    v.p - 1 near the axis."""
     dtype = _float_dtype(direction, axis, sharpness, amplitude)
     d = np.asarray(direction, dtype) - np.asarray(axis, dtype)
     value = np.asarray(amplitude) * np.exp(-0.5 * np.asarray(sharpness, dtype) * np.sum(d * d, axis=-1))
@@ -103,12 +104,16 @@ def inner_product(axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2):
 
 
 def rotate(axis, rotation):
-    """Rotate lobe axes by a 3x3 matrix (or a stack of them); sharpness and amplitude are unchanged."""
+    """Rotate lobe axes by a 3x3 matrix (or a stack of them); sharpness and amplitude are
+    unchanged since an SG is symmetric about its axis (wang2009 section 3)."""
     return np.einsum("...ij,...j->...i", np.asarray(rotation), np.asarray(axis))
 
 
 def support_area(sharpness, epsilon=0.1):
-    """fa(lambda) of wang2009 eq. 3: solid angle where G(v; z, lambda, 1) >= epsilon."""
+    """fa(lambda) of wang2009 eq. 3: solid angle where G(v; z, lambda, 1) >= epsilon.
+
+    Exact (the region is a cap of cos(theta) >= 1 + ln(epsilon) / lambda) while it lies
+    within a hemisphere, lambda > -ln(epsilon); the paper uses epsilon = 0.1."""
     return -TWO_PI * np.log(epsilon) / np.asarray(sharpness)
 
 
