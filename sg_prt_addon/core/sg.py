@@ -112,8 +112,9 @@ def rotate(axis, rotation):
 def support_area(sharpness, epsilon=0.1):
     """fa(lambda) of wang2009 eq. 3: solid angle where G(v; z, lambda, 1) >= epsilon.
 
-    Exact (the region is a cap of cos(theta) >= 1 + ln(epsilon) / lambda) while it lies
-    within a hemisphere, lambda > -ln(epsilon); the paper uses epsilon = 0.1."""
+    The region is the cap cos(theta) >= 1 + ln(epsilon) / lambda, so this is exact for
+    lambda >= -ln(epsilon) / 2 (below, the cap would exceed the sphere); for
+    lambda > -ln(epsilon) the cap lies within a hemisphere.  The paper uses epsilon = 0.1."""
     return -TWO_PI * np.log(epsilon) / np.asarray(sharpness)
 
 
