@@ -153,12 +153,17 @@ def brdf_slice_lobes(axis, sharpness, amplitude, wo, m_factor, mode=DEFAULT_MODE
     assumes it constant over the lobe).  ``m_factor(wo, wi)`` takes
     broadcastable (..., 3) directions.  Non-finite Mo (e.g. 1/(n.wi) at a
     centre on the horizon) is replaced by 0.
+
+    m_factor is called with the lobe index as the LEADING axis, directions
+    (K', ..., 3), so model parameters shaped like the pixels (...) broadcast
+    (core.brdf models with spatially varying roughness).
     """
     warped_axis, warped_sharpness, warped_amplitude = warp_lobes(axis, sharpness, amplitude, wo, mode)
     wo_lobes = np.broadcast_to(sg.normalize(np.asarray(wo).astype(warped_axis.dtype, copy=False))[..., None, :],
                                warped_axis.shape)
     with np.errstate(all="ignore"):
-        mo = np.asarray(m_factor(wo_lobes, warped_axis))
+        mo = np.asarray(m_factor(np.moveaxis(wo_lobes, -2, 0), np.moveaxis(warped_axis, -2, 0)))
+    mo = np.moveaxis(np.broadcast_to(mo, warped_axis.shape[-2:-1] + warped_axis.shape[:-2]), 0, -1)
     mo = np.where(np.isfinite(mo), mo, 0).astype(warped_axis.dtype, copy=False)
     return warped_axis, warped_sharpness, warped_amplitude * mo
 

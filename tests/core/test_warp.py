@@ -206,6 +206,23 @@ def ggx_slice_ratio(roughness, theta, mode):
 
 
 @pytest.mark.skipif(importlib.util.find_spec("sg_prt_addon.core.brdf") is None, reason="core.brdf not written yet")
+def test_spatially_varying_brdf_parameters_broadcast():
+    from sg_prt_addon.core import brdf
+
+    roughness = np.linspace(0.1, 0.9, 12).reshape(3, 4)
+    model = brdf.GGX(roughness=roughness)
+    axis, sharpness, amplitude = model.ndf_lobes(2)                       # (3, 4, 2, 3)
+    wo = np.broadcast_to(view(50, 20), (3, 4, 3))
+    out_axis, _, out_amplitude = warp.brdf_slice_lobes(axis, sharpness, amplitude, wo, model.m_factor)
+    assert out_amplitude.shape == (3, 4, 2 * len(warp.SPLIT_RULES[warp.DEFAULT_MODE][0]))
+    # pixel (1, 2) alone gives the same lobes
+    single = brdf.GGX(roughness=roughness[1, 2])
+    lobes = warp.brdf_slice_lobes(axis[1, 2], sharpness[1, 2], amplitude[1, 2], wo[1, 2], single.m_factor)
+    np.testing.assert_allclose(out_amplitude[1, 2], lobes[2], rtol=1e-6)
+    np.testing.assert_allclose(out_axis[1, 2], lobes[0], atol=1e-12)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("sg_prt_addon.core.brdf") is None, reason="core.brdf not written yet")
 @pytest.mark.parametrize("roughness, theta, expected", [
     # measured ratios (paper, split2, split3); the bounds are +-0.02 around them
     (0.3, 30, (0.991, 0.991, 0.991)),
