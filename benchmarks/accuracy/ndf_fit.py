@@ -68,8 +68,23 @@ def _anisotropic_rows():
     return rows
 
 
+def _broad_lobe_rows():
+    rows = []
+    cases = (("Ward aniso 0.5/0.5", brdf.WardAnisotropic(alpha_x=0.5, alpha_y=0.5)),
+             ("Ward aniso 0.8/0.4", brdf.WardAnisotropic(alpha_x=0.8, alpha_y=0.4)),
+             ("Ward aniso 0.6/0.15", brdf.WardAnisotropic(alpha_x=0.6, alpha_y=0.15)),
+             ("Ashikhmin-Shirley 3/30", brdf.AshikhminShirley(nu=3.0, nv=30.0)))
+    for label, model in cases:
+        for lobe_count in (4, 8):
+            plain = ndf_fit.ndf_l2_error(model, model.ndf_lobes(lobe_count))
+            corrected = ndf_fit.ndf_l2_error(model, model.ndf_lobes(lobe_count, broad_lobe_correction=True))
+            rows.append(_row(f"{label}, {lobe_count} lobes, broad_lobe_correction", QUADRATURE, L2, corrected,
+                             f"table without the correction: {plain:.3g}"))
+    return rows
+
+
 def measure():
-    return _isotropic_rows() + _anisotropic_rows()
+    return _isotropic_rows() + _anisotropic_rows() + _broad_lobe_rows()
 
 
 if __name__ == "__main__":

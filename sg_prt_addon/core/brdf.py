@@ -405,11 +405,16 @@ class WardAnisotropic(_Microfacet):
         no, ni, visible = _cosines(wo, wi)
         return np.where(visible, 0.25 / np.sqrt(ni * no), 0)
 
-    def ndf_lobes(self, lobe_count=4):
-        """K SG lobes from the normalized anisotropy table (ndf_fit.anisotropic_lobes)."""
+    def ndf_lobes(self, lobe_count=4, broad_lobe_correction=False):
+        """K SG lobes from the normalized anisotropy table (ndf_fit.anisotropic_lobes).
+
+        broad_lobe_correction applies the Ward isotropic L2 mapping at the geometric-mean
+        width (much better for alpha >~ 0.3; off by default because the GLSL mirror,
+        shaders/resources/anisotropic_lobes.glsl, does not apply it yet)."""
         from . import ndf_fit
         ax, ay = self._alphas(_dtype(self.alpha_x, self.alpha_y))
-        return ndf_fit.anisotropic_lobes(ax, ay, 1 / (np.pi * ax * ay), lobe_count)
+        return ndf_fit.anisotropic_lobes(ax, ay, 1 / (np.pi * ax * ay), lobe_count,
+                                         "WARD_ISO" if broad_lobe_correction else None)
 
     def half_vector_pdf(self, h):
         ax, ay = self._alphas(h.dtype)
@@ -468,15 +473,17 @@ class AshikhminShirley(_Microfacet):
         fresnel = fresnel_schlick(kh, _param(self.rf0, wo.dtype))
         return np.where(visible, fresnel / (4 * kh * np.maximum(ni, no)), 0)
 
-    def ndf_lobes(self, lobe_count=4):
+    def ndf_lobes(self, lobe_count=4, broad_lobe_correction=False):
         """K SG lobes from the normalized anisotropy table; widths sqrt(2/nu), sqrt(2/nv)
-        (the small-angle Gaussian of (n.h)^e)."""
+        (the small-angle Gaussian of (n.h)^e).  broad_lobe_correction: the Blinn-Phong
+        L2 mapping (same (n.h)^n shape) at the geometric-mean width, see WardAnisotropic."""
         from . import ndf_fit
         nu, nv = self._exponents(_dtype(self.nu, self.nv))
         floor = np.asarray(1e-6, nu.dtype)
         width_x = np.sqrt(2 / np.maximum(nu, floor))
         width_y = np.sqrt(2 / np.maximum(nv, floor))
-        return ndf_fit.anisotropic_lobes(width_x, width_y, np.sqrt((nu + 1) * (nv + 1)) / (2 * np.pi), lobe_count)
+        return ndf_fit.anisotropic_lobes(width_x, width_y, np.sqrt((nu + 1) * (nv + 1)) / (2 * np.pi), lobe_count,
+                                         "BLINN_PHONG" if broad_lobe_correction else None)
 
     def half_vector_pdf(self, h):
         return self.ndf(h)

@@ -141,3 +141,15 @@ def test_batched_fit_matches_scipy_levenberg_marquardt():
         single = ndf_fit.fit_isotropic(values, theta, weights, lobe_count)
         np.testing.assert_allclose(batch[2], single[2], rtol=1e-6, atol=1e-9)
         np.testing.assert_allclose(batch[0], single[0], rtol=1e-4)
+
+
+@pytest.mark.parametrize("model, corrected_bound", [
+    (brdf.WardAnisotropic(alpha_x=0.5, alpha_y=0.5), 0.07), (brdf.WardAnisotropic(alpha_x=0.8, alpha_y=0.4), 0.16),
+    (brdf.WardAnisotropic(alpha_x=0.3, alpha_y=0.05), 0.31), (brdf.AshikhminShirley(nu=3.0, nv=30.0), 0.12),
+    (brdf.AshikhminShirley(nu=75.0, nv=1200.0), 0.18)], ids=str)
+def test_broad_lobe_correction(model, corrected_bound):
+    """The geometric-mean-width isotropic mapping fixes the small-angle scaling of broad lobes
+    (measured 0.066, 0.147, 0.303, 0.113, 0.178 with 4 lobes) and never makes it worse."""
+    plain = ndf_fit.ndf_l2_error(model, model.ndf_lobes(4), 16, 128)
+    corrected = ndf_fit.ndf_l2_error(model, model.ndf_lobes(4, broad_lobe_correction=True), 16, 128)
+    assert corrected < corrected_bound and corrected <= plain + 1e-3
