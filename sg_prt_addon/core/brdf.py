@@ -182,8 +182,8 @@ def _polynomial(coefficients, x):
 # lobe's by at most 0.002 (GGX: 0.006) anywhere in width_range (measured: <= 1e-5,
 # 2e-4, 3e-6, 0.0055 at alpha = 1).  shaders/lib/brdf.glsl copies these numbers.
 # (derive_isotropic_mapping(..., endpoint_weight=30) gives GGX an excess <= 3e-4;
-# switch brdf.py and brdf.glsl together if adopted.)  Small widths tend to the Gaussian limit (2, 1); GGX's
-# heavy tails give (2.29, 0.87) instead.
+# switch brdf.py and brdf.glsl together if adopted.)  Small widths tend to the
+# Gaussian limit (2, 1); GGX's heavy tails give (2.29, 0.87) instead.
 # fmt: off
 ISOTROPIC_MAPPINGS = {
     "BECKMANN": {"width_range": (0.0, 1.0),
@@ -226,7 +226,8 @@ def _from_spherical(cos_theta, phi):
 
 
 class _Microfacet:
-    """Shared protocol; subclasses define ndf, m_factor, half_vector_pdf, sample_half_vector."""
+    """Shared protocol; subclasses define ndf(h), _m_factor(wo, wi, h) on unit vectors,
+    ndf_lobes, and either half_vector_pdf + sample_half_vector or their own sample/pdf."""
 
     def specular(self, wo, wi):
         """rho_s(o, i) = M_o(i) D(h) (eq. 9); 0 below the horizon of either direction."""
