@@ -21,11 +21,12 @@ const float WARP_MAX_WARPED_SHARPNESS = 1.0e6;
 const float WARP_MAX_SPLIT_OFFSET = 0.2;
 const float WARP_FULL_SPLIT_SHARPNESS = 8.0;
 
-/* psi(h) = 2 (h.wo) h - wo and lambda / (4 max(|h.wo|, floor)), capped. */
+/* psi(h) = 2 (h.wo) h - wo (unit for unit h and wo: no normalize) and
+ * lambda / (4 max(|h.wo|, floor)), capped. */
 void warp_at(vec3 half_vector, float sharpness, vec3 wo, float signed_cos,
              out vec3 axis, out float warped_sharpness)
 {
-  axis = safe_normalize(2.0 * signed_cos * half_vector - wo);
+  axis = 2.0 * signed_cos * half_vector - wo;
   float tau = 4.0 * max(abs(signed_cos), WARP_COS_FLOOR);
   warped_sharpness = min(sharpness / tau, WARP_MAX_WARPED_SHARPNESS);
 }
@@ -50,9 +51,15 @@ void warp_split_frame(vec3 axis, float sharpness, vec3 wo,
   unit_axis = safe_normalize(axis);
   unit_wo = safe_normalize(wo);
   float signed_cos = clamp(dot(unit_axis, unit_wo), -1.0, 1.0);
-  in_plane = safe_normalize(unit_wo - signed_cos * unit_axis, vec3(1.0, 0.0, 0.0));
-  in_plane = in_plane - dot(in_plane, unit_axis) * unit_axis;  /* the fallback may not be orthogonal */
-  in_plane = safe_normalize(in_plane, vec3(0.0, 1.0, 0.0));
+  in_plane = unit_wo - signed_cos * unit_axis;
+  if (dot(in_plane, in_plane) < 1.0e-12) {
+    /* wo along the axis: no plane of incidence (delta = 0 there anyway), any perpendicular */
+    vec3 helper = abs(unit_axis.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+    in_plane = cross(unit_axis, helper);
+  }
+  in_plane = safe_normalize(in_plane);
+  /* wo near -axis: wo - c axis cancels, so restore orthogonality (second-order error left) */
+  in_plane = in_plane - dot(in_plane, unit_axis) * unit_axis;
   float offset_cap = WARP_MAX_SPLIT_OFFSET * min(sharpness * (1.0 / WARP_FULL_SPLIT_SHARPNESS), 1.0);
   offset = sharpness > 0.0 ? min(sqrt((1.0 - signed_cos) / sharpness), offset_cap) : offset_cap;
 }

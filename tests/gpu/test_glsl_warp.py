@@ -90,7 +90,7 @@ def test_brdf_slice_ggx(glsl, fuzz, record_error):
                   brdf_slice_amplitude(amplitudes[2], ggx_m_factor(wo.xyz, axes[2], m.w)), 0.0);
     """
     out = glsl(LIB, body, {"wo": wo, "m": np.c_[lobe_sharpness, lobe_amplitude, np.zeros(N), roughness]}, 3)
-    model = brdf.GGX(roughness=roughness[:, None])
+    model = brdf.GGX(roughness=roughness)  # brdf_slice_lobes calls m_factor with the lobe axis first
     warped_axis, _, expected = warp.brdf_slice_lobes(axis[:, None], lobe_sharpness, lobe_amplitude, wo,
                                                      model.m_factor, mode="split3")
     # Mo ~ 1/(n.wi (n.o)): relative error ~ 1e-7 / (n.wi) near the horizon; compare above 0.05
