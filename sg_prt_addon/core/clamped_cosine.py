@@ -134,11 +134,12 @@ def _langevin_moments(sharpness):
     safe = np.where(small, 1, lam)
     decay = np.exp(-2 * safe)
     one_minus_decay = -np.expm1(-2 * safe)
-    square = np.where(small, lam * lam, 0)  # series argument, kept small so no branch can overflow
-    mean = np.where(small, lam * (1 / 3 - square / 45 + 2 * square ** 2 / 945 - square ** 3 / 4725),
+    series_lam = np.where(small, lam, 0)  # series argument, kept small so no branch can overflow
+    square = series_lam * series_lam
+    mean = np.where(small, series_lam * (1 / 3 - square / 45 + 2 * square ** 2 / 945 - square ** 3 / 4725),
                     (1 + decay) / one_minus_decay - 1 / safe)
     variance = np.where(small, 1 / 3 - square / 15 + 2 * square ** 2 / 189 - square ** 3 / 675 + 2 * square ** 4 / 10395,
-                        1 / (safe * safe) - 4 * decay / (one_minus_decay * one_minus_decay))
+                        (1 / safe) ** 2 - 4 * decay / (one_minus_decay * one_minus_decay))  # (1/l)^2: no overflow
     return mean, np.maximum(variance, 0)
 
 
@@ -152,8 +153,9 @@ VARIANCE_F2 = 4.64645
 # tail blend beta = lambda^P / (lambda^P + B)
 TAIL_POWER = 2.94198
 TAIL_OFFSET = 43.2488
-# sharpness above which every term is at its limit; keeps lambda^P finite in float32
-_MAX_SHARPNESS = 1e6
+# the fitted terms are at their limits (beta = 1, f = 1 + 4e-7) beyond this sharpness;
+# clamping their argument keeps lambda^2 and lambda^P finite in float32
+_FIT_SHARPNESS_LIMIT = 1e6
 
 
 def _gaussian_positive_mean(mean, variance):
@@ -181,11 +183,12 @@ def clamped_cosine_from_cosine(cosine, sharpness):
     """I(c, lambda) with unit amplitude, c = n.p in [-1, 1] (fast closed form, keeps the dtype)."""
     dtype = _float_dtype(cosine, sharpness)
     c = np.clip(np.asarray(cosine, dtype), -1, 1)
-    lam = np.clip(np.asarray(sharpness, dtype), 0, _MAX_SHARPNESS)
+    lam = np.maximum(np.asarray(sharpness, dtype), 0)
+    fit_lam = np.minimum(lam, _FIT_SHARPNESS_LIMIT)
     upper, lower = _pole_integrals(lam)
     mean_cos, var_cos = _langevin_moments(lam)
-    scale = 1 + (VARIANCE_F1 * lam + VARIANCE_F0) / (lam * lam + VARIANCE_F3 * lam + VARIANCE_F2)
-    lam_power = lam ** dtype.type(TAIL_POWER)
+    scale = 1 + (VARIANCE_F1 * fit_lam + VARIANCE_F0) / (fit_lam * fit_lam + VARIANCE_F3 * fit_lam + VARIANCE_F2)
+    lam_power = fit_lam ** dtype.type(TAIL_POWER)
     beta = lam_power / (lam_power + dtype.type(TAIL_OFFSET))
     sin_alpha = np.sqrt(np.maximum(1 - c * c, 0))
     across = (1 - beta) * (1 - c * c) + beta * 0.5 * (1 + sin_alpha)

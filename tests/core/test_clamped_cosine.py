@@ -140,3 +140,14 @@ def test_degenerate_inputs():
     assert np.all(np.isfinite(out)) and np.all(out == 0)
     flat = cc.sg_clamped_cosine_integral(Z, 0.0, 1.0, -Z)
     assert abs(flat - np.pi) < 1e-12
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_beyond_the_fit_range(dtype):
+    """lambda > 1e6 (and up to 1e30): the lit value follows (2 pi / lambda)(1 - 1/lambda) c."""
+    lam = np.array([1e7, 1e12, 1e30], dtype)
+    for cosine in (1.0, 0.5):
+        value = cc.clamped_cosine_from_cosine(np.asarray(cosine, dtype), lam)
+        assert value.dtype == dtype and np.all(np.isfinite(value))
+        expected = 2 * np.pi / lam.astype(float) * cosine
+        np.testing.assert_allclose(value, expected, rtol=1e-5 if dtype == np.float32 else 1e-6)
