@@ -10,9 +10,9 @@ import pytest
 
 from sg_prt_addon.core import brdf
 
-# 1e6 inputs per kernel take ~2 s per model on a quiet core; the default keeps the file fast
+# 1e6 inputs per kernel: 71 s for the file on the loaded 2-core machine (all pass); the default keeps it fast
 # on the shared machine.  SGPRT_STRESS_COUNT=1000000 runs the full-size version.
-TOTAL = int(os.environ.get("SGPRT_STRESS_COUNT", 200_000))
+TOTAL = int(os.environ.get("SGPRT_STRESS_COUNT", 100_000))
 
 
 def hostile_directions(rng, count, dtype):
