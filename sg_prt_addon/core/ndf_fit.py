@@ -298,7 +298,8 @@ def _anisotropic_objective(params, lobe_count, directions, weights, target, scal
     return np.sum(weights * residual ** 2) / scale2, gradient.ravel()
 
 
-def fit_anisotropic(ndf_values, directions, weights, lobe_count, initial=None, max_iterations=400):
+def fit_anisotropic(ndf_values, directions, weights, lobe_count, initial=None, max_iterations=400,
+                    method="L-BFGS-B"):
     """K free-axis SG lobes fitted to an NDF on a hemisphere quadrature (wang2009 section 4.2,
     L-BFGS-B as in the paper).
 
@@ -306,7 +307,9 @@ def fit_anisotropic(ndf_values, directions, weights, lobe_count, initial=None, m
     ``initial`` (axis (K,3), sharpness (K,), amplitude (K,)) the mixture is grown
     one lobe at a time, each new lobe placed at the largest residual and all
     lobes refitted.  Returns (axis (K, 3), sharpness (K,), amplitude (K,),
-    relative_l2), lobes sorted by increasing sharpness.
+    relative_l2), lobes sorted by increasing sharpness.  method "TNC" (also bounded, with
+    the same gradient) avoids scipy L-BFGS-B's multi-threaded BLAS calls, which run
+    several times slower on a busy machine.
     """
     target = np.asarray(ndf_values, np.float64)
     directions = np.asarray(directions, np.float64)
@@ -314,10 +317,10 @@ def fit_anisotropic(ndf_values, directions, weights, lobe_count, initial=None, m
     scale2 = max(np.sum(weights * target ** 2), 1e-300)
 
     def optimize(start, count):
-        result = minimize(_anisotropic_objective, start.ravel(), jac=True, method="L-BFGS-B",
+        options = {"maxiter": max_iterations} if method == "L-BFGS-B" else {"maxfun": 10 * max_iterations}
+        result = minimize(_anisotropic_objective, start.ravel(), jac=True, method=method,
                           args=(count, directions, weights, target, scale2),
-                          bounds=([(None, None)] * 3 + [(-10, 16), (-60, 60)]) * count,
-                          options={"maxiter": max_iterations})
+                          bounds=([(None, None)] * 3 + [(-10, 16), (-60, 60)]) * count, options=options)
         return result.x.reshape(count, 5), result.fun
 
     if initial is not None:
