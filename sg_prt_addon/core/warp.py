@@ -52,6 +52,12 @@ upper-hemisphere cosine) was measured and is worse.  So split3 is the
 default: as good as 'paper' up to 75 deg (mean within 0.01), better beyond,
 for 3x the lobes; split2 is the cheaper middle ground.
 
+Not a mode: an anisotropic SG (Xu et al. 2013) with the exact Jacobian at the
+centre has a much lower L2 for sharp lobes (mean 0.17 at 60 deg against
+split3's 0.28) but no fan, so it loses the grazing energy like 'paper'
+(mean |cos-energy - 1| 0.51 at 85 deg), and fh and the isotropic prefiltered
+environment cannot take it (measured in the accuracy table).
+
 Grazing clamp: tau = 4 max(|h.wo|, COS_FLOOR) and the warped sharpness is
 capped at MAX_WARPED_SHARPNESS, so grazing views (wo.z = 0, wo in the tangent
 plane) give large but finite sharpness.  The cap (angular width ~1e-3 rad)
