@@ -78,10 +78,28 @@ def _compile_error_message(log, source):
     """Quote every source line the driver's log points at (`:line:column: Error`)."""
     lines = source.split("\n")
     messages_by_line = {}
+    # Blender 5.x: "<file>:line:column: Error: ..." with line numbers of our source (#line)
     for match in re.finditer(r":(\d+):(\d+): *(?:Error|error)[: ]*(.*)", log):
         number = int(match.group(1))
         if 1 <= number <= len(lines):
             messages_by_line.setdefault(number, []).append(f"column {match.group(2)}: {match.group(3)}")
+    if not messages_by_line:
+        # Blender 4.x quotes the offending code ("  178 |   code", "      | Error: ...") with
+        # numbers of the assembled source: find the quoted code in ours
+        code = None
+        for log_line in log.split("\n"):
+            quoted = re.match(r"\s*\d*\s*\| ?(.*)$", log_line)
+            if not quoted:
+                continue
+            text = quoted.group(1)
+            error = re.match(r"\s*(?:Error|error)[: ]*(.*)", text)
+            if error and code:
+                for number, line in enumerate(lines, 1):
+                    if line.strip() == code:
+                        messages_by_line.setdefault(number, []).append(error.group(1))
+                        break
+            elif text.strip() and set(text.strip()) != {"^"}:
+                code = text.strip()
     quoted = []
     for number, messages in sorted(messages_by_line.items()):
         context = [f"{n:5d}{'>' if n == number else ' '} {lines[n - 1]}"
