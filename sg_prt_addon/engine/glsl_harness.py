@@ -1,7 +1,7 @@
 """Evaluate GLSL functions on many inputs at once, from a plain Python process.
 
 The `gpu` module only works inside a RenderEngine's render() with
-bl_use_gpu_context = True (docs/DESIGN.md), so `run_glsl` stashes a job,
+bl_use_gpu_context = True (see the design notes), so `run_glsl` stashes a job,
 calls bpy.ops.render.render() on a private scene whose engine is
 SG_PRT_GLSL_HARNESS, and the engine's render() does the GPU work:
 

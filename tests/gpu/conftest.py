@@ -1,4 +1,4 @@
-"""Fixtures for GLSL tests on Mesa llvmpipe through a RenderEngine (see docs/DESIGN.md).
+"""Fixtures for GLSL tests on Mesa llvmpipe through a RenderEngine (gpu works only inside render()).
 
 - `blender`: session-wide; imports pip `bpy` (skips the tests if it is
   missing) and resets it to empty factory settings once.
