@@ -130,9 +130,9 @@ def ndf_lobes(model, params, lobe_count=1):
 def specular_slice(model, params, lobe_count, view_local):
     """BRDF slice lobes (local frame) for the view: warped NDF lobes times M_o at their centres."""
     axis, sharpness, amplitude = ndf_lobes(model, params, lobe_count)
-    # m_factor takes per-pixel parameters broadcast over the lobe axis
-    broadcast = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[..., None] for k, v in params.items()})
-    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, broadcast.m_factor, mode=warp.DEFAULT_MODE)
+    # brdf_slice_lobes calls m_factor with the lobe index leading, so per-pixel parameters broadcast
+    instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
+    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, instance.m_factor, mode=warp.DEFAULT_MODE)
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,

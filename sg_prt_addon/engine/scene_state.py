@@ -104,6 +104,7 @@ class SceneState:
         import bpy
 
         dirty = self.dirty
+        membership_changed = False
         for update in depsgraph.updates:
             datablock = update.id
             if isinstance(datablock, bpy.types.Material):
@@ -113,16 +114,38 @@ class SceneState:
                 self.world = export.export_world(datablock)
                 self.environment = environment_data(self.world)
                 dirty.world = True
-            elif isinstance(datablock, bpy.types.Scene):
-                continue        # the scene itself updates on any edit; its objects report their own
+            elif isinstance(datablock, (bpy.types.Scene, bpy.types.Collection)):
+                membership_changed = True       # objects may have been added, removed or hidden
             elif isinstance(datablock, bpy.types.Object):
                 self._update_object(depsgraph, datablock.evaluated_get(depsgraph), update, dirty)
             elif isinstance(datablock, bpy.types.Light):
                 dirty.lights = True
+        if membership_changed:
+            self._sync_membership(depsgraph, dirty)
         if dirty.lights:
             self.lights = [export.export_light(obj) for obj in depsgraph.objects if obj.type == "LIGHT"]
             self.lights = [light for light in self.lights if light is not None]
         return dirty
+
+    def _sync_membership(self, depsgraph, dirty):
+        """Drop objects no longer in the evaluated scene, export the ones that appeared."""
+        present = {obj.name: obj for obj in depsgraph.objects}
+        for name in [name for name in self.objects if name.split("#")[0] not in present]:
+            del self.objects[name]
+            dirty.objects = True
+        for name, obj in present.items():
+            if obj.type == "LIGHT":
+                if not any(light.name == name for light in self.lights):
+                    dirty.lights = True
+            elif obj.type in ("MESH", "CURVE", "SURFACE", "META", "FONT") and name not in self.objects:
+                mesh_key = self._mesh_key(obj)
+                self.meshes[mesh_key] = export.export_object_mesh(obj)
+                dirty.meshes.add(mesh_key)
+                self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
+                                                 self._read_materials(obj))
+                dirty.objects = True
+        if len([obj for obj in present.values() if obj.type == "LIGHT"]) != len(self.lights):
+            dirty.lights = True
 
     def _update_object(self, depsgraph, obj, update, dirty):
         if obj.type == "LIGHT":

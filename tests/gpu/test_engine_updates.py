@@ -1,0 +1,101 @@
+"""Viewport update logic (SceneState.update with depsgraph.updates): what an edit re-exports.
+
+view_draw needs a window, but view_update's logic is plain Python over depsgraph.updates:
+it runs here from a depsgraph_update_post handler, as Blender calls it after each edit.
+"""
+import numpy as np
+import pytest
+
+import engine_fixtures as fx
+
+
+@pytest.fixture()
+def tracked_scene(blender):
+    """A scene with two spheres and a light, a synced SceneState and a handler feeding it updates."""
+    from sg_prt_addon.engine import scene_state
+
+    fx.ensure_registered()
+    bpy = blender
+    # the context's scene: its depsgraph is the one Blender evaluates and reports updates for
+    scene = bpy.context.scene
+    for obj in list(scene.objects):
+        bpy.data.objects.remove(obj)
+    material = fx.material("updates_material", roughness=0.3)
+    first = fx.uv_sphere(scene, "updates_a", (0.0, 0.0, 1.0), segments=12, rings=6)
+    first.data.materials.append(material)
+    second = fx.uv_sphere(scene, "updates_b", (2.0, 0.0, 1.0), segments=12, rings=6)
+    fx.point_light(scene, "updates_light", (0.0, -2.0, 3.0), 100.0)
+    view_layer = bpy.context.view_layer
+    view_layer.update()             # evaluate the new scene once, before tracking edits
+    state = scene_state.SceneState()
+    state.sync(view_layer.depsgraph)
+    assert set(state.objects) == {first.name, second.name} and len(state.lights) == 1
+    state.consume_dirty()
+
+    def on_update(updated_scene, depsgraph):
+        if updated_scene == scene:
+            state.update(depsgraph)
+
+    bpy.app.handlers.depsgraph_update_post.append(on_update)
+    try:
+        yield bpy, scene, view_layer, state, material, first, second
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(on_update)
+        for obj in list(scene.objects):
+            bpy.data.objects.remove(obj)
+
+
+def _exports():
+    from sg_prt_addon.blender import export
+    return export.export_counter["meshes"]
+
+
+def test_material_edit_does_not_reexport_meshes(tracked_scene):
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    before = _exports()
+    material.sgprt.roughness = 0.8
+    material.update_tag()            # what the properties editor does after an edit
+    view_layer.update()
+    assert _exports() == before
+    assert state.materials[material.name].roughness == pytest.approx(0.8)
+    dirty = state.consume_dirty()
+    assert dirty.materials == {material.name} and not dirty.meshes
+
+
+def test_transform_edit_moves_without_reexport(tracked_scene):
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    before = _exports()
+    second.location.x = 3.5
+    view_layer.update()
+    assert _exports() == before
+    assert state.objects[second.name].matrix_world[0, 3] == pytest.approx(3.5)
+    assert not state.consume_dirty().meshes
+
+
+def test_geometry_edit_reexports_only_that_mesh(tracked_scene):
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    before = _exports()
+    second.data.vertices[0].co.x += 0.25
+    second.data.update()
+    view_layer.update()
+    assert _exports() == before + 1
+    dirty = state.consume_dirty()
+    assert dirty.meshes == {state.objects[second.name].mesh_key}
+    moved = state.meshes[state.objects[second.name].mesh_key].positions
+    assert np.any(np.isclose(moved[:, 0], second.data.vertices[0].co.x))
+
+
+def test_light_edit_and_removed_object(tracked_scene):
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    before = _exports()
+    light = next(obj for obj in scene.objects if obj.type == "LIGHT")
+    light.data.energy = 250.0
+    light.data.update_tag()
+    view_layer.update()
+    assert state.consume_dirty().lights
+    assert state.lights[0].colour_intensity[0] == pytest.approx(250.0 / (4 * np.pi))
+    second_name = second.name
+    bpy.data.objects.remove(second)
+    view_layer.update()
+    assert second_name not in state.objects and first.name in state.objects
+    assert _exports() == before
