@@ -238,3 +238,42 @@ def test_model_from_name():
         assert brdf.model_from_name(name) is not None
     with pytest.raises(ValueError):
         brdf.model_from_name("PHONG")
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.sampled_from(["COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX"]),
+       st.floats(0.01, 1.0), st.floats(0.01, 1.0), st.floats(1.0, 1e4), st.integers(0, 2 ** 31))
+def test_reciprocity_and_positivity_for_random_parameters(name, roughness, alpha_y, exponent, seed):
+    model = brdf.model_from_name(name, roughness=roughness, ior=1.0 + roughness, exponent=exponent,
+                                 alpha_x=roughness, alpha_y=alpha_y, nu=exponent, nv=exponent * alpha_y)
+    rng = np.random.default_rng(seed)
+    wo, wi = random_upper(rng, 200, 1e-3), random_upper(rng, 200, 1e-3)
+    forward, backward = model.specular(wo, wi), model.specular(wi, wo)
+    assert np.all(np.isfinite(forward)) and np.all(forward >= 0)
+    np.testing.assert_allclose(forward, backward, rtol=1e-9)
+
+
+def grid_around(axis, n_polar=200, n_phi=360):
+    """Gauss-Legendre in the polar angle around ``axis`` x uniform phi: directions, solid angles."""
+    x, w = np.polynomial.legendre.leggauss(n_polar)
+    polar, polar_weight = 0.5 * np.pi * (x + 1), 0.5 * np.pi * w
+    phi = (np.arange(n_phi) + 0.5) * 2 * np.pi / n_phi
+    b, p = np.meshgrid(polar, phi, indexing="ij")
+    z = axis / np.linalg.norm(axis)
+    t = np.cross(z, [0.0, 1.0, 0.0])
+    t /= np.linalg.norm(t)
+    local = [np.sin(b) * np.cos(p), np.sin(b) * np.sin(p), np.cos(b)]
+    directions = local[0][..., None] * t + local[1][..., None] * np.cross(z, t) + local[2][..., None] * z
+    return directions, np.sin(b) * polar_weight[:, None] * (2 * np.pi / n_phi)
+
+
+@pytest.mark.parametrize("model", [brdf.GGX(roughness=0.5), brdf.WardAnisotropic(0.4, 0.2), brdf.BlinnPhong(10.0),
+                                   brdf.AshikhminShirley(nu=10.0, nv=40.0)], ids=lambda m: type(m).__name__)
+def test_pdf_normalized_at_grazing_view(model):
+    """At 80 degrees many NDF-sampled half vectors face away from the view (o.h < 0); their
+    wi crowd towards -wo, where p_h / (4 |o.h|) has an integrable 1/angle singularity.
+    A grid polar around -wo resolves it: pdf() integrates to 1 over the sphere."""
+    t = np.radians(80.0)
+    wo = np.array([np.sin(t), 0.0, np.cos(t)])
+    directions, solid_angle = grid_around(-wo)
+    assert abs(np.sum(model.pdf(wo, directions) * solid_angle) - 1) < 1e-4
