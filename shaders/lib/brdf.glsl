@@ -8,6 +8,8 @@
  *
  *   brdf_half_vector          <- brdf.half_vector
  *   reflect_about             <- brdf.reflect (2 (o.h) h - o; GLSL's reflect is the opposite sign)
+ *   brdf_theta                <- brdf._theta
+ *   brdf_log_cosine           <- np.log of a cosine, accurate near 1 (see below)
  *   fresnel_dielectric        <- brdf.fresnel_dielectric (eq. 14)
  *   fresnel_schlick           <- brdf.fresnel_schlick
  *   shadowing_cook_torrance   <- brdf.shadowing_cook_torrance
@@ -21,7 +23,8 @@
  *   ward_isotropic_*          <- WardIsotropic
  *   ashikhmin_shirley_*       <- AshikhminShirley (ndf, m_factor; lobes from a table)
  *   ggx_*                     <- GGX (Blender conventions: alpha = roughness^2,
- *                                height-correlated Smith, no Fresnel), ggx_smith_lambda
+ *                                height-correlated Smith, no Fresnel); ggx_alpha <- GGX._alpha,
+ *                                ggx_smith_lambda <- GGX.smith_lambda
  *   lambert_m_factor          <- Lambert.m_factor
  * beckmann_ndf, ward_anisotropic_ndf and ggx_ndf normalise h first (brdf.py takes
  * h as given): a tiny non-unit h would overflow float32 there.

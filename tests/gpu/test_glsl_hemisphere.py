@@ -55,3 +55,16 @@ def test_hemisphere_integral(glsl, fuzz, record_error):
     expected = hemisphere.hemisphere_integral(axis, sharpness, amplitude, normal)
     scale = 2 * np.pi * np.minimum(1.0, 1.0 / sharpness) * np.maximum(amplitude, 1e-30)
     assert record_error("hemisphere hemisphere_integral, relative to mu fh(pi/2)", (np.abs(out - expected) / scale).max()) <= 1e-5
+
+
+def test_fh_symmetry_and_bounds(glsl, fuzz):
+    """Properties of the GLSL itself: fh(t) + fh(-t) = sphere integral (g is odd),
+    e^-lambda <= fh_hat <= 1, and fh_hat non-decreasing in theta_d."""
+    theta = fuzz.uniform(0.0, np.pi / 2, N)
+    sharpness = fuzz.log_uniform(1e-4, 1e6, N)
+    call = ("vec4(fh(a.x, a.y) + fh(-a.x, a.y), sg_sphere_integral(a.y, 1.0),"
+            " fh_normalized(a.x, a.y), fh_normalized(a.x + 1e-3, a.y) - fh_normalized(a.x, a.y))")
+    out = glsl(LIB, call, {"a": np.c_[theta, sharpness]}, 4)
+    assert np.all(np.abs(out[:, 0] - out[:, 1]) <= 1e-6 * out[:, 1] + 1e-30)
+    assert np.all(out[:, 2] >= np.exp(-sharpness) * (1 - 1e-5)) and np.all(out[:, 2] <= 1)
+    assert out[:, 3].min() >= -1e-6

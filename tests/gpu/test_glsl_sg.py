@@ -123,3 +123,21 @@ def test_rotate(glsl, fuzz, record_error):
     out = glsl(LIB, call, {"p": axis, "c0": rotation[:, :, 0], "c1": rotation[:, :, 1],
                            "c2": rotation[:, :, 2]}, 3)
     assert record_error("sg rotate, absolute", np.abs(out - sg.rotate(axis, rotation)).max()) <= 1e-6
+
+
+def test_product_is_symmetric_and_inner_product_bounded(glsl, fuzz):
+    """Properties of the GLSL itself: G1 (x) G2 = G2 (x) G1, and Cauchy-Schwarz
+    <G1, G2>^2 <= <G1, G1> <G2, G2>."""
+    axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2 = _product_inputs(fuzz)
+    call = ("vec4(sg_inner_product(p1.xyz, p1.w, m.x, p2.xyz, p2.w, m.y),"
+            " sg_inner_product(p2.xyz, p2.w, m.y, p1.xyz, p1.w, m.x),"
+            " sg_inner_product(p1.xyz, p1.w, m.x, p1.xyz, p1.w, m.x),"
+            " sg_inner_product(p2.xyz, p2.w, m.y, p2.xyz, p2.w, m.y))")
+    out = glsl(LIB, call, {"p1": np.c_[axis1, sharpness1], "p2": np.c_[axis2, sharpness2],
+                           "m": np.c_[amplitude1, amplitude2]}, 4).astype(np.float64)
+    # l1 + l2 and l2 + l1 round alike, but (lambda_m + l1) + l2 does not: the exponent's
+    # rounding (relative 1e-7 of |log amplitude|) is all the asymmetry there may be
+    log_amplitude = np.abs(np.log(np.maximum(out[:, 0], 1e-300) / np.maximum(amplitude1 * amplitude2, 1e-300)))
+    tolerance = (1e-6 + 3e-7 * log_amplitude) * out[:, 0] + 1e-37
+    assert np.all(np.abs(out[:, 0] - out[:, 1]) <= tolerance)
+    assert np.all(out[:, 0] ** 2 <= out[:, 2] * out[:, 3] * (1 + 1e-5) + 1e-37)
