@@ -81,9 +81,7 @@ SQRT_TWO = np.sqrt(2.0)
 INV_SQRT_TWO_PI = 1.0 / np.sqrt(2.0 * np.pi)
 
 
-def _float_dtype(*arrays):
-    """Common floating dtype by dtype (not value): Python floats count as float64, float32 stays float32."""
-    return np.result_type(*[np.asarray(a).dtype for a in arrays], np.float32)
+_float_dtype = sg._float_dtype  # same dtype rule as the SG algebra (Python scalars do not promote arrays)
 
 
 def clamped_cosine_lobe():

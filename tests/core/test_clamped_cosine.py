@@ -151,3 +151,11 @@ def test_beyond_the_fit_range(dtype):
         assert value.dtype == dtype and np.all(np.isfinite(value))
         expected = 2 * np.pi / lam.astype(float) * cosine
         np.testing.assert_allclose(value, expected, rtol=1e-5 if dtype == np.float32 else 1e-6)
+
+
+def test_dtype_rules():
+    """float32 arrays with Python scalars stay float32; all-scalar inputs compute in float64."""
+    axis32 = np.array([[0.0, 0.6, 0.8]], np.float32)
+    assert cc.sg_clamped_cosine_integral(axis32, 3.0, 1.0, Z.astype(np.float32)).dtype == np.float32
+    assert cc.sg_clamped_cosine_integral_paper(axis32, 3.0, 1.0, Z.astype(np.float32)).dtype == np.float32
+    assert cc.clamped_cosine_from_cosine(0.5, 3.0).dtype == np.float64
