@@ -65,8 +65,8 @@ def measure():
     for theta in VIEW_ANGLES:
         results = {mode: [warp.slice_errors(_view(theta), Z, s, mode) for s in SHARPNESSES] for mode in warp.MODES}
         paper_l2 = np.array([r["l2"] for r in results["paper"]])
-        for key, metric in (("energy_cosine", "|cos-weighted energy ratio - 1|"),
-                            ("energy_sphere", "|sphere energy ratio - 1|"),
+        for key, metric in (("energy_cosine", "abs(cos-weighted energy ratio - 1)"),
+                            ("energy_sphere", "abs(sphere energy ratio - 1)"),
                             ("l2", "relative L2 over the sphere")):
             ours = np.array([r[key] for r in results["split2"]])
             paper = np.array([r[key] for r in results["paper"]])
@@ -87,7 +87,7 @@ def measure():
         rows.append({"name": f"ASG (Xu 2013) warp, view {theta} deg, comparison only", "reference": reference,
                      "metric": "relative L2 over the sphere", "max_error": float(asg[:, 1].max()),
                      "mean_error": float(asg[:, 1].mean()), "paper": float(paper_l2.max()),
-                     "note": (f"|cos-weighted energy ratio - 1| max {np.abs(asg[:, 0] - 1).max():.3g} mean "
+                     "note": (f"abs(cos-weighted energy ratio - 1) max {np.abs(asg[:, 0] - 1).max():.3g} mean "
                               f"{np.abs(asg[:, 0] - 1).mean():.3g}; split3 L2 mean {split3_l2.mean():.3g}; "
                               "isotropic consumers cannot take it")})
     for alpha in ALPHAS:
@@ -97,7 +97,7 @@ def measure():
             ours = warp.slice_errors(_view(85), Z, sharpness, mode)
             error = abs(ours["energy_cosine"] - 1)
             rows.append({"name": f"warp {mode}, view 85 deg, alpha {alpha}", "reference": reference,
-                         "metric": "|cos-weighted energy ratio - 1|", "max_error": error, "mean_error": error,
+                         "metric": "abs(cos-weighted energy ratio - 1)", "max_error": error, "mean_error": error,
                          "paper": abs(paper["energy_cosine"] - 1),
                          "note": (f"ratio {ours['energy_cosine']:.3f} vs paper {paper['energy_cosine']:.3f}; "
                                   f"L2 {ours['l2']:.2f} vs {paper['l2']:.2f}")})
@@ -107,7 +107,7 @@ def measure():
                                   for mode in ("split2", "split3", "paper"))
             rows.append({"name": f"eq. 22 slice (warp split2, Mo at lobe centres), GGX, view {theta} deg",
                          "reference": "quadrature of Mo(wi) D*(h) cos(theta_i) with GGX's SG D* and Mo",
-                         "metric": "|energy ratio - 1|", "max_error": float(ours.max()),
+                         "metric": "abs(energy ratio - 1)", "max_error": float(ours.max()),
                          "mean_error": float(ours.mean()), "paper": float(paper.max()),
                          "note": (f"roughness 0.2-0.9, includes eq. 22's constant-Mo error; paper mean "
                                   f"{paper.mean():.3g}; split3 max {three.max():.3g} mean {three.mean():.3g}")})
