@@ -120,13 +120,24 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
     scene).  samples_per_pixel counts camera rays: use at least 4 for a
     usable standard error.
     """
-    renderer = _Renderer(scene, tracer if tracer is not None else
-                         RayTracer(scene.vertices, scene.triangles, threads=threads), environment_samples)
+    own_tracer = tracer is None
+    if own_tracer:
+        tracer = RayTracer(scene.vertices, scene.triangles, threads=threads)
+    try:
+        return _render(scene, camera, samples_per_pixel, seed, progress, batch_rays, threads,
+                       _Renderer(scene, tracer, environment_samples))
+    finally:
+        if own_tracer:
+            tracer.close()
+
+
+def _render(scene, camera, samples_per_pixel, seed, progress, batch_rays, threads, renderer):
+    environment_samples = renderer.environment_samples
     height, width = camera.height, camera.width
     pixel_count = height * width
     samples_per_pixel = int(samples_per_pixel)
     # Each batch takes `repeats` samples of a run of `pixels_per_batch` pixels.
-    samples_per_batch = max(1, batch_rays // (max(1, int(environment_samples)) if scene_has_environment(scene) else 1))
+    samples_per_batch = max(1, batch_rays // (environment_samples if renderer.environment is not None else 1))
     pixels_per_batch = min(pixel_count, samples_per_batch)
     repeats = max(1, min(samples_per_pixel, samples_per_batch // pixels_per_batch))
     batches = [(first_sample, min(repeats, samples_per_pixel - first_sample), first_pixel,
@@ -179,10 +190,6 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
     variance = squares / np.maximum(n - 1, 1)
     standard_error = np.where(n > 1, np.sqrt(variance / np.maximum(n, 1)), np.inf)
     return mean.reshape(height, width, 3), standard_error.reshape(height, width, 3)
-
-
-def scene_has_environment(scene):
-    return scene.environment is not None or scene.background is not None
 
 
 def _orthonormal_tangents(normals):
