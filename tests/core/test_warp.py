@@ -27,6 +27,17 @@ def test_quadrature_integrates_sharp_and_wide_sg_exactly():
         assert numeric == pytest.approx(float(sg.sphere_integral(sharpness)), rel=1e-6)
 
 
+@pytest.mark.parametrize("theta, sharpness", [(60, 200.0), (85, 1e4)])
+def test_quadrature_integrates_true_slice(theta, sharpness):
+    # integral of D(h(wi)) dwi = integral of D(h) 4 (h.wo) dh; when the lobe lies well inside h.wo > 0 that is
+    # 4 (p.wo) (2 pi / lambda) ((1 - 1/lambda) + e^(-2 lambda) (1 + 1/lambda)); 85 deg: strongly anisotropic
+    wo = view(theta)
+    exact = 4 * wo[2] * 2 * np.pi / sharpness * ((1 - 1 / sharpness) + np.exp(-2 * sharpness) * (1 + 1 / sharpness))
+    directions, weights = warp.lighting_quadrature(2 * wo[2] * Z - wo, 2 * wo[2] / np.sqrt(sharpness), 256)
+    numeric = np.sum(warp.true_slice(directions, wo, Z[None], np.array([sharpness])) * weights)
+    assert numeric == pytest.approx(exact, rel=1e-5)
+
+
 def test_paper_mode_is_eq_18_to_21():
     axis = sg.normalize(np.array([[0.3, -0.2, 0.9], [0.0, 0.0, 1.0]]))
     sharpness, amplitude = np.array([50.0, 7.0]), np.array([2.0, 0.5])
