@@ -441,7 +441,7 @@ class _Renderer:
         # BRDF sample: the lobe choice gets its own uniform, the direction a stratified pair.
         brdf_uniforms = np.concatenate([rng.random((count, 1)), _stratified_uniforms(rng, count, per_point, 2)], 1)
         wi_brdf_local, pdf_brdf = self._brdf_sample(points, brdf_uniforms)
-        wi_brdf = _normalize(np.einsum("nij,nj->ni", to_world, wi_brdf_local), points.normal)
+        wi_brdf = _normalize(np.einsum("nij,nj->ni", to_world, wi_brdf_local), points.frame[:, 2])
         radiance_brdf, pdf_env_at_brdf = self.environment.lookup(wi_brdf)
         value_brdf = self._brdf_cosine(points, wi_brdf_local) * radiance_brdf
         # Power heuristic, written as 1 / (1 + ratio^2) so huge pdfs do not overflow.
@@ -480,12 +480,17 @@ def _power_weight(pdf_own, pdf_other):
 class _Points:
     """Shading points of one batch (plain attribute bag)."""
 
+    # What the environment estimator reads; the specular ones only when a specular model is present.
+    _SAMPLING_FIELDS = ("position", "geometric_normal", "frame", "diffuse_over_pi", "specular_probability")
+    _SPECULAR_FIELDS = ("material", "wo_local", "specular_color")
+
     def repeat(self, times, renderer):
-        """Every point ``times`` times in a row (point i -> rows i * times ... i * times + times - 1)."""
+        """Every point ``times`` times in a row (point i -> rows i * times ... i * times + times - 1),
+        with only the fields the environment estimator uses."""
         out = _Points()
-        for name, value in vars(self).items():
-            if isinstance(value, np.ndarray):
-                setattr(out, name, np.repeat(value, times, axis=0))
+        names = self._SAMPLING_FIELDS + (self._SPECULAR_FIELDS if self.groups else ())
+        for name in names:
+            setattr(out, name, np.repeat(getattr(self, name), times, axis=0))
         out.origin_offset = self.origin_offset
-        out.groups = renderer._groups(out.material)
+        out.groups = renderer._groups(out.material) if self.groups else []
         return out
