@@ -344,6 +344,39 @@ def fit_anisotropic(ndf_values, directions, weights, lobe_count, initial=None, m
     return axis[order], sharpness[order], amplitude[order], float(np.sqrt(value))
 
 
+def fit_ndf(ndf, lobe_count, width_hint=0.1, isotropic=None):
+    """Convenience front end: SG mixture of a callable or tabulated NDF.
+
+    ndf: a callable D(h) on unit vectors (M, 3) (a model's ``ndf`` for instance), or an
+    isotropic table (theta (T,), values (T,)) in radians, interpolated linearly (0
+    beyond the table).  width_hint: the NDF's angular width(s), which place the
+    quadrature breaks.  isotropic (default: True for tables, False for callables)
+    selects fit_isotropic (lobes on z+, K <= 2) or fit_anisotropic (free axes).
+
+    Returns (axis (K, 3), sharpness (K,), amplitude (K,), relative_l2).
+    """
+    tabulated = isinstance(ndf, tuple)
+    if isotropic is None:
+        isotropic = tabulated
+    if tabulated:
+        table_theta, table_values = (np.asarray(a, np.float64) for a in ndf)
+
+        def evaluate(directions):
+            theta = np.arctan2(np.hypot(directions[..., 0], directions[..., 1]), directions[..., 2])
+            return np.interp(theta, table_theta, table_values, right=0.0)
+    else:
+        evaluate = ndf
+    if isotropic:
+        theta, weights = polar_quadrature(width_hint)
+        directions = np.stack([np.sin(theta), np.zeros_like(theta), np.cos(theta)], axis=-1)
+        sharpness, amplitude, error = fit_isotropic(evaluate(directions), theta, weights * 2 * np.pi, lobe_count)
+        axis = np.zeros((lobe_count, 3))
+        axis[:, 2] = 1
+        return axis, sharpness, amplitude, float(error)
+    directions, weights = hemisphere_quadrature(width_hint)
+    return fit_anisotropic(evaluate(directions), directions, weights, lobe_count)
+
+
 # ----------------------------------------------------------------------------- normalized anisotropy table
 
 def _row_layout(lobe_count):

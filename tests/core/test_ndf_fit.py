@@ -153,3 +153,18 @@ def test_broad_lobe_correction(model, corrected_bound):
     plain = ndf_fit.ndf_l2_error(model, model.ndf_lobes(4), 16, 128)
     corrected = ndf_fit.ndf_l2_error(model, model.ndf_lobes(4, broad_lobe_correction=True), 16, 128)
     assert corrected < corrected_bound and corrected <= plain + 1e-3
+
+
+def test_fit_ndf_front_end():
+    """Callable and tabulated inputs reach the same fits as the model's own numbers."""
+    model = brdf.GGX(roughness=0.4)
+    alpha = 0.16
+    axis, sharpness, amplitude, error = ndf_fit.fit_ndf(model.ndf, 2, alpha, isotropic=True)
+    assert error < 0.05 and np.all(axis[:, 2] == 1)
+    table_theta = np.linspace(0, np.pi / 2, 4000)
+    table = model.ndf(np.stack([np.sin(table_theta), 0 * table_theta, np.cos(table_theta)], -1))
+    _, table_sharpness, _, table_error = ndf_fit.fit_ndf((table_theta, table), 2, alpha)
+    np.testing.assert_allclose(table_sharpness, sharpness, rtol=1e-3)
+    ward = brdf.WardAnisotropic(alpha_x=0.2, alpha_y=0.1)
+    *_, anisotropic_error = ndf_fit.fit_ndf(ward.ndf, 2, [0.2, 0.1])
+    assert anisotropic_error < ndf_fit.ndf_l2_error(ward, ward.ndf_lobes(1)) - 0.05
