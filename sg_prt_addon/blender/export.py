@@ -293,9 +293,13 @@ def export_world(world):
     """WorldExport of a bpy World: the first Environment Texture node's image, else its colour."""
     if world is None:
         return WorldExport(colour=(0.0, 0.0, 0.0))
+    import bpy
+
     colour = tuple(world.color)
     strength = 1.0
-    if world.use_nodes and world.node_tree is not None:
+    # Blender 5 always renders worlds with nodes (use_nodes is deprecated there)
+    uses_nodes = world.node_tree is not None and (bpy.app.version >= (5, 0, 0) or world.use_nodes)
+    if uses_nodes:
         for node in world.node_tree.nodes:
             if node.type == "BACKGROUND":
                 if not node.inputs["Color"].is_linked:

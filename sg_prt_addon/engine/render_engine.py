@@ -74,15 +74,18 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
                 shader_variants.clear_cache()
         result = self.begin_result(0, 0, width, height)
         layer = result.layers[0]
+        written = []
         for name in renderer_module.PASS_NAMES:
             render_pass = layer.passes.get(name)
             if render_pass is None:
                 continue
             channels = render_pass.channels
             render_pass.rect.foreach_set(np.ascontiguousarray(passes[name][..., :channels]).ravel())
+            written.append(name)
         self.end_result(result)
         last_render.clear()
-        last_render.update(passes=passes, state=state, timings=timings, size=(width, height))
+        last_render.update(passes=passes, state=state, timings=timings, size=(width, height),
+                           written_passes=written)
 
     # ----------------------------------------------------------------- viewport
 
@@ -112,8 +115,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         try:
             self.viewport_renderer.upload(self.viewport_state, self.viewport_state.consume_dirty(), camera)
             self.viewport_renderer.ensure_targets(width, height)
-            self.viewport_renderer.draw(self.viewport_state, camera, background=background_colour(
-                self.viewport_state))
+            self.viewport_renderer.draw(self.viewport_state, camera)
         except ShaderCompileError as error:
             if str(error) != self.viewport_error:
                 print(error)
@@ -124,11 +126,6 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         draw_texture_2d(self.viewport_renderer.targets[0], width, height)
         self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
-
-
-def background_colour(state):
-    colour = state.environment.colour if state.environment.prefiltered is None else (0.0, 0.0, 0.0)
-    return tuple(float(c) for c in colour[:3]) + (1.0,)
 
 
 def draw_texture_2d(texture, width, height):
@@ -160,7 +157,7 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     renderer.ensure_targets(width, height)
     timings["upload"] = time.perf_counter() - start
     start = time.perf_counter()
-    renderer.draw(state, camera, background=(0.0, 0.0, 0.0, 0.0))
+    renderer.draw(state, camera, background_alpha=0.0 if scene.render.film_transparent else 1.0)
     passes = {name: renderer.read_output(name.lower()) for name in renderer_module.PASS_NAMES}
     if gbuffer:
         for name in renderer_module.GBUFFER_OUTPUTS:

@@ -138,6 +138,7 @@ class Renderer:
         self.targets = []
         self.size = None
         self.uploads = {"meshes": 0, "materials": 0}
+        self.background_batch = None
 
     # ----------------------------------------------------------------- uploads
 
@@ -196,15 +197,16 @@ class Renderer:
 
     # ----------------------------------------------------------------- drawing
 
-    def draw(self, state, camera, background=(0.0, 0.0, 0.0, 0.0)):
-        """Draw every object into our framebuffer (call ensure_targets first)."""
+    def draw(self, state, camera, background_alpha=1.0):
+        """Draw every object, then the world behind them, into our framebuffer (call ensure_targets
+        first).  background_alpha: alpha of the world pixels (0 for a transparent film)."""
         import gpu
 
         has_lights = state.light_data().count > 0
         has_environment = state.environment.prefiltered is not None
         view_projection = _column_major(camera.projection @ camera.view)
         with self.framebuffer.bind():
-            self.framebuffer.clear(color=tuple(background), depth=1.0)
+            self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(True)
             gpu.state.face_culling_set("NONE")
@@ -234,8 +236,29 @@ class Renderer:
                         shader.uniform_sampler("texture_" + texture_name,
                                                self.textures[params.textures[texture_name]])
                     batch.draw(shader)
+            if not self.gbuffer:
+                self._draw_background(camera, has_environment, background_alpha)
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
+
+    def _draw_background(self, camera, has_environment, alpha):
+        """Full-screen triangle at the far plane: only where no surface was drawn (depth test)."""
+        import gpu
+        from gpu_extras.batch import batch_for_shader
+
+        shader = shader_variants.get_background_shader(has_environment)
+        if self.background_batch is None:
+            self.background_batch = batch_for_shader(shader, "TRIS", {"position": [(-1, -1), (3, -1), (-1, 3)]})
+        gpu.state.depth_mask_set(False)
+        shader.bind()
+        shader.uniform_float("background_alpha", float(alpha))
+        shader.uniform_block("scene", self.scene_buffer)
+        if has_environment:      # (the world-colour variant has no use for the view ray)
+            shader.uniform_float("inverse_view_projection",
+                                 _column_major(np.linalg.inv(camera.projection @ camera.view)))
+            shader.uniform_sampler("environment_texture", self.environment_texture)
+        self.background_batch.draw(shader)
+        gpu.state.depth_mask_set(True)
 
     def read_output(self, name):
         """(H, W, 4) float32 of output `name` ("combined", "diffuse", "position"...), row 0 at the bottom."""

@@ -236,9 +236,11 @@ def _fit_environment(image):
         from ..core import env_fit
     except ImportError:
         return _fit_environment_fixed_axes(image)
-    axis, sharpness, amplitude = env_fit.fit_environment(image, ENVIRONMENT_FIT_LOBES)[:3]
-    return (np.asarray(axis, np.float32), np.asarray(sharpness, np.float32),
-            np.asarray(amplitude, np.float32).reshape(len(sharpness), -1)[:, :3])
+    fit = env_fit.fit_environment_sg(image, lobes=ENVIRONMENT_FIT_LOBES)
+    if isinstance(fit, tuple):          # (fit, report)
+        fit = fit[0]
+    return (np.asarray(fit.axis, np.float32), np.asarray(fit.sharpness, np.float32),
+            np.asarray(fit.amplitude, np.float32).reshape(len(fit.sharpness), -1)[:, :3])
 
 
 def _fit_environment_fixed_axes(image, lobe_count=12, sharpness=3.0, rows=32):

@@ -152,6 +152,11 @@ def numbered(source):
     return "\n".join(f"{n:5d}  {line}" for n, line in enumerate(source.split("\n"), 1))
 
 
+def _code_only(line):
+    """A source line as Blender's log quotes it: comments removed (its preprocessor strips them)."""
+    return re.sub(r"/\*.*?\*/|//.*$", "", line).strip()
+
+
 _LOG_SOURCE_LINE = re.compile(r"\|\s*(\d*)\s*\|(?: (.*))?$")
 _LOG_ERROR = re.compile(r"(?::\d+:\d+:|ERROR:\s*\d+:\d+:)\s*[Ee]rror:?\s*(.*)$")
 
@@ -181,7 +186,7 @@ def _error_message(key, log, sources):
         if last_text:
             for stage, source in sources:
                 lines = source.split("\n")
-                hits = [n for n, line in enumerate(lines, 1) if line.strip() == last_text]
+                hits = [n for n, line in enumerate(lines, 1) if _code_only(line) == _code_only(last_text)]
                 if hits:
                     number = hits[0]
                     location = f"{stage} line {number}"
@@ -282,3 +287,43 @@ def anisotropy_table(lobe_count):
     """ndf_fit's table as an (R, K, 4) float32 texture: texel (k, row)."""
     from ..core import ndf_fit
     return np.ascontiguousarray(ndf_fit.anisotropy_table_array(lobe_count), np.float32)
+
+
+def background_create_info(has_environment):
+    import gpu
+
+    info = gpu.types.GPUShaderCreateInfo()
+    for name, value in LIMITS.items():
+        info.define(name, str(value))
+    if has_environment:
+        info.define("HAS_ENVIRONMENT", "1")
+        info.define("ENV_PREFILTER_MAX_LAYERS", str(MAX_LAYERS))
+    info.typedef_source(typedef_source())
+    info.vertex_in(0, "VEC2", "position")
+    interface = gpu.types.GPUStageInterfaceInfo("sgprt_background_interface")
+    interface.smooth("VEC2", "ndc")
+    info.vertex_out(interface)
+    info.push_constant("MAT4", "inverse_view_projection")
+    info.push_constant("FLOAT", "background_alpha")
+    info.uniform_buf(0, "SceneData", "scene")
+    if has_environment:
+        info.sampler(0, "FLOAT_2D_ARRAY", "environment_texture")
+    for index, name in enumerate(output_names(False)):
+        info.fragment_out(index, "VEC4", "out_" + name)
+    info.vertex_source(_read(os.path.join(RESOURCE_DIR, "background.vert.glsl")))
+    libraries = [library_source("sg.glsl")] + ([library_source("env_prefilter.glsl")] if has_environment else [])
+    info.fragment_source("\n".join(libraries + [_read(os.path.join(RESOURCE_DIR, "background.frag.glsl"))]))
+    return info
+
+
+def get_background_shader(has_environment):
+    """Shader drawing the world behind the surfaces (cached like the surface variants)."""
+    key = ("background", bool(has_environment))
+    shader = _cache.get(key)
+    if shader is None:
+        info = background_create_info(has_environment)
+        shader, error, log = _create_capturing_log(info)
+        if shader is None:
+            raise ShaderCompileError(f"SG-PRT background shader failed to compile\n{log.strip()}") from error
+        _cache[key] = shader
+    return shader

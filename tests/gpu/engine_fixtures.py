@@ -111,6 +111,10 @@ def world_colour(scene, colour):
 
     world = bpy.data.worlds.new(scene.name + "_world")
     world.color = colour
+    if world.node_tree is not None:     # what renders (Blender 5 worlds always use nodes)
+        for node in world.node_tree.nodes:
+            if node.type == "BACKGROUND":
+                node.inputs["Color"].default_value = tuple(colour) + (1.0,)
     scene.world = world
     return world
 
@@ -119,7 +123,8 @@ def world_texture(scene, path, strength=1.0):
     import bpy
 
     world = bpy.data.worlds.new(scene.name + "_world")
-    world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
     nodes = world.node_tree.nodes
     background = next(node for node in nodes if node.type == "BACKGROUND")
     background.inputs["Strength"].default_value = strength
