@@ -139,6 +139,27 @@ def test_constant_background_lights_like_a_constant_environment_and_fills_misses
     assert np.all(np.abs(centre - [0.1, 0.2, 0.4]) < 5 * error[5:11, 5:11] + 1e-12)
 
 
+def test_sphere_occluding_a_constant_environment_matches_its_form_factor():
+    """A sphere (radius R, centre c) fully above a plane point p hides the cosine-weighted fraction
+    R^2 c_z / |c - p|^3 of the sky: R = kd L (1 - R^2 c_z / d^3).  Tests environment visibility."""
+    sphere_vertices, sphere_triangles, sphere_normals = make_icosphere(4, 1.0, (0.0, 0.0, 1.3))
+    plane_vertices, plane_triangles, plane_normals = ground_plane()
+    scene = Scene(np.concatenate([sphere_vertices, plane_vertices]),
+                  np.concatenate([sphere_triangles, plane_triangles + len(sphere_vertices)]),
+                  np.concatenate([sphere_normals, plane_normals]), [Material((0.5, 0.5, 0.5))],
+                  background=(1.0, 1.0, 1.0))
+    pixels = 24
+    image, error = render_reference(scene, orthographic_down(1.5, pixels, height_above=0.25), 16, seed=12)
+    y, x = np.mgrid[0:pixels, 0:pixels]
+    centre = np.stack([-1.5 + (x + 0.5) * 3 / pixels, 1.5 - (y + 0.5) * 3 / pixels, np.zeros((pixels, pixels))], -1)
+    distance = np.linalg.norm(np.array([0, 0, 1.3]) - centre, axis=-1)
+    expected = 0.5 * (1 - 1.3 / distance ** 3)
+    assert expected.min() < 0.3 and expected.max() > 0.4        # the shadowing really varies
+    z = (image[..., 0] - expected) / error[..., 0]
+    assert rms(z) < 1.3 and abs(np.mean(z)) < 0.3, (rms(z), np.mean(z))
+    assert np.mean(error[..., 0] / expected) < 0.03                 # the z-test has power: errors of ~3%
+
+
 # -- (b) directional light on a Lambertian sphere: kd / pi E max(0, n.l) ------------------------------
 def test_directional_light_on_lambertian_sphere_matches_closed_form():
     vertices, triangles, normals = make_icosphere(4)
