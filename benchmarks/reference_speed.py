@@ -14,7 +14,8 @@ import numpy as np
 
 from sg_prt_addon.core.camera import Camera
 from sg_prt_addon.core.raytrace import RayTracer
-from sg_prt_addon.core.reference import DirectionalLight, Material, PointLight, Scene, render_reference
+from sg_prt_addon.core.reference import (DirectionalLight, Material, PointLight, Scene, mean_relative_error,
+                                         render_reference)
 
 
 def make_icosphere(subdivisions, radius=1.0, center=(0.0, 0.0, 0.0)):
@@ -83,14 +84,9 @@ def main():
     tracer = RayTracer(scene.vertices, scene.triangles)
     print(f"{len(scene.triangles)} triangles, {args.size}x{args.size} pixels")
 
-    def relative_error(image, error, statistic=np.mean):
-        # Over pixels that see the scene (background pixels are exact, error 0) and are not black.
-        surface = (error.max(axis=-1) > 0) & (image.mean(axis=-1) > 1e-3 * image.mean())
-        return float(statistic(error[surface] / image[surface]))
-
     start = time.perf_counter()
     image, error = render_reference(scene, camera, args.pilot_spp, seed=1, tracer=tracer)
-    pilot_noise = relative_error(image, error)
+    pilot_noise = mean_relative_error(image, error)
     spp = int(np.clip(np.ceil(args.pilot_spp * (pilot_noise / args.noise) ** 2), 2, args.max_spp))
     print(f"pilot {args.pilot_spp} spp: {time.perf_counter() - start:.1f} s, mean relative error {pilot_noise:.4f}"
           f" -> {spp} spp")
@@ -103,8 +99,8 @@ def main():
     print(f"render {spp} spp: {seconds:.1f} s wall, {cpu_seconds:.1f} s CPU, "
           f"{tracer.rays_traced / seconds / 1e6:.2f} M rays/s wall "
           f"({tracer.rays_traced / (spp * args.size ** 2):.2f} rays per pixel sample), "
-          f"relative standard error over surface pixels: mean {relative_error(image, error):.4f}, "
-          f"median {relative_error(image, error, np.median):.4f}")
+          f"relative standard error over surface pixels: mean {mean_relative_error(image, error):.4f}, "
+          f"median {mean_relative_error(image, error, np.median):.4f}")
     assert np.all(np.isfinite(image)) and np.all(np.isfinite(error))
     return image, error
 

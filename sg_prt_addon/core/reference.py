@@ -131,6 +131,46 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
             tracer.close()
 
 
+def mean_relative_error(image, standard_error, statistic=np.mean):
+    """Noise figure of a render: ``statistic`` (mean by default) of standard_error / value over the
+    pixels that carry noise (background pixels are exact) and are not black (< 1e-3 of the mean)."""
+    noisy = (standard_error.max(axis=-1) > 0) & (image.mean(axis=-1) > 1e-3 * image.mean())
+    if not noisy.any():
+        return 0.0
+    return float(statistic(standard_error[noisy] / np.maximum(image[noisy], 1e-300)))
+
+
+def render_to_noise(scene, camera, relative_error=0.01, pilot_samples=8, max_samples=4096, seed=0,
+                    tracer=None, **options):
+    """Render until mean_relative_error is about ``relative_error``: a pilot of ``pilot_samples``
+    samples per pixel predicts the count (error ~ 1/sqrt(samples)), then the remaining samples are
+    rendered with another seed and merged.  Returns (image, standard_error, samples_per_pixel).
+    The merge assumes both runs finish: a progress callback must not stop them."""
+    own_tracer = tracer is None
+    if own_tracer:
+        tracer = RayTracer(scene.vertices, scene.triangles, threads=options.get("threads", 2))
+    try:
+        pilot_samples = max(2, int(pilot_samples))
+        image, error = render_reference(scene, camera, pilot_samples, seed=seed, tracer=tracer, **options)
+        pilot_error = mean_relative_error(image, error)
+        wanted = int(np.clip(np.ceil(pilot_samples * (pilot_error / relative_error) ** 2), pilot_samples, max_samples))
+        if wanted <= pilot_samples:
+            return image, error, pilot_samples
+        rest = wanted - pilot_samples
+        image2, error2 = render_reference(scene, camera, rest, seed=(seed, 1), tracer=tracer, **options)
+        # Merge two uniform-count runs (means and sums of squared deviations, Chan et al.).
+        n1, n2 = float(pilot_samples), float(rest)
+        squares1 = np.where(np.isfinite(error), error ** 2 * n1 * (n1 - 1), 0.0)
+        squares2 = np.where(np.isfinite(error2), error2 ** 2 * n2 * (n2 - 1), 0.0)
+        merged = (n1 * image + n2 * image2) / (n1 + n2)
+        squares = squares1 + squares2 + (image2 - image) ** 2 * (n1 * n2 / (n1 + n2))
+        merged_error = np.sqrt(squares / (n1 + n2 - 1) / (n1 + n2))
+        return merged, merged_error, wanted
+    finally:
+        if own_tracer:
+            tracer.close()
+
+
 def _render(scene, camera, samples_per_pixel, seed, progress, batch_rays, threads, renderer):
     environment_samples = renderer.environment_samples
     height, width = camera.height, camera.width

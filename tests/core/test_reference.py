@@ -401,3 +401,15 @@ def test_tangents_orient_the_local_frame(tangent, expected_x):
         assert np.ptp(image) < 1e-12
     else:
         np.testing.assert_allclose(image, 2.0 * 0.8 * expected_x, atol=1e-12)
+
+
+def test_render_to_noise_reaches_the_target_and_stays_calibrated():
+    from sg_prt_addon.core.reference import mean_relative_error, render_to_noise
+    scene = _constant_sky_scene()
+    camera = orthographic_down(1.0, 16)
+    image, error, samples = render_to_noise(scene, camera, relative_error=0.01, pilot_samples=4,
+                                            environment_samples=4, seed=13)
+    assert samples > 8
+    assert 0.008 < mean_relative_error(image, error) < 0.012
+    ratio = rms(image - 0.6 * np.array([1.0, 0.5, 2.0])) / rms(error)
+    assert 0.85 < ratio < 1.15, ratio
