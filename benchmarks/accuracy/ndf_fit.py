@@ -94,8 +94,11 @@ def _broad_lobe_rows():
         for lobe_count in (4, 8):
             plain = ndf_fit.ndf_l2_error(model, model.ndf_lobes(lobe_count))
             corrected = ndf_fit.ndf_l2_error(model, model.ndf_lobes(lobe_count, broad_lobe_correction=True))
+            refined = ndf_fit.ndf_l2_error(model, model.ndf_lobes(lobe_count, broad_lobe_correction=True,
+                                                                  refine=True))
             rows.append(_row(f"{label}, {lobe_count} lobes, broad_lobe_correction", QUADRATURE, L2, corrected,
-                             f"table without the correction: {plain:.3g}"))
+                             f"table without the correction: {plain:.3g}; refine=True (sphere fit, uniform "
+                             f"parameters): {refined:.3g}"))
     return rows
 
 

@@ -406,13 +406,17 @@ class WardAnisotropic(_Microfacet):
         no, ni, visible = _cosines(wo, wi)
         return np.where(visible, 0.25 / np.sqrt(ni * no), 0)
 
-    def ndf_lobes(self, lobe_count=4, broad_lobe_correction=False):
+    def ndf_lobes(self, lobe_count=4, broad_lobe_correction=False, refine=False):
         """K SG lobes from the normalized anisotropy table (ndf_fit.anisotropic_lobes).
 
         broad_lobe_correction applies the Ward isotropic L2 mapping at the geometric-mean
         width (much better for alpha >~ 0.3; off by default because the GLSL mirror,
-        shaders/resources/anisotropic_lobes.glsl, does not apply it yet)."""
+        shaders/resources/anisotropic_lobes.glsl, does not apply it yet).  refine (scalar
+        parameters only) fits the exact D on the sphere from there
+        (ndf_fit.refined_anisotropic_lobes, cached)."""
         from . import ndf_fit
+        if refine:
+            return ndf_fit.refined_anisotropic_lobes(self, lobe_count, "WARD_ISO" if broad_lobe_correction else None)
         ax, ay = self._alphas(_dtype(self.alpha_x, self.alpha_y))
         return ndf_fit.anisotropic_lobes(ax, ay, 1 / (np.pi * ax * ay), lobe_count,
                                          "WARD_ISO" if broad_lobe_correction else None)
@@ -474,11 +478,14 @@ class AshikhminShirley(_Microfacet):
         fresnel = fresnel_schlick(kh, _param(self.rf0, wo.dtype))
         return np.where(visible, fresnel / (4 * kh * np.maximum(ni, no)), 0)
 
-    def ndf_lobes(self, lobe_count=4, broad_lobe_correction=False):
+    def ndf_lobes(self, lobe_count=4, broad_lobe_correction=False, refine=False):
         """K SG lobes from the normalized anisotropy table; widths sqrt(2/nu), sqrt(2/nv)
         (the small-angle Gaussian of (n.h)^e).  broad_lobe_correction: the Blinn-Phong
-        L2 mapping (same (n.h)^n shape) at the geometric-mean width, see WardAnisotropic."""
+        L2 mapping (same (n.h)^n shape) at the geometric-mean width; refine: see
+        WardAnisotropic."""
         from . import ndf_fit
+        if refine:
+            return ndf_fit.refined_anisotropic_lobes(self, lobe_count, "BLINN_PHONG" if broad_lobe_correction else None)
         nu, nv = self._exponents(_dtype(self.nu, self.nv))
         floor = np.asarray(1e-6, nu.dtype)
         width_x = np.sqrt(2 / np.maximum(nu, floor))

@@ -36,6 +36,7 @@
 * ``ndf_l2_error`` / ``brdf_relative_rmse``: the two error measures the tests
   and benchmarks/accuracy/ndf_fit.py report.
 """
+import dataclasses
 import functools
 import itertools
 
@@ -385,6 +386,31 @@ def fit_ndf(ndf, lobe_count, width_hint=0.1, isotropic=None):
         return axis, sharpness, amplitude, float(error)
     directions, weights = hemisphere_quadrature(width_hint)
     return fit_anisotropic(evaluate(directions), directions, weights, lobe_count)
+
+
+@functools.lru_cache(maxsize=256)
+def _refined_lobes(model_class, parameters, lobe_count, mapping_kind):
+    model = model_class(**dict(parameters))
+    widths = model_widths(model)
+    width_x, width_y = widths if len(widths) == 2 else widths * 2
+    peak = float(model.ndf(np.array([0.0, 0.0, 1.0])))
+    start = anisotropic_lobes(np.float64(width_x), np.float64(width_y), peak, lobe_count, mapping_kind)
+    directions, weights = hemisphere_quadrature(widths, 16, 160)
+    axis, sharpness, amplitude, _ = fit_anisotropic(model.ndf(directions), directions, weights, lobe_count,
+                                                    initial=start, max_iterations=100, method="TNC")
+    return axis, sharpness, amplitude
+
+
+def refined_anisotropic_lobes(model, lobe_count, mapping_kind=None):
+    """Lobes of a uniform-parameter anisotropic model refined on the sphere: the table's lobes
+    warm-start fit_anisotropic on the exact D (TNC, about 0.5-2 s, cached per model and K).
+    For materials without textured parameters, where the table's small-angle scaling
+    is poor (broad lobes): Ward (0.8, 0.4), 4 lobes, 0.28 -> 0.035 relative L2."""
+    # keyed by value (the models compare by identity): equal materials share one fit
+    parameters = tuple((field.name, float(getattr(model, field.name))) for field in dataclasses.fields(model)
+                       if getattr(model, field.name) is not None)
+    axis, sharpness, amplitude = _refined_lobes(type(model), parameters, lobe_count, mapping_kind)
+    return axis.copy(), sharpness.copy(), amplitude.copy()
 
 
 # ----------------------------------------------------------------------------- normalized anisotropy table
