@@ -14,7 +14,7 @@ from .shader_variants import ShaderCompileError
 # Debug hooks for tests and benchmarks (no UI): when `capture_gbuffer` is True the next
 # final render also writes the shading inputs; every final render leaves its float
 # passes, the G-buffer and the SceneState in `last_render`.
-debug = {"capture_gbuffer": False, "environment_layer_size": None}
+debug = {"capture_gbuffer": False, "environment_layer_size": None, "timed_redraws": 0}
 last_render = {}
 
 
@@ -163,6 +163,17 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
         for name in renderer_module.GBUFFER_OUTPUTS:
             passes["gbuffer_" + name] = renderer.read_output(name)
     timings["draw_and_read"] = time.perf_counter() - start
+    # steady-state frame cost (shaders compiled and JIT-ed, data uploaded): draw + read the passes
+    frame_times = []
+    for _ in range(int(debug.get("timed_redraws") or 0)):
+        start = time.perf_counter()
+        renderer.upload(state, state.consume_dirty(), camera)
+        renderer.draw(state, camera, background_alpha=0.0 if scene.render.film_transparent else 1.0)
+        for name in renderer_module.PASS_NAMES:
+            renderer.read_output(name.lower())
+        frame_times.append(time.perf_counter() - start)
+    if frame_times:
+        timings["frames"] = frame_times
     passes["camera"] = camera
     passes["material_ids"] = dict(renderer.material_ids)
     return passes, state, timings

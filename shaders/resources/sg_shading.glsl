@@ -78,6 +78,28 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
 #endif
 }
 
+#ifdef HAS_ENVIRONMENT
+/* env_prefilter_lookup (env_prefilter.glsl) step for step, with the per-layer texcoord
+ * transforms read from the scene block in place: passing them as the library's array
+ * argument copies the whole array for every lobe of every fragment. */
+vec3 environment_radiance(vec3 axis, float sharpness)
+{
+  vec2 coords = oct_encode(safe_normalize(axis));
+  int layer_count = scene.counts.w;
+  float position = env_prefilter_blend_parameter(sharpness, scene.prefilter_info.x, scene.prefilter_info.y,
+                                                 layer_count);
+  int last = layer_count - 1;
+  int lower = min(int(floor(position)), max(last - 1, 0));
+  int upper = min(lower + 1, last);
+  float fraction = position - float(lower);
+  vec2 lower_transform = scene.prefilter_scale_offset[lower].xy;
+  vec2 upper_transform = scene.prefilter_scale_offset[upper].xy;
+  vec4 lower_value = texture(environment_texture, vec3(coords * lower_transform.x + lower_transform.y, float(lower)));
+  vec4 upper_value = texture(environment_texture, vec3(coords * upper_transform.x + upper_transform.y, float(upper)));
+  return (lower_value + (upper_value - lower_value) * fraction).rgb;
+}
+#endif
+
 /* Light l (point/spot first, then suns) as an SG at the shading position. */
 void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, out vec3 amplitude)
 {
@@ -165,18 +187,10 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
 #endif
 
-#ifdef HAS_ENVIRONMENT
-  vec2 scale_offset[ENV_PREFILTER_MAX_LAYERS];
-  for (int k = 0; k < ENV_PREFILTER_MAX_LAYERS; k++) {
-    scale_offset[k] = scene.prefilter_scale_offset[k].xy;
-  }
-#endif
   for (int j = 0; j < SLICE_LOBES; j++) {
     float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n);
 #ifdef HAS_ENVIRONMENT
-    radiance += slice_cosine * env_prefilter_lookup(environment_texture, slice_axis[j], slice_sharpness[j],
-                                                    scene.prefilter_info.x, scene.prefilter_info.y,
-                                                    scene.counts.w, scale_offset).rgb;
+    radiance += slice_cosine * environment_radiance(slice_axis[j], slice_sharpness[j]);
 #else
     radiance += slice_cosine * scene.world_colour.rgb;
 #endif
