@@ -14,8 +14,9 @@ from . import equirect
 
 # Rec. 709 luminance weights (Blender's default scene-linear space).
 LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
-# Every texel keeps at least this fraction of the mean weight, so directions with
-# dim but non-zero (or coloured, zero-luminance) radiance are still sampled.
+# A floor, uniform in solid angle, of this fraction of the mean texel weight: every
+# direction keeps a non-zero pdf, so dim texels are still sampled and MIS never
+# divides by a zero environment pdf.
 _FLOOR_FRACTION = 1e-3
 
 

@@ -9,12 +9,14 @@ indirect light.  Every sample of a pixel takes a new uniformly jittered
 position inside the pixel (anti-aliasing) and traces its own camera ray, so a
 pixel's value is the average of R over its footprint.
 
-Estimators, one sample each per pixel sample:
-  - environment: multiple importance sampling of one environment sample
-    (core.env_sampling) and one BRDF sample, power heuristic;
-  - point lights (sphere of radius r, r = 0 a true point) and directional
-    lights (cone of angular radius a, a = 0 a delta): light sampling uniform
-    over the solid angle the light subtends.
+Estimators, per pixel sample (one camera ray):
+  - environment (an equirect map, or a constant background colour):
+    multiple importance sampling, power heuristic, of ``environment_samples``
+    (default 16, stratified 4x4) environment samples (core.env_sampling) and as
+    many BRDF samples (cosine lobe or the specular model, picked by weight);
+  - point lights (sphere of radius r, r = 0 a true point, optional spot cone)
+    and directional lights (cone of angular radius a, a = 0 a delta): one light
+    sample, uniform over the solid angle the light subtends.
 
 Conventions:
   - Pixels whose camera ray misses the scene show the environment radiance
