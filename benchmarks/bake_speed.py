@@ -1,0 +1,126 @@
+"""Visibility bake speed and PCA error vs terms (sg_prt_addon/bake).
+
+Procedural scenes (numpy only): a subdivided icosphere resting over a
+subdivided floor grid, about 5k, 20k (and 80k) vertices; every vertex is
+baked and the whole scene occludes.  Prints, per size: bake time (rays + SSDF
++ PCA), rays per vertex, rays/s of the bake, and the raw occlusion rate of
+RayTracer.occluded on the same scene (one big batch of random hemisphere rays
+from the same vertices) in the same run, and their ratio; then the PCA's RMS
+angular error against the number of terms (plot: benchmarks/ssdf_pca_error.png).
+
+    .venv/bin/python -m benchmarks.bake_speed            # 5k and 20k
+    .venv/bin/python -m benchmarks.bake_speed 5000 20000 80000
+"""
+import sys
+import time
+
+import numpy as np
+
+from sg_prt_addon.bake import BakeOptions, bake_visibility, hemisphere_map
+from sg_prt_addon.core.raytrace import RayTracer
+
+
+def icosphere(subdivisions):
+    """Unit icosphere: (vertices (V, 3), triangles (T, 3)), outward winding."""
+    t = (1 + 5 ** 0.5) / 2
+    vertices = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+                (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+             (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
+             (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    vertices = np.array(vertices, np.float64)
+    vertices /= np.linalg.norm(vertices, axis=1, keepdims=True)
+    faces = np.array(faces, np.int64)
+    for _ in range(subdivisions):
+        edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+        unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+        midpoints = vertices[unique[:, 0]] + vertices[unique[:, 1]]
+        midpoints /= np.linalg.norm(midpoints, axis=1, keepdims=True)
+        mid = inverse.reshape(3, -1) + len(vertices)   # mid[0]: edge (0,1), mid[1]: (1,2), mid[2]: (2,0)
+        a, b, c = faces.T
+        faces = np.concatenate([np.stack([a, mid[0], mid[2]], 1), np.stack([b, mid[1], mid[0]], 1),
+                                np.stack([c, mid[2], mid[1]], 1), np.stack([mid[0], mid[1], mid[2]], 1)])
+        vertices = np.concatenate([vertices, midpoints])
+    return vertices, faces
+
+
+def grid(count_per_side, half_size):
+    """Floor z = 0 over [-half_size, half_size]^2: (vertices, triangles), normals +z."""
+    coords = np.linspace(-half_size, half_size, count_per_side)
+    x, y = np.meshgrid(coords, coords, indexing="ij")
+    vertices = np.stack([x.ravel(), y.ravel(), np.zeros(x.size)], axis=1)
+    index = np.arange(x.size).reshape(count_per_side, count_per_side)
+    a, b, c, d = index[:-1, :-1].ravel(), index[1:, :-1].ravel(), index[1:, 1:].ravel(), index[:-1, 1:].ravel()
+    return vertices, np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+
+
+def sphere_over_floor(target_vertices):
+    """An icosphere (radius 1, resting at height 0.05) over a 6 x 6 floor, about target_vertices in all.
+    Returns (vertices, triangles, normals)."""
+    subdivisions = int(np.clip(np.round(np.log(max(target_vertices / 2 / 10, 1)) / np.log(4)), 0, 8))
+    sphere_v, sphere_t = icosphere(subdivisions)
+    floor_side = int(round(np.sqrt(max(target_vertices - len(sphere_v), 4))))
+    floor_v, floor_t = grid(floor_side, 3.0)
+    vertices = np.concatenate([sphere_v + [0.0, 0.0, 1.05], floor_v])
+    triangles = np.concatenate([sphere_t, floor_t + len(sphere_v)])
+    normals = np.concatenate([sphere_v, np.tile([0.0, 0.0, 1.0], (len(floor_v), 1))])
+    return vertices, triangles, normals
+
+
+def raw_rate(vertices, triangles, normals, rays=2_000_000, seed=0):
+    """RayTracer.occluded rays/s on one big batch of random upper-hemisphere rays from the vertices."""
+    rng = np.random.default_rng(seed)
+    tracer = RayTracer(vertices, triangles, threads=2, chunk_rays=1 << 15)
+    pick = rng.integers(0, len(vertices), rays)
+    frames = hemisphere_map.local_frame(normals[pick])
+    local = hemisphere_map.square_to_hemisphere(rng.uniform(-1, 1, (rays, 2)))
+    directions = np.einsum("nc,ncw->nw", local, frames)
+    origins = vertices[pick] + tracer.offset * normals[pick]
+    started = time.perf_counter()
+    tracer.occluded(origins, directions)
+    seconds = time.perf_counter() - started
+    tracer.close()
+    return rays / seconds
+
+
+def run(target_vertices, options=None):
+    vertices, triangles, normals = sphere_over_floor(target_vertices)
+    options = options or BakeOptions()
+    raw = raw_rate(vertices, triangles, normals)
+    result = bake_visibility(vertices, triangles, normals, vertices, triangles, options)
+    bake_rate = result.rays_traced / result.seconds
+    print(f"{len(vertices):6d} vertices, {len(triangles):6d} triangles: bake {result.seconds:6.1f} s, "
+          f"{result.rays_traced / len(vertices):6.0f} rays/vertex, {bake_rate / 1e6:5.2f} M rays/s "
+          f"(raw RayTracer.occluded {raw / 1e6:5.2f} M rays/s, bake/raw {bake_rate / raw:4.2f}); "
+          f"PCA {result.terms} terms, RMS {result.rms_error:.4f} rad", flush=True)
+    return result
+
+
+def plot_pca_error(result, path="benchmarks/ssdf_pca_error.png"):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    errors = result.rms_error_by_terms
+    figure, axes = plt.subplots(figsize=(5, 3.5))
+    axes.semilogy(np.arange(len(errors)), errors, marker=".")
+    axes.set_xlabel("PCA terms")
+    axes.set_ylabel("RMS SSDF error (rad)")
+    axes.set_title(f"SSDF PCA, {result.vertex_count} vertices, {result.resolution}^2 texels")
+    axes.grid(True, which="both", alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
+
+
+def main(sizes):
+    last = None
+    for size in sizes:
+        last = run(size)
+    errors = last.rms_error_by_terms
+    print("PCA RMS error (rad) by terms: " + ", ".join(f"{n}:{errors[n]:.4f}" for n in
+                                                      (0, 1, 2, 4, 8, 12, 16, 24, 32, 48) if n < len(errors)))
+    plot_pca_error(last)
+
+
+if __name__ == "__main__":
+    main([int(a) for a in sys.argv[1:]] or [5000, 20000])

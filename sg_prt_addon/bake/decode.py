@@ -1,0 +1,100 @@
+"""Numpy mirror of shaders/lib/ssdf.glsl: SSDF lookup from PCA data and its product with an SG.
+
+GPU layout (``pack_basis_texture``, ``pack_coefficients``): the mean and the
+basis images share one RGBA32F sampler2DArray, four images a layer in the
+order [mean, B_0, B_1, ...], zero-padded; each vertex's coefficients are
+[1, w_0, w_1, ...] padded to the same 4 x layers floats.  The decoded SSDF is
+then sum over layers of dot(texture(basis, (s, t, layer)), coefficients[layer]):
+one bilinear fetch per four terms, and bilinear filtering commutes with the
+linear PCA sum, so this equals the bilinear sample of the reconstructed image.
+
+``sample_bilinear`` reproduces a GPU linear sampler with clamp-to-edge: texel
+centres at (k + 0.5) / R, weights from the fractional part.
+"""
+import numpy as np
+
+from ..core import hemisphere
+from . import hemisphere_map
+
+
+def sample_bilinear(images, texcoord):
+    """Bilinear samples of images (..., R, R) at texture coordinates (Q, 2) in [0, 1]^2 -> (..., Q).
+
+    images are indexed [t row, s column]; clamp-to-edge like a GPU sampler.
+    """
+    return _sample(np.asarray(images), np.asarray(texcoord, np.float64))
+
+
+def _sample(images, texcoord):
+    rows, cols = images.shape[-2], images.shape[-1]
+    x = texcoord[..., 0] * cols - 0.5
+    y = texcoord[..., 1] * rows - 0.5
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    fx = x - x0
+    fy = y - y0
+    c0 = np.clip(x0, 0, cols - 1).astype(np.intp)
+    c1 = np.clip(x0 + 1, 0, cols - 1).astype(np.intp)
+    r0 = np.clip(y0, 0, rows - 1).astype(np.intp)
+    r1 = np.clip(y0 + 1, 0, rows - 1).astype(np.intp)
+    top = images[..., r0, c0] * (1 - fx) + images[..., r0, c1] * fx
+    bottom = images[..., r1, c0] * (1 - fx) + images[..., r1, c1] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def texcoord_of(local_direction):
+    """Texture coordinates (..., 2) and angle below the horizon (...) of local directions."""
+    square, below = hemisphere_map.horizon_lookup(local_direction)
+    return 0.5 * (square + 1.0), below
+
+
+def decode(coefficients, basis, mean, local_direction):
+    """SSDF values (...) at local directions (..., 3) from per-point coefficients (..., N),
+    basis (N, R, R) and mean (R, R): bilinear in the map, minus the angle below the horizon."""
+    local_direction = np.asarray(local_direction, np.float64)
+    texcoord, below = texcoord_of(local_direction)
+    flat_coord = texcoord.reshape(-1, 2)
+    count = flat_coord.shape[0]
+    mean_value = _sample(np.asarray(mean, np.float64), flat_coord)
+    basis_values = _sample(np.asarray(basis, np.float64), flat_coord)        # (N, Q)
+    weights = np.asarray(coefficients, np.float64).reshape(count, -1)
+    value = mean_value + np.einsum("qn,nq->q", weights, basis_values)
+    return value.reshape(below.shape) - below
+
+
+def decode_image(image, local_direction):
+    """SSDF (...) at local directions from one uncompressed (R, R) image (same lookup as ``decode``)."""
+    texcoord, below = texcoord_of(local_direction)
+    return _sample(np.asarray(image, np.float64), texcoord) - below
+
+
+def visibility_product(axis_local, sharpness, amplitude, theta_d):
+    """Lobe (x) visibility, wang2009 eq. 31 in the integral-preserving form of core.hemisphere
+    (apply to the final product lobe).  theta_d = the decoded SSDF at the lobe axis."""
+    return hemisphere.visibility_product_integral_preserving(axis_local, sharpness, amplitude, theta_d)
+
+
+def shadowed_integral(axis_local, sharpness, amplitude, coefficients, basis, mean):
+    """Integral over the sphere of G(i; p, lambda, mu) V(i) ~ mu fh(V_d(p), lambda) (eq. 30)."""
+    theta_d = decode(coefficients, basis, mean, axis_local)
+    return np.asarray(amplitude) * hemisphere.fh(theta_d, sharpness)
+
+
+def pack_basis_texture(mean, basis):
+    """(L, R, R, 4) float32 sampler2DArray data: images [mean, B_0, ..., B_{N-1}] four to a layer."""
+    images = np.concatenate([np.asarray(mean)[None], np.asarray(basis)], axis=0)
+    layers = -(-images.shape[0] // 4)
+    padded = np.zeros((layers * 4,) + images.shape[1:], np.float32)
+    padded[:images.shape[0]] = images
+    return np.ascontiguousarray(padded.reshape(layers, 4, *images.shape[1:]).transpose(0, 2, 3, 1))
+
+
+def pack_coefficients(coefficients):
+    """(V, 4 L) float32 per-vertex rows [1, w_0, ..., w_{N-1}, 0...] matching ``pack_basis_texture``."""
+    coefficients = np.asarray(coefficients, np.float32)
+    count, terms = coefficients.shape
+    layers = -(-(terms + 1) // 4)
+    out = np.zeros((count, layers * 4), np.float32)
+    out[:, 0] = 1.0
+    out[:, 1:terms + 1] = coefficients
+    return out

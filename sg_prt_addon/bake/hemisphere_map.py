@@ -1,0 +1,133 @@
+"""Square <-> upper hemisphere map of the SSDF textures (wang2009 section 5.2).
+
+Shirley & Chiu's concentric map takes the square [-1, 1]^2 to the unit disc
+without folding, then the disc lifts to the hemisphere with equal area
+(z = 1 - r^2, (x, y) scaled by sqrt(2 - r^2)): every texel covers the same
+solid angle (2 pi / R^2) and texels stay nearly square.
+
+Conventions (shared by the bake, ``decode`` and shaders/lib/ssdf.glsl):
+
+- local frame: the vertex normal along z+; x+ along the ``local_frame`` tangent;
+- square coordinates (a, b) in [-1, 1]^2, a along local x, b along local y;
+- a grid of R x R texels is indexed [row, column] = [b index, a index]; texel k
+  has its centre at -1 + (2 k + 1) / R; texture coordinates are
+  (s, t) = ((a + 1) / 2, (b + 1) / 2), texture row t = 0 is numpy row 0;
+- the square's edge is the horizon (z = 0).
+
+Directions below the horizon (a lobe centre can be, e.g. for the diffuse
+product of eq. 39) have no texel.  Below the horizon the surface itself
+occludes, so the SSDF there is negative and its distance to the visible set
+grows by the angle below the horizon: ``horizon_lookup`` maps such a direction
+to the horizon point of the same azimuth and returns that angle, which the
+decoder subtracts from the value looked up there.
+"""
+import numpy as np
+
+QUARTER_PI = 0.25 * np.pi
+
+# Reference axis of the default tangent: an oblique world direction that mesh normals
+# (floors, walls, axis-aligned faces) practically never equal, so that the frame varies
+# smoothly between the vertices of a triangle (any tangent field has a singular normal).
+FRAME_REFERENCE_AXIS = np.array([0.2672612419124244, 0.5345224838248488, 0.8017837257372732])
+FRAME_FALLBACK_AXIS = np.array([0.8017837257372732, -0.2672612419124244, -0.5345224838248488])
+
+
+def square_to_disc(square):
+    """Concentric map (Shirley & Chiu 1997): (..., 2) square points -> (..., 2) disc points."""
+    square = np.asarray(square, np.float64)
+    a, b = square[..., 0], square[..., 1]
+    a_major = np.abs(a) >= np.abs(b)
+    radius = np.where(a_major, a, b)  # signed: a negative radius puts the point on the other side
+    safe_radius = np.where(radius == 0, 1.0, radius)
+    angle = np.where(a_major, QUARTER_PI * b / safe_radius, 2 * QUARTER_PI - QUARTER_PI * a / safe_radius)
+    return np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=-1)
+
+
+def disc_to_square(disc):
+    """Inverse of ``square_to_disc``."""
+    disc = np.asarray(disc, np.float64)
+    x, y = disc[..., 0], disc[..., 1]
+    radius = np.hypot(x, y)
+    x_major = np.abs(x) >= np.abs(y)
+    safe_x = np.where(x == 0, 1.0, x)
+    safe_y = np.where(y == 0, 1.0, y)
+    # |x| >= |y|: a = sign(x) r, b = a (4 / pi) atan(y / x); otherwise with the roles swapped.
+    a = np.where(x_major, np.copysign(radius, x), np.copysign(radius, y) * np.arctan(x / safe_y) / QUARTER_PI)
+    b = np.where(x_major, np.copysign(radius, x) * np.arctan(y / safe_x) / QUARTER_PI, np.copysign(radius, y))
+    return np.stack([a, b], axis=-1)
+
+
+def square_to_hemisphere(square):
+    """(..., 2) square points -> (..., 3) unit directions with z >= 0 (equal-area lift of the disc)."""
+    disc = square_to_disc(square)
+    radius2 = np.sum(disc * disc, axis=-1)
+    scale = np.sqrt(np.maximum(2.0 - radius2, 0.0))
+    return np.concatenate([disc * scale[..., None], (1.0 - radius2)[..., None]], axis=-1)
+
+
+def hemisphere_to_square(direction):
+    """(..., 3) unit directions with z >= 0 -> (..., 2) square points (inverse of square_to_hemisphere).
+
+    The disc point is (x, y) / sqrt(1 + z): no cancellation near the pole or the horizon.
+    """
+    direction = np.asarray(direction, np.float64)
+    z = np.clip(direction[..., 2], 0.0, 1.0)
+    disc = direction[..., :2] / np.sqrt(1.0 + z)[..., None]
+    return disc_to_square(disc)
+
+
+def texel_centres(resolution):
+    """(R,) square coordinates of the texel centres along one axis: -1 + (2 k + 1) / R."""
+    return -1.0 + (2.0 * np.arange(resolution) + 1.0) / resolution
+
+
+def texel_directions(resolution):
+    """(R, R, 3) local directions of the texel centres, indexed [b index, a index]."""
+    centres = texel_centres(resolution)
+    b, a = np.meshgrid(centres, centres, indexing="ij")
+    return square_to_hemisphere(np.stack([a, b], axis=-1))
+
+
+def elevation(direction):
+    """Signed angle of unit directions above the horizon, asin(z) in the well-conditioned atan2 form."""
+    direction = np.asarray(direction, np.float64)
+    return np.arctan2(direction[..., 2], np.hypot(direction[..., 0], direction[..., 1]))
+
+
+def horizon_lookup(direction):
+    """Where to look up the SSDF for any local direction: (square (..., 2), angle below horizon (...)).
+
+    Upper hemisphere: the direction's own square point and 0.  Below: the horizon
+    point of the same azimuth (straight down: azimuth 0) and the angle below the
+    horizon, which the caller subtracts from the SSDF value found there.
+    """
+    direction = np.asarray(direction, np.float64)
+    horizontal = np.hypot(direction[..., 0], direction[..., 1])
+    below = direction[..., 2] < 0
+    straight_down = below & (horizontal == 0)
+    clamped = np.where(below[..., None], np.concatenate(
+        [direction[..., :2] / np.where(horizontal == 0, 1.0, horizontal)[..., None],
+         np.zeros(direction.shape[:-1] + (1,))], axis=-1), direction)
+    clamped = np.where(straight_down[..., None], np.array([1.0, 0.0, 0.0]), clamped)
+    angle_below = np.where(below, np.arctan2(-direction[..., 2], horizontal), 0.0)
+    return hemisphere_to_square(clamped), angle_below
+
+
+def local_frame(normals, tangents=None):
+    """(..., 3, 3) rotations world -> local: rows (tangent, bitangent, normal).
+
+    Without tangents, the tangent is FRAME_REFERENCE_AXIS projected on the tangent
+    plane (FRAME_FALLBACK_AXIS when the normal is within ~0.6 degrees of it).
+    local = frame @ world; world = local @ frame.
+    """
+    n = np.asarray(normals, np.float64)
+    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    if tangents is None:
+        parallel = np.abs(np.sum(n * FRAME_REFERENCE_AXIS, axis=-1, keepdims=True)) > 0.99995
+        reference = np.where(parallel, FRAME_FALLBACK_AXIS, FRAME_REFERENCE_AXIS)
+    else:
+        reference = np.asarray(tangents, np.float64)
+    t = reference - np.sum(reference * n, axis=-1, keepdims=True) * n
+    t = t / np.linalg.norm(t, axis=-1, keepdims=True)
+    b = np.cross(n, t)
+    return np.stack([t, b, n], axis=-2)

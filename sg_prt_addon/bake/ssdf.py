@@ -1,0 +1,120 @@
+"""Binary visibility -> spherical signed distance function (wang2009 eq. 23).
+
+V_d(i) = +min over occluded t of arccos(t.i) where i is visible, -min over
+visible t where occluded.  On a grid the boundary is sampled by the
+midpoints (on the sphere: normalized sums) of 4-adjacent texels of opposite
+visibility, and distances are true geodesic angles to the nearest of them.
+
+The horizon is a boundary too: below it the surface itself occludes.  So a
+visible direction's distance is also capped by its elevation, which makes the
+SSDF of an unoccluded plane exactly the elevation: V_d(n) = pi/2, and fh
+(theta_d = V_d(p)) reconstructs the upper hemisphere for every lobe centre p
+(the reconstructed hemisphere's boundary passes through the nearest horizon
+point).  Occluded directions need no horizon term: the nearest visible point
+of a direction above the horizon is never interior to a horizon segment.
+
+No boundary at all: fully visible gives the elevation (above); fully occluded
+(nothing visible) gives -pi, the largest angle on the sphere (fh saturates at
+-pi/2 anyway).
+
+Values are sampled at the stored texel centres rather than averaged over them:
+the SSDF is continuous (1-Lipschitz), so point samples do not alias the way
+binary visibility does, and bilinear interpolation of point samples is what
+the GPU does.
+
+``signed_distance`` finds the nearest boundary point per vertex by a
+float32 matrix product of query and boundary directions (BLAS) and argmax of
+the cosine, then takes the angle to that point exactly in float64 (from the
+chord: arccos is ill-conditioned near 0).  float32 can only pick a point whose
+cosine is within ~1e-7 of the best: measured <= 2e-6 rad from
+``signed_distance_brute_force`` (float64 arccos against every boundary
+point), its test reference.  This is 3-4x faster than a k-d tree per vertex
+here (scipy cKDTree: ~1.5 us per query), and a map-domain distance transform
+was dropped: the map is not isometric and its nearest texel was off by up to
+0.7 rad.
+"""
+import numpy as np
+
+from . import hemisphere_map
+
+FULLY_OCCLUDED_VALUE = -np.pi
+
+
+def boundary_points(visible, directions):
+    """Boundary midpoints of a batch of grids.
+
+    visible (B, F, F) bool; directions (F, F, 3) texel-centre directions.
+    Returns (vertex index (M,), unit directions (M, 3)).
+    """
+    horizontal = visible[:, :, 1:] != visible[:, :, :-1]
+    vertical = visible[:, 1:, :] != visible[:, :-1, :]
+    v_h, r_h, c_h = np.nonzero(horizontal)
+    v_v, r_v, c_v = np.nonzero(vertical)
+    sums = np.concatenate([directions[r_h, c_h] + directions[r_h, c_h + 1],
+                           directions[r_v, c_v] + directions[r_v + 1, c_v]])
+    points = sums / np.linalg.norm(sums, axis=-1, keepdims=True)
+    return np.concatenate([v_h, v_v]), points
+
+
+def _chord_to_angle(chord):
+    return 2.0 * np.arcsin(np.clip(0.5 * chord, 0.0, 1.0))
+
+
+def _assemble(nearest_angle, query_visible, query_directions):
+    """Sign, horizon cap and the no-boundary cases (nearest_angle inf: no boundary)."""
+    up = hemisphere_map.elevation(query_directions)
+    visible_value = np.minimum(nearest_angle, up)
+    occluded_value = np.where(np.isfinite(nearest_angle), -nearest_angle, FULLY_OCCLUDED_VALUE)
+    return np.where(query_visible, visible_value, occluded_value)
+
+
+def signed_distance(visible, fine_directions, query_visible, query_directions):
+    """SSDF (B, Q) float64 at query directions from fine grids (nearest boundary point, see module doc).
+
+    visible (B, F, F) bool fine visibility; fine_directions (F, F, 3);
+    query_visible (B, Q) bool (the sign); query_directions (Q, 3).
+    """
+    count = visible.shape[0]
+    vertex, points = boundary_points(visible, fine_directions)
+    order = np.argsort(vertex, kind="stable")
+    points = points[order]
+    points32 = points.astype(np.float32)
+    starts = np.searchsorted(vertex[order], np.arange(count + 1))
+    query_directions = np.asarray(query_directions, np.float64)
+    queries32 = query_directions.astype(np.float32)
+    nearest = np.full(query_visible.shape, np.inf)
+    for index in np.nonzero(starts[1:] > starts[:-1])[0]:
+        first, stop = starts[index], starts[index + 1]
+        best = first + np.argmax(queries32 @ points32[first:stop].T, axis=1)
+        chord = np.linalg.norm(query_directions - points[best], axis=1)
+        nearest[index] = _chord_to_angle(chord)
+    return _assemble(nearest, query_visible, np.broadcast_to(query_directions, query_visible.shape + (3,)))
+
+
+def signed_distance_brute_force(visible, fine_directions, query_visible, query_directions):
+    """Same as ``signed_distance`` by arccos against every boundary point (tests only)."""
+    query_directions = np.asarray(query_directions, np.float64)
+    out = np.empty(query_visible.shape)
+    vertex, points = boundary_points(visible, fine_directions)
+    for index in range(visible.shape[0]):
+        mine = points[vertex == index]
+        if len(mine):
+            cosines = np.clip(query_directions @ mine.T, -1.0, 1.0)
+            nearest = np.arccos(cosines.max(axis=1))
+        else:
+            nearest = np.full(len(query_directions), np.inf)
+        out[index] = _assemble(nearest, query_visible[index], query_directions)
+    return out
+
+
+def ssdf_from_fine(visible_fine, refinement):
+    """(B, C, C) SSDF at the coarse texel centres from (B, C f, C f) fine visibility (f odd):
+    the coarse centre is the fine texel (i f + f // 2, j f + f // 2), whose visibility gives the sign."""
+    count, fine_resolution, _ = visible_fine.shape
+    coarse_resolution = fine_resolution // refinement
+    centre = np.arange(coarse_resolution) * refinement + refinement // 2
+    query_visible = visible_fine[:, centre][:, :, centre].reshape(count, -1)
+    fine_directions = hemisphere_map.texel_directions(fine_resolution)
+    query_directions = fine_directions[centre][:, centre].reshape(-1, 3)
+    values = signed_distance(visible_fine, fine_directions, query_visible, query_directions)
+    return values.reshape(count, coarse_resolution, coarse_resolution)

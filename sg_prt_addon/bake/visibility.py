@@ -1,0 +1,72 @@
+"""Binary visibility of the upper hemisphere at mesh vertices, through the square map.
+
+wang2009 section 5.2 casts 512 x 512 rays a vertex and downsamples to 128 x 128:
+far too many rays for 20k vertices on a CPU.  ``adaptive_visibility`` casts a
+coarse grid (one ray per stored texel) and supersamples, at ``refinement``^2
+rays (odd, so a coarse centre is also a fine centre), only the coarse cells
+whose 3 x 3 neighbourhood holds both visible and occluded samples.  It matches
+the dense fine grid except where a feature fits between coarse samples
+(thinner than a coarse cell, ~2.8 degrees at 32 x 32); tests/core/test_bake_visibility.py
+and benchmarks/bake_speed.py measure the mismatch.
+
+Grids are (B, F, F) bool, True = visible, indexed [vertex, b index, a index]
+as in ``hemisphere_map``.
+"""
+import numpy as np
+from scipy import ndimage
+
+from . import hemisphere_map
+
+
+def world_directions(local_directions, frames):
+    """local (..., K, 3) with frames (..., 3, 3) (rows t, b, n) -> world (..., K, 3)."""
+    return np.matmul(local_directions, frames)
+
+
+def dense_visibility(tracer, origins, frames, resolution):
+    """(B, R, R) visibility from one ray per texel centre (the reference for the adaptive scheme)."""
+    local = hemisphere_map.texel_directions(resolution).reshape(-1, 3)
+    count = len(origins)
+    directions = world_directions(np.broadcast_to(local, (count,) + local.shape), frames)
+    ray_origins = np.broadcast_to(np.asarray(origins, np.float64)[:, None, :], directions.shape)
+    occluded = tracer.occluded(ray_origins.reshape(-1, 3), directions.reshape(-1, 3))
+    return ~occluded.reshape(count, resolution, resolution)
+
+
+def cells_to_refine(coarse_visible):
+    """(B, C, C) bool: cells whose 3 x 3 neighbourhood (clamped at the square's edge) is mixed."""
+    footprint = np.ones((1, 3, 3), bool)
+    any_visible = ndimage.maximum_filter(coarse_visible, footprint=footprint, mode="nearest")
+    all_visible = ndimage.minimum_filter(coarse_visible, footprint=footprint, mode="nearest")
+    return any_visible != all_visible
+
+
+def adaptive_visibility(tracer, origins, frames, coarse_resolution, refinement):
+    """(B, F, F) visibility with F = coarse_resolution * refinement, and the number of rays cast.
+
+    Coarse rays at the coarse texel centres; in mixed cells (``cells_to_refine``)
+    the other refinement^2 - 1 fine texels are traced; elsewhere fine texels copy
+    their coarse cell.
+    """
+    if refinement % 2 != 1:
+        raise ValueError("refinement must be odd (coarse texel centres must be fine texel centres)")
+    coarse = dense_visibility(tracer, origins, frames, coarse_resolution)
+    rays = coarse.size
+    fine = np.repeat(np.repeat(coarse, refinement, axis=1), refinement, axis=2)
+    if refinement == 1:
+        return fine, rays
+    cell_vertex, cell_row, cell_col = np.nonzero(cells_to_refine(coarse))
+    if len(cell_vertex) == 0:
+        return fine, rays
+    fine_resolution = coarse_resolution * refinement
+    fine_local = hemisphere_map.texel_directions(fine_resolution)
+    offset_row, offset_col = np.divmod(np.arange(refinement * refinement), refinement)
+    not_centre = (offset_row != refinement // 2) | (offset_col != refinement // 2)
+    offset_row, offset_col = offset_row[not_centre], offset_col[not_centre]
+    rows = cell_row[:, None] * refinement + offset_row            # (M, f^2 - 1)
+    cols = cell_col[:, None] * refinement + offset_col
+    directions = world_directions(fine_local[rows, cols], frames[cell_vertex])
+    ray_origins = np.broadcast_to(np.asarray(origins, np.float64)[cell_vertex][:, None, :], directions.shape)
+    occluded = tracer.occluded(ray_origins.reshape(-1, 3), directions.reshape(-1, 3)).reshape(rows.shape)
+    fine[cell_vertex[:, None], rows, cols] = ~occluded
+    return fine, rays + occluded.size
