@@ -152,6 +152,11 @@ class Renderer:
         for key in list(self.mesh_buffers):
             if key not in state.meshes:
                 del self.mesh_buffers[key]
+        for image_name in dirty.images:
+            self.textures.pop(image_name, None)
+        for name, params in state.materials.items():      # materials whose image changed reload it
+            if name not in dirty.materials and any(image in dirty.images for image in params.textures.values()):
+                dirty.materials.add(name)
         for name in dirty.materials:
             params = state.materials.get(name)
             if params is None:

@@ -32,12 +32,13 @@ class ObjectEntry:
 class Dirty:
     meshes: set = field(default_factory=set)        # mesh keys to (re-)upload
     materials: set = field(default_factory=set)     # material names to rebuild
+    images: set = field(default_factory=set)        # image names whose pixels changed
     lights: bool = False
     world: bool = False
     objects: bool = False                          # object list or matrices changed
 
     def any(self):
-        return bool(self.meshes or self.materials or self.lights or self.world or self.objects)
+        return bool(self.meshes or self.materials or self.images or self.lights or self.world or self.objects)
 
 
 class SceneState:
@@ -110,6 +111,12 @@ class SceneState:
             if isinstance(datablock, bpy.types.Material):
                 self.materials[datablock.name] = export.export_material(datablock)
                 dirty.materials.add(datablock.name)
+            elif isinstance(datablock, bpy.types.Image):
+                dirty.images.add(datablock.name)
+                if self.world.image_name == datablock.name and depsgraph.scene.world is not None:
+                    self.world = export.export_world(depsgraph.scene.world)
+                    self.environment = environment_data(self.world)
+                    dirty.world = True
             elif isinstance(datablock, bpy.types.World):
                 self.world = export.export_world(datablock)
                 self.environment = environment_data(self.world)

@@ -157,8 +157,10 @@ def _code_only(line):
     return re.sub(r"/\*.*?\*/|//.*$", "", line).strip()
 
 
-_LOG_SOURCE_LINE = re.compile(r"\|\s*(\d*)\s*\|(?: (.*))?$")
-_LOG_ERROR = re.compile(r"(?::\d+:\d+:|ERROR:\s*\d+:\d+:)\s*[Ee]rror:?\s*(.*)$")
+# "<prefix>|  1176 |   text" (Blender 5) or " 1397 |   text" (Blender 4.2): Blender's copy of a source line
+_LOG_SOURCE_LINE = re.compile(r"^(?:.*?\|)?\s*(\d*)\s*\| ?(.*)$")
+# ":950:15: Error: ..." (Blender 5) or "| Error: ..." (Blender 4.2)
+_LOG_ERROR = re.compile(r"(?:\d+:\d+:|\|)\s*(?:Error|error):\s*(.*)$")
 
 
 def _error_message(key, log, sources):
@@ -171,14 +173,13 @@ def _error_message(key, log, sources):
     quoted, seen = [], set()
     last_text = None
     for raw in log.splitlines():
-        source_match = _LOG_SOURCE_LINE.search(raw)
-        if source_match and source_match.group(2) and not _LOG_ERROR.search(source_match.group(2)):
-            text = source_match.group(2).strip()
-            if text.strip("^~ "):              # not the caret line under the source text
-                last_text = text
-            continue
         error_match = _LOG_ERROR.search(raw)
         if not error_match:
+            source_match = _LOG_SOURCE_LINE.search(raw)
+            text = source_match.group(2).strip() if source_match else ""
+            # not the caret line under the source text, nor a warning
+            if text.strip("^~ ") and not re.match(r"(?::?\d+:\d+:)?\s*[Ww]arning", text):
+                last_text = text
             continue
         message = error_match.group(1).strip()
         location = "unknown line"

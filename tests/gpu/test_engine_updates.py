@@ -99,3 +99,4 @@ def test_light_edit_and_removed_object(tracked_scene):
     view_layer.update()
     assert second_name not in state.objects and first.name in state.objects
     assert _exports() == before
+
