@@ -104,6 +104,9 @@ class MeshBuffers:
     def __init__(self, mesh):
         import gpu
 
+        self.batches = []               # (material slot index, GPUBatch)
+        if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
+            return
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="normal", comp_type="F32", len=3, fetch_mode="FLOAT")
@@ -114,7 +117,6 @@ class MeshBuffers:
         vertices.attr_fill("normal", mesh.normals)
         vertices.attr_fill("tangent", mesh.tangents)
         vertices.attr_fill("uv", mesh.uvs)
-        self.batches = []               # (material slot index, GPUBatch)
         for material_index, first, count in mesh.material_ranges:
             indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])
             self.batches.append((material_index, gpu.types.GPUBatch(type="TRIS", buf=vertices, elem=indices)))

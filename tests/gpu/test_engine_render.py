@@ -66,3 +66,48 @@ def test_compile_error_names_variant_and_line(engine, monkeypatch):
     number = next(n for n, line in enumerate(lines, 1) if broken_line in line)
     assert f"fragment line {number}: `frame_that_does_not_exist' undeclared" in message
     assert f"{number:5d}> {lines[number - 1]}" in message
+
+
+def test_awkward_geometry(engine):
+    """Text, an empty mesh, n-gons with UVs (calc_tangents refuses them), several material slots
+    (one empty), a mirrored object."""
+    import bmesh
+    import bpy
+
+    scene = fx.new_scene("render_awkward", 96, 96)
+    fx.world_colour(scene, (0.1, 0.1, 0.1))
+    fx.point_light(scene, "awkward_light", (0.0, -3.0, 3.0), 500.0)
+    text = bpy.data.objects.new("awkward_text", bpy.data.curves.new("awkward_text", "FONT"))
+    text.data.body = "SG"
+    text.location = (-1.5, 0.0, 1.5)
+    text.rotation_euler = (1.57, 0.0, 0.0)
+    fx.add_object(scene, text)
+    fx.add_object(scene, bpy.data.objects.new("awkward_empty_mesh", bpy.data.meshes.new("awkward_empty")))
+    mesh = bpy.data.meshes.new("awkward_ngons")
+    bm = bmesh.new()
+    bm.loops.layers.uv.new("uv")
+    bmesh.ops.create_circle(bm, cap_ends=True, segments=9, radius=0.8, calc_uvs=True)
+    bmesh.ops.create_cube(bm, size=0.6, calc_uvs=True)
+    bm.to_mesh(mesh)
+    bm.free()
+    mesh.polygons[0].material_index = 1
+    mesh.materials.append(fx.material("awkward_a", model="BLINN_PHONG", exponent=20.0))
+    mesh.materials.append(None)
+    ngons = fx.add_object(scene, bpy.data.objects.new("awkward_ngons", mesh))
+    ngons.location = (1.0, 0.0, 1.0)
+    ngons.rotation_euler = (1.2, 0.3, 0.0)
+    mirrored = fx.uv_sphere(scene, "awkward_mirrored", (0.0, 1.0, 0.6), radius=0.5, segments=12, rings=6)
+    mirrored.scale = (-1.0, 1.0, 1.0)
+    mirrored.data.materials.append(fx.material("awkward_ward", model="WARD_ANISO", lobe_count=2))
+    result = fx.render(scene)
+    assert "error" not in result, result.get("error")
+    combined = result["passes"]["Combined"]
+    assert np.all(np.isfinite(combined))
+    surface = result["passes"]["Diffuse"][..., 3] > 0.5
+    assert surface.mean() > 0.05
+    mesh_export = result["state"].meshes[result["state"].objects["awkward_ngons"].mesh_key]
+    # corner tangents are unit and perpendicular to the corner normals, and follow +u
+    assert mesh_export.has_uv
+    np.testing.assert_allclose(np.linalg.norm(mesh_export.tangents[:, :3], axis=1), 1.0, atol=1e-5)
+    assert np.abs(np.sum(mesh_export.tangents[:, :3] * mesh_export.normals, axis=1)).max() < 1e-4
+    assert sorted(index for index, _, _ in mesh_export.material_ranges) == [0, 1]
