@@ -7,6 +7,7 @@ numpy mirror (core/shading.py) see exactly the same numbers:
   tangent sign flips need no vertex splitting logic; triangles index corners;
   positions/normals/tangents are in object space, with the object's
   matrix_world alongside (a transform edit then needs no re-export);
+  `to_world` gives the world-space arrays;
 - materials: `material.sgprt` read into `MaterialParams` (defaults when the
   material has no settings or the slot is empty);
 - lights in Blender units, converted to the quantities core/lights.py takes;
@@ -190,6 +191,25 @@ def export_mesh_data(mesh):
         material_ranges=ranges,
         has_uv=uv_layer is not None,
     )
+
+
+def to_world(mesh, matrix_world):
+    """The MeshExport in world space (positions, normals by the inverse transpose, tangents with
+    the bitangent sign flipped by mirroring transforms), e.g. for ray tracing the scene."""
+    matrix = np.asarray(matrix_world, np.float64)
+    linear = matrix[:3, :3]
+    normal_matrix = np.linalg.inv(linear).T
+    handedness = -1.0 if np.linalg.det(linear) < 0 else 1.0
+
+    def unit(v):
+        return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-30)
+
+    tangents = np.concatenate([unit(mesh.tangents[:, :3] @ linear.T), mesh.tangents[:, 3:] * handedness], axis=1)
+    return MeshExport(
+        positions=np.ascontiguousarray(mesh.positions @ linear.T + matrix[:3, 3], np.float32),
+        normals=np.ascontiguousarray(unit(mesh.normals @ normal_matrix.T), np.float32),
+        tangents=np.ascontiguousarray(tangents, np.float32),
+        uvs=mesh.uvs, triangles=mesh.triangles, material_ranges=list(mesh.material_ranges), has_uv=mesh.has_uv)
 
 
 def export_object_mesh(object_eval):

@@ -100,3 +100,27 @@ def test_light_edit_and_removed_object(tracked_scene):
     assert second_name not in state.objects and first.name in state.objects
     assert _exports() == before
 
+
+
+def test_world_space_export_matches_blender(tracked_scene):
+    """export.to_world against Blender's own evaluated world-space vertex positions and normals."""
+    from sg_prt_addon.blender import export
+
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    first.scale = (1.0, -2.0, 0.5)        # mirrored and non-uniform
+    first.rotation_euler = (0.3, 0.2, 0.1)
+    view_layer.update()
+    entry = state.objects[first.name]
+    world = export.to_world(state.meshes[entry.mesh_key], entry.matrix_world)
+    matrix = np.array(first.matrix_world)
+    expected = np.array([matrix @ np.append(v.co, 1.0) for v in first.data.vertices])[:, :3]
+    corners = np.array([loop.vertex_index for loop in first.data.loops])
+    np.testing.assert_allclose(world.positions, expected[corners], atol=1e-5)
+    blender_normals = np.array([n.vector for n in first.data.corner_normals]) if hasattr(
+        first.data, "corner_normals") else None
+    if blender_normals is not None:
+        normal_matrix = np.linalg.inv(matrix[:3, :3]).T
+        reference = blender_normals @ normal_matrix.T
+        reference /= np.linalg.norm(reference, axis=1, keepdims=True)
+        np.testing.assert_allclose(world.normals, reference, atol=1e-5)
+    assert np.all(world.tangents[:, 3] == -state.meshes[entry.mesh_key].tangents[:, 3])
