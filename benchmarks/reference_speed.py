@@ -77,7 +77,7 @@ def make_benchmark_scene(subdivisions=5):
     return Scene(vertices, triangles, normals, materials, material_index, lights=lights, environment=make_sky())
 
 
-def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64):
+def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64, glossy_roughness=None):
     """Cross-check of conventions (camera matrices, equirect mapping, light units): the
     benchmark scene built from Blender primitives, rendered by Cycles with direct light only
     (max_bounces 0, box pixel filter, closest-texel world texture) and by render_reference
@@ -87,6 +87,7 @@ def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64):
     import bpy
     import mathutils
 
+    from sg_prt_addon.core.brdf import GGX
     from sg_prt_addon.core.lights import blender_point_light_intensity
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -100,14 +101,19 @@ def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64):
     scene.render.resolution_x = scene.render.resolution_y = size
     scene.render.resolution_percentage = 100
 
-    def diffuse_material(name, colour):
+    def diffuse_material(name, colour, roughness=None):
         material = bpy.data.materials.new(name)
         material.use_nodes = True
         nodes = material.node_tree.nodes
         for node in list(nodes):
             if node.type != "OUTPUT_MATERIAL":
                 nodes.remove(node)
-        bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+        if roughness is None:
+            bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+        else:
+            bsdf = nodes.new("ShaderNodeBsdfGlossy")
+            bsdf.distribution = "GGX"
+            bsdf.inputs["Roughness"].default_value = roughness
         bsdf.inputs["Color"].default_value = (*colour, 1.0)
         material.node_tree.links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
         return material
@@ -115,7 +121,7 @@ def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64):
     bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=3, radius=1.0, location=(0.0, 0.0, 1.0))
     sphere = bpy.context.object
     bpy.ops.object.shade_smooth()
-    sphere.data.materials.append(diffuse_material("sphere", (0.7, 0.3, 0.2)))
+    sphere.data.materials.append(diffuse_material("sphere", (0.7, 0.3, 0.2), glossy_roughness))
     bpy.ops.mesh.primitive_plane_add(size=8.0)
     ground = bpy.context.object
     ground.data.materials.append(diffuse_material("ground", (0.6, 0.6, 0.6)))
@@ -160,7 +166,9 @@ def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64):
         material_index.append(np.full(len(triangles[-1]), index))
         evaluated.to_mesh_clear()
     ours = Scene(np.concatenate(vertices), np.concatenate(triangles), np.concatenate(normals),
-                 [Material((0.7, 0.3, 0.2)), Material((0.6, 0.6, 0.6))], np.concatenate(material_index),
+                 [Material((0.7, 0.3, 0.2)) if glossy_roughness is None else
+                  Material((0, 0, 0), (0.7, 0.3, 0.2), GGX(roughness=glossy_roughness)),
+                  Material((0.6, 0.6, 0.6))], np.concatenate(material_index),
                  lights=[PointLight(tuple(point.location), (float(blender_point_light_intensity(100.0)),) * 3, 0.2),
                          DirectionalLight(to_sun, (0.5,) * 3, angular_radius=0.01)],
                  environment=sky)
@@ -175,8 +183,14 @@ def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64):
         result = bpy.data.images.load(scene.render.filepath)
         cycles_image = np.array(result.pixels[:], dtype=np.float64).reshape(size, size, 4)[::-1, :, :3]
     ratio = cycles_image.mean(axis=(0, 1)) / reference.mean(axis=(0, 1))
+    on_sphere = np.zeros((size, size), bool)
+    hits = RayTracer(ours.vertices, ours.triangles).intersect(*(a.reshape(-1, 3) for a in camera.primary_rays()))
+    on_sphere.ravel()[:] = hits.hit & (ours.material_index[np.maximum(hits.triangle, 0)] == 0)
+    sphere_ratio = cycles_image[on_sphere].mean(axis=0) / reference[on_sphere].mean(axis=0)
+    sphere_error = np.sqrt(np.sum(error[on_sphere] ** 2, axis=0)) / on_sphere.sum() / reference[on_sphere].mean(axis=0)
     relative = np.abs(cycles_image - reference) / np.maximum(reference, 1e-3)
-    print(f"Cycles {cycles_samples} spp / reference {reference_samples} spp, mean per channel: {np.round(ratio, 4)}; "
+    print(f"Cycles {cycles_samples} spp / reference {reference_samples} spp, mean per channel: {np.round(ratio, 4)} "
+          f"(sphere pixels {np.round(sphere_ratio, 4)}, reference standard error {np.round(sphere_error, 4)}); "
           f"per-pixel |difference| median {np.median(relative):.4f}, 90th percentile {np.percentile(relative, 90):.4f}; "
           f"reference median relative standard error {mean_relative_error(reference, error, np.median):.4f}")
     return ratio
@@ -190,9 +204,10 @@ def main():
     parser.add_argument("--max-spp", type=int, default=4096)
     parser.add_argument("--subdivisions", type=int, default=5)
     parser.add_argument("--cycles", action="store_true", help="cross-check against Cycles (64x64, needs bpy)")
+    parser.add_argument("--glossy", type=float, default=None, help="with --cycles: GGX sphere of this roughness")
     args = parser.parse_args()
     if args.cycles:
-        return compare_with_cycles()
+        return compare_with_cycles(glossy_roughness=args.glossy)
 
     scene = make_benchmark_scene(args.subdivisions)
     camera = Camera.look_at((0.0, -5.0, 3.0), (0.0, 0.0, 0.7), (0.0, 0.0, 1.0), 40.0, args.size, args.size)

@@ -420,51 +420,71 @@ class _Renderer:
         return visible
 
     def _light_contribution(self, points, light, rng):
+        """One light sample; for lights of finite size seen by glossy points also one BRDF
+        sample, combined by the power heuristic (a sharp lobe barely sees a light sample)."""
         count = len(points.position)
         uniforms = rng.random((count, 2))
+        cone = None   # (axis, 1 - cos of the half-angle, radiance, sphere centre distance or None)
         if isinstance(light, PointLight):
             to_centre = np.asarray(light.position, float)[None, :] - points.position
             distance = np.linalg.norm(to_centre, axis=-1)
             axis = _normalize(to_centre, np.array([0.0, 0.0, 1.0]))
-            intensity = np.asarray(light.intensity, float)
+            intensity = np.asarray(light.intensity, float)[None, :] * light.spot_falloff(axis)[:, None]
             radius = float(light.radius)
             if radius > 0:
+                # A uniform sphere of this intensity has radiance I / (pi r^2); points inside it get nothing.
                 outside = distance > radius
                 sin_max = np.where(outside, radius / np.maximum(distance, 1e-300), 1.0)
                 one_minus_cos = _one_minus_cos_from_sin(sin_max)
-                wi = _cone_directions(axis, 1.0 - one_minus_cos, uniforms)
-                # Radiance of a uniform sphere of this intensity: I / (pi r^2); times the cone's solid angle.
-                scale = np.where(outside, 2.0 * np.pi * one_minus_cos / (np.pi * radius ** 2), 0.0)
-                cos_to_centre = np.sum(wi * axis, axis=-1)
-                chord = np.maximum(radius ** 2 - distance ** 2 * (1.0 - cos_to_centre ** 2), 0.0)
-                max_distance = distance * cos_to_centre - np.sqrt(chord)
+                radiance = intensity * np.where(outside, 1.0 / (np.pi * radius ** 2), 0.0)[:, None]
+                cone = (axis, one_minus_cos, radiance, distance, radius)
             else:
                 wi = axis
-                scale = 1.0 / np.maximum(distance, 1e-300) ** 2
+                weight = intensity / np.maximum(distance, 1e-300)[:, None] ** 2
                 max_distance = distance
-            weight = (scale * light.spot_falloff(axis))[:, None] * intensity[None, :]
         elif isinstance(light, DirectionalLight):
             axis = _normalize(np.asarray(light.direction, float)[None, :], np.array([0.0, 0.0, 1.0]))
             axis = np.broadcast_to(axis, (count, 3))
-            alpha = float(light.angular_radius)
+            alpha = min(float(light.angular_radius), np.pi / 2)
             irradiance = np.asarray(light.irradiance, float)
             if alpha > 0:
-                one_minus_cos = float(_one_minus_cos_from_sin(np.sin(min(alpha, np.pi / 2))))
-                wi = _cone_directions(axis, np.full(count, 1.0 - one_minus_cos), uniforms)
-                # Radiance E / (pi sin^2 a) (irradiance of the disc facing it is E) times its solid angle.
-                scale = 2.0 * np.pi * one_minus_cos / (np.pi * np.sin(min(alpha, np.pi / 2)) ** 2)
+                # Radiance E / (pi sin^2 a): the irradiance of the cap on a surface facing it is E.
+                one_minus_cos = np.full(count, float(_one_minus_cos_from_sin(np.sin(alpha))))
+                radiance = np.broadcast_to(irradiance / (np.pi * np.sin(alpha) ** 2), (count, 3))
+                cone = (axis, one_minus_cos, radiance, None, None)
             else:
                 wi = np.array(axis)
-                scale = 1.0
-            weight = np.broadcast_to(scale * irradiance, (count, 3))
-            max_distance = None
+                weight = np.broadcast_to(irradiance, (count, 3))
+                max_distance = None
         else:
             raise TypeError(f"unknown light type {type(light).__name__}")
+        if cone is None:
+            value = self._brdf_cosine(points, np.einsum("nij,nj->ni", points.frame, wi)) * weight
+            return value * self._visible(points, wi, max_distance, np.any(value > 0, axis=-1))[:, None]
+
+        axis, one_minus_cos, radiance, distance, radius = cone
+        solid_angle = 2.0 * np.pi * one_minus_cos
+        light_pdf = 1.0 / np.maximum(solid_angle, 1e-300)
+        use_mis = bool(points.groups)
+        # Light sample, uniform over the cone.
+        wi = _cone_directions(axis, 1.0 - one_minus_cos, uniforms)
         wi_local = np.einsum("nij,nj->ni", points.frame, wi)
-        value = self._brdf_cosine(points, wi_local) * weight
-        active = np.any(value > 0, axis=-1)
-        visible = self._visible(points, wi, max_distance, active)
-        return value * visible[:, None]
+        value = self._brdf_cosine(points, wi_local) * radiance * solid_angle[:, None]
+        if use_mis:
+            value *= _power_weight(light_pdf, self._brdf_pdf(points, wi_local))[:, None]
+        max_distance = None if distance is None else _sphere_entry(distance, radius, np.sum(wi * axis, axis=-1))
+        total = value * self._visible(points, wi, max_distance, np.any(value > 0, axis=-1))[:, None]
+        if not use_mis:
+            return total
+        # BRDF sample: counts where it falls inside the light's cone.
+        wi_local, brdf_pdf = self._brdf_sample(points, rng.random((count, 3)))
+        wi = _normalize(np.einsum("nji,nj->ni", points.frame, wi_local), points.frame[:, 2])
+        cos_to_axis = np.sum(wi * axis, axis=-1)
+        inside = (cos_to_axis >= 1.0 - one_minus_cos) & (brdf_pdf > 0)
+        weight = np.where(inside, _power_weight(brdf_pdf, light_pdf) / np.where(brdf_pdf > 0, brdf_pdf, 1.0), 0.0)
+        value = self._brdf_cosine(points, wi_local) * radiance * weight[:, None]
+        max_distance = None if distance is None else _sphere_entry(distance, radius, cos_to_axis)
+        return total + value * self._visible(points, wi, max_distance, np.any(value > 0, axis=-1))[:, None]
 
     def _environment_contribution(self, points, rng):
         """MIS of `environment_samples` environment samples and as many BRDF samples, stratified
@@ -512,6 +532,13 @@ def _stratified_uniforms(rng, count, per_point, dimensions):
     else:
         uniforms[:, 0] = (stratum + uniforms[:, 0]) / per_point
     return uniforms
+
+
+def _sphere_entry(distance, radius, cos_to_centre):
+    """Distance along a ray to where it enters a sphere of ``radius`` at ``distance`` whose
+    centre is at angle acos(cos_to_centre) off the ray (the ray is aimed inside its cone)."""
+    chord = np.maximum(radius ** 2 - distance ** 2 * (1.0 - cos_to_centre ** 2), 0.0)
+    return np.maximum(distance * cos_to_centre - np.sqrt(chord), 0.0)
 
 
 def _power_weight(pdf_own, pdf_other):

@@ -413,3 +413,37 @@ def test_render_to_noise_reaches_the_target_and_stays_calibrated():
     assert 0.008 < mean_relative_error(image, error) < 0.012
     ratio = rms(image - 0.6 * np.array([1.0, 0.5, 2.0])) / rms(error)
     assert 0.85 < ratio < 1.15, ratio
+
+
+@pytest.mark.parametrize("exponent", [20.0, 2000.0])
+def test_glossy_highlight_of_a_small_cone_light_matches_quadrature(exponent):
+    """Light sample + BRDF sample (MIS) of a sun-like cone seen in a glossy lobe: unbiased."""
+    vertices, triangles, normals = ground_plane()
+    model = PhongStandIn(exponent)
+    alpha = 0.05
+    wo = np.array([0.0, -np.sin(0.7), np.cos(0.7)])
+    to_light = np.array([0.02, np.sin(0.7), np.cos(0.7)])          # just off the mirror direction
+    to_light /= np.linalg.norm(to_light)
+    light = DirectionalLight(to_light, (2.0, 2.0, 2.0), angular_radius=alpha)
+    scene = Scene(vertices, triangles, normals, [Material((0.1, 0.1, 0.1), (0.5, 0.5, 0.5), model)], lights=[light])
+    view = Camera.look_at(4 * wo, (0, 0, 0), (0, 0, 1.0), 10.0, 16, 16).view_matrix
+    projection = np.diag([1.0, 1.0, -0.02, 1.0])
+    projection[2, 3] = -1.0
+    image, error = render_reference(scene, Camera(view, projection, 16, 16), 16, seed=14)
+    # Quadrature over the cone (polar grid around its axis, uniform in cos and azimuth).
+    cos_grid, phi_grid = np.meshgrid(1 - (np.arange(400) + 0.5) / 400 * (1 - np.cos(alpha)),
+                                     (np.arange(400) + 0.5) / 400 * 2 * np.pi, indexing="ij")
+    sin_grid = np.sqrt(1 - cos_grid ** 2)
+    tangent = np.cross(to_light, [1.0, 0, 0])
+    tangent /= np.linalg.norm(tangent)
+    bitangent = np.cross(to_light, tangent)
+    wi = (tangent * (sin_grid * np.cos(phi_grid))[..., None] + bitangent * (sin_grid * np.sin(phi_grid))[..., None]
+          + to_light * cos_grid[..., None]).reshape(-1, 3)
+    solid_angle = 2 * np.pi * (1 - np.cos(alpha)) / len(wi)
+    radiance = 2.0 / (np.pi * np.sin(alpha) ** 2)
+    brdf = 0.1 / np.pi + 0.5 * model.specular(np.broadcast_to(wo, wi.shape), wi)
+    expected = np.sum(brdf * wi[:, 2]) * radiance * solid_angle
+    mean = image[..., 0].mean()
+    error_of_mean = np.sqrt(np.sum(error[..., 0] ** 2)) / 256
+    assert error_of_mean < 0.01 * expected
+    assert abs(mean - expected) < 4 * error_of_mean + 1e-3 * expected, (mean, expected, error_of_mean)
