@@ -16,7 +16,9 @@ Estimators, per pixel sample (one camera ray):
     many BRDF samples (cosine lobe or the specular model, picked by weight);
   - point lights (sphere of radius r, r = 0 a true point, optional spot cone)
     and directional lights (cone of angular radius a, a = 0 a delta): one light
-    sample, uniform over the solid angle the light subtends.
+    sample, uniform over the solid angle the light subtends; lights of finite
+    size seen by points with a specular model add one BRDF sample, power
+    heuristic (sharp lobes rarely meet a light sample).
 
 Conventions:
   - Pixels whose camera ray misses the scene show the environment radiance
