@@ -140,3 +140,20 @@ def test_prefilter_is_fast_and_float32_in_float32_out():
     assert time.perf_counter() - start < 5.0
     out = ep.lookup(pre, np.float32([[0, 0, 1]]), np.float32([10.0]))
     assert out.dtype == np.float32
+
+
+def test_equirect_mapping_matches_cycles():
+    """Cycles direction_to_equirectangular: u = (atan2(y, x) - pi) / (-2 pi), v = (acos(z) - pi) / (-pi),
+    v = 0 at the image's bottom row (our row = (1 - v) * height)."""
+    directions = _random_axes(200, 9)
+    u, v = equirect.direction_to_uv(directions)
+    cycles_u = (np.arctan2(directions[:, 1], directions[:, 0]) - np.pi) / (-2 * np.pi)
+    cycles_v = (np.arccos(directions[:, 2]) - np.pi) / (-np.pi)
+    np.testing.assert_allclose(u, cycles_u, atol=1e-12)
+    np.testing.assert_allclose(v, cycles_v, atol=1e-12)
+    # +x is the image centre, +y a quarter from the left, +z the top row
+    assert equirect.direction_to_uv(np.array([1.0, 0, 0]))[0] == pytest.approx(0.5)
+    assert equirect.direction_to_uv(np.array([0, 1.0, 0]))[0] == pytest.approx(0.25)
+    image = np.zeros((8, 16, 3))
+    image[0] = 1.0
+    assert equirect.lookup_nearest(image, np.array([0, 0, 1.0]))[0] == 1.0
