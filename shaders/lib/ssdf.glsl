@@ -1,0 +1,102 @@
+/* SSDF visibility (wang2009 eq. 23-31): GLSL mirror of sg_prt_addon/bake/decode.py and
+ * bake/hemisphere_map.py.  Depends on sg.glsl and hemisphere.glsl.
+ *
+ *   ssdf_disc_to_square            <- hemisphere_map.disc_to_square
+ *   ssdf_hemisphere_to_square      <- hemisphere_map.hemisphere_to_square
+ *   ssdf_horizon_lookup            <- hemisphere_map.horizon_lookup (vec3(square.xy, angle below horizon))
+ *   ssdf_local_frame, ssdf_to_local <- hemisphere_map.local_frame (default tangent)
+ *   ssdf_decode                    <- decode.decode, in the packed layout of decode.pack_basis_texture
+ *   ssdf_visibility_amplitude      <- hemisphere.visibility_product_integral_preserving (its amplitude)
+ *   ssdf_shadowed_integral         <- decode.shadowed_integral
+ *
+ * Layout: `basis` is an RGBA32F sampler2DArray holding the images [mean, B_0, B_1, ...] four to a
+ * layer (linear filtering, clamp-to-edge: a GPU texture from Python); `coefficients[l]` holds the
+ * vertex-interpolated [1, w_0, w_1, ...] four to a vec4.  Square coordinates (a, b) in [-1, 1]^2 map
+ * to texture coordinates ((a + 1) / 2, (b + 1) / 2).  #define SSDF_MAX_LAYERS before this file to
+ * change the array size (default 13: the mean and 48 terms).
+ */
+
+#ifndef SSDF_MAX_LAYERS
+#define SSDF_MAX_LAYERS 13
+#endif
+
+const float SSDF_QUARTER_PI = 0.25 * SG_PI;
+const vec3 SSDF_FRAME_REFERENCE_AXIS = vec3(0.2672612419124244, 0.5345224838248488, 0.8017837257372732);
+const vec3 SSDF_FRAME_FALLBACK_AXIS = vec3(0.8017837257372732, -0.2672612419124244, -0.5345224838248488);
+
+/* Inverse concentric map (Shirley & Chiu 1997): disc point -> square point. */
+vec2 ssdf_disc_to_square(vec2 disc)
+{
+  float radius = length(disc);
+  if (abs(disc.x) >= abs(disc.y)) {
+    float a = disc.x < 0.0 ? -radius : radius;
+    float b = disc.x == 0.0 ? 0.0 : a * atan(disc.y / disc.x) / SSDF_QUARTER_PI;
+    return vec2(a, b);
+  }
+  float b = disc.y < 0.0 ? -radius : radius;
+  return vec2(b * atan(disc.x / disc.y) / SSDF_QUARTER_PI, b);
+}
+
+/* Unit direction with z >= 0 -> square point; the disc point (x, y) / sqrt(1 + z) has no cancellation. */
+vec2 ssdf_hemisphere_to_square(vec3 direction)
+{
+  float z = clamp(direction.z, 0.0, 1.0);
+  return ssdf_disc_to_square(direction.xy / sqrt(1.0 + z));
+}
+
+/* Square point of a local direction and the angle below the horizon (0 above it): below, the
+ * horizon point of the same azimuth (straight down: azimuth 0). */
+vec3 ssdf_horizon_lookup(vec3 direction)
+{
+  if (direction.z >= 0.0) {
+    return vec3(ssdf_hemisphere_to_square(direction), 0.0);
+  }
+  float horizontal = length(direction.xy);
+  vec3 on_horizon = horizontal > 0.0 ? vec3(direction.xy / horizontal, 0.0) : vec3(1.0, 0.0, 0.0);
+  return vec3(ssdf_hemisphere_to_square(on_horizon), atan(-direction.z, horizontal));
+}
+
+/* The bake's local frame of a normal: tangent = reference axis projected on the tangent plane. */
+void ssdf_local_frame(vec3 normal, out vec3 tangent, out vec3 bitangent, out vec3 unit_normal)
+{
+  unit_normal = safe_normalize(normal);
+  vec3 reference = abs(dot(unit_normal, SSDF_FRAME_REFERENCE_AXIS)) > 0.99995 ? SSDF_FRAME_FALLBACK_AXIS
+                                                                               : SSDF_FRAME_REFERENCE_AXIS;
+  tangent = normalize(reference - dot(reference, unit_normal) * unit_normal);
+  bitangent = cross(unit_normal, tangent);
+}
+
+/* World direction -> the SSDF's local frame of `normal`. */
+vec3 ssdf_to_local(vec3 world_direction, vec3 normal)
+{
+  vec3 t, b, n;
+  ssdf_local_frame(normal, t, b, n);
+  return vec3(dot(world_direction, t), dot(world_direction, b), dot(world_direction, n));
+}
+
+/* SSDF value (radians, + visible) at a local direction: one bilinear fetch per four PCA images. */
+float ssdf_decode(sampler2DArray basis, vec4 coefficients[SSDF_MAX_LAYERS], int layer_count, vec3 local_direction)
+{
+  vec3 lookup = ssdf_horizon_lookup(local_direction);
+  vec2 texcoord = 0.5 * lookup.xy + 0.5;
+  float value = 0.0;
+  for (int layer = 0; layer < layer_count; ++layer) {
+    value += dot(texture(basis, vec3(texcoord, float(layer))), coefficients[layer]);
+  }
+  return value - lookup.z;
+}
+
+/* eq. 31, integral-preserving: the lobe's amplitude after the product with the SSDF visibility
+ * (apply to the final product lobe). */
+float ssdf_visibility_amplitude(float sharpness, float amplitude, float theta_d)
+{
+  float lam = max(sharpness, 0.0);
+  return amplitude * fh_normalized(theta_d, lam) / (1.0 + exp(-lam));
+}
+
+/* Integral of G(i; p, lambda, mu) V(i) over the sphere ~ mu fh(V_d(p), lambda) (eq. 30); p local. */
+float ssdf_shadowed_integral(vec3 axis_local, float sharpness, float amplitude, sampler2DArray basis,
+                             vec4 coefficients[SSDF_MAX_LAYERS], int layer_count)
+{
+  return amplitude * fh(ssdf_decode(basis, coefficients, layer_count, axis_local), sharpness);
+}

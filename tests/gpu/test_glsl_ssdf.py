@@ -1,0 +1,66 @@
+"""shaders/lib/ssdf.glsl (float32, llvmpipe) against sg_prt_addon/bake (float64)."""
+import numpy as np
+
+from sg_prt_addon.bake import decode, hemisphere_map
+from sg_prt_addon.core import hemisphere
+
+N = 20000
+LIB = ["sg.glsl", "hemisphere.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl"]
+
+
+def _directions(fuzz, count):
+    d = fuzz.unit_vectors(count)
+    d[:6] = [[0, 0, 1], [0, 0, -1], [1, 0, 0], [0, -1, 0], [0.6, 0.8, 0], [-0.6, 0, -0.8]]
+    return fuzz.f32(d)
+
+
+def test_horizon_lookup(glsl, fuzz, record_error):
+    d = _directions(fuzz, N)
+    out = glsl(LIB, "vec4(ssdf_horizon_lookup(a.xyz), 0)", {"a": d}, 3)
+    square, below = hemisphere_map.horizon_lookup(d)
+    # float32 atan near the square's diagonals and the poles: measured 4.2e-6
+    assert record_error("ssdf horizon_lookup square, absolute", np.abs(out[:, :2] - square).max()) <= 1e-5
+    assert record_error("ssdf horizon_lookup angle below, absolute", np.abs(out[:, 2] - below).max()) <= 1e-5
+
+
+def test_local_frame(glsl, fuzz, record_error):
+    n = _directions(fuzz, N)
+    n[6] = hemisphere_map.FRAME_REFERENCE_AXIS
+    w = _directions(fuzz, N)[::-1].copy()
+    out = glsl(LIB, "vec4(ssdf_to_local(w.xyz, n.xyz), 0)", {"w": w, "n": n}, 3)
+    expected = np.einsum("nij,nj->ni", hemisphere_map.local_frame(n), w)
+    # the tangent is a projection of length >= 0.01 (fallback threshold): float32 rounding x 100 at worst
+    assert record_error("ssdf to_local, absolute", np.abs(out - expected).max()) <= 3e-5
+
+
+def test_decode_and_shadowed_integral(glsl, fuzz, record_error):
+    resolution, terms = 16, 9                               # 10 images: 3 layers, the last one padded
+    basis = fuzz.f32(fuzz.rng.normal(size=(terms, resolution, resolution)) * 0.3)
+    mean = fuzz.f32(fuzz.rng.uniform(-1.5, 1.5, (resolution, resolution)))
+    coefficients = fuzz.f32(fuzz.rng.normal(size=(N, terms)))
+    packed = decode.pack_coefficients(coefficients)         # (N, 12)
+    d = _directions(fuzz, N)
+    sharpness = fuzz.log_uniform(0.1, 1e4, N)
+    call = """
+    vec4 c[SSDF_MAX_LAYERS];
+    c[0] = c0; c[1] = c1; c[2] = c2;
+    float value = ssdf_decode(ssdf_basis, c, 3, d.xyz);
+    result = vec4(value, ssdf_shadowed_integral(d.xyz, d.w, 1.0, ssdf_basis, c, 3),
+                  ssdf_visibility_amplitude(d.w, 1.0, value), 0.0);
+    """
+    out = glsl(LIB, call, {"d": np.c_[d, sharpness], "c0": packed[:, 0:4], "c1": packed[:, 4:8], "c2": packed[:, 8:12]},
+               3, textures={"ssdf_basis": decode.pack_basis_texture(mean, basis)})
+    expected = decode.decode(coefficients, basis, mean, d)
+    # bilinear weights on llvmpipe: the sum of |w| |image| bounds float32 rounding
+    scale = 1.0 + np.abs(coefficients).sum(axis=1) * 0.3
+    assert record_error("ssdf decode, relative to sum |w_j| |B_j|",
+                        (np.abs(out[:, 0] - expected) / scale).max()) <= 1e-4
+    integral = decode.shadowed_integral(d, sharpness, 1.0, coefficients, basis, mean)
+    # compare at GLSL's own decoded value: fh's float32 error alone, relative to fh(pi/2)
+    at_glsl_value = hemisphere.fh(out[:, 0].astype(np.float64), sharpness)
+    upper = 2 * np.pi * np.minimum(1.0, 1.0 / sharpness)
+    assert record_error("ssdf shadowed_integral (at GLSL's theta_d), relative to fh(pi/2)",
+                        (np.abs(out[:, 1] - at_glsl_value) / upper).max()) <= 1e-5
+    assert np.abs(out[:, 1] - integral).max() / upper.max() < 0.05
+    _, _, amplitude = hemisphere.visibility_product_integral_preserving(None, sharpness, 1.0, out[:, 0].astype(np.float64))
+    assert record_error("ssdf visibility_amplitude, absolute", np.abs(out[:, 2] - amplitude).max()) <= 5e-6
