@@ -16,6 +16,7 @@ import math
 import os
 import statistics
 import sys
+import tempfile
 import time
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -100,12 +101,30 @@ def _eevee_nodes(material, diffuse, specular, roughness):
     tree.links.new(add.outputs[0], output.inputs["Surface"])
 
 
-def render_seconds(scene):
+def render_seconds(scene, write_to=None):
+    """Wall time of one render; with write_to, also saves the result as a float EXR there."""
     import bpy
 
+    if write_to:
+        scene.render.image_settings.file_format = "OPEN_EXR"
+        scene.render.image_settings.color_depth = "32"
+        scene.render.filepath = write_to
     start = time.perf_counter()
-    bpy.ops.render.render(write_still=False)
+    bpy.ops.render.render(write_still=bool(write_to))
     return time.perf_counter() - start
+
+
+def read_exr(path):
+    """(H, W, 4) float32 pixels of an EXR, row 0 at the bottom like the engine's passes."""
+    import bpy
+    import numpy as np
+
+    image = bpy.data.images.load(path)
+    width, height = image.size
+    pixels = np.empty(width * height * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    bpy.data.images.remove(image)
+    return pixels.reshape(height, width, 4)
 
 
 def main(argv=None):
@@ -137,16 +156,32 @@ def main(argv=None):
             ("SG-PRT steady-state frame (draw + read 3 passes)", frame)]
     eevee_engine = "BLENDER_EEVEE_NEXT" if bpy.app.version < (5, 0, 0) else "BLENDER_EEVEE"
     scene.render.engine = eevee_engine
+    sg_prt_image = result["passes"]["Combined"]
+    comparisons = []
     for index, samples in enumerate(args.eevee_samples):
         scene.eevee.taa_render_samples = samples
         if index == 0:      # EEVEE compiles its shaders on the first render: report it apart
             rows.append((f"EEVEE first render, {samples} sample(s), with compile", render_seconds(scene)))
-        rows.append((f"EEVEE {samples} sample(s) (bpy.ops.render.render)", render_seconds(scene)))
+        path = os.path.join(tempfile.gettempdir(), f"sgprt_eevee_{samples}.exr")
+        rows.append((f"EEVEE {samples} sample(s) (bpy.ops.render.render)", render_seconds(scene, path)))
+        comparisons.append((samples, image_difference(sg_prt_image, read_exr(path))))
     print(f"\n{args.size}x{args.size}, {triangles} triangles, Blender {bpy.app.version_string}")
     print(f"{'':52s} {'seconds':>9s} {'x SG-PRT frame':>15s}")
     for name, seconds in rows:
         print(f"{name:52s} {seconds:9.3f} {seconds / frame:15.1f}")
+    for samples, (relative_rms, mean_ratio) in comparisons:
+        print(f"SG-PRT vs EEVEE {samples} sample(s): relative RMS difference {relative_rms:.3f}, "
+              f"mean brightness ratio {mean_ratio:.3f} (whole image, world included)")
     return rows
+
+
+def image_difference(image, reference):
+    """(relative RMS difference, ratio of mean luminance) of two linear RGB images."""
+    import numpy as np
+
+    a, b = image[..., :3].astype(np.float64), reference[..., :3].astype(np.float64)
+    relative_rms = float(np.sqrt(np.mean((a - b) ** 2)) / max(np.sqrt(np.mean(b * b)), 1e-30))
+    return relative_rms, float(a.mean() / max(b.mean(), 1e-30))
 
 
 if __name__ == "__main__":

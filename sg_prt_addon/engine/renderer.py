@@ -134,6 +134,7 @@ class Renderer:
         self.textures = {}              # image name -> GPUTexture
         self.scene_buffer = None
         self.environment_texture = None
+        self.equirect_texture = None
         self.environment_source = None
         self.anisotropy_tables = {}     # lobe count -> GPUTexture
         self.framebuffer = None
@@ -176,6 +177,11 @@ class Renderer:
             padded[..., :layers.shape[3]] = layers
             self.environment_texture = _texture_2d_array(padded)
             self.environment_source = state.environment
+            # the map itself for the background, in Blender's row order (texture t = 0 at the bottom)
+            equirect = state.world.equirect[::-1]
+            rgba = np.ones(equirect.shape[:2] + (4,), np.float32)
+            rgba[..., :3] = equirect
+            self.equirect_texture = _texture_2d(rgba)
         block = scene_block(camera, state.light_data(), state.environment)
         if self.scene_buffer is None:
             self.scene_buffer = _uniform_buffer(block)
@@ -263,7 +269,7 @@ class Renderer:
         if has_environment:      # (the world-colour variant has no use for the view ray)
             shader.uniform_float("inverse_view_projection",
                                  _column_major(np.linalg.inv(camera.projection @ camera.view)))
-            shader.uniform_sampler("environment_texture", self.environment_texture)
+            shader.uniform_sampler("equirect_texture", self.equirect_texture)
         self.background_batch.draw(shader)
         gpu.state.depth_mask_set(True)
 

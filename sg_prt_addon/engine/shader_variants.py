@@ -298,7 +298,6 @@ def background_create_info(has_environment):
         info.define(name, str(value))
     if has_environment:
         info.define("HAS_ENVIRONMENT", "1")
-        info.define("ENV_PREFILTER_MAX_LAYERS", str(MAX_LAYERS))
     info.typedef_source(typedef_source())
     info.vertex_in(0, "VEC2", "position")
     interface = gpu.types.GPUStageInterfaceInfo("sgprt_background_interface")
@@ -308,12 +307,12 @@ def background_create_info(has_environment):
     info.push_constant("FLOAT", "background_alpha")
     info.uniform_buf(0, "SceneData", "scene")
     if has_environment:
-        info.sampler(0, "FLOAT_2D_ARRAY", "environment_texture")
+        info.sampler(0, "FLOAT_2D", "equirect_texture")
     for index, name in enumerate(output_names(False)):
         info.fragment_out(index, "VEC4", "out_" + name)
     info.vertex_source(_read(os.path.join(RESOURCE_DIR, "background.vert.glsl")))
-    libraries = [library_source("sg.glsl")] + ([library_source("env_prefilter.glsl")] if has_environment else [])
-    info.fragment_source("\n".join(libraries + [_read(os.path.join(RESOURCE_DIR, "background.frag.glsl"))]))
+    info.fragment_source("\n".join([library_source("sg.glsl"),
+                                    _read(os.path.join(RESOURCE_DIR, "background.frag.glsl"))]))
     return info
 
 

@@ -111,3 +111,41 @@ def test_awkward_geometry(engine):
     np.testing.assert_allclose(np.linalg.norm(mesh_export.tangents[:, :3], axis=1), 1.0, atol=1e-5)
     assert np.abs(np.sum(mesh_export.tangents[:, :3] * mesh_export.normals, axis=1)).max() < 1e-4
     assert sorted(index for index, _, _ in mesh_export.material_ranges) == [0, 1]
+
+
+def test_environment_background_follows_blender_mapping(engine):
+    """Background pixels = the world image bilinearly sampled along each pixel's view ray with
+    Blender's equirect mapping (core.equirect): orientation and flips end to end."""
+    from sg_prt_addon.core import equirect, shading
+    from sg_prt_addon.engine import render_engine
+
+    rng = np.random.default_rng(5)
+    pixels = np.ones((32, 64, 4), np.float32)
+    pixels[..., :3] = rng.uniform(0.0, 2.0, (32, 64, 3))
+    scene = fx.new_scene("render_background", 64, 48)
+    world = fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    world.node_tree.nodes["Environment Texture"].image = fx.image("background_env", pixels)
+    scene.camera.rotation_euler = (1.2, 0.0, 0.7)
+    render_engine.debug["environment_layer_size"] = 16
+    try:
+        result = fx.render(scene)
+    finally:
+        render_engine.debug["environment_layer_size"] = None
+    assert "error" not in result, result.get("error")
+    camera = result["passes"]["camera"]
+    height, width = 48, 64
+    x = (np.arange(width) + 0.5) / width * 2 - 1
+    y = (np.arange(height) + 0.5) / height * 2 - 1
+    ndc = np.stack(np.broadcast_arrays(x[None, :], y[:, None]), axis=-1).reshape(-1, 2)
+    inverse = np.linalg.inv(camera.projection @ camera.view)
+    far = np.c_[ndc, np.ones(len(ndc)), np.ones(len(ndc))] @ inverse.T
+    near = np.c_[ndc, -np.ones(len(ndc)), np.ones(len(ndc))] @ inverse.T
+    direction = far[:, :3] / far[:, 3:] - near[:, :3] / near[:, 3:]
+    u, v = equirect.direction_to_uv(direction / np.linalg.norm(direction, axis=1, keepdims=True))
+    expected = shading.sample_bilinear(pixels, np.stack([u, v], axis=1))[:, :3]
+    actual = result["passes"]["Combined"].reshape(-1, 4)
+    away_from_seam = (u > 1.5 / 64) & (u < 1 - 1.5 / 64)
+    assert away_from_seam.mean() > 0.8
+    error = np.abs(actual[away_from_seam, :3] - expected[away_from_seam]).max()
+    assert error < 2e-3 * pixels[..., :3].max()
+    assert np.all(actual[:, 3] == 1.0)
