@@ -25,6 +25,7 @@ phi; S linearly, clamped below its first node, and falling linearly to 0 at pi/2
 beyond its last node (if that is short of pi/2), as microfacet shadowing does.  The scale between S and D is fixed by
 max S = 1 (what microfacet_fit writes); readers do not depend on it.
 """
+import zipfile
 from dataclasses import dataclass
 
 import numpy as np
@@ -228,7 +229,7 @@ def read_svbrdf_table(path):
     try:
         with np.load(path, allow_pickle=False) as data:
             contents = {name: data[name] for name in data.files}
-    except (OSError, ValueError, EOFError) as error:
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
         raise SvbrdfTableError(f"cannot read SVBRDF table {path!r}: {error}") from error
     if str(contents.get("format", "")) != FORMAT_NAME:
         raise SvbrdfTableError(f"{path!r}: not an SVBRDF table (format field {contents.get('format')!r})")
