@@ -9,6 +9,8 @@
  *   hemisphere_integral           <- hemisphere.hemisphere_integral
  *   visibility_product_amplitude  <- hemisphere.visibility_product (its amplitude;
  *                                    axis and sharpness pass through unchanged)
+ *   visibility_product_integral_preserving_amplitude
+ *                                 <- hemisphere.visibility_product_integral_preserving (amplitude)
  *
  * fh_hat = e^-lambda + (1 - e^-lambda) (1 + g) / 2,
  * g = erf(k x (1 - (1 - x^2)/9)) / erf(k), x = sin(theta_d) = p.m.
@@ -79,4 +81,11 @@ float hemisphere_integral(vec3 axis, float sharpness, float amplitude, vec3 norm
 float visibility_product_amplitude(float sharpness, float amplitude, float theta_d)
 {
   return amplitude * fh_normalized(theta_d, sharpness);
+}
+
+/* eq. 31 normalised as its text intends: the lobe's sphere integral is mu fh(theta_d),
+ * i.e. mu fh_hat / (1 + e^-lambda) (the printed form over-counts by 1 + e^-lambda). */
+float visibility_product_integral_preserving_amplitude(float sharpness, float amplitude, float theta_d)
+{
+  return amplitude * fh_normalized(theta_d, sharpness) / (1.0 + exp(-max(sharpness, 0.0)));
 }

@@ -31,8 +31,9 @@ def test_fh_and_visibility_product(glsl, fuzz, record_error):
     theta = fuzz.uniform(-2.0, 2.0, N)
     sharpness = fuzz.log_uniform(1e-4, 1e6, N)
     amplitude = fuzz.uniform(0.0, 4.0, N)
-    out = glsl(LIB, "vec4(fh_normalized(a.x, a.y), fh(a.x, a.y), visibility_product_amplitude(a.y, a.z, a.x), 0)",
-               {"a": np.c_[theta, sharpness, amplitude]}, 3)
+    out = glsl(LIB, "vec4(fh_normalized(a.x, a.y), fh(a.x, a.y), visibility_product_amplitude(a.y, a.z, a.x),"
+                    " visibility_product_integral_preserving_amplitude(a.y, a.z, a.x))",
+               {"a": np.c_[theta, sharpness, amplitude]}, 4)
     normalized = hemisphere.fh_normalized(theta, sharpness)
     # sin(theta) in float32 near +-pi/2 and rounding of x: absolute error on fh_hat in [0, 1]
     assert record_error("hemisphere fh_normalized, absolute", np.abs(out[:, 0] - normalized).max()) <= 3e-6
@@ -43,6 +44,9 @@ def test_fh_and_visibility_product(glsl, fuzz, record_error):
     _, _, expected_amplitude = hemisphere.visibility_product(None, sharpness, amplitude, theta)
     assert record_error("hemisphere visibility_product amplitude (mu <= 4), absolute",
                         np.abs(out[:, 2] - expected_amplitude).max()) <= 4 * 3e-6
+    _, _, preserving = hemisphere.visibility_product_integral_preserving(None, sharpness, amplitude, theta)
+    assert record_error("hemisphere visibility_product_integral_preserving amplitude (mu <= 4), absolute",
+                        np.abs(out[:, 3] - preserving).max()) <= 4 * 3e-6
 
 
 def test_hemisphere_integral(glsl, fuzz, record_error):

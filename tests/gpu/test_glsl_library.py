@@ -18,9 +18,10 @@ DEPENDENCIES = {
     "warp.glsl": ["sg.glsl"],
     "lights.glsl": ["sg.glsl"],
     "env_prefilter.glsl": ["sg.glsl"],
+    "ssdf.glsl": ["sg.glsl", "hemisphere.glsl"],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl", "warp.glsl", "lights.glsl",
-         "env_prefilter.glsl"]
+         "env_prefilter.glsl", "ssdf.glsl"]
 
 
 def test_every_file_is_listed():

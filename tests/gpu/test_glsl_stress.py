@@ -73,7 +73,8 @@ def test_hemisphere_stress(glsl, fuzz):
     theta[kind == 3] = 0.0
     inputs = {"p": np.c_[axis, sharpness], "n": np.c_[normal, amplitude], "t": theta}
     call = ("vec4(fh_normalized_from_sine(t.x, p.w), fh(t.x, p.w),"
-            " hemisphere_integral(p.xyz, p.w, n.w, n.xyz), visibility_product_amplitude(p.w, n.w, t.x))")
+            " hemisphere_integral(p.xyz, p.w, n.w, n.xyz), visibility_product_amplitude(p.w, n.w, t.x)"
+            " + visibility_product_integral_preserving_amplitude(p.w, n.w, t.x))")
     out = glsl(["sg.glsl", "hemisphere.glsl"], call, inputs, 4)
     _assert_finite(out, "hemisphere.glsl")
     assert out.min() >= 0 and out[:, 0].max() <= 1
