@@ -63,6 +63,21 @@ class PrefilteredEnvironment:
     def log2_min_sharpness(self):
         return float(np.log2(self.sharpness[0]))
 
+    def texture_data(self):
+        """Layers as contiguous float32 RGBA (L, size, size, 4), alpha 1, ready for a 2D array texture
+        (upload as is: row 0 is t = 0)."""
+        layers = self.layers
+        if layers.shape[3] < 4:
+            alpha = np.ones(layers.shape[:3] + (4 - layers.shape[3],), np.float32)
+            layers = np.concatenate([layers, alpha], axis=3)
+        return np.ascontiguousarray(layers[..., :4], dtype=np.float32)
+
+    def level_uniforms(self):
+        """Per-level vec4 (texcoord_scale, texcoord_offset, sharpness, 0) as float32 (L, 4), std140-ready."""
+        zeros = np.zeros_like(self.texcoord_scale)
+        return np.ascontiguousarray(np.stack([self.texcoord_scale, self.texcoord_offset,
+                                              self.sharpness.astype(np.float32), zeros], axis=1), np.float32)
+
 
 # -- octahedral mapping ----------------------------------------------------------
 
@@ -336,12 +351,20 @@ def lookup(prefiltered, axis, sharpness):
 
     Exactly what the shader does: octahedral coords, per-layer scale/offset,
     two bilinear fetches with clamp-to-edge, linear blend in log2 sharpness.
-    Computed in float32 like the GPU.
+    Computed in float32 like the GPU (so float32 out whatever the input dtype).
+    In GLSL, with u_level[k] = level_uniforms()[k]::
+
+        vec2 oct = oct_encode(normalize(axis));
+        float t = clamp((log2(max(lambda, 1e-38)) - log2_min) * levels_per_octave, 0.0, last);
+        float k0 = min(floor(t), max(last - 1.0, 0.0));
+        float k1 = min(k0 + 1.0, last);
+        vec3 a = texture(layers, vec3(oct * u_level[int(k0)].x + u_level[int(k0)].y, k0)).rgb;
+        vec3 b = texture(layers, vec3(oct * u_level[int(k1)].x + u_level[int(k1)].y, k1)).rgb;
+        return mix(a, b, t - k0);
     """
     axis = np.asarray(axis, dtype=np.float32)
     coords = oct_encode(sg.normalize(axis)).astype(np.float32)
-    position = blend_parameter(prefiltered, sharpness)
-    position, coords = np.broadcast_arrays(position, coords[..., 0])[0], coords
+    position = np.broadcast_to(blend_parameter(prefiltered, sharpness), coords.shape[:-1])
     last = prefiltered.sharpness.size - 1
     lower = np.minimum(np.floor(position).astype(np.int64), max(last - 1, 0))
     upper = np.minimum(lower + 1, last)

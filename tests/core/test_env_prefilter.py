@@ -157,3 +157,12 @@ def test_equirect_mapping_matches_cycles():
     image = np.zeros((8, 16, 3))
     image[0] = 1.0
     assert equirect.lookup_nearest(image, np.array([0, 0, 1.0]))[0] == 1.0
+
+
+def test_texture_and_uniform_data(prefiltered):
+    data = prefiltered.texture_data()
+    assert data.shape == prefiltered.layers.shape[:3] + (4,) and data.dtype == np.float32 and data.flags.c_contiguous
+    np.testing.assert_array_equal(data[..., :3], prefiltered.layers)
+    uniforms = prefiltered.level_uniforms()
+    assert uniforms.shape == (prefiltered.sharpness.size, 4) and uniforms.dtype == np.float32
+    np.testing.assert_array_equal(uniforms[:, 0], prefiltered.texcoord_scale)
