@@ -53,6 +53,10 @@ class Material:
     diffuse_color: Any = (0.8, 0.8, 0.8)     # kd (3,), albedo of the Lambertian term kd / pi
     specular_color: Any = (0.0, 0.0, 0.0)    # ks (3,), scales the specular model
     specular_model: Any = None               # object with specular / sample / pdf, or None
+    # Spatial variation: callable uv (N, 2) -> dict with any of diffuse_color (N, 3),
+    # specular_color (N, 3) and specular_model (a model whose parameters are (N,) arrays),
+    # replacing the constant fields above at those points.  None: a homogeneous material.
+    textures: Optional[Callable] = None
 
 
 @dataclass
@@ -95,7 +99,7 @@ class Scene:
     normals: Any                              # (V, 3) shading normals, interpolated
     materials: Sequence[Material] = field(default_factory=lambda: [Material()])
     material_index: Any = None                # (T,) int into materials; None: all 0
-    uvs: Any = None                           # (V, 2), unused for now (no textures yet)
+    uvs: Any = None                           # (V, 2), read by materials with textures
     tangents: Any = None                      # (V, 3) for anisotropic models; None: built from the normal
     lights: Sequence[Any] = ()                # PointLight / DirectionalLight
     environment: Any = None                   # equirect (H, W, 3) radiance, Blender world mapping
@@ -287,6 +291,8 @@ class _Renderer:
         self.specular = np.array([np.broadcast_to(np.asarray(m.specular_color, float), 3)
                                   if m.specular_model is not None else np.zeros(3) for m in materials])
         self.models = [m.specular_model for m in materials]
+        self.texture_lookups = [m.textures for m in materials]
+        self.uvs = None if scene.uvs is None else np.asarray(scene.uvs, np.float64).reshape(-1, 2)
         # Probability of sampling the specular lobe: its share of the colour weight,
         # kept in [0.1, 0.9] when both lobes exist so neither is starved.
         diffuse_weight = self.diffuse @ LUMINANCE_WEIGHTS
@@ -302,15 +308,18 @@ class _Renderer:
         self.environment = None if environment is None else EnvironmentSampler(environment)
 
     # -- per-point BRDF in the local frame ------------------------------------------------------
-    def _groups(self, material):
-        """(model, indices into the batch) for every material with a specular model present."""
+    def _groups(self, material, uv):
+        """A _ModelGroup for every material with a specular model present in the batch."""
         groups = []
         for m, model in enumerate(self.models):
-            if model is None:
+            lookup = self.texture_lookups[m]
+            idx = np.flatnonzero(material == m) if (model is not None or lookup is not None) else ()
+            if not len(idx):
                 continue
-            idx = np.flatnonzero(material == m)
-            if len(idx):
-                groups.append((model, idx))
+            if lookup is not None and "specular_model" in lookup(uv[idx[:1]]):
+                groups.append(_ModelGroup(idx, None, lookup, uv[idx]))
+            elif model is not None:
+                groups.append(_ModelGroup(idx, model))
         return groups
 
     def _brdf_cosine(self, points, wi_local):
@@ -319,18 +328,21 @@ class _Renderer:
         if not points.groups:
             return points.diffuse_over_pi * cosine[:, None]
         specular = np.zeros(len(wi_local))
-        for model, idx in points.groups:
-            above = idx[cosine[idx] > 0]
+        for group in points.groups:
+            idx = group.idx
+            is_above = cosine[idx] > 0
+            above = idx[is_above]
             if len(above):
-                value = model.specular(points.wo_local[above], wi_local[above])
+                value = group.model_for(is_above).specular(points.wo_local[above], wi_local[above])
                 specular[above] = np.nan_to_num(value, nan=0.0, posinf=0.0, neginf=0.0)
         return (points.diffuse_over_pi + points.specular_color * specular[:, None]) * cosine[:, None]
 
     def _brdf_pdf(self, points, wi_local):
         q = points.specular_probability
         pdf = (1.0 - q) * np.maximum(wi_local[:, 2], 0.0) * INV_PI
-        for model, idx in points.groups:
-            pdf[idx] += q[idx] * np.nan_to_num(model.pdf(points.wo_local[idx], wi_local[idx]),
+        for group in points.groups:
+            idx = group.idx
+            pdf[idx] += q[idx] * np.nan_to_num(group.model_for().pdf(points.wo_local[idx], wi_local[idx]),
                                                nan=0.0, posinf=0.0, neginf=0.0)
         return pdf
 
@@ -341,11 +353,12 @@ class _Renderer:
         wi_local = np.stack([radius * np.cos(phi), radius * np.sin(phi),
                              np.sqrt(np.maximum(0.0, 1.0 - uniforms[:, 1]))], axis=-1)
         choose_specular = uniforms[:, 0] < points.specular_probability
-        for model, idx in points.groups:
-            chosen = idx[choose_specular[idx]]
+        for group in points.groups:
+            is_chosen = choose_specular[group.idx]
+            chosen = group.idx[is_chosen]
             if len(chosen):
                 # The choice used uniforms[:, 0]; the lobe gets the other two.
-                sampled, _ = model.sample(points.wo_local[chosen], uniforms[chosen, 1:3])
+                sampled, _ = group.model_for(is_chosen).sample(points.wo_local[chosen], uniforms[chosen, 1:3])
                 # A model that fails to sample (non-finite) gives a direction below the horizon: no light.
                 wi_local[chosen] = np.where(np.isfinite(sampled).all(axis=-1, keepdims=True), sampled, [0.0, 0.0, -1.0])
         return wi_local, self._brdf_pdf(points, wi_local)
@@ -396,9 +409,19 @@ class _Renderer:
         wo_local[:, 2] = np.maximum(wo_local[:, 2], _MIN_VIEW_COSINE)
         points.wo_local = _normalize(wo_local, np.array([0.0, 0.0, 1.0]))
         points.material = self.material_index[triangle]
-        points.groups = self._groups(points.material)
+        points.uv = (np.zeros((len(rows), 2)) if self.uvs is None
+                     else np.einsum("nk,nkc->nc", weights, self.uvs[corners]))
+        points.groups = self._groups(points.material, points.uv)
         points.diffuse_over_pi = self.diffuse[points.material] * INV_PI
         points.specular_color = self.specular[points.material]
+        for m, lookup in enumerate(self.texture_lookups):
+            idx = np.flatnonzero(points.material == m) if lookup is not None else ()
+            if len(idx):
+                values = lookup(points.uv[idx])
+                if "diffuse_color" in values:
+                    points.diffuse_over_pi[idx] = np.asarray(values["diffuse_color"], float) * INV_PI
+                if "specular_color" in values:
+                    points.specular_color[idx] = values["specular_color"]
         points.specular_probability = self.specular_probability[points.material]
         points.origin_offset = self.tracer.offset
         return points
@@ -548,12 +571,26 @@ def _power_weight(pdf_own, pdf_other):
     return np.where(pdf_own > 0, 1.0 / (1.0 + np.minimum(ratio, 1e150) ** 2), 0.0)
 
 
+class _ModelGroup:
+    """The batch points ``idx`` of one material and their specular model: one model for a
+    homogeneous material, or one with per-point parameters from its texture lookup."""
+
+    def __init__(self, idx, model, lookup=None, uv=None):
+        self.idx, self.model, self.lookup, self.uv = idx, model, lookup, uv
+
+    def model_for(self, mask=None):
+        """The model for the points idx[mask] (all of idx without a mask)."""
+        if self.lookup is None:
+            return self.model
+        return self.lookup(self.uv if mask is None else self.uv[mask])["specular_model"]
+
+
 class _Points:
     """Shading points of one batch (plain attribute bag)."""
 
     # What the environment estimator reads; the specular ones only when a specular model is present.
     _SAMPLING_FIELDS = ("position", "geometric_normal", "frame", "diffuse_over_pi", "specular_probability")
-    _SPECULAR_FIELDS = ("material", "wo_local", "specular_color")
+    _SPECULAR_FIELDS = ("material", "uv", "wo_local", "specular_color")
 
     def repeat(self, times, renderer):
         """Every point ``times`` times in a row (point i -> rows i * times ... i * times + times - 1),
@@ -563,5 +600,5 @@ class _Points:
         for name in names:
             setattr(out, name, np.repeat(getattr(self, name), times, axis=0))
         out.origin_offset = self.origin_offset
-        out.groups = renderer._groups(out.material) if self.groups else []
+        out.groups = renderer._groups(out.material, out.uv) if self.groups else []
         return out
