@@ -18,7 +18,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-SHADER_DIR = os.path.normpath(os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders"))
+def _shader_dir():
+    """shaders/ inside the package (installed extension) or next to it (the repository)."""
+    package_dir = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    for candidate in (os.path.join(package_dir, "shaders"), os.path.join(package_dir, os.pardir, "shaders")):
+        if os.path.isdir(os.path.join(candidate, "resources")):
+            return os.path.normpath(candidate)
+    return os.path.normpath(os.path.join(package_dir, os.pardir, "shaders"))
+
+
+SHADER_DIR = _shader_dir()
 LIB_DIR = os.path.join(SHADER_DIR, "lib")
 RESOURCE_DIR = os.path.join(SHADER_DIR, "resources")
 
