@@ -9,7 +9,9 @@ one bilinear fetch per four terms, and bilinear filtering commutes with the
 linear PCA sum, so this equals the bilinear sample of the reconstructed image.
 
 ``sample_bilinear`` reproduces a GPU linear sampler with clamp-to-edge: texel
-centres at (k + 0.5) / R, weights from the fractional part.
+centres at (k + 0.5) / R, weights from the fractional part.  Stored samples sit
+at the texel centres (``hemisphere_map.sample_texcoord``), so the lookup
+interpolates all the way to the horizon.
 """
 import numpy as np
 
@@ -42,17 +44,17 @@ def _sample(images, texcoord):
     return top * (1 - fy) + bottom * fy
 
 
-def texcoord_of(local_direction):
-    """Texture coordinates (..., 2) and angle below the horizon (...) of local directions."""
+def texcoord_of(local_direction, resolution):
+    """Texture coordinates (..., 2) in an R x R SSDF texture and angle below the horizon (...) of local directions."""
     square, below = hemisphere_map.horizon_lookup(local_direction)
-    return 0.5 * (square + 1.0), below
+    return hemisphere_map.sample_texcoord(square, resolution), below
 
 
 def decode(coefficients, basis, mean, local_direction):
     """SSDF values (...) at local directions (..., 3) from per-point coefficients (..., N),
     basis (N, R, R) and mean (R, R): bilinear in the map, minus the angle below the horizon."""
     local_direction = np.asarray(local_direction, np.float64)
-    texcoord, below = texcoord_of(local_direction)
+    texcoord, below = texcoord_of(local_direction, np.shape(mean)[-1])
     flat_coord = texcoord.reshape(-1, 2)
     count = flat_coord.shape[0]
     mean_value = _sample(np.asarray(mean, np.float64), flat_coord)
@@ -64,7 +66,7 @@ def decode(coefficients, basis, mean, local_direction):
 
 def decode_image(image, local_direction):
     """SSDF (...) at local directions from one uncompressed (R, R) image (same lookup as ``decode``)."""
-    texcoord, below = texcoord_of(local_direction)
+    texcoord, below = texcoord_of(local_direction, np.shape(image)[-1])
     return _sample(np.asarray(image, np.float64), texcoord) - below
 
 

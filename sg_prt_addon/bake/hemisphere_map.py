@@ -9,9 +9,16 @@ Conventions (shared by the bake, ``decode`` and shaders/lib/ssdf.glsl):
 
 - local frame: the vertex normal along z+; x+ along the ``local_frame`` tangent;
 - square coordinates (a, b) in [-1, 1]^2, a along local x, b along local y;
-- a grid of R x R texels is indexed [row, column] = [b index, a index]; texel k
-  has its centre at -1 + (2 k + 1) / R; texture coordinates are
-  (s, t) = ((a + 1) / 2, (b + 1) / 2), texture row t = 0 is numpy row 0;
+- grids are indexed [row, column] = [b index, a index];
+- ray grids (``texel_directions``): R x R texels, texel k centred at
+  -1 + (2 k + 1) / R;
+- stored SSDF images (``sample_directions``): R x R samples on the lattice
+  -1 + 2 k / (R - 1), whose outer rows lie ON the horizon, so that bilinear
+  interpolation covers the whole hemisphere with no clamp-to-edge band (with
+  texel centres, the outer half texel, 3.5 degrees at R = 32, would repeat
+  the edge value).  A GPU texture of these samples is read at texture
+  coordinates ``sample_texcoord`` = ((a + 1) / 2 (R - 1) + 1 / 2) / R, so that
+  sample k sits at texel centre k; texture row t = 0 is numpy row 0;
 - the square's edge is the horizon (z = 0).
 
 Directions below the horizon (a lobe centre can be, e.g. for the diffuse
@@ -86,6 +93,23 @@ def texel_directions(resolution):
     centres = texel_centres(resolution)
     b, a = np.meshgrid(centres, centres, indexing="ij")
     return square_to_hemisphere(np.stack([a, b], axis=-1))
+
+
+def sample_points(resolution):
+    """(R,) square coordinates of the stored SSDF samples along one axis: -1 + 2 k / (R - 1)."""
+    return np.linspace(-1.0, 1.0, resolution)
+
+
+def sample_directions(resolution):
+    """(R, R, 3) local directions of the stored SSDF samples, indexed [b index, a index]."""
+    points = sample_points(resolution)
+    b, a = np.meshgrid(points, points, indexing="ij")
+    return square_to_hemisphere(np.stack([a, b], axis=-1))
+
+
+def sample_texcoord(square, resolution):
+    """Texture coordinates (..., 2) of square points in an R x R texture of stored samples."""
+    return ((np.asarray(square, np.float64) + 1.0) * (0.5 * (resolution - 1)) + 0.5) / resolution
 
 
 def elevation(direction):

@@ -21,7 +21,7 @@ class BakeCancelled(Exception):
 
 @dataclass
 class BakeOptions:
-    resolution: int = 32            # stored SSDF texels per side = coarse rays per side
+    resolution: int = 32            # stored SSDF samples per side = coarse rays per side
     refinement: int = 5             # odd supersampling factor of mixed coarse cells (fine grid 160 x 160)
     terms: Optional[int] = None     # PCA terms; None: the fewest reaching error_target
     error_target: float = 0.02      # RMS angular error of the PCA, radians (used when terms is None)
@@ -33,7 +33,8 @@ class BakeOptions:
 
 @dataclass
 class BakeResult:
-    """A finished bake.  SSDF of vertex x at texel (b, a) ~ mean + coefficients[x] @ basis."""
+    """A finished bake.  SSDF of vertex x at the stored sample [b, a] (``hemisphere_map.sample_directions``)
+    ~ mean + coefficients[x] @ basis."""
     coefficients: np.ndarray        # (V, N) float32
     basis: np.ndarray               # (N, R, R) float32, orthonormal over texels
     mean: np.ndarray                # (R, R) float32
@@ -81,7 +82,7 @@ def bake_ssdf(vertices, normals, tracer, options, progress=None, tangents=None):
     for start in range(0, count, options.batch_vertices):
         part = slice(start, min(start + options.batch_vertices, count))
         fine, _ = visibility.adaptive_visibility(tracer, origins[part], frames[part], resolution, options.refinement)
-        out[part] = ssdf.ssdf_from_fine(fine, options.refinement).reshape(fine.shape[0], -1)
+        out[part] = ssdf.ssdf_from_fine(fine, resolution).reshape(fine.shape[0], -1)
         _report(progress, 0.9 * part.stop / max(count, 1), f"visibility {part.stop}/{count} vertices")
     return out
 

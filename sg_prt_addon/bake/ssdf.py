@@ -17,10 +17,11 @@ No boundary at all: fully visible gives the elevation (above); fully occluded
 (nothing visible) gives -pi, the largest angle on the sphere (fh saturates at
 -pi/2 anyway).
 
-Values are sampled at the stored texel centres rather than averaged over them:
-the SSDF is continuous (1-Lipschitz), so point samples do not alias the way
-binary visibility does, and bilinear interpolation of point samples is what
-the GPU does.
+Values are point samples at the stored lattice (``hemisphere_map.sample_directions``,
+outer rows on the horizon) rather than averages over texels: the SSDF is
+continuous (1-Lipschitz), so point samples do not alias the way binary
+visibility does, and bilinear interpolation of point samples is what the GPU
+does.  The sign of a sample is the visibility of the fine texel containing it.
 
 ``signed_distance`` finds the nearest boundary point per vertex by a
 float32 matrix product of query and boundary directions (BLAS) and argmax of
@@ -107,14 +108,14 @@ def signed_distance_brute_force(visible, fine_directions, query_visible, query_d
     return out
 
 
-def ssdf_from_fine(visible_fine, refinement):
-    """(B, C, C) SSDF at the coarse texel centres from (B, C f, C f) fine visibility (f odd):
-    the coarse centre is the fine texel (i f + f // 2, j f + f // 2), whose visibility gives the sign."""
+def ssdf_from_fine(visible_fine, resolution):
+    """(B, R, R) SSDF at the stored samples (``hemisphere_map.sample_directions(R)``) from
+    (B, F, F) fine visibility; the sign is the visibility of the fine texel holding each sample."""
     count, fine_resolution, _ = visible_fine.shape
-    coarse_resolution = fine_resolution // refinement
-    centre = np.arange(coarse_resolution) * refinement + refinement // 2
-    query_visible = visible_fine[:, centre][:, :, centre].reshape(count, -1)
+    index = np.clip(np.floor((hemisphere_map.sample_points(resolution) + 1.0) * 0.5 * fine_resolution),
+                    0, fine_resolution - 1).astype(np.intp)
+    query_visible = visible_fine[:, index][:, :, index].reshape(count, -1)
     fine_directions = hemisphere_map.texel_directions(fine_resolution)
-    query_directions = fine_directions[centre][:, centre].reshape(-1, 3)
+    query_directions = hemisphere_map.sample_directions(resolution).reshape(-1, 3)
     values = signed_distance(visible_fine, fine_directions, query_visible, query_directions)
-    return values.reshape(count, coarse_resolution, coarse_resolution)
+    return values.reshape(count, resolution, resolution)

@@ -11,8 +11,9 @@
  *
  * Layout: `basis` is an RGBA32F sampler2DArray holding the images [mean, B_0, B_1, ...] four to a
  * layer (linear filtering, clamp-to-edge: a GPU texture from Python); `coefficients[l]` holds the
- * vertex-interpolated [1, w_0, w_1, ...] four to a vec4.  Square coordinates (a, b) in [-1, 1]^2 map
- * to texture coordinates ((a + 1) / 2, (b + 1) / 2).  #define SSDF_MAX_LAYERS before this file to
+ * vertex-interpolated [1, w_0, w_1, ...] four to a vec4.  The R x R stored samples lie on the lattice
+ * -1 + 2 k / (R - 1) of the square (outer rows on the horizon), at the texel centres: square (a, b) ->
+ * texture coordinates ((a, b) + 1) / 2 (R - 1) + 1 / 2) / R (hemisphere_map.sample_texcoord).  #define SSDF_MAX_LAYERS before this file to
  * change the array size (default 13: the mean and 48 terms).
  */
 
@@ -78,7 +79,8 @@ vec3 ssdf_to_local(vec3 world_direction, vec3 normal)
 float ssdf_decode(sampler2DArray basis, vec4 coefficients[SSDF_MAX_LAYERS], int layer_count, vec3 local_direction)
 {
   vec3 lookup = ssdf_horizon_lookup(local_direction);
-  vec2 texcoord = 0.5 * lookup.xy + 0.5;
+  float resolution = float(textureSize(basis, 0).x);
+  vec2 texcoord = ((lookup.xy + 1.0) * (0.5 * (resolution - 1.0)) + 0.5) / resolution;
   float value = 0.0;
   for (int layer = 0; layer < layer_count; ++layer) {
     value += dot(texture(basis, vec3(texcoord, float(layer))), coefficients[layer]);

@@ -31,7 +31,7 @@ def test_packed_layout_decodes_the_same():
     texture = decode.pack_basis_texture(mean, basis)
     packed = decode.pack_coefficients(coefficients)
     assert texture.shape == (2, resolution, resolution, 4) and packed.shape == (50, 8)
-    texcoord, below = decode.texcoord_of(direction)
+    texcoord, below = decode.texcoord_of(direction, resolution)
     fetched = decode.sample_bilinear(np.moveaxis(texture, -1, 1), texcoord)        # (L, 4, Q)
     value = np.einsum("lcq,qlc->q", fetched, packed.reshape(50, 2, 4)) - below
     assert np.abs(value - expected).max() < 1e-5
@@ -53,7 +53,7 @@ def test_shadowed_integral_against_exact_visibility():
     cap_centre = np.array([0.0, np.sin(0.5), np.cos(0.5)])
     cap_radius = 0.5
     visible = (fine @ cap_centre < np.cos(cap_radius))[None]
-    image = ssdf.ssdf_from_fine(visible, refinement)[0]
+    image = ssdf.ssdf_from_fine(visible, resolution)[0]
     basis = image[None]
     mean = np.zeros_like(image)
     # lobes around the cap's edge

@@ -19,7 +19,7 @@ def ssdf_samples():
     radius = rng.uniform(0.05, 0.8, count)
     radius[:20] = 0.0
     visible = np.einsum("rcx,bx->brc", fine, centre) < np.cos(radius)[:, None, None]
-    values = ssdf.ssdf_from_fine(visible, refinement).reshape(count, -1)
+    values = ssdf.ssdf_from_fine(visible, resolution).reshape(count, -1)
     return values.astype(np.float16)
 
 

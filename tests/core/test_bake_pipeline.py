@@ -72,7 +72,7 @@ def test_bake_result_shapes_and_metadata(scene):
     rms = np.sqrt(np.mean((result.ssdf().reshape(count, -1) - raw) ** 2))
     assert abs(rms - result.rms_error) < 1e-3 * max(result.rms_error, 1e-3) + 1e-5
     # visible values never exceed the elevation (the horizon is a boundary)
-    elevation = np.arcsin(hemisphere_map.texel_directions(16)[..., 2]).ravel()
+    elevation = np.arcsin(hemisphere_map.sample_directions(16)[..., 2]).ravel()
     assert np.all(raw <= elevation + 1e-3)
 
 

@@ -28,7 +28,7 @@ def _edge_normal(azimuth):
 def _ssdf_images():
     fine = hemisphere_map.texel_directions(RESOLUTION * REFINEMENT)
     visible = np.stack([fine @ _edge_normal(a) < 0 for a in AZIMUTHS])
-    return ssdf.ssdf_from_fine(visible, REFINEMENT), visible
+    return ssdf.ssdf_from_fine(visible, RESOLUTION), visible
 
 
 def _ring(count=3600):
