@@ -72,6 +72,11 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
                 # GPU shaders still alive at interpreter exit crash Blender's teardown (no context
                 # then): batch renders drop them while the render's context is current.
                 shader_variants.clear_cache()
+        dropped = state.dropped_lights(shader_variants.MAX_POINT_LIGHTS, shader_variants.MAX_SUNS)
+        if dropped:
+            self.report({"WARNING"}, f"SG-PRT: {len(dropped)} dimmest light(s) left out (at most "
+                                     f"{shader_variants.MAX_POINT_LIGHTS} point/spot/area and "
+                                     f"{shader_variants.MAX_SUNS} sun lights): {', '.join(dropped[:5])}")
         result = self.begin_result(0, 0, width, height)
         layer = result.layers[0]
         written = []

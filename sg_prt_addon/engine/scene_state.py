@@ -183,6 +183,11 @@ class SceneState:
     def light_data(self):
         return light_data(self.lights)
 
+    def dropped_lights(self, max_points, max_suns):
+        """Names of the lights beyond the shader's limits (the dimmest are dropped)."""
+        kept = set(light.name for light in _strongest(self.lights, max_points, max_suns))
+        return [light.name for light in self.lights if light.name not in kept]
+
 
 def _visible(obj):
     """Visibility in the view layer (asked of the original: evaluated copies report False)."""
@@ -193,12 +198,24 @@ def _visible(obj):
         return True
 
 
-def light_data(light_exports):
-    """shading.LightData (float32) from export.LightExport records."""
-    from ..core import lights as core_lights
+def _strongest(light_exports, max_points, max_suns):
+    """At most max_points point-like lights and max_suns suns, the brightest first."""
+    def power(light):
+        return -float(np.sum(light.colour_intensity))
+    points = sorted((light for light in light_exports if light.kind == "POINT"), key=power)[:max_points]
+    suns = sorted((light for light in light_exports if light.kind == "SUN"), key=power)[:max_suns]
+    return points + suns
 
-    points = [light for light in light_exports if light.kind == "POINT"]
-    suns = [light for light in light_exports if light.kind == "SUN"]
+
+def light_data(light_exports):
+    """shading.LightData (float32) from export.LightExport records (the shader's limits applied:
+    the dimmest lights beyond them are left out)."""
+    from ..core import lights as core_lights
+    from .shader_variants import MAX_POINT_LIGHTS, MAX_SUNS
+
+    kept = _strongest(light_exports, MAX_POINT_LIGHTS, MAX_SUNS)
+    points = [light for light in kept if light.kind == "POINT"]
+    suns = [light for light in kept if light.kind == "SUN"]
     data = shading.LightData()
     f = np.float32
     if points:
