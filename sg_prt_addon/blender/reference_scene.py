@@ -1,0 +1,106 @@
+"""The scene the engine sees, as input for the Monte Carlo reference renderer.
+
+The engine's own export (engine.scene_state.SceneState) is converted, so the
+reference and the engine score the same geometry, materials, textures (same
+bilinear sampler), lights, world and camera; only the light transport differs.
+"""
+import numpy as np
+
+from ..core import brdf, reference, shading
+from ..core.camera import Camera
+from . import export
+
+_MODEL_PARAMETERS = shading._MODEL_PARAMETERS   # the material fields each model reads
+
+
+def _texture_lookup(params, images):
+    """uv -> per-point colours and model for a material with textures (the engine's sampling)."""
+    def lookup(uv):
+        count = len(uv)
+        values = {}
+        for name in ("diffuse_color", "specular_color"):
+            colour = np.broadcast_to(np.asarray(getattr(params, name), np.float64), (count, 3))
+            if name in images:
+                colour = colour * shading.sample_bilinear(images[name], uv)[:, :3]
+            values[name] = colour
+        model_parameters = {}
+        for name in _MODEL_PARAMETERS[params.model]:
+            value = np.full(count, float(getattr(params, name)))
+            if name in images:
+                value = value * shading.sample_bilinear(images[name], uv)[:, 0]
+            model_parameters[name] = value
+        values["specular_model"] = brdf.model_from_name(params.model, **model_parameters)
+        return values
+    return lookup
+
+
+def reference_material(params, image_pixels_by_name):
+    """core.reference.Material of an export.MaterialParams."""
+    constant = {name: float(getattr(params, name)) for name in _MODEL_PARAMETERS[params.model]}
+    material = reference.Material(np.asarray(params.diffuse_color, float), np.asarray(params.specular_color, float),
+                                  brdf.model_from_name(params.model, **constant))
+    images = {name: image_pixels_by_name[image] for name, image in params.textures.items()
+              if name != "normal_map" and image in image_pixels_by_name}
+    if images:
+        material.textures = _texture_lookup(params, images)
+    return material
+
+
+def reference_lights(light_exports):
+    lights = []
+    for light in light_exports:
+        if light.kind == "SUN":
+            lights.append(reference.DirectionalLight(-np.asarray(light.direction), np.asarray(light.colour_intensity),
+                                                     angular_radius=0.5 * light.angle))
+        else:
+            spot = dict(spot_direction=np.asarray(light.direction), spot_size=light.spot_size,
+                        spot_blend=light.spot_blend) if light.is_spot else {}
+            lights.append(reference.PointLight(np.asarray(light.position), np.asarray(light.colour_intensity),
+                                               radius=light.radius, **spot))
+    return lights
+
+
+def reference_scene(state, images):
+    """core.reference.Scene of a synced engine SceneState; ``images``: image name -> pixels
+    (export.image_pixels orientation) for the textures the materials use."""
+    material_names = list(state.materials)
+    materials = [reference_material(state.materials[name], images) for name in material_names]
+    vertices, normals, uvs, tangents, triangles, material_index = [], [], [], [], [], []
+    offset = 0
+    for entry in state.objects.values():
+        mesh = export.to_world(state.meshes[entry.mesh_key], entry.matrix_world)
+        per_triangle = np.zeros(len(mesh.triangles), np.int64)
+        for slot, first, count in mesh.material_ranges:
+            name = entry.material_names[min(slot, len(entry.material_names) - 1)]
+            per_triangle[first:first + count] = material_names.index(name)
+        vertices.append(mesh.positions)
+        normals.append(mesh.normals)
+        uvs.append(mesh.uvs)
+        tangents.append(mesh.tangents[:, :3])
+        triangles.append(mesh.triangles.astype(np.int64) + offset)
+        material_index.append(per_triangle)
+        offset += len(mesh.positions)
+    if not triangles:
+        raise ValueError("the scene has no visible mesh to render")
+    world = state.world
+    return reference.Scene(
+        vertices=np.concatenate(vertices).astype(np.float64), triangles=np.concatenate(triangles),
+        normals=np.concatenate(normals).astype(np.float64), materials=materials,
+        material_index=np.concatenate(material_index), uvs=np.concatenate(uvs).astype(np.float64),
+        tangents=np.concatenate(tangents).astype(np.float64), lights=reference_lights(state.lights),
+        environment=None if world.equirect is None else np.asarray(world.equirect, np.float64),
+        background=np.asarray(world.colour[:3], np.float64))
+
+
+def reference_inputs(depsgraph, width, height):
+    """(core.reference.Scene, core.camera.Camera) of an evaluated depsgraph, as the engine sees it."""
+    import bpy
+    from ..engine.scene_state import SceneState
+
+    state = SceneState()
+    state.sync(depsgraph)
+    names = {image for params in state.materials.values() for image in params.textures.values()}
+    images = {name: export.image_pixels(bpy.data.images[name]) for name in names if name in bpy.data.images}
+    scene = depsgraph.scene
+    camera = export.export_camera(scene.camera.evaluated_get(depsgraph), depsgraph, width, height)
+    return reference_scene(state, images), Camera(camera.view, camera.projection, width, height)
