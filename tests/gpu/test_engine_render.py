@@ -149,3 +149,25 @@ def test_environment_background_follows_blender_mapping(engine):
     error = np.abs(actual[away_from_seam, :3] - expected[away_from_seam]).max()
     assert error < 2e-3 * pixels[..., :3].max()
     assert np.all(actual[:, 3] == 1.0)
+
+
+def test_render_result_written_to_file_matches_passes(engine, tmp_path):
+    """What Blender saves from the RenderResult is the engine's Combined pass, same orientation."""
+    import bpy
+
+    scene = fx.new_scene("render_saved", 48, 32)
+    fx.world_colour(scene, (0.1, 0.2, 0.3))
+    fx.uv_sphere(scene, "saved_sphere", (0.7, 0.0, 1.3), radius=0.8, segments=12, rings=6)
+    fx.point_light(scene, "saved_light", (1.0, -3.0, 3.0), 500.0)
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = str(tmp_path / "saved.exr")
+    from sg_prt_addon.engine import render_engine
+    with bpy.context.temp_override(scene=scene):
+        bpy.ops.render.render(scene=scene.name, write_still=True)
+    combined = render_engine.last_render["passes"]["Combined"]
+    image = bpy.data.images.load(str(tmp_path / "saved.exr"))
+    pixels = np.empty(48 * 32 * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    np.testing.assert_allclose(pixels.reshape(32, 48, 4), combined, rtol=1e-6, atol=1e-7)
+    assert combined[..., :3].std() > 0.01          # not a flat image: the comparison means something
