@@ -1,7 +1,7 @@
 """PCA compression of per-vertex SSDFs (wang2009 eq. 24), in bounded memory.
 
 V_d,x(i) ~ mean(i) + sum_j w_x,j B_j(i).  The D x D covariance (D = R^2 texels)
-is accumulated in float64 chunk by chunk (8 MB at 32 x 32, 134 MB at 64 x 64),
+is accumulated in float64 (from float32 chunk products) chunk by chunk (8 MB at 32 x 32, 134 MB at 64 x 64),
 never a V x D float64 matrix; only the leading eigenpairs are computed
 (scipy eigh with subset_by_index above 48 x 48 texels).  The residual of n terms follows from the
 trace: RMS angular error(n) = sqrt((trace C - sum of the n largest
@@ -50,8 +50,10 @@ def fit(samples, terms=None, error_target=0.02, max_terms=48):
         mean += samples[part].astype(np.float64).sum(axis=0)
     mean /= max(count, 1)
     covariance = np.zeros((dims, dims))
+    mean32 = mean.astype(np.float32)
     for part in _chunks(count):
-        centred = samples[part].astype(np.float64) - mean
+        # float32 products (2x faster BLAS), summed in float64 across chunks: relative error ~1e-6
+        centred = samples[part].astype(np.float32) - mean32
         covariance += centred.T @ centred
     covariance /= max(count, 1)
     total = float(np.trace(covariance))
@@ -77,8 +79,10 @@ def fit(samples, terms=None, error_target=0.02, max_terms=48):
 def project(model, samples):
     """PCA coefficients (V, N) float32 of samples (V, D)."""
     out = np.empty((samples.shape[0], model.terms), np.float32)
+    mean32 = model.mean.astype(np.float32)
+    basis32 = model.basis.T.astype(np.float32)
     for part in _chunks(samples.shape[0]):
-        out[part] = (samples[part].astype(np.float64) - model.mean) @ model.basis.T
+        out[part] = (samples[part].astype(np.float32) - mean32) @ basis32
     return out
 
 
