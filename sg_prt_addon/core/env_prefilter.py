@@ -24,6 +24,7 @@ log2(lambda); outside the level range the blend clamps to the end layer
 (sharper than the top level: the top layer approximates the radiance itself,
 which is what Gamma / integral G tends to).  ``lookup`` mirrors exactly that.
 """
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -220,7 +221,10 @@ def convolve_equirect(source, sharpness, row_block=64):
     radius = 2 * np.arcsin(min(1.0, 0.5 * np.sqrt(2 * np.log(1 / WEIGHT_CUTOFF) / sharpness)))
     half_rows = min(int(np.ceil(radius * height / np.pi)) + 1, height)
     # float32 spectra: the kernel sums are normalized, so rounding stays ~1e-6 relative
-    spectrum = fft.rfft(source.astype(np.float32), axis=1)  # (H, W/2+1, C)
+    # the column kernel's spectrum ~ exp(-k^2 / (2 lambda cos t_p cos t_q)): frequencies past
+    # sqrt(2 ln(1/cutoff) lambda) are below WEIGHT_CUTOFF and are dropped
+    frequencies = min(width // 2 + 1, int(np.ceil(np.sqrt(2 * np.log(1 / WEIGHT_CUTOFF) * sharpness))) + 2)
+    spectrum = fft.rfft(source.astype(np.float32), axis=1)[:, :frequencies]  # (H, K, C)
     out = np.empty((height, width, channels), np.float64)
     offsets = np.arange(-half_rows, half_rows + 1)
     for start in range(0, height, row_block):
@@ -233,7 +237,7 @@ def convolve_equirect(source, sharpness, row_block=64):
         cos_product = np.maximum(np.cos(t_out) * np.cos(t_in), 0.0)
         column_kernel = np.exp(np.float32(-2 * sharpness) * cos_product[..., None].astype(np.float32)
                                * half_sin2_dphi.astype(np.float32))  # (n, 2R+1, W)
-        kernel_spectrum = fft.rfft(column_kernel, axis=2).real  # symmetric kernel: real spectrum
+        kernel_spectrum = fft.rfft(column_kernel, axis=2)[:, :, :frequencies].real  # symmetric: real
         weighted = row_weight[..., None].astype(np.float32) * kernel_spectrum  # (n, 2R+1, W/2+1)
         total = np.einsum("nqk,nqkc->nkc", weighted, spectrum[rows_in])
         norm = weighted[:, :, 0].astype(np.float64).sum(axis=1)  # DC term = sum of the kernel over columns
@@ -282,11 +286,13 @@ def sample_equirect_bicubic(image, directions, taps=None):
     return np.maximum(values, 0.0)
 
 
-def prefilter_environment(equirect_image, levels=None, size=256, levels_per_octave=3):
+def prefilter_environment(equirect_image, levels=None, size=256, levels_per_octave=3, workers=2):
     """Prefilter an equirect map (H, W, C) (Blender world mapping, row 0 at the top).
 
     levels: the level sharpnesses (log-spaced with ``levels_per_octave`` per
-    octave; default ``default_levels``).  Returns a PrefilteredEnvironment.
+    octave; default ``default_levels`` up to ``max_sharpness_for(size)``);
+    ``workers`` threads filter levels in parallel.  Returns a PrefilteredEnvironment.
+    courtyard.exr (1024 x 512) at size 256, 44 layers: about 4 s of CPU.
     """
     image = np.asarray(equirect_image, dtype=np.float32)
     image = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0)
@@ -302,14 +308,27 @@ def prefilter_environment(equirect_image, levels=None, size=256, levels_per_octa
     layers = np.zeros((levels.size, size, size, channels), np.float32)
     taps_cache = {}  # many levels share a content size and a source grid
     for k, sharpness in enumerate(levels):
-        n = int(content[k])
         source = _source_for(pyramid, sharpness)
-        key = (n, source.shape[0], source.shape[1])
+        key = (int(content[k]), source.shape[0], source.shape[1])
         if key not in taps_cache:
-            taps_cache[key] = bicubic_taps(source.shape[0], source.shape[1], oct_decode(content_texel_coords(n)))
-        kernel = _compensated_sharpness(sharpness, source.shape[0], pyramid[0].shape[0])
-        values = sample_equirect_bicubic(convolve_equirect(source, kernel), None, taps_cache[key])
+            taps_cache[key] = bicubic_taps(source.shape[0], source.shape[1], oct_decode(content_texel_coords(key[0])))
+
+    def filter_level(k):
+        n = int(content[k])
+        source = _source_for(pyramid, levels[k])
+        kernel = _compensated_sharpness(levels[k], source.shape[0], pyramid[0].shape[0])
+        values = sample_equirect_bicubic(convolve_equirect(source, kernel), None,
+                                         taps_cache[(n, source.shape[0], source.shape[1])])
         layers[k, :n, :n] = values.reshape(n, n, channels)
+
+    # levels are independent and numpy/scipy release the GIL in exp, FFT and einsum: threads scale
+    order = list(np.argsort(-levels))  # sharpest (slowest) first for better balance
+    if workers > 1:
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            list(pool.map(filter_level, order))
+    else:
+        for k in order:
+            filter_level(k)
     interior = content - 2
     scale = (interior / (2.0 * size)).astype(np.float32)
     offset = ((1 + interior / 2.0) / size).astype(np.float32)
