@@ -397,9 +397,17 @@ def lookup(prefiltered, axis, sharpness):
 
 
 def lookup_integral(prefiltered, axis, sharpness, amplitude=1.0):
-    """<G(axis, sharpness, amplitude), L> = amplitude * Gamma_L (eq. 35): lookup times the SG integral."""
-    scale = sg.sphere_integral(np.asarray(sharpness, dtype=np.float32), amplitude)
-    return lookup(prefiltered, axis, sharpness) * np.asarray(scale)[..., None]
+    """<G(axis, sharpness, amplitude), L> = amplitude * Gamma_L (eq. 35): lookup times the SG integral.
+
+    amplitude: scalar, per lobe (...) or per lobe and colour (..., C).  Returns (..., C).
+    """
+    values = lookup(prefiltered, axis, sharpness)
+    kernel_integral = sg.sphere_integral(np.asarray(sharpness, dtype=np.float32))
+    amplitude = np.asarray(amplitude, dtype=np.float32)
+    scale = np.broadcast_to(kernel_integral, values.shape[:-1])[..., None]
+    if amplitude.ndim == 0 or amplitude.ndim < values.ndim:
+        amplitude = amplitude[..., None]
+    return values * scale * amplitude
 
 
 def brute_force_convolution(equirect_image, axis, sharpness):

@@ -166,3 +166,16 @@ def test_texture_and_uniform_data(prefiltered):
     uniforms = prefiltered.level_uniforms()
     assert uniforms.shape == (prefiltered.sharpness.size, 4) and uniforms.dtype == np.float32
     np.testing.assert_array_equal(uniforms[:, 0], prefiltered.texcoord_scale)
+
+
+def test_lookup_integral_amplitude_shapes(prefiltered):
+    axes = _random_axes(5, 10)
+    lam = np.full(5, 20.0)
+    base = ep.lookup_integral(prefiltered, axes, lam)
+    np.testing.assert_allclose(ep.lookup_integral(prefiltered, axes, lam, 2.0), 2 * base, rtol=1e-6)
+    per_lobe = np.arange(1.0, 6.0)
+    np.testing.assert_allclose(ep.lookup_integral(prefiltered, axes, lam, per_lobe), base * per_lobe[:, None], rtol=1e-6)
+    colour = np.tile([1.0, 2.0, 3.0], (5, 1))
+    np.testing.assert_allclose(ep.lookup_integral(prefiltered, axes, lam, colour), base * colour, rtol=1e-6)
+    # a scalar sharpness broadcasts over the axes
+    np.testing.assert_allclose(ep.lookup_integral(prefiltered, axes, 20.0), base, rtol=1e-6)
