@@ -51,7 +51,8 @@ def texcoord_of(local_direction, resolution):
 
 
 def decode(coefficients, basis, mean, local_direction):
-    """SSDF values (...) at local directions (..., 3) from per-point coefficients (..., N),
+    """SSDF values (...) at local directions (..., 3) from coefficients (..., N) (broadcast: one vertex's
+    (N,) decodes many directions),
     basis (N, R, R) and mean (R, R): bilinear in the map, minus the angle below the horizon."""
     local_direction = np.asarray(local_direction, np.float64)
     texcoord, below = texcoord_of(local_direction, np.shape(mean)[-1])
@@ -59,7 +60,8 @@ def decode(coefficients, basis, mean, local_direction):
     count = flat_coord.shape[0]
     mean_value = _sample(np.asarray(mean, np.float64), flat_coord)
     basis_values = _sample(np.asarray(basis, np.float64), flat_coord)        # (N, Q)
-    weights = np.asarray(coefficients, np.float64).reshape(count, -1)
+    coefficients = np.asarray(coefficients, np.float64)
+    weights = np.broadcast_to(coefficients, below.shape + coefficients.shape[-1:]).reshape(count, -1)
     value = mean_value + np.einsum("qn,nq->q", weights, basis_values)
     return value.reshape(below.shape) - below
 

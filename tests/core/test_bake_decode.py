@@ -28,6 +28,8 @@ def test_packed_layout_decodes_the_same():
     direction = rng.normal(size=(50, 3))
     direction /= np.linalg.norm(direction, axis=1, keepdims=True)
     expected = decode.decode(coefficients, basis, mean, direction)
+    # one vertex's coefficients broadcast over many directions
+    assert np.allclose(decode.decode(coefficients[3], basis, mean, direction)[3], expected[3])
     texture = decode.pack_basis_texture(mean, basis)
     packed = decode.pack_coefficients(coefficients)
     assert texture.shape == (2, resolution, resolution, 4) and packed.shape == (50, 8)
