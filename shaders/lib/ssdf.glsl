@@ -14,11 +14,11 @@
  * vertex-interpolated [1, w_0, w_1, ...] four to a vec4.  The R x R stored samples lie on the lattice
  * -1 + 2 k / (R - 1) of the square (outer rows on the horizon), at the texel centres: square (a, b) ->
  * texture coordinates ((a, b) + 1) / 2 (R - 1) + 1 / 2) / R (hemisphere_map.sample_texcoord).  #define SSDF_MAX_LAYERS before this file to
- * change the array size (default 13: the mean and 48 terms).
+ * change the array size (default 12: the mean and 47 terms, BakeOptions.max_terms).
  */
 
 #ifndef SSDF_MAX_LAYERS
-#define SSDF_MAX_LAYERS 13
+#define SSDF_MAX_LAYERS 12
 #endif
 
 const float SSDF_QUARTER_PI = 0.25 * SG_PI;
