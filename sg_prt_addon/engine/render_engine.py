@@ -32,10 +32,6 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         self.viewport_renderer = None
         self.viewport_error = None
 
-    def __del__(self):
-        # GPU objects are freed with their Python owners; nothing to release explicitly
-        pass
-
     # ----------------------------------------------------------------- passes
 
     def update_render_passes(self, scene=None, renderlayer=None):

@@ -10,13 +10,14 @@ def studio_world_path(name="courtyard.exr"):
 
 
 def ensure_registered():
-    """Material settings and the SG-PRT engine, registered once per process."""
+    """The add-on (material settings, panels, engine), registered once per process: through
+    sg_prt_addon.register() unless another tier's fixture already did it."""
     import bpy
-    from sg_prt_addon.blender import properties
+    import sg_prt_addon
     from sg_prt_addon import engine
 
     if not hasattr(bpy.types.Material, "sgprt"):
-        properties.register()
+        sg_prt_addon.register()
     for cls in engine.classes:
         if not getattr(cls, "is_registered", False):
             bpy.utils.register_class(cls)
