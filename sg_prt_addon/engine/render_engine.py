@@ -49,6 +49,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         if scene.camera is None:
             self.report({"ERROR"}, "SG-PRT: the scene has no camera")
             return
+        self.update_stats("", "SG-PRT: exporting the scene, drawing")
         try:
             passes, state, timings = render_frame(depsgraph, width, height, gbuffer=debug["capture_gbuffer"])
         except ShaderCompileError as error:
@@ -73,7 +74,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, f"SG-PRT: {len(dropped)} dimmest light(s) left out (at most "
                                      f"{shader_variants.MAX_POINT_LIGHTS} point/spot/area and "
                                      f"{shader_variants.MAX_SUNS} sun lights): {', '.join(dropped[:5])}")
-        result = self.begin_result(0, 0, width, height)
+        # one render() per view layer: write into the one being rendered
+        result = self.begin_result(0, 0, width, height, layer=depsgraph.view_layer.name)
         layer = result.layers[0]
         written = []
         for name in renderer_module.PASS_NAMES:

@@ -171,3 +171,36 @@ def test_render_result_written_to_file_matches_passes(engine, tmp_path):
     image.pixels.foreach_get(pixels)
     np.testing.assert_allclose(pixels.reshape(32, 48, 4), combined, rtol=1e-6, atol=1e-7)
     assert combined[..., :3].std() > 0.01          # not a flat image: the comparison means something
+
+
+def test_second_view_layer_renders_its_own_objects(engine, tmp_path):
+    """Each view layer's render() writes its own layer: a layer that excludes the sphere shows
+    only the world."""
+    import bpy
+    from sg_prt_addon.engine import render_engine
+
+    scene = fx.new_scene("render_layers", 32, 32)
+    fx.world_colour(scene, (0.3, 0.2, 0.1))
+    sphere = fx.uv_sphere(scene, "layers_sphere", (0.0, 0.0, 1.0), radius=1.2, segments=12, rings=6)
+    collection = bpy.data.collections.new("layers_collection")
+    scene.collection.children.link(collection)
+    scene.collection.objects.unlink(sphere)
+    collection.objects.link(sphere)
+    empty_layer = scene.view_layers.new("without_sphere")
+    empty_layer.layer_collection.children["layers_collection"].exclude = True
+    coverage = {}
+    original = render_engine.render_frame
+
+    def recording(depsgraph, *args, **kwargs):
+        passes, state, timings = original(depsgraph, *args, **kwargs)
+        coverage[depsgraph.view_layer.name] = float((passes["Diffuse"][..., 3] > 0.5).mean())
+        return passes, state, timings
+
+    render_engine.render_frame = recording
+    try:
+        with bpy.context.temp_override(scene=scene):
+            bpy.ops.render.render(scene=scene.name, write_still=False)
+    finally:
+        render_engine.render_frame = original
+    assert coverage["without_sphere"] == 0.0
+    assert coverage[scene.view_layers[0].name] > 0.2
