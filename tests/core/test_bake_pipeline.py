@@ -33,7 +33,7 @@ def test_adaptive_matches_dense_on_smooth_features(scene):
 
 
 def test_adaptive_misses_only_features_thinner_than_a_coarse_cell():
-    """A thin rod (0.6 degrees wide, a coarse cell is ~2.8) over a floor point: the adaptive grid
+    """A thin rod (about 2 degrees wide, a coarse cell is 4.5) near a floor point: the adaptive grid
     may miss it, and every mismatch is a missed occluded texel of the rod."""
     floor_v, floor_t = grid(3, 1.0)
     rod_v, rod_t = icosphere(2)
