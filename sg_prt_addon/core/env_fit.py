@@ -91,9 +91,12 @@ def _greedy_init(radiance, directions, omega, lobes):
     residual = radiance.copy()
     candidates = np.array([1.0, 3.0, 10.0, 30.0, 100.0])
     candidates = candidates[candidates <= max_sharpness_for(np.sqrt(directions.shape[0] / 2))]
+    available = np.ones(directions.shape[0], bool)
     params = []
     for _ in range(lobes):
-        luminance = residual.mean(axis=1)
+        # identical lobes would stay identical under the optimizer (symmetric gradients): each new
+        # lobe starts away from the previous ones
+        luminance = np.where(available, residual.mean(axis=1), -np.inf)
         axis = directions[np.argmax(luminance)]
         best = None
         for sharpness in candidates:
@@ -105,6 +108,9 @@ def _greedy_init(radiance, directions, omega, lobes):
                 best = (cost, sharpness, amplitude, g)
         _, sharpness, amplitude, g = best
         residual = residual - g[:, None] * amplitude
+        available &= directions @ axis < np.cos(max(0.3, 1.0 / np.sqrt(sharpness)))
+        if not np.any(available):
+            available[:] = True
         params.append(np.concatenate([axis, [np.log(sharpness)], amplitude]))
     return np.concatenate(params)
 

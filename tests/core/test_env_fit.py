@@ -38,8 +38,9 @@ def test_fits_an_sg_environment_nearly_exactly():
     fit = env_fit.fit_environment_sg(image, lobes=4, irradiance_weight=1.0)
     report = env_fit.evaluate_fit(fit, image, reference_height=64)
     assert fit.amplitude.shape == (4, 3) and np.all(fit.amplitude >= 0)
-    assert report.radiance_rms_error < 0.05  # 3 SGs + a constant, 4 lobes: the constant is a broad lobe
-    assert report.irradiance_max_error < 0.01
+    # 3 SGs + a constant, 4 lobes (the constant becomes a broad lobe): measured 0.0027 and 0.0012
+    assert report.radiance_rms_error < 0.01
+    assert report.irradiance_max_error < 0.003
 
 
 def test_sun_and_sky_irradiance_error_is_small_and_fast():
@@ -49,8 +50,8 @@ def test_sun_and_sky_irradiance_error_is_small_and_fast():
     elapsed = time.perf_counter() - start
     report = env_fit.evaluate_fit(fit, image)
     assert elapsed < 8.0
-    assert report.irradiance_max_error < 0.03  # measured 0.021
-    assert report.irradiance_rms_error < 0.03  # measured 0.020
+    assert report.irradiance_max_error < 0.025  # measured 0.018
+    assert report.irradiance_rms_error < 0.025  # measured 0.019
     # a lobe sits on the sun
     sun_axis = sg.normalize(np.array([0.5, 0.2, 0.6]))
     assert np.max(fit.axis @ sun_axis) > np.cos(np.radians(5.0))
