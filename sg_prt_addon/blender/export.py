@@ -272,6 +272,26 @@ def image_pixels(image):
     return out
 
 
+COLOUR_SLOTS = ("diffuse_color", "specular_color")
+
+
+def srgb_to_linear(values):
+    """The sRGB transfer function inverted (IEC 61966-2-1), elementwise."""
+    values = np.asarray(values, np.float32)
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def texture_pixels(image, slot):
+    """What the shader samples for `slot`: image_pixels, with the RGB of colour slots made
+    scene-linear when the image holds sRGB-encoded bytes (float images are linear already;
+    data slots such as roughness or the normal map are used as stored, like Non-Color)."""
+    pixels = image_pixels(image)
+    if slot in COLOUR_SLOTS and not image.is_float and image.colorspace_settings.name == "sRGB":
+        pixels = pixels.copy()
+        pixels[..., :3] = srgb_to_linear(pixels[..., :3])
+    return pixels
+
+
 # --------------------------------------------------------------------------- lights
 
 def export_light(object_eval):

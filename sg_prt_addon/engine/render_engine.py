@@ -118,7 +118,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         try:
             self.viewport_renderer.upload(self.viewport_state, self.viewport_state.consume_dirty(), camera)
             self.viewport_renderer.ensure_targets(width, height)
-            self.viewport_renderer.draw(self.viewport_state, camera)
+            self.viewport_renderer.draw(self.viewport_state, camera,
+                                        background_alpha=0.0 if depsgraph.scene.render.film_transparent else 1.0)
         except ShaderCompileError as error:
             if str(error) != self.viewport_error:
                 print(error)

@@ -33,6 +33,11 @@ def _texture_2d_array(layers):
                                 data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
 
 
+def _texture_key(image_name, slot):
+    from ..blender.export import COLOUR_SLOTS
+    return image_name, slot in COLOUR_SLOTS
+
+
 def _uniform_buffer(data):
     import gpu
     data = np.ascontiguousarray(data, np.float32)
@@ -131,7 +136,7 @@ class Renderer:
         self.mesh_buffers = {}          # mesh key -> MeshBuffers
         self.material_buffers = {}      # material name -> GPUUniformBuf
         self.material_ids = {}          # material name -> id written to the G-buffer (uv.z)
-        self.textures = {}              # image name -> GPUTexture
+        self.textures = {}              # (image name, slot is a colour) -> GPUTexture
         self.scene_buffer = None
         self.environment_texture = None
         self.equirect_texture = None
@@ -155,8 +160,8 @@ class Renderer:
         for key in list(self.mesh_buffers):
             if key not in state.meshes:
                 del self.mesh_buffers[key]
-        for image_name in dirty.images:
-            self.textures.pop(image_name, None)
+        for key in [key for key in self.textures if key[0] in dirty.images]:
+            del self.textures[key]
         for name, params in state.materials.items():      # materials whose image changed reload it
             if name not in dirty.materials and any(image in dirty.images for image in params.textures.values()):
                 dirty.materials.add(name)
@@ -167,10 +172,11 @@ class Renderer:
             material_id = self.material_ids.setdefault(name, len(self.material_ids))
             self.material_buffers[name] = _uniform_buffer(material_block(params, material_id))
             self.uploads["materials"] += 1
-            for image_name in params.textures.values():
-                if image_name not in self.textures and image_name in bpy.data.images:
+            for slot, image_name in params.textures.items():
+                key = _texture_key(image_name, slot)
+                if key not in self.textures and image_name in bpy.data.images:
                     from ..blender import export
-                    self.textures[image_name] = _texture_2d(export.image_pixels(bpy.data.images[image_name]))
+                    self.textures[key] = _texture_2d(export.texture_pixels(bpy.data.images[image_name], slot))
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             layers = state.environment.prefiltered.layers
             padded = np.ones(layers.shape[:3] + (4,), np.float32)
@@ -246,8 +252,8 @@ class Renderer:
                     if key.model in shader_variants.ANISOTROPIC_MODELS:
                         shader.uniform_sampler("anisotropy_table", self._anisotropy_texture(key.ndf_lobes))
                     for texture_name in key.textures:
-                        shader.uniform_sampler("texture_" + texture_name,
-                                               self.textures[params.textures[texture_name]])
+                        shader.uniform_sampler("texture_" + texture_name, self.textures[
+                            _texture_key(params.textures[texture_name], texture_name)])
                     batch.draw(shader)
             if not self.gbuffer:
                 self._draw_background(camera, has_environment, background_alpha)

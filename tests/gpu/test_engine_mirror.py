@@ -124,7 +124,7 @@ def test_anisotropic_models_textures_and_normal_map(engine):
         "mat_as": {"specular_color": colour, "nv": scalar},
     }
     # the engine uploads exactly what export.image_pixels reads
-    np.testing.assert_array_equal(export.image_pixels(images["colour"]), colour)
+    np.testing.assert_array_equal(export.texture_pixels(images["colour"], "diffuse_color"), colour)
     _check(result, textures)
 
 

@@ -204,3 +204,21 @@ def test_second_view_layer_renders_its_own_objects(engine, tmp_path):
         render_engine.render_frame = original
     assert coverage["without_sphere"] == 0.0
     assert coverage[scene.view_layers[0].name] > 0.2
+
+
+def test_srgb_byte_textures_are_linearised_for_colours_only(engine, tmp_path):
+    import bpy
+    from sg_prt_addon.blender import export
+
+    image = bpy.data.images.new("srgb_bytes", 4, 2, alpha=True)       # byte buffer, sRGB
+    values = np.linspace(0.0, 1.0, 32, dtype=np.float32)
+    image.pixels.foreach_set(values)
+    stored = export.image_pixels(image)
+    colour = export.texture_pixels(image, "diffuse_color")
+    data = export.texture_pixels(image, "roughness")
+    np.testing.assert_array_equal(data, stored)
+    expected = np.where(stored[..., :3] <= 0.04045, stored[..., :3] / 12.92,
+                        ((stored[..., :3] + 0.055) / 1.055) ** 2.4)
+    np.testing.assert_allclose(colour[..., :3], expected, rtol=1e-6, atol=1e-7)
+    np.testing.assert_array_equal(colour[..., 3], stored[..., 3])
+    assert np.abs(colour[..., :3] - stored[..., :3]).max() > 0.1
