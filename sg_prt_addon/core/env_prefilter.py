@@ -22,7 +22,9 @@ A fetch is, per layer, texcoord = oct(p) * texcoord_scale[k] + texcoord_offset[k
 (oct(p) in [-1, 1]^2), then a linear blend of two adjacent layers in
 log2(lambda); outside the level range the blend clamps to the end layer
 (sharper than the top level: the top layer approximates the radiance itself,
-which is what Gamma / integral G tends to).  ``lookup`` mirrors exactly that.
+which is what Gamma / integral G tends to); broader than the first level, the
+value moves linearly in lambda to the map's mean radiance (exact at lambda = 0).
+``lookup`` mirrors exactly that.
 """
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -48,6 +50,8 @@ class PrefilteredEnvironment:
     content_size: int (L,), texels used in each layer (gutter included).
     texcoord_scale, texcoord_offset: float32 (L,), oct coords -> texture coords.
     levels_per_octave: layers per doubling of sharpness.
+    mean_radiance: the lambda = 0 value; below the broadest level the lookup blends linearly in
+    lambda between it and the broadest layer (the normalized convolution is affine in lambda near 0).
     """
     layers: np.ndarray
     sharpness: np.ndarray
@@ -55,6 +59,7 @@ class PrefilteredEnvironment:
     texcoord_scale: np.ndarray
     texcoord_offset: np.ndarray
     levels_per_octave: float
+    mean_radiance: np.ndarray  # (C,) float32, the lambda -> 0 limit (solid-angle mean of the map)
 
     @property
     def size(self):
@@ -332,7 +337,11 @@ def prefilter_environment(equirect_image, levels=None, size=256, levels_per_octa
     interior = content - 2
     scale = (interior / (2.0 * size)).astype(np.float32)
     offset = ((1 + interior / 2.0) / size).astype(np.float32)
-    return PrefilteredEnvironment(layers, levels, content, scale, offset, float(levels_per_octave))
+    finest = pyramid[0]
+    row_omega = equirect.texel_solid_angles(finest.shape[0], finest.shape[1])[:, 0]
+    mean = (np.einsum("h,hwc->c", row_omega, finest.astype(np.float64)) / (row_omega.sum() * finest.shape[1]))
+    return PrefilteredEnvironment(layers, levels, content, scale, offset, float(levels_per_octave),
+                                  mean.astype(np.float32))
 
 
 # -- lookup (numpy mirror of the GLSL) -------------------------------------------------
@@ -379,7 +388,7 @@ def lookup(prefiltered, axis, sharpness):
         float k1 = min(k0 + 1.0, last);
         vec3 a = texture(layers, vec3(oct * u_level[int(k0)].x + u_level[int(k0)].y, k0)).rgb;
         vec3 b = texture(layers, vec3(oct * u_level[int(k1)].x + u_level[int(k1)].y, k1)).rgb;
-        return mix(a, b, t - k0);
+        return mix(mean_radiance, mix(a, b, t - k0), clamp(lambda / lambda_min, 0.0, 1.0));
     """
     axis = np.asarray(axis, dtype=np.float32)
     coords = oct_encode(sg.normalize(axis)).astype(np.float32)
@@ -393,7 +402,13 @@ def lookup(prefiltered, axis, sharpness):
         s = coords[..., 0] * prefiltered.texcoord_scale[index] + prefiltered.texcoord_offset[index]
         t = coords[..., 1] * prefiltered.texcoord_scale[index] + prefiltered.texcoord_offset[index]
         values.append(_bilinear_clamp(prefiltered.layers, index, s, t))
-    return values[0] + (values[1] - values[0]) * fraction
+    result = values[0] + (values[1] - values[0]) * fraction
+    # below the broadest level: affine in lambda towards the mean radiance at lambda = 0
+    below = np.clip(np.nan_to_num(np.asarray(sharpness, dtype=np.float32), nan=0.0)
+                    / np.float32(prefiltered.sharpness[0]), 0, 1)
+    below = np.broadcast_to(below, coords.shape[:-1])[..., None]
+    mean = np.asarray(prefiltered.mean_radiance, dtype=np.float32)
+    return mean + (result - mean) * below
 
 
 def lookup_integral(prefiltered, axis, sharpness, amplitude=1.0):
