@@ -125,6 +125,8 @@ def fit_environment_sg(equirect_image, lobes=8, fit_height=32, irradiance_weight
     ``irradiance_weight`` times irradiance residuals at ``normal_count``
     normals (scaled so both terms are comparable).  Returns an EnvironmentSGFit.
     """
+    if lobes < 1:
+        raise ValueError("at least one lobe")
     image = np.nan_to_num(np.asarray(equirect_image, dtype=np.float32), nan=0.0, posinf=0.0, neginf=0.0)
     small = _downsampled(image, fit_height)
     height, width, channels = small.shape

@@ -3,7 +3,6 @@ against exact quadrature of synthetic maps (SG lobes, a sharp sun disc, a sky gr
 import time
 
 import numpy as np
-import pytest
 
 from sg_prt_addon.core import env_fit, equirect, sg
 
