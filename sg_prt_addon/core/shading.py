@@ -27,6 +27,9 @@ import numpy as np
 from . import brdf, env_prefilter, lights, sg, warp
 
 FLOAT = np.float32
+# GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
+# GGX's projected area at roughness 0.3-0.5 (its long tail), two lobes 0.93-0.97.
+GGX_NDF_LOBES = 2
 # Local frame fallback when a tangent is parallel to the normal.
 _FALLBACK_TANGENT = np.array([1.0, 0.0, 0.0], FLOAT)
 
@@ -124,6 +127,8 @@ def ndf_lobes(model, params, lobe_count=1):
     instance = brdf.model_from_name(model, **params)
     if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY"):
         return instance.ndf_lobes(lobe_count)
+    if model == "GGX":
+        return instance.ndf_lobes(GGX_NDF_LOBES)
     return instance.ndf_lobes()
 
 

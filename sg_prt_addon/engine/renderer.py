@@ -142,6 +142,7 @@ class Renderer:
         self.equirect_texture = None
         self.environment_source = None
         self.anisotropy_tables = {}     # lobe count -> GPUTexture
+        self.ggx_texture = None
         self.framebuffer = None
         self.targets = []
         self.size = None
@@ -251,6 +252,10 @@ class Renderer:
                         shader.uniform_sampler("environment_texture", self.environment_texture)
                     if key.model in shader_variants.ANISOTROPIC_MODELS:
                         shader.uniform_sampler("anisotropy_table", self._anisotropy_texture(key.ndf_lobes))
+                    if shader_variants.uses_ggx_table(key):
+                        if self.ggx_texture is None:
+                            self.ggx_texture = _texture_2d(shader_variants.ggx_table())
+                        shader.uniform_sampler("ggx_table", self.ggx_texture)
                     for texture_name in key.textures:
                         shader.uniform_sampler("texture_" + texture_name, self.textures[
                             _texture_key(params.textures[texture_name], texture_name)])

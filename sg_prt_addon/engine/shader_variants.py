@@ -45,7 +45,7 @@ GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
 # Library files in dependency order; env_prefilter only with an environment texture.
 LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
 # Our own pieces (shaders/resources/), after the library.
-RESOURCE_FILES = ("anisotropic_lobes.glsl", "sg_shading.glsl")
+RESOURCE_FILES = ("anisotropic_lobes.glsl", "ggx_two_lobes.glsl", "sg_shading.glsl")
 
 
 def output_names(gbuffer):
@@ -79,8 +79,12 @@ class VariantKey:
 
 def variant_key(material_params, has_lights, has_environment, gbuffer=False):
     """VariantKey of an export.MaterialParams in a scene."""
+    from ..core.shading import GGX_NDF_LOBES
+
     model = material_params.model
     lobes = int(material_params.lobe_count) if model in ANISOTROPIC_MODELS else 1
+    if model == "GGX":
+        lobes = GGX_NDF_LOBES
     textures = tuple(sorted(name for name in material_params.textures if name in TEXTURE_SLOTS))
     return VariantKey(model, lobes, bool(has_lights), bool(has_environment), textures, bool(gbuffer))
 
@@ -147,6 +151,8 @@ def fragment_source(key):
         parts.append(library_source(file_name))
     for file_name in RESOURCE_FILES:
         if file_name == "anisotropic_lobes.glsl" and key.model not in ANISOTROPIC_MODELS:
+            continue
+        if file_name == "ggx_two_lobes.glsl" and not uses_ggx_table(key):
             continue
         parts.append(_read(os.path.join(RESOURCE_DIR, file_name)))
     parts.append(_read(os.path.join(SHADER_DIR, "surface.frag.glsl")))
@@ -264,6 +270,9 @@ def create_info(key):
     if key.model in ANISOTROPIC_MODELS:
         info.sampler(slot, "FLOAT_2D", "anisotropy_table")
         slot += 1
+    if uses_ggx_table(key):
+        info.sampler(slot, "FLOAT_2D", "ggx_table")
+        slot += 1
     for name in key.textures:
         info.sampler(slot, "FLOAT_2D", "texture_" + name)
         slot += 1
@@ -291,6 +300,21 @@ def get_shader(key):
 
 def clear_cache():
     _cache.clear()
+
+
+def uses_ggx_table(key):
+    return key.model == "GGX" and key.ndf_lobes == 2
+
+
+def ggx_table():
+    """ndf_fit's two-lobe GGX table as an (A, 2, 4) float32 texture: texel (k, row) =
+    (log alpha, sharpness * alpha^2, amplitude / D(n), 0)."""
+    from ..core import ndf_fit
+    alphas, table = ndf_fit.ggx_two_lobe_table()
+    out = np.zeros((len(alphas), 2, 4), np.float32)
+    out[..., 0] = np.log(alphas)[:, None]
+    out[..., 1:3] = table
+    return out
 
 
 def anisotropy_table(lobe_count):

@@ -37,8 +37,10 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
 {
   axis = vec3(0.0, 0.0, 1.0);
   vec2 lobe = vec2(0.0, 0.0);
-#if defined(MODEL_GGX)
+#if defined(MODEL_GGX) && NDF_LOBES == 1
   lobe = ggx_ndf_lobe(p.x);
+#elif defined(MODEL_GGX)
+  ggx_two_lobes(ggx_table, p.x, k, lobe.x, lobe.y);
 #elif defined(MODEL_COOK_TORRANCE)
   lobe = cook_torrance_ndf_lobe(p.x);
 #elif defined(MODEL_BLINN_PHONG)
