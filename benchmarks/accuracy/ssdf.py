@@ -98,6 +98,30 @@ def measure():
     samples = bake_ssdf(vertices, normals, tracer, BakeOptions())
     tracer.close()
     model = pca.fit(samples, terms=48)
+    # end to end at those vertices: mu fh(V_d(p)) from the PCA-decoded SSDF vs the SG integrated over
+    # the dense ray-traced visibility (equal-area texels, 2 pi / 160^2 each)
+    fine_local = hemisphere_map.texel_directions(160).reshape(-1, 3)
+    axes = rng.normal(size=(32, 3))
+    axes[:, 2] = np.abs(axes[:, 2]) + 0.2
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    for terms in (16, 32, None):
+        truncated = model if terms is None else pca.PcaModel(
+            model.mean, model.basis[:terms], model.eigenvalues, model.rms_error_by_terms, model.total_variance)
+        coefficients = pca.project(truncated, samples[pick])
+        resolution = 32
+        basis = truncated.basis.reshape(-1, resolution, resolution)
+        mean = truncated.mean.reshape(resolution, resolution)
+        for sharpness in (10.0, 100.0):
+            errors = []
+            for index in range(len(pick)):
+                theta_d = decode.decode(coefficients[index], basis, mean, axes)
+                approx = hemisphere.fh(theta_d, sharpness)
+                lit = dense[index].ravel()
+                exact = np.array([sg.evaluate(fine_local[lit], a, sharpness).sum() for a in axes]) * 2 * np.pi / 160 ** 2
+                errors.append(np.abs(approx - exact) / sg.axis_hemisphere_integral(sharpness))
+            rows.append(_row(f"bake end to end: mu fh(V_d(p)), lambda {sharpness:g}, PCA {truncated.terms} terms",
+                             np.concatenate(errors), "SG over dense 160^2 ray-traced visibility",
+                             "abs error / fh(pi/2)", note=f"{len(pick)} vertices of sphere over floor, 32 lobe axes each"))
     data = samples.astype(np.float64)
     for terms in (8, 16, 32, 48):
         truncated = pca.PcaModel(model.mean, model.basis[:terms], model.eigenvalues, model.rms_error_by_terms,
