@@ -13,11 +13,12 @@ which may return True to cancel; a cancelled step returns None):
    domain (Ngan 2005 / Wang 2008 style): with S fixed, (kd, D) is a linear problem
    (D piecewise linear on a theta_h grid); with kd, D fixed, S is linear once the
    other direction's factor takes the previous S (both roles of every pair are used,
-   so the update is symmetric).  Weights: the caller's quadrature weight times
+   so the update is symmetric), then a few damped Gauss-Newton steps on S polish the
+   linear-domain objective.  Weights: the caller's quadrature weight times
    ((i.n)^2 + (o.n)^2)/2 (the cosine-weighted BRDF is what renders and what
    relative_rmse measures), masked by validity.  Small
    second-difference penalties keep D and S smooth where samples are scarce.  Scale:
-   max S = 1, D normalized (integral of D cos = 1), ks takes the rest; kd and ks per
+   S = 1 on average below 60 degrees, D normalized (integral of D cos = 1), ks takes the rest; kd and ks per
    channel by a final 2-parameter least squares.  eta: a fixed value (the paper uses
    1.33) or candidates from which each texel keeps the best.
 2. ``compress_shadowing``: PCA of S across texels (the paper: 90D to 8D).
@@ -40,6 +41,7 @@ from .svbrdf_table import (SvbrdfTable, default_ndf_theta, default_shadowing_the
 HALF_PI = 0.5 * np.pi
 PAPER_ETA = 1.33
 DEFAULT_ETA_CANDIDATES = (1.2, 1.33, 1.5, 1.7, 2.0)
+POLISH_SMOOTHNESS_RATIO = 0.1  # linear-domain S penalty relative to the log-domain one
 
 
 # ----------------------------------------------------------------------------- sample sets
@@ -147,7 +149,7 @@ def _solve_banded_normal(diagonal, upper, penalty, rhs, extra=None):
 @dataclass
 class MicrofacetFactorization:
     """Per texel (B,): diffuse kd (B, 3), specular ks (B, 3), eta (B,), NDF (B, T) on ndf_theta
-    (integral of D cos = 1), shadowing (B, S) on shadowing_theta (max 1), and the relative
+    (integral of D cos = 1), shadowing (B, S) on shadowing_theta (mean 1 below 60 degrees), and the relative
     weighted RMS residual of the grey fit (B,)."""
     diffuse: np.ndarray
     specular: np.ndarray
@@ -184,6 +186,7 @@ class _Pairs:
         # the error metric weights (rho (i.n))^2; symmetrized over the two roles of a pair
         self.weights = weights * 0.5 * (self.cos_o ** 2 + self.cos_i ** 2)
         self.ndf_count, self.shadowing_count = len(ndf_theta), len(shadowing_theta)
+        self.shadowing_theta = shadowing_theta
         self.transposed = {name: getattr(self, name).T.tocsr() for name in ("h_linear", "h_square", "h_cross")}
         # log(rho_s / geometry) = log D(h) + log S(o) + log S(i): one row of 6 hat weights per pair
         # over the unknowns (log D nodes, log S nodes); products of the 6 give the normal matrix
@@ -295,8 +298,11 @@ def _shadowing_gauss_newton(pairs, grey, weights, geometry, diffuse, ndf, shadow
               + _right(pairs.outer_ii_t, we2 * s_o * s_o).reshape(-1, size, size)
               + cross + np.swapaxes(cross, 1, 2))
     rhs = _right(pairs.o_linear_t, weights * residual * e * s_i) + _right(pairs.i_linear_t, weights * residual * e * s_o)
-    scale = np.maximum(np.einsum("bii->b", matrix) / size, 1e-300)
-    regularization = scale[:, None, None] * penalty
+    diagonal = np.einsum("bii->bi", matrix)
+    scale = np.maximum(diagonal.mean(axis=1), 1e-300)
+    # relative to the largest diagonal entry: grazing nodes carry most of the weight, and data
+    # outside the model class (retro-reflection, non-Lambert diffuse) make them oscillate
+    regularization = np.maximum(diagonal.max(axis=1), 1e-300)[:, None, None] * penalty
     matrix += regularization
     index = np.arange(size)
     matrix[:, index, index] += damping * scale[:, None]
@@ -308,9 +314,16 @@ def _shadowing_gauss_newton(pairs, grey, weights, geometry, diffuse, ndf, shadow
     return np.where((after < before)[:, None], candidate, shadowing)
 
 
+def _normalize_shadowing(shadowing, shadowing_theta):
+    """S scaled to mean 1 over theta < 60 degrees (unshadowed there for any plausible roughness);
+    the max is a poor gauge: one noisy grazing node would rescale everything."""
+    near_normal = shadowing_theta < np.radians(60)
+    return shadowing / np.maximum(shadowing[:, near_normal].mean(axis=1), 1e-12)[:, None]
+
+
 def _factorize_chunk(pairs, grey, weights, eta, iterations, smoothness, shadowing_smoothness, polish_iterations):
     """Factorize grey (B, N) with per-pair weights (B, N): alternate the linear (kd, D) step and
-    the joint log-domain (D, S) step.  Returns D (B, T), S (B, S) (max 1), the specular
+    the joint log-domain (D, S) step, then polish S.  Returns D (B, T), S (B, S), the specular
     shape geometry S S D at the pairs (B, N) and the relative residual (B,)."""
     geometry = pairs.geometry(eta)
     ndf_penalty = smoothness * _second_difference_penalty(pairs.ndf_count)
@@ -322,16 +335,14 @@ def _factorize_chunk(pairs, grey, weights, eta, iterations, smoothness, shadowin
     diffuse, ndf, q = _linear_step(pairs, grey, weights, geometry, shadowing, ndf_penalty)
     for _ in range(iterations):
         _, log_shadowing = _log_step(pairs, grey, weights, geometry, diffuse, log_penalty)
-        log_shadowing -= log_shadowing.max(axis=1, keepdims=True)  # max S = 1
-        shadowing = np.exp(log_shadowing)
+        shadowing = _normalize_shadowing(np.exp(log_shadowing), pairs.shadowing_theta)
         diffuse, ndf, q = _linear_step(pairs, grey, weights, geometry, shadowing, ndf_penalty)
     # the log-domain optimum is not the linear one where the data leave the model class:
     # polish S by Gauss-Newton on the linear objective
-    linear_penalty = shadowing_smoothness * 1e-2 * _second_difference_penalty(pairs.shadowing_count)
+    linear_penalty = shadowing_smoothness * POLISH_SMOOTHNESS_RATIO * _second_difference_penalty(pairs.shadowing_count)
     for _ in range(polish_iterations):
         shadowing = _shadowing_gauss_newton(pairs, grey, weights, geometry, diffuse, ndf, shadowing, linear_penalty)
-        peak = np.maximum(shadowing.max(axis=1), 1e-12)[:, None]
-        shadowing = shadowing / peak
+        shadowing = _normalize_shadowing(shadowing, pairs.shadowing_theta)
         diffuse, ndf, q = _linear_step(pairs, grey, weights, geometry, shadowing, ndf_penalty)
     shape = q * _at_pairs(pairs.h_linear, ndf)
     residual = np.sqrt(np.sum(weights * (diffuse[:, None] + shape - grey) ** 2, axis=1)
@@ -347,7 +358,7 @@ def _ndf_normalization(ndf, ndf_theta):
 
 
 def factorize(wo, wi, rho, weights=None, valid=None, eta=PAPER_ETA, ndf_theta=None, shadowing_theta=None,
-              iterations=6, polish_iterations=6, smoothness=1e-4, shadowing_smoothness=0.1, chunk=256, progress=None):
+              iterations=3, polish_iterations=4, smoothness=1e-4, shadowing_smoothness=0.1, chunk=256, progress=None):
     """Recover (kd, ks, eta, D, S) per texel from samples (see module doc).
 
     wo, wi (N, 3) shared direction pairs above the horizon; rho (B, N, 3) (or (N, 3));
@@ -422,8 +433,9 @@ def compress_shadowing(shadowing, components=8):
 
 
 def decompress_shadowing(mean, basis, coefficients):
-    """S (B, S) from its PCA form, clipped to [0, 1]."""
-    return np.clip(mean + np.asarray(coefficients) @ basis, 0, 1)
+    """S (B, S) from its PCA form, clipped at 0 (S may exceed 1: it is normalized to mean 1
+    below 60 degrees and can absorb effects the separable model lacks, e.g. correlated masking)."""
+    return np.maximum(mean + np.asarray(coefficients) @ basis, 0)
 
 
 # ----------------------------------------------------------------------------- SG fits of D
@@ -445,8 +457,8 @@ def _interpolate_rows(values, grid, theta):
     return (1 - t) * values[:, low] + t * values[:, low + 1]
 
 
-def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_count=32, progress=None,
-                  chunk=1024):
+def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_count=24, progress=None,
+                  chunk=1024, max_iterations=150):
     """SG mixtures of tabulated NDFs ndf (B, T) (isotropic) or (B, T, P) on (ndf_theta, ndf_phi).
 
     free_axes False (default for isotropic tables and K <= 2): K lobes around z+ by batched
@@ -479,8 +491,8 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
                 values[part], theta, weights, lobe_count)
         axis[..., 2] = 1
     else:
-        # a coarser theta quadrature: every other Gauss node, weights doubled
-        directions_theta, directions_weight = theta[::2], weights[::2] * 2 / phi_count
+        # a coarser theta quadrature for the per-texel optimizer: every fourth node, weights x4
+        directions_theta, directions_weight = theta[::4], weights[::4] * 4 / phi_count
         phi = (np.arange(phi_count) + 0.5) * (2 * np.pi / phi_count)
         t, p = np.meshgrid(directions_theta, phi, indexing="ij")
         directions = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1).reshape(-1, 3)
@@ -500,7 +512,7 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
             values = interpolate_ndf(table[texel:texel + 1], ndf_theta, ndf_phi, directions)[0]
             initial = None if starts is None else _tilted_start(starts[0][texel], starts[1][texel], lobe_count)
             axis[texel], sharpness[texel], amplitude[texel], error[texel] = ndf_fit.fit_anisotropic(
-                values, directions, solid_angle, lobe_count, initial=initial, method="TNC")
+                values, directions, solid_angle, lobe_count, initial=initial, max_iterations=max_iterations, method="TNC")
     if progress is not None and progress(1.0):
         return None
     return axis, sharpness, amplitude, error
@@ -597,9 +609,12 @@ def fit_lobes(factorization, lobe_count, shadowing_components=8, free_axes=None,
 
 # ----------------------------------------------------------------------------- 4D error
 
-def relative_rmse(reference, fitted, samples=None, texel_chunk=16):
+def relative_rmse(reference, fitted, samples=None, texel_chunk=16, cosines="i"):
     """Relative RMSE of the cosine-weighted BRDF rho(o, i) (i.n) over both hemispheres, per
     texel: sqrt(int |f - r|^2 (i.n)^2 / int |r|^2 (i.n)^2), summed over RGB.
+    cosines="io" weights by (i.n)(o.n) instead: the (i.n) form is dominated by near-grazing
+    specular pairs for glossy materials (rho (i.n) stays large as (o.n) -> 0), where
+    tabulated data are least reliable; the symmetric form measures the bulk.
 
     reference, fitted: callables (wo (N, 3), wi (N, 3), texels (b,)) -> (b, N, 3), called on
     texel chunks; samples (wo, wi, weights) default to an offset half/difference grid
@@ -609,7 +624,7 @@ def relative_rmse(reference, fitted, samples=None, texel_chunk=16):
     if samples is None:
         samples = half_difference_samples(64, 32, 32, 2, offset=0.3)
     wo, wi, weights = samples
-    weight = weights * wi[:, 2] ** 2
+    weight = weights * (wi[:, 2] ** 2 if cosines == "i" else (wi[:, 2] * wo[:, 2]) ** 2)
     count = getattr(reference, "texel_count", 1)
     errors = np.empty(count)
     for start in range(0, count, texel_chunk):

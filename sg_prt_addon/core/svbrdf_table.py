@@ -23,7 +23,8 @@ File: a NumPy ``.npz`` (no pickles) with
 D is interpolated linearly in theta (0 beyond the last node) and periodically in
 phi; S linearly, clamped below its first node, and falling linearly to 0 at pi/2
 beyond its last node (if that is short of pi/2), as microfacet shadowing does.  The scale between S and D is fixed by
-max S = 1 (what microfacet_fit writes); readers do not depend on it.
+S = 1 on average below 60 degrees
+(what microfacet_fit writes; S may exceed 1 near grazing); readers do not depend on it.
 """
 import zipfile
 from dataclasses import dataclass
