@@ -147,9 +147,7 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     start = time.perf_counter()
     scene = depsgraph.scene
     if state is None:
-        state = scene_state.SceneState()
-        if debug.get("environment_layer_size"):
-            scene_state.ENVIRONMENT_LAYER_SIZE = debug["environment_layer_size"]
+        state = scene_state.SceneState(environment_layer_size=debug.get("environment_layer_size"))
         state.sync(depsgraph)
     camera_object = scene.camera.evaluated_get(depsgraph)
     camera = export.export_camera(camera_object, depsgraph, width, height,

@@ -42,7 +42,8 @@ class Dirty:
 
 
 class SceneState:
-    def __init__(self):
+    def __init__(self, environment_layer_size=None):
+        self.environment_layer_size = environment_layer_size or ENVIRONMENT_LAYER_SIZE
         self.objects = {}           # object name -> ObjectEntry
         self.meshes = {}            # mesh key -> export.MeshExport
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
@@ -78,7 +79,7 @@ class SceneState:
             self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(instance.matrix_world),
                                              self._read_materials(obj))
         self.world = export.export_world(depsgraph.scene.world)
-        self.environment = environment_data(self.world)
+        self.environment = environment_data(self.world, self.environment_layer_size)
         self.dirty = Dirty(meshes=set(self.meshes), materials=set(self.materials), lights=True, world=True,
                            objects=True)
 
@@ -115,11 +116,11 @@ class SceneState:
                 dirty.images.add(datablock.name)
                 if self.world.image_name == datablock.name and depsgraph.scene.world is not None:
                     self.world = export.export_world(depsgraph.scene.world)
-                    self.environment = environment_data(self.world)
+                    self.environment = environment_data(self.world, self.environment_layer_size)
                     dirty.world = True
             elif isinstance(datablock, bpy.types.World):
                 self.world = export.export_world(datablock)
-                self.environment = environment_data(self.world)
+                self.environment = environment_data(self.world, self.environment_layer_size)
                 dirty.world = True
             elif isinstance(datablock, (bpy.types.Scene, bpy.types.Collection)):
                 membership_changed = True       # objects may have been added, removed or hidden
