@@ -6,6 +6,7 @@ whatever the caller stored before intact.
 """
 import hashlib
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
@@ -79,11 +80,23 @@ def bake_ssdf(vertices, normals, tracer, options, progress=None, tangents=None):
     count = len(vertices)
     resolution = options.resolution
     out = np.empty((count, resolution * resolution), np.float16)
-    for start in range(0, count, options.batch_vertices):
-        part = slice(start, min(start + options.batch_vertices, count))
-        fine, _ = visibility.adaptive_visibility(tracer, origins[part], frames[part], resolution, options.refinement)
+
+    def distances(part, fine):
         out[part] = ssdf.ssdf_from_fine(fine, resolution).reshape(fine.shape[0], -1)
-        _report(progress, 0.9 * part.stop / max(count, 1), f"visibility {part.stop}/{count} vertices")
+
+    # Pipelined: the SSDF of one batch (BLAS, GIL released) overlaps the rays of the next.
+    with ThreadPoolExecutor(1) as pool:
+        pending = None
+        for start in range(0, count, options.batch_vertices):
+            part = slice(start, min(start + options.batch_vertices, count))
+            fine, _ = visibility.adaptive_visibility(tracer, origins[part], frames[part], resolution,
+                                                     options.refinement)
+            if pending is not None:
+                pending.result()
+            pending = pool.submit(distances, part, fine)
+            _report(progress, 0.9 * part.stop / max(count, 1), f"visibility {part.stop}/{count} vertices")
+        if pending is not None:
+            pending.result()
     return out
 
 
