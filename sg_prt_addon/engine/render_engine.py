@@ -54,7 +54,9 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             passes, state, timings = render_frame(depsgraph, width, height, gbuffer=debug["capture_gbuffer"])
         except ShaderCompileError as error:
             print(error)
-            self.report({"ERROR"}, str(error).split("\n", 1)[0])
+            # the UI gets the variant and the first located error; the console has every line quoted
+            lines = str(error).split("\n")
+            self.report({"ERROR"}, ": ".join(lines[:2]) if len(lines) > 1 else lines[0])
             last_render.clear()
             last_render["error"] = str(error)
             return

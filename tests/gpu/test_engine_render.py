@@ -58,9 +58,10 @@ def test_compile_error_names_variant_and_line(engine, monkeypatch):
     shader_variants.clear_cache()
     scene = fx.new_scene("render_broken", 16, 16)
     fx.uv_sphere(scene, "broken_sphere", (0.0, 0.0, 1.0), segments=8, rings=4)
-    with pytest.raises(RuntimeError, match=r"SG-PRT shader variant \[GGX, \d lobe\(s\), no lights"):
+    with pytest.raises(RuntimeError, match=r"SG-PRT shader variant \[GGX, \d lobe\(s\), no lights") as raised:
         with bpy.context.temp_override(scene=scene):
             bpy.ops.render.render(scene=scene.name, write_still=False)
+    assert "frame_that_does_not_exist' undeclared" in str(raised.value)      # what the UI reports
     message = render_engine.last_render["error"]
     from sg_prt_addon.core.shading import GGX_NDF_LOBES
     lines = broken(shader_variants.VariantKey(ndf_lobes=GGX_NDF_LOBES)).split("\n")
