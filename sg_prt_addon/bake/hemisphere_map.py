@@ -141,17 +141,29 @@ def local_frame(normals, tangents=None):
     """(..., 3, 3) rotations world -> local: rows (tangent, bitangent, normal).
 
     Without tangents, the tangent is FRAME_REFERENCE_AXIS projected on the tangent
-    plane (FRAME_FALLBACK_AXIS when the normal is within ~0.6 degrees of it).
+    plane (FRAME_FALLBACK_AXIS when the normal is within ~0.6 degrees of it).  Zero or
+    non-finite normals become +z; tangents parallel to their normal fall back to the default.
     local = frame @ world; world = local @ frame.
     """
     n = np.asarray(normals, np.float64)
-    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    length = np.linalg.norm(n, axis=-1, keepdims=True)
+    # zero or non-finite normals (degenerate vertices) get +z rather than NaN rays
+    usable = np.isfinite(length) & (length > 1e-30)
+    n = np.where(usable, n / np.where(usable, length, 1.0), np.array([0.0, 0.0, 1.0]))
     if tangents is None:
         parallel = np.abs(np.sum(n * FRAME_REFERENCE_AXIS, axis=-1, keepdims=True)) > 0.99995
         reference = np.where(parallel, FRAME_FALLBACK_AXIS, FRAME_REFERENCE_AXIS)
     else:
         reference = np.asarray(tangents, np.float64)
     t = reference - np.sum(reference * n, axis=-1, keepdims=True) * n
-    t = t / np.linalg.norm(t, axis=-1, keepdims=True)
+    t_length = np.linalg.norm(t, axis=-1, keepdims=True)
+    if tangents is not None:
+        # a given tangent parallel to the normal (or zero): fall back to the default frame's tangent
+        bad = ~(t_length > 1e-9)
+        if np.any(bad):
+            default = local_frame(n)[..., 0, :]
+            t = np.where(bad, default, t)
+            t_length = np.where(bad, 1.0, t_length)
+    t = t / t_length
     b = np.cross(n, t)
     return np.stack([t, b, n], axis=-2)

@@ -88,3 +88,12 @@ def test_local_frame_orthonormal_and_smooth():
     nudged = n + 1e-3 * rng.normal(size=n.shape)
     change = np.abs(hm.local_frame(nudged) - frame).max(axis=(1, 2))
     assert change[far].max() < 0.02
+
+
+def test_local_frame_degenerate_inputs():
+    frame = hm.local_frame(np.array([[0.0, 0.0, 0.0], [np.nan, 0.0, 1.0], [0.0, 0.0, 2.0]]),
+                           np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]))
+    assert np.all(np.isfinite(frame))
+    assert np.allclose(frame[:, 2], [0, 0, 1])
+    assert np.allclose(frame[0, 0], [1, 0, 0])
+    assert np.allclose(frame[2], hm.local_frame(np.array([[0.0, 0.0, 1.0]]))[0])   # parallel tangent

@@ -98,3 +98,12 @@ def test_bad_options_are_refused(scene):
         bake_visibility(vertices, triangles, normals, vertices, triangles, BakeOptions(refinement=4))
     with pytest.raises(ValueError):
         bake_visibility(vertices, triangles, normals[:5], vertices, triangles)
+
+
+def test_no_occluders_gives_the_open_plane():
+    points = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]])
+    normals = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
+    result = bake_visibility(points, np.zeros((0, 3), int), normals, np.zeros((0, 3)), np.zeros((0, 3), int),
+                             BakeOptions(resolution=8, refinement=3, terms=2))
+    elevation = np.arcsin(hemisphere_map.sample_directions(8)[..., 2])
+    assert np.abs(result.ssdf() - elevation).max() < 1e-3
