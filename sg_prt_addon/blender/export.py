@@ -365,6 +365,18 @@ class CameraExport:
     is_perspective: bool = True
 
 
+def camera_from_view(view_matrix, projection_matrix, is_perspective):
+    """CameraExport from a view (world -> camera) and projection matrix, e.g. a 3D viewport's
+    region_data.view_matrix / window_matrix."""
+    view = matrix_to_numpy(view_matrix)
+    camera_to_world = np.linalg.inv(view)
+    forward = -camera_to_world[:3, 2]
+    return CameraExport(view=view, projection=matrix_to_numpy(projection_matrix),
+                        position=tuple(camera_to_world[:3, 3]),
+                        forward=tuple(forward / max(np.linalg.norm(forward), 1e-30)),
+                        is_perspective=bool(is_perspective))
+
+
 def export_camera(camera_object, depsgraph, width, height, scale_x=1.0, scale_y=1.0):
     """Render camera of the scene: view = matrix_world^-1, projection from calc_matrix_camera."""
     matrix_world = camera_object.matrix_world

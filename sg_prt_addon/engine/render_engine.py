@@ -111,12 +111,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         if self.viewport_renderer is None:
             self.viewport_renderer = renderer_module.Renderer()
         region_3d = context.region_data
-        camera = export.CameraExport(
-            view=export.matrix_to_numpy(region_3d.view_matrix),
-            projection=export.matrix_to_numpy(region_3d.window_matrix),
-            position=tuple(region_3d.view_matrix.inverted().translation),
-            forward=tuple(-np.asarray(region_3d.view_matrix.inverted().col[2][:3])),
-            is_perspective=region_3d.is_perspective)
+        camera = export.camera_from_view(region_3d.view_matrix, region_3d.window_matrix,
+                                         region_3d.is_perspective)
         try:
             self.viewport_renderer.upload(self.viewport_state, self.viewport_state.consume_dirty(), camera)
             self.viewport_renderer.ensure_targets(width, height)

@@ -140,3 +140,24 @@ def test_lights_beyond_the_shader_limit_drop_the_dimmest():
     state.lights = lights
     assert state.dropped_lights(shader_variants.MAX_POINT_LIGHTS, shader_variants.MAX_SUNS) == \
         ["point0", "point1", "point2"]
+
+
+def test_viewport_camera_from_view_matrices_matches_render_camera(tracked_scene):
+    """view_draw builds its camera from region_data's matrices with export.camera_from_view:
+    fed the scene camera's own matrices it must equal the final render's camera."""
+    from sg_prt_addon.blender import export
+
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    camera = bpy.data.objects.new("updates_camera", bpy.data.cameras.new("updates_camera"))
+    scene.collection.objects.link(camera)
+    camera.location = (1.0, -4.0, 2.0)
+    camera.rotation_euler = (1.2, 0.1, 0.3)
+    view_layer.update()
+    depsgraph = view_layer.depsgraph
+    rendered = export.export_camera(camera, depsgraph, 64, 48)
+    projection = camera.calc_matrix_camera(depsgraph, x=64, y=48)
+    viewport = export.camera_from_view(camera.matrix_world.inverted(), projection, True)
+    np.testing.assert_allclose(viewport.view, rendered.view, atol=1e-6)
+    np.testing.assert_allclose(viewport.projection, rendered.projection, atol=1e-6)
+    np.testing.assert_allclose(viewport.position, (1.0, -4.0, 2.0), atol=1e-5)
+    np.testing.assert_allclose(viewport.forward, rendered.forward, atol=1e-6)
