@@ -130,3 +130,20 @@ def test_fast_nearest_boundary_matches_brute_force():
     fast = ssdf.ssdf_from_fine(visible, resolution).reshape(len(visible), -1)
     exact = ssdf.signed_distance_brute_force(visible, fine, query_visible, query)
     assert np.abs(fast - exact).max() < 5e-6
+
+
+def test_bilinear_lookup_between_samples():
+    """What shading sees: the stored 32 x 32 image looked up bilinearly at random directions,
+    against the closed form.  The max sits on the ridge where the plane and the horizon are
+    equidistant (bilinear interpolation of a kink): measured max 0.058, mean 0.0065 rad."""
+    tilt = np.radians(55.0)
+    m = np.array([np.sin(tilt), 0.3 * np.cos(tilt), np.cos(tilt)])
+    m /= np.linalg.norm(m)
+    vertices, triangles = quad(1.0 * m, m, 400.0)
+    _, _, image, frame = _bake_one(vertices, triangles)
+    rng = np.random.default_rng(10)
+    local = rng.normal(size=(20000, 3))
+    local[:, 2] = np.abs(local[:, 2])
+    local /= np.linalg.norm(local, axis=1, keepdims=True)
+    error = np.abs(decode.decode_image(image, local) - tilted_plane_ssdf(local @ frame, m))
+    assert error.max() < 0.07 and error.mean() < 0.008, (error.max(), error.mean())
