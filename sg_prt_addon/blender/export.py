@@ -150,7 +150,8 @@ def export_mesh_data(mesh):
     material_index = np.empty(triangle_count, np.int64)
     mesh.loop_triangles.foreach_get("material_index", material_index)
 
-    uv_layer = mesh.uv_layers.active
+    # the UV map renders use (camera icon in the UI), else the active one
+    uv_layer = next((layer for layer in mesh.uv_layers if layer.active_render), mesh.uv_layers.active)
     uvs = np.zeros((loop_count, 2), np.float32)
     tangents = None
     if uv_layer is not None and loop_count:
