@@ -24,7 +24,9 @@ which may return True to cancel; a cancelled step returns None):
 2. ``compress_shadowing``: PCA of S across texels (the paper: 90D to 8D).
 3. ``fit_ndf_lobes``: SG mixtures of the tabulated D: 1-2 lobes around z+ by
    Levenberg-Marquardt (ndf_fit.fit_isotropic_batch, lobes sorted by increasing
-   sharpness) or K free-axis lobes (ndf_fit.fit_anisotropic, bounded quasi-Newton).
+   sharpness) or K free-axis lobes (fit_free_axes_batch: the same model as
+   ndf_fit.fit_anisotropic, Levenberg-Marquardt over many texels at once; the paper uses
+   L-BFGS-B per texel, which ran 4-15x slower here).
 4. ``fit_lobes``: steps 1-3 together, returning a ``LobeFit`` whose ``evaluate``
    is the fitted model, and ``relative_rmse``: the 4D error against any BRDF.
 """
@@ -462,8 +464,9 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
     """SG mixtures of tabulated NDFs ndf (B, T) (isotropic) or (B, T, P) on (ndf_theta, ndf_phi).
 
     free_axes False (default for isotropic tables and K <= 2): K lobes around z+ by batched
-    Levenberg-Marquardt; True: K free-axis lobes per texel (ndf_fit.fit_anisotropic, TNC)
-    on a hemisphere quadrature with phi_count azimuths.  Returns (axis (B, K, 3),
+    Levenberg-Marquardt (ndf_fit.fit_isotropic_batch); True: K free-axis lobes by batched
+    Levenberg-Marquardt (fit_free_axes_batch) on a hemisphere quadrature with phi_count
+    azimuths, at most max_iterations steps.  Returns (axis (B, K, 3),
     sharpness (B, K), amplitude (B, K), relative L2 of D (B,)), lobes sorted by increasing
     sharpness, or None if cancelled.
     """
@@ -491,45 +494,133 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
                 values[part], theta, weights, lobe_count)
         axis[..., 2] = 1
     else:
-        # a coarser theta quadrature for the per-texel optimizer: every fourth node, weights x4
+        # a coarser theta quadrature for the free-axis fit: every fourth node, weights x4
         directions_theta, directions_weight = theta[::4], weights[::4] * 4 / phi_count
         phi = (np.arange(phi_count) + 0.5) * (2 * np.pi / phi_count)
         t, p = np.meshgrid(directions_theta, phi, indexing="ij")
         directions = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1).reshape(-1, 3)
         solid_angle = np.repeat(directions_weight, phi_count)
+        # start: the z+ 2-lobe fit of the azimuthal mean plus faint tilted lobes (growing lobes one
+        # at a time from a single lobe stalls in the symmetric optimum)
+        mean_rows = _interpolate_rows(table.mean(axis=2), ndf_theta, theta)
         sharpness = np.empty((batch, lobe_count))
         amplitude = np.empty((batch, lobe_count))
         error = np.empty(batch)
-        starts = None
-        if table.shape[2] == 1 and lobe_count > 2:
-            # isotropic tables: start from the z+ 2-lobe fit plus faint tilted lobes (greedy growth
-            # from one lobe stalls in the symmetric optimum)
-            values = _interpolate_rows(table[..., 0], ndf_theta, theta)
-            starts = ndf_fit.fit_isotropic_batch(values, theta, weights, 2)[:2]
-        for texel in range(batch):
-            if progress is not None and progress(texel / batch):
+        small_chunk = max(1, chunk // 16)  # the Jacobian is (chunk, M, 5 K)
+        for start in range(0, batch, small_chunk):
+            if progress is not None and progress(start / batch):
                 return None
-            values = interpolate_ndf(table[texel:texel + 1], ndf_theta, ndf_phi, directions)[0]
-            initial = None if starts is None else _tilted_start(starts[0][texel], starts[1][texel], lobe_count)
-            axis[texel], sharpness[texel], amplitude[texel], error[texel] = ndf_fit.fit_anisotropic(
-                values, directions, solid_angle, lobe_count, initial=initial, max_iterations=max_iterations, method="TNC")
+            part = slice(start, start + small_chunk)
+            start_sharpness, start_amplitude, _ = ndf_fit.fit_isotropic_batch(
+                mean_rows[part], theta, weights, min(lobe_count, 2))
+            initial = _tilted_start(start_sharpness, start_amplitude, lobe_count)
+            values = interpolate_ndf(table[part], ndf_theta, ndf_phi, directions)
+            axis[part], sharpness[part], amplitude[part], error[part] = fit_free_axes_batch(
+                values, directions, solid_angle, initial, max_iterations)
     if progress is not None and progress(1.0):
         return None
     return axis, sharpness, amplitude, error
 
 
 def _tilted_start(sharpness, amplitude, lobe_count):
-    """Initial K free-axis lobes: two z+ lobes (sharpness, amplitude (2,)) and K - 2 faint lobes
-    tilted by half the broad lobe's width on a ring, at the geometric-mean sharpness."""
-    extra = lobe_count - 2
-    tilt = 0.5 / np.sqrt(max(sharpness[0], 1e-6))
-    phi = 2 * np.pi * np.arange(extra) / extra
-    axis = np.zeros((lobe_count, 3))
-    axis[:2, 2] = 1
-    axis[2:] = np.stack([np.sin(tilt) * np.cos(phi), np.sin(tilt) * np.sin(phi), np.full(extra, np.cos(tilt))], -1)
-    all_sharpness = np.concatenate([sharpness, np.full(extra, np.sqrt(sharpness[0] * sharpness[1]))])
-    all_amplitude = np.concatenate([amplitude, np.full(extra, 1e-2 * amplitude.max())])
+    """Initial K free-axis lobes (B, K, ...) from z+ lobes (sharpness, amplitude (B, J), J <= 2):
+    the J lobes on z+ and K - J faint lobes tilted by half the broad lobe's width on a ring,
+    at the geometric-mean sharpness."""
+    batch, given = sharpness.shape
+    extra = lobe_count - given
+    tilt = 0.5 / np.sqrt(np.maximum(sharpness[:, :1], 1e-6))  # (B, 1)
+    phi = 2 * np.pi * np.arange(extra) / max(extra, 1)
+    axis = np.zeros((batch, lobe_count, 3))
+    axis[:, :given, 2] = 1
+    axis[:, given:] = np.stack([np.sin(tilt) * np.cos(phi), np.sin(tilt) * np.sin(phi),
+                                np.broadcast_to(np.cos(tilt), (batch, extra))], axis=-1)
+    middle = np.exp(np.mean(np.log(np.maximum(sharpness, 1e-6)), axis=1, keepdims=True))
+    all_sharpness = np.concatenate([sharpness, np.broadcast_to(middle, (batch, extra))], axis=1)
+    all_amplitude = np.concatenate([amplitude, np.broadcast_to(1e-2 * amplitude.max(1, keepdims=True),
+                                                               (batch, extra))], axis=1)
     return axis, all_sharpness, all_amplitude
+
+
+def _free_axes_residual(params, directions, root_weights, target, scale):
+    """Weighted relative residual (B, M) and the lobes' parts for the Jacobian."""
+    raw = params[..., :3]
+    length = np.maximum(np.linalg.norm(raw, axis=-1), 1e-12)
+    axis = raw / length[..., None]
+    sharpness = np.exp(np.clip(params[..., 3], -10, 16))
+    cosine = np.einsum("bkj,mj->bkm", axis, directions)
+    lobes = np.exp(np.clip(params[..., 4], -60, 60))[..., None] * np.exp(
+        sharpness[..., None] * np.minimum(cosine - 1, 0))
+    residual = root_weights * (lobes.sum(1) - target) / scale
+    return residual, axis, length, sharpness, cosine, lobes
+
+
+def fit_free_axes_batch(values, directions, weights, initial, max_iterations=150):
+    """K free-axis SG lobes fitted to B NDFs at once by Levenberg-Marquardt with per-texel
+    damping (the batched counterpart of ndf_fit.fit_anisotropic, which runs one texel per
+    scipy call).  values (B, M) at directions (M, 3) with solid-angle weights (M,); initial
+    (axis (B, K, 3), sharpness (B, K), amplitude (B, K)).  Parameters: raw axis (normalized
+    in the model), log sharpness, log amplitude.  Returns (axis (B, K, 3), sharpness (B, K),
+    amplitude (B, K), relative L2 (B,)), lobes sorted by increasing sharpness."""
+    target = np.asarray(values, np.float64)
+    root_weights = np.sqrt(np.asarray(weights, np.float64))
+    scale = np.maximum(np.sqrt(np.sum(root_weights ** 2 * target ** 2, axis=1)), 1e-300)[:, None]
+    axis, sharpness, amplitude = (np.asarray(a, np.float64) for a in initial)
+    params = np.concatenate([axis, np.log(np.maximum(sharpness, 1e-4))[..., None],
+                             np.log(np.maximum(amplitude, 1e-30))[..., None]], axis=-1)  # (B, K, 5)
+    batch, lobe_count = params.shape[:2]
+    residual = _free_axes_residual(params, directions, root_weights, target, scale)[0]
+    cost = np.sum(residual ** 2, axis=1)
+    damping = np.full(batch, 1e-3)
+    active = np.ones(batch, bool)
+    for _ in range(max_iterations):
+        if not active.any():
+            break
+        rows = np.nonzero(active)[0]
+        p = params[rows]
+        r, axis, length, sharp, cosine, lobes = _free_axes_residual(p, directions, root_weights, target[rows],
+                                                                    scale[rows])
+        factor = (root_weights / scale[rows])[:, None, :] * lobes  # (b, K, M)
+        d_axis = (factor * sharp[..., None])[..., None] * (directions[None, None] - cosine[..., None] * axis[:, :, None])
+        jacobian = np.concatenate([d_axis / length[..., None, None],
+                                   (factor * sharp[..., None] * (cosine - 1))[..., None],
+                                   factor[..., None]], axis=-1)  # (b, K, M, 5)
+        jacobian = np.moveaxis(jacobian, 2, 1).reshape(len(rows), -1, lobe_count * 5)
+        normal = np.swapaxes(jacobian, 1, 2) @ jacobian
+        gradient = (np.swapaxes(jacobian, 1, 2) @ r[..., None])[..., 0]
+        diagonal = np.einsum("bpp->bp", normal)
+        improved = np.zeros(len(rows), bool)
+        new_params = p.copy()
+        new_cost = cost[rows].copy()
+        for _attempt in range(4):
+            trial = ~improved
+            if not trial.any():
+                break
+            system = normal[trial] + (damping[rows[trial]][:, None] * np.maximum(diagonal[trial], 1e-12))[..., None] \
+                * np.eye(lobe_count * 5)
+            step = np.linalg.solve(system, -gradient[trial][..., None])[..., 0].reshape(-1, lobe_count, 5)
+            candidate = p[trial] + step
+            candidate[..., 3] = np.clip(candidate[..., 3], -10, 16)
+            candidate[..., 4] = np.clip(candidate[..., 4], -60, 60)
+            # keep |raw axis| near 1: the scale of the raw axis is a free direction of the model
+            candidate[..., :3] /= np.maximum(np.linalg.norm(candidate[..., :3], axis=-1, keepdims=True), 1e-12)
+            trial_cost = np.sum(_free_axes_residual(candidate, directions, root_weights, target[rows[trial]],
+                                                    scale[rows[trial]])[0] ** 2, axis=1)
+            better = trial_cost < cost[rows[trial]]
+            index = np.nonzero(trial)[0]
+            new_params[index[better]] = candidate[better]
+            new_cost[index[better]] = trial_cost[better]
+            improved[index[better]] = True
+            damping[rows[index[better]]] *= 0.3
+            damping[rows[index[~better]]] *= 10
+        relative_gain = (cost[rows] - new_cost) / np.maximum(cost[rows], 1e-300)
+        params[rows], cost[rows] = new_params, new_cost
+        active[rows] = improved & (relative_gain > 1e-6) & (damping[rows] < 1e8)
+    raw = params[..., :3]
+    axis = raw / np.maximum(np.linalg.norm(raw, axis=-1, keepdims=True), 1e-12)
+    sharpness, amplitude = np.exp(params[..., 3]), np.exp(params[..., 4])
+    order = np.argsort(sharpness, axis=1)
+    take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
+    return (np.take_along_axis(axis, order[..., None], axis=1), take(sharpness), take(amplitude), np.sqrt(cost))
 
 
 # ----------------------------------------------------------------------------- the fitted model
