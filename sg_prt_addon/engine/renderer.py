@@ -5,7 +5,6 @@ viewport (view_draw draws the same framebuffer's Combined texture).  Only
 what SceneState marks dirty is re-uploaded.  Must run where the `gpu` module
 works: inside render() with bl_use_gpu_context, or in view_update/view_draw.
 """
-import struct
 
 import numpy as np
 
