@@ -15,7 +15,7 @@ interpolates all the way to the horizon.
 """
 import numpy as np
 
-from ..core import hemisphere
+from ..core import hemisphere, sg
 from . import hemisphere_map
 
 
@@ -45,8 +45,9 @@ def _sample(images, texcoord):
 
 
 def texcoord_of(local_direction, resolution):
-    """Texture coordinates (..., 2) in an R x R SSDF texture and angle below the horizon (...) of local directions."""
-    square, below = hemisphere_map.horizon_lookup(local_direction)
+    """Texture coordinates (..., 2) in an R x R SSDF texture and angle below the horizon (...) of local
+    directions (normalized here; zero or non-finite -> +z, as in the shader)."""
+    square, below = hemisphere_map.horizon_lookup(sg.normalize(np.asarray(local_direction, np.float64)))
     return hemisphere_map.sample_texcoord(square, resolution), below
 
 

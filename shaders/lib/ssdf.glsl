@@ -79,10 +79,11 @@ vec3 ssdf_to_local(vec3 world_direction, vec3 normal)
   return vec3(dot(world_direction, t), dot(world_direction, b), dot(world_direction, n));
 }
 
-/* SSDF value (radians, + visible) at a local direction: one bilinear fetch per four PCA images. */
+/* SSDF value (radians, + visible) at a local direction (normalized here; zero -> +z): one bilinear
+ * fetch per four PCA images. */
 float ssdf_decode(sampler2DArray basis, vec4 coefficients[SSDF_MAX_LAYERS], int layer_count, vec3 local_direction)
 {
-  vec3 lookup = ssdf_horizon_lookup(local_direction);
+  vec3 lookup = ssdf_horizon_lookup(safe_normalize(local_direction));
   float resolution = float(textureSize(basis, 0).x);
   vec2 texcoord = ((lookup.xy + 1.0) * (0.5 * (resolution - 1.0)) + 0.5) / resolution;
   float value = 0.0;

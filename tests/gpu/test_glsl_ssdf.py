@@ -64,3 +64,22 @@ def test_decode_and_shadowed_integral(glsl, fuzz, record_error):
     assert np.abs(out[:, 1] - integral).max() / upper.max() < 0.05
     _, _, amplitude = hemisphere.visibility_product_integral_preserving(None, sharpness, 1.0, out[:, 0].astype(np.float64))
     assert record_error("ssdf visibility_amplitude, absolute", np.abs(out[:, 2] - amplitude).max()) <= 5e-6
+
+
+def test_decode_degenerate_directions_are_finite(glsl, fuzz):
+    resolution = 8
+    basis = fuzz.f32(fuzz.rng.normal(size=(3, resolution, resolution)))
+    mean = fuzz.f32(fuzz.rng.normal(size=(resolution, resolution)))
+    d = fuzz.stress_vectors(N)
+    coefficients = fuzz.f32(fuzz.rng.normal(size=(N, 3)))
+    packed = decode.pack_coefficients(coefficients)
+    call = """
+    vec4 c[SSDF_MAX_LAYERS];
+    c[0] = c0; c[1] = vec4(0.0); c[2] = vec4(0.0);
+    result = vec4(ssdf_decode(ssdf_basis, c, 1, d.xyz));
+    """
+    out = glsl(LIB, call, {"d": d, "c0": packed[:, 0:4]}, 1,
+               textures={"ssdf_basis": decode.pack_basis_texture(mean, basis)})
+    assert np.all(np.isfinite(out))
+    expected = decode.decode(coefficients, basis, mean, d)
+    assert np.abs(out - expected).max() < 1e-3 * (1 + np.abs(coefficients).sum(axis=1) * 3).max()
