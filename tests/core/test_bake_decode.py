@@ -3,7 +3,7 @@ and the shadowed lobe integral against ray-traced visibility."""
 import numpy as np
 
 from sg_prt_addon.bake import decode, hemisphere_map, ssdf
-from sg_prt_addon.core import hemisphere, sg
+from sg_prt_addon.core import sg
 
 
 def test_bilinear_is_exact_at_texel_centres_linear_between_and_clamped():

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from benchmarks.bake_speed import grid, icosphere, sphere_over_floor
-from sg_prt_addon.bake import BakeCancelled, BakeOptions, bake_visibility, hemisphere_map, pca, topology_hash, visibility
+from sg_prt_addon.bake import BakeCancelled, BakeOptions, bake_visibility, hemisphere_map, topology_hash, visibility
 from sg_prt_addon.bake.pipeline import bake_ssdf
 from sg_prt_addon.core.raytrace import RayTracer
 
