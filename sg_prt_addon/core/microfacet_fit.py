@@ -459,14 +459,15 @@ def _interpolate_rows(values, grid, theta):
     return (1 - t) * values[:, low] + t * values[:, low + 1]
 
 
-def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_count=24, progress=None,
-                  chunk=1024, max_iterations=150):
+def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_count=None, progress=None,
+                  chunk=1024, max_iterations=50):
     """SG mixtures of tabulated NDFs ndf (B, T) (isotropic) or (B, T, P) on (ndf_theta, ndf_phi).
 
     free_axes False (default for isotropic tables and K <= 2): K lobes around z+ by batched
     Levenberg-Marquardt (ndf_fit.fit_isotropic_batch); True: K free-axis lobes by batched
     Levenberg-Marquardt (fit_free_axes_batch) on a hemisphere quadrature with phi_count
-    azimuths, at most max_iterations steps.  Returns (axis (B, K, 3),
+    azimuths (default 12 for isotropic tables, where more did not lower the error, else 32),
+    at most max_iterations steps.  Returns (axis (B, K, 3),
     sharpness (B, K), amplitude (B, K), relative L2 of D (B,)), lobes sorted by increasing
     sharpness, or None if cancelled.
     """
@@ -494,6 +495,7 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
                 values[part], theta, weights, lobe_count)
         axis[..., 2] = 1
     else:
+        phi_count = phi_count or (12 if table.shape[2] == 1 else 32)
         # a coarser theta quadrature for the free-axis fit: every fourth node, weights x4
         directions_theta, directions_weight = theta[::4], weights[::4] * 4 / phi_count
         phi = (np.arange(phi_count) + 0.5) * (2 * np.pi / phi_count)
@@ -511,10 +513,13 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
             if progress is not None and progress(start / batch):
                 return None
             part = slice(start, start + small_chunk)
-            start_sharpness, start_amplitude, _ = ndf_fit.fit_isotropic_batch(
-                mean_rows[part], theta, weights, min(lobe_count, 2))
-            initial = _tilted_start(start_sharpness, start_amplitude, lobe_count)
             values = interpolate_ndf(table[part], ndf_theta, ndf_phi, directions)
+            if table.shape[2] == 1:
+                start_sharpness, start_amplitude, _ = ndf_fit.fit_isotropic_batch(
+                    mean_rows[part], theta, weights, min(lobe_count, 2))
+                initial = _tilted_start(start_sharpness, start_amplitude, lobe_count)
+            else:
+                initial = _moment_start(values, directions, solid_angle, table[part, 0].mean(axis=1), lobe_count)
             axis[part], sharpness[part], amplitude[part], error[part] = fit_free_axes_batch(
                 values, directions, solid_angle, initial, max_iterations)
     if progress is not None and progress(1.0):
@@ -528,7 +533,7 @@ def _tilted_start(sharpness, amplitude, lobe_count):
     at the geometric-mean sharpness."""
     batch, given = sharpness.shape
     extra = lobe_count - given
-    tilt = 0.5 / np.sqrt(np.maximum(sharpness[:, :1], 1e-6))  # (B, 1)
+    tilt = np.minimum(0.5 / np.sqrt(np.maximum(sharpness[:, :1], 1e-6)), 0.5)  # (B, 1), radians
     phi = 2 * np.pi * np.arange(extra) / max(extra, 1)
     axis = np.zeros((batch, lobe_count, 3))
     axis[:, :given, 2] = 1
@@ -539,6 +544,28 @@ def _tilted_start(sharpness, amplitude, lobe_count):
     all_amplitude = np.concatenate([amplitude, np.broadcast_to(1e-2 * amplitude.max(1, keepdims=True),
                                                                (batch, extra))], axis=1)
     return axis, all_sharpness, all_amplitude
+
+
+def _moment_start(values, directions, weights, peak, lobe_count):
+    """Initial K lobes of anisotropic NDFs values (B, M): Gaussian widths and orientation from
+    the second moments of the slopes (x, y) = (h_x, h_y) / h_z under D (n.h), then
+    ndf_fit.anisotropic_lobes (the normalized anisotropy table) rotated to that orientation."""
+    cos_theta = np.maximum(directions[:, 2], 1e-3)
+    slope_x, slope_y = directions[:, 0] / cos_theta, directions[:, 1] / cos_theta
+    mass = np.maximum(values, 0) * weights * cos_theta
+    total = np.maximum(mass.sum(axis=1), 1e-300)
+    xx, yy, xy = ((mass * a * b).sum(axis=1) / total for a, b in
+                  ((slope_x, slope_x), (slope_y, slope_y), (slope_x, slope_y)))
+    angle = 0.5 * np.arctan2(2 * xy, xx - yy)  # principal direction of the slope covariance
+    spread = np.sqrt(0.25 * (xx - yy) ** 2 + xy * xy)
+    # exp(-x^2/w^2) has variance w^2/2
+    long_width = np.clip(np.sqrt(2 * (0.5 * (xx + yy) + spread)), 1e-3, 1.5)
+    short_width = np.clip(np.sqrt(2 * np.maximum(0.5 * (xx + yy) - spread, 0)), 1e-3, 1.5)
+    axis, sharpness, amplitude = ndf_fit.anisotropic_lobes(long_width, short_width, peak, lobe_count)
+    cos_a, sin_a = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    rotated = np.stack([cos_a * axis[..., 0] - sin_a * axis[..., 1], sin_a * axis[..., 0] + cos_a * axis[..., 1],
+                        axis[..., 2]], axis=-1)
+    return rotated, np.asarray(sharpness, np.float64), np.maximum(np.asarray(amplitude, np.float64), 1e-6 * peak[:, None])
 
 
 def _free_axes_residual(params, directions, root_weights, target, scale):
@@ -614,7 +641,8 @@ def fit_free_axes_batch(values, directions, weights, initial, max_iterations=150
             damping[rows[index[~better]]] *= 10
         relative_gain = (cost[rows] - new_cost) / np.maximum(cost[rows], 1e-300)
         params[rows], cost[rows] = new_params, new_cost
-        active[rows] = improved & (relative_gain > 1e-6) & (damping[rows] < 1e8)
+        # a failed step only raised the damping: retry until it is hopeless
+        active[rows] = np.where(improved, relative_gain > 1e-6, damping[rows] < 1e8)
     raw = params[..., :3]
     axis = raw / np.maximum(np.linalg.norm(raw, axis=-1, keepdims=True), 1e-12)
     sharpness, amplitude = np.exp(params[..., 3]), np.exp(params[..., 4])
