@@ -57,6 +57,9 @@ def scene_block(camera, light_data, environment):
         raise ValueError(f"SG-PRT draws at most {MAX_POINT_LIGHTS} point/spot/area and {MAX_SUNS} sun lights")
     camera_vec = (list(camera.position) + [1.0]) if camera.is_perspective else (list(camera.forward) + [0.0])
     prefiltered = environment.prefiltered
+    mean_radiance = getattr(prefiltered, "mean_radiance", None) if prefiltered is not None else None
+    world_colour = (list(np.asarray(mean_radiance, np.float32).ravel()[:3]) + [1.0]) if mean_radiance is not None \
+        else (list(environment.colour[:3]) + [0.0])
     env_lobes = min(len(environment.lobe_sharpness), MAX_ENV_LOBES) if prefiltered is not None else 0
     layer_count = len(prefiltered.sharpness) if prefiltered is not None else 0
     if layer_count > MAX_LAYERS:
@@ -68,7 +71,7 @@ def scene_block(camera, light_data, environment):
                              np.zeros(layer_count), np.zeros(layer_count)], axis=1) if layer_count else []
     parts = [
         np.array([camera_vec], np.float32),
-        np.array([list(environment.colour[:3]) + [1.0]], np.float32),
+        np.array([world_colour], np.float32),
         counts[None],
         np.array([info], np.float32),
         vec4_array(MAX_LAYERS, scale_offset),

@@ -4,6 +4,8 @@
 struct SceneData {
   /* xyz: camera position (perspective) or camera forward (orthographic); w: 1 perspective, 0 ortho */
   vec4 camera;
+  /* rgb: the world colour; with an environment texture its mean radiance, w = 1 when the
+   * lookup blends to it below the broadest prefiltered level */
   vec4 world_colour;
   /* x point/spot lights, y suns, z environment SG lobes, w prefiltered layers */
   ivec4 counts;

@@ -98,7 +98,11 @@ vec3 environment_radiance(vec3 axis, float sharpness)
   vec2 upper_transform = scene.prefilter_scale_offset[upper].xy;
   vec4 lower_value = texture(environment_texture, vec3(coords * lower_transform.x + lower_transform.y, float(lower)));
   vec4 upper_value = texture(environment_texture, vec3(coords * upper_transform.x + upper_transform.y, float(upper)));
-  return (lower_value + (upper_value - lower_value) * fraction).rgb;
+  vec3 value = (lower_value + (upper_value - lower_value) * fraction).rgb;
+  /* below the broadest level: affine in lambda towards the mean radiance (world_colour.rgb when
+   * world_colour.w is 1) at lambda = 0 */
+  float below = clamp((isnan(sharpness) ? 0.0 : sharpness) / exp2(scene.prefilter_info.x), 0.0, 1.0);
+  return scene.world_colour.w > 0.5 ? scene.world_colour.rgb + (value - scene.world_colour.rgb) * below : value;
 }
 #endif
 

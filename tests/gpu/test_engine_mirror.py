@@ -145,8 +145,11 @@ def test_environment_texture(engine):
     glossy = fx.material("mat_env_ggx", model="GGX", roughness=0.25, diffuse_color=(0.3, 0.3, 0.3),
                          specular_color=(0.8, 0.8, 0.8))
     shirley = fx.material("mat_env_as", model="ASHIKHMIN_SHIRLEY", nu=30.0, nv=300.0, lobe_count=2)
-    fx.uv_sphere(scene, "glossy", (-1.0, 0.0, 1.0), radius=0.9).data.materials.append(glossy)
-    fx.uv_sphere(scene, "brushed", (1.0, 0.0, 1.0), radius=0.9).data.materials.append(shirley)
+    # lobes broader than the broadest prefiltered level: the lookup blends to the mean radiance
+    rough = fx.material("mat_env_rough", model="GGX", roughness=1.0)
+    fx.uv_sphere(scene, "glossy", (-1.2, 0.0, 1.0), radius=0.7).data.materials.append(glossy)
+    fx.uv_sphere(scene, "brushed", (0.4, 0.0, 1.0), radius=0.7).data.materials.append(shirley)
+    fx.uv_sphere(scene, "rough", (1.6, 0.0, 1.4), radius=0.5).data.materials.append(rough)
     render_engine.debug["environment_layer_size"] = 32
     try:
         result = fx.render(scene, gbuffer=True)
