@@ -157,3 +157,17 @@ def test_environment_texture(engine):
         render_engine.debug["environment_layer_size"] = None
     assert result["state"].environment.prefiltered is not None
     _check(result)
+
+
+def test_orthographic_camera(engine):
+    """The orthographic view direction (the camera's forward, not towards a position)."""
+    scene = fx.new_scene("mirror_ortho", 96, 96)
+    scene.camera.data.type = "ORTHO"
+    scene.camera.data.ortho_scale = 3.0
+    fx.world_colour(scene, (0.1, 0.1, 0.1))
+    fx.uv_sphere(scene, "ortho_sphere", (0.0, 0.0, 1.0), radius=1.2).data.materials.append(
+        fx.material("mat_ortho", model="COOK_TORRANCE", roughness=0.2, ior=1.8))
+    fx.point_light(scene, "ortho_light", (2.0, -3.0, 2.0), 600.0, radius=0.3)
+    result = fx.render(scene, gbuffer=True)
+    assert not result["passes"]["camera"].is_perspective
+    _check(result)
