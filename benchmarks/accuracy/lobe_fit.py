@@ -45,7 +45,8 @@ def _merl_rows(label, material, directory):
     reference = lambda a, b, texels: material.evaluate(a, b)[None]  # noqa: E731
     table = factorization.to_table((1, 1))
     rows = [_row(f"MERL {label}: tabulated D and S (no SG)", microfacet_fit.relative_rmse(reference, table.evaluate),
-                 f"MERL bins are 1 degree wide in theta_d: coarse at grazing; factorization residual {factorization.residual[0]:.3g}, eta chosen {factorization.eta[0]:.2f} "
+                 f"MERL bins are 1 degree wide in theta_d: coarse at grazing; factorization residual "
+                 f"{factorization.residual[0]:.3g}, eta chosen {factorization.eta[0]:.2f} "
                  f"(true {material.eta})")]
     for lobe_count in (1, 2, 4):
         fit = microfacet_fit.fit_lobes(factorization, lobe_count)
@@ -97,4 +98,5 @@ def measure():
 
 if __name__ == "__main__":
     for row in measure():
-        print(f"{row['name']} [{row['metric']}]: max {row['max_error']:.4f} mean {row['mean_error']:.4f}  {row['note']}")
+        print(f"{row['name']} [{row['metric']}]: max {row['max_error']:.4f} mean {row['mean_error']:.4f}  "
+              f"{row['note']}")

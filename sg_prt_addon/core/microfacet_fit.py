@@ -9,26 +9,29 @@ which may return True to cancel; a cancelled step returns None):
 
        rho(o, i) = kd / pi + ks F(o, i) S(o) S(i) D(h) / (pi (i.n)(o.n)).
 
-   The grey (channel-mean) data are fitted by alternating least squares in the linear
-   domain (Ngan 2005 / Wang 2008 style): with S fixed, (kd, D) is a linear problem
-   (D piecewise linear on a theta_h grid); with kd, D fixed, S is linear once the
-   other direction's factor takes the previous S (both roles of every pair are used,
-   so the update is symmetric), then a few damped Gauss-Newton steps on S polish the
-   linear-domain objective.  Weights: the caller's quadrature weight times
+   The grey (channel-mean) data are fitted by alternation (Ngan 2005 / Wang 2008 style):
+   with S fixed, (kd, D) is a linear least-squares problem (D piecewise linear on a
+   theta_h grid); with kd fixed, log((rho - kd/pi) / F-and-cosines) = log D(h) +
+   log S(o) + log S(i) is linear in (log D, log S), solved jointly (weighted by the
+   squared specular part so it approximates the linear error); a few damped Gauss-Newton
+   steps on S then polish the linear-domain objective, which the log optimum misses
+   where the data leave the model class.  Weights: the caller's quadrature weight times
    ((i.n)^2 + (o.n)^2)/2 (the cosine-weighted BRDF is what renders and what
-   relative_rmse measures), masked by validity.  Small
-   second-difference penalties keep D and S smooth where samples are scarce.  Scale:
-   S = 1 on average below 60 degrees, D normalized (integral of D cos = 1), ks takes the rest; kd and ks per
-   channel by a final 2-parameter least squares.  eta: a fixed value (the paper uses
-   1.33) or candidates from which each texel keeps the best.
+   relative_rmse measures), masked by validity.  Second-difference penalties keep D and
+   S smooth where samples are scarce or inconsistent (S near grazing).  Scale: S = 1 on
+   average below 60 degrees, D normalized (integral of D cos = 1), ks takes the rest;
+   kd and ks per channel by a final 2-parameter least squares.  eta: a fixed value (the
+   paper uses 1.33) or candidates from which each texel keeps the best residual (eta
+   is weakly identifiable: S and ks absorb most of its effect).
 2. ``compress_shadowing``: PCA of S across texels (the paper: 90D to 8D).
 3. ``fit_ndf_lobes``: SG mixtures of the tabulated D: 1-2 lobes around z+ by
    Levenberg-Marquardt (ndf_fit.fit_isotropic_batch, lobes sorted by increasing
    sharpness) or K free-axis lobes (fit_free_axes_batch: the same model as
    ndf_fit.fit_anisotropic, Levenberg-Marquardt over many texels at once; the paper uses
    L-BFGS-B per texel, which ran 4-15x slower here).
-4. ``fit_lobes``: steps 1-3 together, returning a ``LobeFit`` whose ``evaluate``
-   is the fitted model, and ``relative_rmse``: the 4D error against any BRDF.
+4. ``fit_lobes``: steps 2-3 on a factorization or an SvbrdfTable, returning a ``LobeFit``
+   whose ``evaluate`` is the fitted model; ``fit_merl``: steps 1-3 for a MERL BRDF;
+   ``relative_rmse``: the 4D error against any BRDF.
 """
 from dataclasses import dataclass
 
@@ -299,7 +302,8 @@ def _shadowing_gauss_newton(pairs, grey, weights, geometry, diffuse, ndf, shadow
     matrix = (_right(pairs.outer_oo_t, we2 * s_i * s_i).reshape(-1, size, size)
               + _right(pairs.outer_ii_t, we2 * s_o * s_o).reshape(-1, size, size)
               + cross + np.swapaxes(cross, 1, 2))
-    rhs = _right(pairs.o_linear_t, weights * residual * e * s_i) + _right(pairs.i_linear_t, weights * residual * e * s_o)
+    weighted_residual = weights * residual * e
+    rhs = _right(pairs.o_linear_t, weighted_residual * s_i) + _right(pairs.i_linear_t, weighted_residual * s_o)
     diagonal = np.einsum("bii->bi", matrix)
     scale = np.maximum(diagonal.mean(axis=1), 1e-300)
     # relative to the largest diagonal entry: grazing nodes carry most of the weight, and data
@@ -565,7 +569,8 @@ def _moment_start(values, directions, weights, peak, lobe_count):
     cos_a, sin_a = np.cos(angle)[:, None], np.sin(angle)[:, None]
     rotated = np.stack([cos_a * axis[..., 0] - sin_a * axis[..., 1], sin_a * axis[..., 0] + cos_a * axis[..., 1],
                         axis[..., 2]], axis=-1)
-    return rotated, np.asarray(sharpness, np.float64), np.maximum(np.asarray(amplitude, np.float64), 1e-6 * peak[:, None])
+    amplitude = np.maximum(np.asarray(amplitude, np.float64), 1e-6 * peak[:, None])
+    return rotated, np.asarray(sharpness, np.float64), amplitude
 
 
 def _free_axes_residual(params, directions, root_weights, target, scale):
@@ -607,7 +612,8 @@ def fit_free_axes_batch(values, directions, weights, initial, max_iterations=150
         r, axis, length, sharp, cosine, lobes = _free_axes_residual(p, directions, root_weights, target[rows],
                                                                     scale[rows])
         factor = (root_weights / scale[rows])[:, None, :] * lobes  # (b, K, M)
-        d_axis = (factor * sharp[..., None])[..., None] * (directions[None, None] - cosine[..., None] * axis[:, :, None])
+        tangential = directions[None, None] - cosine[..., None] * axis[:, :, None]  # d(cosine)/d(axis) * |raw|
+        d_axis = (factor * sharp[..., None])[..., None] * tangential
         jacobian = np.concatenate([d_axis / length[..., None, None],
                                    (factor * sharp[..., None] * (cosine - 1))[..., None],
                                    factor[..., None]], axis=-1)  # (b, K, M, 5)
@@ -724,6 +730,23 @@ def fit_lobes(factorization, lobe_count, shadowing_components=8, free_axes=None,
                    shadowing_theta=factorization.shadowing_theta, shadowing_mean=mean, shadowing_basis=basis,
                    shadowing_coefficients=coefficients, ndf_error=error,
                    factorization_residual=factorization.residual)
+
+
+def _scaled_progress(progress, low, high):
+    if progress is None:
+        return None
+    return lambda fraction: progress(low + (high - low) * fraction)
+
+
+def fit_merl(brdf, lobe_count, eta=DEFAULT_ETA_CANDIDATES, free_axes=None, progress=None):
+    """A MerlBrdf (merl.read_merl) to a 1-texel LobeFit: factorize its bin-centre samples
+    (invalid bins ignored), then fit ``lobe_count`` SG lobes.  progress(fraction) may return
+    True to cancel (then None is returned); about 3 s on this machine."""
+    wo, wi, rho, valid, weights = merl_samples(brdf)
+    factorization = factorize(wo, wi, rho, weights, valid, eta=eta, progress=_scaled_progress(progress, 0, 0.9))
+    if factorization is None:
+        return None
+    return fit_lobes(factorization, lobe_count, free_axes=free_axes, progress=_scaled_progress(progress, 0.9, 1))
 
 
 # ----------------------------------------------------------------------------- 4D error

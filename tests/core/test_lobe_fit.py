@@ -131,3 +131,12 @@ def test_free_axis_lobes_of_tabulated_anisotropic_ndfs():
         error = ndf_fit.ndf_l2_error(model, lobes)
         assert error < 1.05 * ndf_fit.ndf_l2_error(model, model.ndf_lobes(4)) and error < 0.2
         assert np.all(np.diff(lobes[1]) >= 0)
+
+
+def test_fit_merl_front_end(ggx_merl):
+    material, brdf, _ = ggx_merl
+    seen = []
+    fit = microfacet_fit.fit_merl(brdf, 2, eta=1.5, progress=lambda f: seen.append(f))
+    assert seen[0] == 0 and seen[-1] == 1 and seen == sorted(seen)
+    assert fit.amplitude.shape == (1, 2, 3) and fit.axis.shape == (1, 2, 3)
+    assert microfacet_fit.fit_merl(brdf, 2, progress=lambda f: f > 0.5) is None
