@@ -94,8 +94,9 @@ class SceneState:
         for slot in obj.material_slots:
             material = slot.material
             key = material.name if material is not None else ""
-            if key not in self.materials:
+            if key not in self.materials:      # first seen (a new object or slot): upload it too
                 self.materials[key] = export.export_material(material)
+                self.dirty.materials.add(key)
             names.append(key)
         return names or [""]
 

@@ -161,3 +161,14 @@ def test_viewport_camera_from_view_matrices_matches_render_camera(tracked_scene)
     np.testing.assert_allclose(viewport.projection, rendered.projection, atol=1e-6)
     np.testing.assert_allclose(viewport.position, (1.0, -4.0, 2.0), atol=1e-5)
     np.testing.assert_allclose(viewport.forward, rendered.forward, atol=1e-6)
+
+
+def test_new_object_with_new_material_is_uploaded(tracked_scene):
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    third = fx.uv_sphere(scene, "updates_c", (-2.0, 0.0, 1.0), segments=8, rings=4)
+    fresh = fx.material("updates_fresh", model="BLINN_PHONG")
+    third.data.materials.append(fresh)
+    view_layer.update()
+    dirty = state.consume_dirty()
+    assert third.name in state.objects
+    assert fresh.name in dirty.materials and state.objects[third.name].mesh_key in dirty.meshes
