@@ -35,35 +35,41 @@ TEXTURED_PARAMETERS = ("diffuse_color", "specular_color", "roughness", "ior", "e
                        "alpha_x", "alpha_y", "nu", "nv")
 
 
+def _tag_material_changed(self, context):
+    """Edits from Python do not tag the material for the depsgraph (the UI does): tag it, so
+    view_update sees every change, whoever made it."""
+    self.id_data.update_tag()
+
+
 def _texture(name):
     return PointerProperty(
-        type=bpy.types.Image, name=f"{name.replace('_', ' ').title()} Texture",
+        type=bpy.types.Image, update=_tag_material_changed, name=f"{name.replace('_', ' ').title()} Texture",
         description=f"Image over the active UV map multiplying {name.replace('_', ' ')} "
                     "(RGB for colours, red channel for scalars)")
 
 
 class SGPRT_PG_material(bpy.types.PropertyGroup):
-    model: EnumProperty(name="Model", items=MODELS, default="GGX",
+    model: EnumProperty(update=_tag_material_changed, name="Model", items=MODELS, default="GGX",
                         description="Specular reflectance model, rendered with spherical Gaussian NDF lobes")
-    diffuse_color: FloatVectorProperty(name="Diffuse", subtype="COLOR", size=3, default=(0.5, 0.5, 0.5),
+    diffuse_color: FloatVectorProperty(update=_tag_material_changed, name="Diffuse", subtype="COLOR", size=3, default=(0.5, 0.5, 0.5),
                                        min=0.0, soft_max=1.0, description="Lambertian albedo kd")
-    specular_color: FloatVectorProperty(name="Specular", subtype="COLOR", size=3, default=(0.25, 0.25, 0.25),
+    specular_color: FloatVectorProperty(update=_tag_material_changed, name="Specular", subtype="COLOR", size=3, default=(0.25, 0.25, 0.25),
                                         min=0.0, soft_max=1.0, description="Specular colour ks")
-    roughness: FloatProperty(name="Roughness", default=0.3, min=0.001, max=1.0,
+    roughness: FloatProperty(update=_tag_material_changed, name="Roughness", default=0.3, min=0.001, max=1.0,
                              description="Cook-Torrance m; for GGX Blender's roughness (alpha = roughness^2)")
-    ior: FloatProperty(name="IOR", default=1.5, min=1.0, max=4.0,
+    ior: FloatProperty(update=_tag_material_changed, name="IOR", default=1.5, min=1.0, max=4.0,
                        description="Relative index of refraction of the Cook-Torrance Fresnel term")
-    exponent: FloatProperty(name="Exponent", default=100.0, min=1.0, max=1e5,
+    exponent: FloatProperty(update=_tag_material_changed, name="Exponent", default=100.0, min=1.0, max=1e5,
                             description="Blinn-Phong specular exponent")
-    alpha_x: FloatProperty(name="Alpha X", default=0.2, min=0.001, max=1.0,
+    alpha_x: FloatProperty(update=_tag_material_changed, name="Alpha X", default=0.2, min=0.001, max=1.0,
                            description="Ward roughness along the tangent (the isotropic model uses this only)")
-    alpha_y: FloatProperty(name="Alpha Y", default=0.05, min=0.001, max=1.0,
+    alpha_y: FloatProperty(update=_tag_material_changed, name="Alpha Y", default=0.05, min=0.001, max=1.0,
                            description="Ward roughness along the bitangent")
-    nu: FloatProperty(name="Nu", default=100.0, min=1.0, max=1e5,
+    nu: FloatProperty(update=_tag_material_changed, name="Nu", default=100.0, min=1.0, max=1e5,
                       description="Ashikhmin-Shirley exponent along the tangent")
-    nv: FloatProperty(name="Nv", default=1000.0, min=1.0, max=1e5,
+    nv: FloatProperty(update=_tag_material_changed, name="Nv", default=1000.0, min=1.0, max=1e5,
                       description="Ashikhmin-Shirley exponent along the bitangent")
-    lobe_count: IntProperty(name="Lobes", default=4, min=1, max=8,
+    lobe_count: IntProperty(update=_tag_material_changed, name="Lobes", default=4, min=1, max=8,
                             description="Spherical Gaussian lobes fitted to an anisotropic NDF")
 
     diffuse_color_texture: _texture("diffuse_color")
@@ -76,20 +82,20 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
     nu_texture: _texture("nu")
     nv_texture: _texture("nv")
 
-    normal_map: PointerProperty(type=bpy.types.Image, name="Normal Map",
+    normal_map: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Normal Map",
                                 description="Tangent-space normal map (OpenGL convention, +Y up)")
-    normal_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=10.0,
+    normal_strength: FloatProperty(update=_tag_material_changed, name="Strength", default=1.0, min=0.0, max=10.0,
                                    description="Blend from the mesh normal (0) to the mapped normal (1) and beyond")
-    tangent_source: EnumProperty(
+    tangent_source: EnumProperty(update=_tag_material_changed, 
         name="Tangent", default="UV_MAP",
         items=(("UV_MAP", "UV Map", "Tangents from the active UV map"),
                ("OBJECT_AXIS", "Object Axis", "A fixed object-space direction projected onto the surface")),
         description="Where the anisotropy direction comes from")
-    tangent_axis: FloatVectorProperty(name="Axis", size=3, default=(1.0, 0.0, 0.0), subtype="XYZ",
+    tangent_axis: FloatVectorProperty(update=_tag_material_changed, name="Axis", size=3, default=(1.0, 0.0, 0.0), subtype="XYZ",
                                       description="Object-space tangent direction when the source is Object Axis")
-    tangent_rotation: FloatProperty(name="Rotation", default=0.0, subtype="ANGLE",
+    tangent_rotation: FloatProperty(update=_tag_material_changed, name="Rotation", default=0.0, subtype="ANGLE",
                                     description="Rotation of the tangent about the normal")
-    show_textures: BoolProperty(name="Show Textures", default=True,
+    show_textures: BoolProperty(update=_tag_material_changed, name="Show Textures", default=True,
                                 description="Show the texture slot next to each parameter")
 
 

@@ -6,10 +6,11 @@ bpy = pytest.importorskip("bpy")
 
 @pytest.fixture(scope="session")
 def addon():
+    """The add-on, registered once per process (the gpu tier may have registered it already)."""
     import sg_prt_addon
-    sg_prt_addon.register()
-    yield sg_prt_addon
-    sg_prt_addon.unregister()
+    if not hasattr(bpy.types.Material, "sgprt"):
+        sg_prt_addon.register()
+    return sg_prt_addon
 
 
 @pytest.fixture

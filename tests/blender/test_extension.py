@@ -14,8 +14,10 @@ import bpy
 zip_path, image_path = sys.argv[1], sys.argv[2]
 bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
 enabled = [name for name in bpy.context.preferences.addons.keys() if name.endswith("sg_prt")]
-bpy.ops.wm.read_factory_settings(use_empty=True)
+# (read_factory_settings would disable the freshly installed extension: empty the scene instead)
 scene = bpy.context.scene
+for obj in list(scene.objects):
+    bpy.data.objects.remove(obj)
 scene.render.engine = "SG_PRT"
 scene.render.resolution_x = scene.render.resolution_y = 64
 bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0)

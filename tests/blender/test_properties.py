@@ -86,3 +86,22 @@ def test_register_unregister_register(addon):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.context.scene.render.engine = "SG_PRT"
     assert bpy.data.materials.new("After").sgprt.model == "GGX"
+
+
+def test_edits_from_python_reach_the_depsgraph(empty_file):
+    material = bpy.data.materials.new("Tagged")
+    bpy.ops.mesh.primitive_plane_add()
+    bpy.context.active_object.data.materials.append(material)
+    bpy.context.evaluated_depsgraph_get().update()
+    updated = []
+
+    def record(scene, depsgraph):
+        updated.extend(update.id.original.name for update in depsgraph.updates)
+
+    bpy.app.handlers.depsgraph_update_post.append(record)
+    try:
+        material.sgprt.roughness = 0.7
+        bpy.context.evaluated_depsgraph_get().update()
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(record)
+    assert "Tagged" in updated
