@@ -124,6 +124,12 @@ def _second_difference_penalty(count):
     return difference.T @ difference
 
 
+def _matrix_scale(values):
+    """Per-texel scale of a normal matrix for relative penalties and ridges; 1 for texels without
+    data (all weights 0), so their systems stay well posed (solution 0) instead of denormal."""
+    return np.where(values > 1e-200, values, 1.0)
+
+
 def _solve_banded_normal(diagonal, upper, penalty, rhs, extra=None):
     """Solve (tridiag(diagonal, upper) + scale * penalty) x = rhs per row (B, G), where scale
     is each row's mean diagonal (so the penalty is relative).  extra = (corner (B,),
@@ -135,7 +141,7 @@ def _solve_banded_normal(diagonal, upper, penalty, rhs, extra=None):
     matrix[:, index, index] = diagonal
     matrix[:, index[:-1], index[:-1] + 1] = upper[:, :-1]
     matrix[:, index[:-1] + 1, index[:-1]] = upper[:, :-1]
-    scale = np.maximum(diagonal.mean(axis=1), 1e-300)
+    scale = _matrix_scale(diagonal.mean(axis=1))
     matrix[:, :count, :count] += scale[:, None, None] * penalty
     # a ridge of 1e-9 keeps empty nodes (no samples) solvable
     matrix[:, index, index] += 1e-9 * scale[:, None]
@@ -272,7 +278,7 @@ def _log_step(pairs, grey, weights, geometry, diffuse, penalty):
     log_weights = np.where(positive, weights * specular * specular, 0)
     size = pairs.ndf_count + pairs.shadowing_count
     matrix = _right(pairs.outer_t, log_weights).reshape(-1, size, size)
-    scale = np.maximum(np.einsum("bii->b", matrix) / size, 1e-300)
+    scale = _matrix_scale(np.einsum("bii->b", matrix) / size)
     matrix += scale[:, None, None] * penalty
     # gauge (log S + a, log D - 2a) and empty nodes: a weak pull of log S towards 0, ridge on all
     index = np.arange(size)
@@ -305,10 +311,10 @@ def _shadowing_gauss_newton(pairs, grey, weights, geometry, diffuse, ndf, shadow
     weighted_residual = weights * residual * e
     rhs = _right(pairs.o_linear_t, weighted_residual * s_i) + _right(pairs.i_linear_t, weighted_residual * s_o)
     diagonal = np.einsum("bii->bi", matrix)
-    scale = np.maximum(diagonal.mean(axis=1), 1e-300)
+    scale = _matrix_scale(diagonal.mean(axis=1))
     # relative to the largest diagonal entry: grazing nodes carry most of the weight, and data
     # outside the model class (retro-reflection, non-Lambert diffuse) make them oscillate
-    regularization = np.maximum(diagonal.max(axis=1), 1e-300)[:, None, None] * penalty
+    regularization = _matrix_scale(diagonal.max(axis=1))[:, None, None] * penalty
     matrix += regularization
     index = np.arange(size)
     matrix[:, index, index] += damping * scale[:, None]
@@ -482,6 +488,19 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
     if free_axes is None:
         free_axes = table.shape[2] > 1 or lobe_count > 2
     batch = len(table)
+    empty = ~(np.max(table.reshape(batch, -1), axis=1) > 0)  # black or unmeasured texels (also NaN)
+    if empty.any():
+        # no specular lobe: zero amplitude, unit sharpness, z+ axis, error 0
+        axis = np.zeros((batch, lobe_count, 3))
+        axis[..., 2] = 1
+        sharpness, amplitude, error = np.ones((batch, lobe_count)), np.zeros((batch, lobe_count)), np.zeros(batch)
+        if not empty.all():
+            fitted = fit_ndf_lobes(ndf_theta, table[~empty], lobe_count, ndf_phi, free_axes, phi_count, progress,
+                                   chunk, max_iterations)
+            if fitted is None:
+                return None
+            axis[~empty], sharpness[~empty], amplitude[~empty], error[~empty] = fitted
+        return axis, sharpness, amplitude, error
     theta, weights = _ndf_quadrature(ndf_theta)
     axis = np.zeros((batch, lobe_count, 3))
     if not free_axes:

@@ -140,3 +140,19 @@ def test_fit_merl_front_end(ggx_merl):
     assert seen[0] == 0 and seen[-1] == 1 and seen == sorted(seen)
     assert fit.amplitude.shape == (1, 2, 3) and fit.axis.shape == (1, 2, 3)
     assert microfacet_fit.fit_merl(brdf, 2, progress=lambda f: f > 0.5) is None
+
+
+def test_black_and_unmeasured_texels(synthetic):
+    """A texel with no valid sample and a black one fit to zero lobes, without NaN or warnings
+    spoiling their neighbours."""
+    table, wo, wi, weights, rho = synthetic
+    damaged = rho[:4].copy()
+    damaged[1] = np.nan
+    damaged[2] = 0.0
+    with np.errstate(over="raise", invalid="raise", divide="raise"):
+        result = microfacet_fit.factorize(wo, wi, damaged, weights, eta=1.3)
+        fit = microfacet_fit.fit_lobes(result, 2)
+    for name in ("diffuse", "specular", "ndf", "shadowing"):
+        assert np.all(np.isfinite(getattr(result, name)))
+    assert np.all(fit.amplitude[1:3] == 0) and np.all(result.diffuse[1:3] == 0)
+    assert np.all(fit.amplitude[[0, 3]] > 0)
