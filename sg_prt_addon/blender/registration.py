@@ -1,7 +1,7 @@
 """Register and unregister everything the add-on adds to Blender, in dependency order."""
 import bpy
 
-from . import panels, properties
+from . import panels, properties, visibility_bake
 
 
 def _engine_classes():
@@ -19,6 +19,7 @@ def register():
     engine_classes = _engine_classes()
     properties.register()
     panels.register()
+    visibility_bake.register()
     for cls in engine_classes:
         bpy.utils.register_class(cls)
         _registered_engine_classes.append(cls)
@@ -27,5 +28,6 @@ def register():
 def unregister():
     while _registered_engine_classes:
         bpy.utils.unregister_class(_registered_engine_classes.pop())
+    visibility_bake.unregister()
     panels.unregister()
     properties.unregister()

@@ -1,0 +1,673 @@
+"""Visibility bake operators and its storage in the .blend (wang2009 section 5; numerics in ../bake).
+
+Which vertices are baked
+------------------------
+The Blender mesh vertices (``mesh.vertices``, one SSDF per vertex), in world
+space, with their smooth vertex normals (``MeshVertex.normal``, also on
+flat-shaded meshes) and the default local frame of
+``bake.hemisphere_map.local_frame`` (no tangents).  The geometry is the
+evaluated object's (deform modifiers apply), but a modifier that changes the
+topology (subdivision, mirror...) is refused: the coefficients live on the
+original mesh datablock, which must index the same vertices.
+
+The engine exports one vertex per face corner (blender/export.py).  To upload
+per-corner data it maps corner -> vertex with the loop's ``vertex_index``::
+
+    stored = visibility_for_object(object_eval)        # or load_visibility_bake(mesh, evaluated_mesh)
+    if stored is not None and stored.usable:
+        vertex_index = np.empty(len(mesh.loops), np.int64)
+        mesh.loops.foreach_get("vertex_index", vertex_index)   # the mesh the corners came from
+        per_corner = stored.corner_coefficients(vertex_index)  # (corners, 4 L) float32, L = stored.layers
+        texture = stored.basis_texture()                       # (L, R, R, 4): decode.pack_basis_texture
+    else:
+        ...render this object unshadowed (no bake, stale or damaged: stored.message says why)
+
+``corner_coefficients`` checks the indices against the stored vertex count,
+so a stale bake is never read out of bounds.
+
+Storage, per mesh datablock (format version 1)
+----------------------------------------------
+- ``sgprt_ssdf_00`` .. ``sgprt_ssdf_{L-1}``: POINT-domain FLOAT_COLOR attributes
+  (4 float32 a vertex; saved, reloaded and propagated through modifiers by 4.2
+  and 5.0 alike), together the rows of ``decode.pack_coefficients``:
+  [1, w_0, w_1, ...] zero-padded to 4 L floats, L = ceil((terms + 1) / 4) <= 12;
+- ``mesh["sgprt_ssdf"]``, an ID property group: ``format_version``,
+  ``resolution`` R, ``terms`` N, ``layers`` L, ``rms_error`` (radians),
+  ``vertex_count``, ``topology_hash`` (``bake.pipeline.topology_hash`` of the
+  vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``),
+  ``frame_reference_axis`` (3), ``date`` (ISO 8601 UTC), ``seconds``,
+  ``resolution``, ``refinement``, ``error_target``, ``rays_traced``, and the
+  basis ``basis`` (N R R) and ``mean`` (R R) as float arrays (stored as double:
+  the float32 values round-trip bit-exactly through save and reopen).
+
+A bake whose vertex count or topology hash no longer matches the mesh is
+STALE; missing or inconsistent data is INVALID; both are unusable.  Moving
+vertices keeps the topology (and the bake usable) but makes the shadows wrong:
+re-bake.  Only the receivers are stored: moving an occluder also needs a
+re-bake.  Occluders are all visible objects with geometry (evaluated, world
+space), the receivers included; a hidden receiver does not shadow itself.
+
+Operators: ``sgprt.bake_visibility`` (execute: synchronous with printed
+progress, for ``blender -b`` and tests; invoke: a background thread polled by
+a timer, window-manager progress, Esc cancels) and ``sgprt.clear_visibility``.
+Results are written only after every receiver finished: a cancelled or failed
+bake leaves the previous bakes untouched.  The bake thread never touches bpy.
+"""
+import datetime
+import threading
+from dataclasses import dataclass
+from typing import Optional
+
+import bpy
+import numpy as np
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+
+from ..bake import decode
+from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility, topology_hash
+
+FORMAT_VERSION = 1
+PROPERTY = "sgprt_ssdf"
+ATTRIBUTE_PREFIX = "sgprt_ssdf_"
+MAX_LAYERS = 12
+GEOMETRY_TYPES = ("MESH", "CURVE", "SURFACE", "META", "FONT")
+
+# Tests (and scripts) may set this to a callable(fraction, message) -> bool: True cancels the bake.
+progress_hook = None
+
+
+def attribute_name(layer):
+    return f"{ATTRIBUTE_PREFIX}{layer:02d}"
+
+
+# --------------------------------------------------------------------------- mesh arrays (main thread)
+
+def mesh_triangles(mesh):
+    """(T, 3) int64 vertex indices of the loop triangles of a bpy Mesh."""
+    triangles = mesh.loop_triangles
+    if len(triangles) == 0 and len(mesh.polygons):
+        mesh.calc_loop_triangles()
+        triangles = mesh.loop_triangles
+    flat = np.empty(len(triangles) * 3, np.int64)
+    triangles.foreach_get("vertices", flat)
+    return flat.reshape(-1, 3)
+
+
+def mesh_topology_hash(mesh):
+    """``bake.pipeline.topology_hash`` of a bpy Mesh: its vertex count and loop triangles' vertices."""
+    return topology_hash(len(mesh.vertices), mesh_triangles(mesh))
+
+
+def _vertex_array(mesh, name):
+    out = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get(name, out)
+    return out.reshape(-1, 3).astype(np.float64)
+
+
+def _matrix(matrix):
+    return np.array([list(row) for row in matrix], np.float64)
+
+
+def _to_world(points, matrix):
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def receiver_arrays(obj, depsgraph):
+    """World-space (vertices, normals, triangles) of a mesh object's vertices, from its evaluated
+    geometry; ValueError with a message for the user when it cannot be baked."""
+    if obj.type != "MESH":
+        raise ValueError(f"'{obj.name}' is not a mesh")
+    if obj.mode == "EDIT":
+        raise ValueError(f"'{obj.name}' is in Edit Mode: leave it before baking")
+    if len(obj.data.polygons) == 0:
+        raise ValueError(f"'{obj.name}' has no faces: nothing to bake")
+    mesh = obj.evaluated_get(depsgraph).data
+    if len(mesh.vertices) != len(obj.data.vertices) or mesh_topology_hash(mesh) != mesh_topology_hash(obj.data):
+        raise ValueError(f"'{obj.name}': its modifiers change the topology; apply them before baking")
+    matrix = _matrix(obj.evaluated_get(depsgraph).matrix_world)
+    vertices = _to_world(_vertex_array(mesh, "co"), matrix)
+    normals = _vertex_array(mesh, "normal") @ np.linalg.inv(matrix[:3, :3])   # inverse transpose
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    return vertices, normals, mesh_triangles(mesh)
+
+
+def occluder_arrays(depsgraph):
+    """(vertices (P, 3) float32, triangles (T, 3) int32) of every visible object with geometry, world space."""
+    by_object = {}
+    vertices, triangles, offset = [], [], 0
+    for instance in depsgraph.object_instances:
+        obj = instance.object
+        if obj.type not in GEOMETRY_TYPES:
+            continue
+        key = obj.name
+        if key not in by_object:
+            mesh = obj.to_mesh()
+            try:
+                by_object[key] = (_vertex_array(mesh, "co"), mesh_triangles(mesh))
+            finally:
+                obj.to_mesh_clear()
+        local, tris = by_object[key]
+        if len(tris) == 0:
+            continue
+        vertices.append(_to_world(local, _matrix(instance.matrix_world)))
+        triangles.append(tris + offset)
+        offset += len(local)
+    if not vertices:
+        return np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32)
+    return (np.ascontiguousarray(np.concatenate(vertices), np.float32),
+            np.ascontiguousarray(np.concatenate(triangles), np.int32))
+
+
+# --------------------------------------------------------------------------- storage
+
+@dataclass
+class StoredBake:
+    """A bake read back from a mesh.  Arrays are None unless ``usable`` (and read_arrays)."""
+    status: str                         # 'VALID', 'STALE' (topology changed) or 'INVALID' (damaged, old format)
+    message: str
+    format_version: int = 0
+    resolution: int = 0
+    terms: int = 0
+    layers: int = 0
+    rms_error: float = 0.0
+    vertex_count: int = 0
+    topology_hash: str = ""
+    frame_reference_axis: Optional[np.ndarray] = None
+    date: str = ""
+    seconds: float = 0.0
+    packed_coefficients: Optional[np.ndarray] = None   # (V, 4 L) float32 rows [1, w_0, ...]
+    basis: Optional[np.ndarray] = None                 # (N, R, R) float32
+    mean: Optional[np.ndarray] = None                  # (R, R) float32
+
+    @property
+    def usable(self):
+        return self.status == "VALID"
+
+    @property
+    def coefficients(self):
+        """(V, N) float32 PCA weights, as ``BakeResult.coefficients``."""
+        return None if self.packed_coefficients is None else self.packed_coefficients[:, 1:self.terms + 1]
+
+    def basis_texture(self):
+        """(L, R, R, 4) float32: ``decode.pack_basis_texture(mean, basis)``."""
+        return decode.pack_basis_texture(self.mean, self.basis)
+
+    def corner_coefficients(self, vertex_index):
+        """Per-corner (C, 4 L) rows from the loops' vertex indices; IndexError if any is out of range."""
+        vertex_index = np.asarray(vertex_index, np.int64)
+        if self.packed_coefficients is None:
+            raise ValueError(f"no usable bake: {self.message}")
+        if vertex_index.size and (vertex_index.min() < 0 or vertex_index.max() >= self.vertex_count):
+            raise IndexError(f"vertex index out of the baked range 0..{self.vertex_count - 1}")
+        return self.packed_coefficients[vertex_index]
+
+
+def has_visibility_bake(mesh):
+    return PROPERTY in mesh.keys()
+
+
+def clear_visibility_bake(mesh):
+    """Remove a stored bake (metadata first, then the attributes). True if there was anything."""
+    found = False
+    if PROPERTY in mesh.keys():
+        del mesh[PROPERTY]
+        found = True
+    for name in [a.name for a in mesh.attributes if a.name.startswith(ATTRIBUTE_PREFIX)]:
+        mesh.attributes.remove(mesh.attributes[name])
+        found = True
+    return found
+
+
+def store_visibility_bake(mesh, result, options=None):
+    """Write a finished ``BakeResult`` to a mesh datablock, replacing any previous bake."""
+    if result.vertex_count != len(mesh.vertices):
+        raise ValueError(f"bake of {result.vertex_count} vertices does not fit '{mesh.name}' "
+                         f"({len(mesh.vertices)} vertices)")
+    packed = decode.pack_coefficients(result.coefficients)
+    layers = packed.shape[1] // 4
+    if layers > MAX_LAYERS:
+        raise ValueError(f"{result.terms} terms need {layers} attributes, more than {MAX_LAYERS}")
+    clear_visibility_bake(mesh)
+    for layer in range(layers):
+        attribute = mesh.attributes.new(attribute_name(layer), "FLOAT_COLOR", "POINT")
+        attribute.data.foreach_set("color", np.ascontiguousarray(packed[:, 4 * layer:4 * layer + 4]).ravel())
+    options = options or BakeOptions(resolution=result.resolution)
+    mesh[PROPERTY] = {
+        "format_version": FORMAT_VERSION,
+        "resolution": int(result.resolution),
+        "terms": int(result.terms),
+        "layers": int(layers),
+        "rms_error": float(result.rms_error),
+        "vertex_count": int(result.vertex_count),
+        "topology_hash": str(result.topology_hash),
+        "frame_reference_axis": [float(x) for x in np.asarray(result.frame_reference_axis).ravel()],
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "seconds": float(result.seconds),
+        "refinement": int(options.refinement),
+        "error_target": float(options.error_target) if options.terms is None else -1.0,
+        "rays_traced": int(result.rays_traced),
+        "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
+        "mean": np.asarray(result.mean, np.float32).ravel().astype(np.float64).tolist(),
+    }
+
+
+def _float_array(value):
+    return np.asarray(value.to_list() if hasattr(value, "to_list") else list(value), np.float64)
+
+
+def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
+    """The bake stored on a mesh datablock, or None if it has none.
+
+    evaluated_mesh: the mesh the engine draws (an object's evaluated data), checked for staleness
+    instead of ``mesh`` itself.  read_arrays=False skips the arrays (cheap status for panels).
+    """
+    group = mesh.get(PROPERTY)
+    if group is None:
+        return None
+    current = evaluated_mesh if evaluated_mesh is not None else mesh
+    try:
+        stored = StoredBake(
+            status="VALID", message="", format_version=int(group.get("format_version", 0)),
+            resolution=int(group["resolution"]), terms=int(group["terms"]), layers=int(group["layers"]),
+            rms_error=float(group["rms_error"]), vertex_count=int(group["vertex_count"]),
+            topology_hash=str(group["topology_hash"]),
+            frame_reference_axis=_float_array(group["frame_reference_axis"]),
+            date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)))
+    except (KeyError, TypeError, ValueError) as error:
+        return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
+    if stored.format_version != FORMAT_VERSION:
+        stored.status, stored.message = "INVALID", (f"bake format {stored.format_version}, this add-on reads "
+                                                    f"{FORMAT_VERSION}: re-bake")
+        return stored
+    if stored.layers != -(-(stored.terms + 1) // 4) or not 0 < stored.layers <= MAX_LAYERS:
+        stored.status, stored.message = "INVALID", "bake metadata inconsistent (terms vs layers): re-bake"
+        return stored
+    if len(current.vertices) != stored.vertex_count:
+        stored.status = "STALE"
+        stored.message = (f"stale: the mesh has {len(current.vertices)} vertices, the bake "
+                          f"{stored.vertex_count}: re-bake")
+        return stored
+    if mesh_topology_hash(current) != stored.topology_hash:
+        stored.status, stored.message = "STALE", "stale: the mesh topology changed since the bake: re-bake"
+        return stored
+    for layer in range(stored.layers):
+        attribute = mesh.attributes.get(attribute_name(layer))
+        if (attribute is None or attribute.data_type != "FLOAT_COLOR" or attribute.domain != "POINT"
+                or len(attribute.data) != stored.vertex_count):
+            stored.status, stored.message = "INVALID", f"attribute {attribute_name(layer)} missing or damaged: re-bake"
+            return stored
+    stored.message = (f"{stored.terms} terms, RMS error {np.degrees(stored.rms_error):.2f} deg, "
+                      f"{stored.vertex_count} vertices, baked {stored.date}")
+    if not read_arrays:
+        return stored
+    resolution = stored.resolution
+    basis = _float_array(group["basis"]) if stored.terms else np.zeros(0)
+    mean = _float_array(group["mean"])
+    if basis.size != stored.terms * resolution * resolution or mean.size != resolution * resolution:
+        stored.status, stored.message = "INVALID", "stored basis has the wrong size: re-bake"
+        return stored
+    stored.basis = basis.astype(np.float32).reshape(stored.terms, resolution, resolution)
+    stored.mean = mean.astype(np.float32).reshape(resolution, resolution)
+    packed = np.empty((stored.vertex_count, 4 * stored.layers), np.float32)
+    column = np.empty(stored.vertex_count * 4, np.float32)
+    for layer in range(stored.layers):
+        mesh.attributes[attribute_name(layer)].data.foreach_get("color", column)
+        packed[:, 4 * layer:4 * layer + 4] = column.reshape(-1, 4)
+    stored.packed_coefficients = packed
+    return stored
+
+
+def visibility_for_object(object_eval, read_arrays=True):
+    """The engine's entry: the bake of an (evaluated) object's mesh, checked against the geometry it
+    draws; None without a bake or for non-mesh objects."""
+    if object_eval.type != "MESH":
+        return None
+    original = getattr(object_eval, "original", None) or object_eval
+    return load_visibility_bake(original.data, evaluated_mesh=object_eval.data, read_arrays=read_arrays)
+
+
+# --------------------------------------------------------------------------- the bake job (no bpy)
+
+class BakeJob:
+    """Bakes receivers one after another; run() synchronously or start() a thread.  Never touches bpy.
+
+    receivers: [(key, label, vertices, normals, triangles)], world space.  results: {key: BakeResult}
+    once every receiver finished; cancelled / error otherwise (results then empty).
+    """
+
+    def __init__(self, receivers, occluder_vertices, occluder_triangles, options, verbose=False, hook=None):
+        self.receivers = receivers
+        self.occluder_vertices = occluder_vertices
+        self.occluder_triangles = occluder_triangles
+        self.options = options
+        self.verbose = verbose
+        self.hook = hook
+        self.results = {}
+        self.cancelled = False
+        self.error = None
+        self.fraction = 0.0
+        self.message = "starting"
+        self._cancel = threading.Event()
+        self._lock = threading.Lock()
+        self._printed_decile = -1
+        self._thread = None
+
+    def cancel(self):
+        self._cancel.set()
+
+    @property
+    def running(self):
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self):
+        self._thread = threading.Thread(target=self.run, name="sgprt-visibility-bake", daemon=True)
+        self._thread.start()
+
+    def join(self, timeout=None):
+        if self._thread is not None:
+            self._thread.join(timeout)
+
+    def _progress_for(self, index, label):
+        count = len(self.receivers)
+
+        def progress(fraction, message):
+            overall = (index + min(max(fraction, 0.0), 1.0)) / count
+            text = f"{label}: {message}"
+            with self._lock:
+                self.fraction, self.message = overall, text
+            decile = int(overall * 10)
+            if self.verbose and (decile > self._printed_decile or fraction >= 1.0):
+                self._printed_decile = decile
+                print(f"[sg-prt] bake {overall * 100:3.0f}% {text}", flush=True)
+            if self.hook is not None and self.hook(overall, text):
+                self._cancel.set()
+            return self._cancel.is_set()
+        return progress
+
+    def run(self):
+        results = {}
+        try:
+            for index, (key, label, vertices, normals, triangles) in enumerate(self.receivers):
+                results[key] = bake_visibility(vertices, triangles, normals, self.occluder_vertices,
+                                               self.occluder_triangles, self.options,
+                                               progress=self._progress_for(index, label))
+                if self._cancel.is_set():
+                    raise BakeCancelled("cancelled after a receiver finished")
+        except BakeCancelled:
+            self.cancelled = True
+            if self.verbose:
+                print("[sg-prt] bake cancelled: nothing written", flush=True)
+            return
+        except Exception as error:       # reported to the user by the operator, nothing written
+            self.error = error
+            if self.verbose:
+                print(f"[sg-prt] bake failed: {error}", flush=True)
+            return
+        self.results = results
+
+
+# --------------------------------------------------------------------------- settings, operators, panel
+
+TERM_MODES = (("ERROR_TARGET", "Error Target", "The fewest PCA terms reaching the RMS error target"),
+              ("FIXED", "Fixed Terms", "A fixed number of PCA terms"))
+TARGETS = (("SELECTED", "Selected", "Bake the selected mesh objects"),
+           ("ALL", "All Visible", "Bake every visible mesh object"))
+OPTION_NAMES = ("target", "resolution", "refinement", "term_mode", "error_target", "terms", "max_terms")
+
+
+def _option_properties():
+    return dict(
+        target=EnumProperty(name="Target", items=TARGETS, default="SELECTED",
+                            description="Which mesh objects receive a bake (all visible objects cast shadows)"),
+        resolution=IntProperty(name="Resolution", default=32, min=4, max=64,
+                               description="SSDF samples per side of each vertex's hemisphere map"),
+        refinement=IntProperty(name="Refinement", default=5, min=1, max=9, step=2,
+                               description="Odd supersampling factor of hemisphere cells that mix visible "
+                                           "and occluded rays"),
+        term_mode=EnumProperty(name="Terms", items=TERM_MODES, default="ERROR_TARGET",
+                               description="How many PCA terms to keep"),
+        error_target=FloatProperty(name="Error Target", default=0.02, min=0.001, max=0.5, subtype="ANGLE",
+                                   description="RMS angular error of the compressed SSDFs"),
+        terms=IntProperty(name="Fixed Terms", default=24, min=0, max=47,
+                          description="PCA terms when the number is fixed"),
+        max_terms=IntProperty(name="Max Terms", default=47, min=1, max=47,
+                              description="Most PCA terms (47 + the mean fill 12 vec4 a vertex)"),
+    )
+
+
+SGPRT_PG_bake = type("SGPRT_PG_bake", (bpy.types.PropertyGroup,),
+                     {"__annotations__": _option_properties(),
+                      "__doc__": "Scene settings of the visibility bake: scene.sgprt_bake"})
+
+
+def _bake_options(settings):
+    fixed = settings.term_mode == "FIXED"
+    refinement = settings.refinement if settings.refinement % 2 else settings.refinement + 1
+    return BakeOptions(resolution=settings.resolution, refinement=refinement,
+                       terms=min(settings.terms, settings.max_terms) if fixed else None,
+                       error_target=settings.error_target, max_terms=settings.max_terms)
+
+
+def _mesh_objects(context, target):
+    if target == "ALL":
+        return [obj for obj in context.scene.objects if obj.type == "MESH" and obj.visible_get()]
+    return [obj for obj in context.selected_objects if obj.type == "MESH"]
+
+
+class SGPRT_OT_bake_visibility(bpy.types.Operator):
+    """Bake all-frequency visibility (PCA-compressed SSDFs) at the vertices of mesh objects"""
+    bl_idname = "sgprt.bake_visibility"
+    bl_label = "Bake Visibility"
+    bl_options = {"REGISTER", "UNDO"}
+    __annotations__ = _option_properties()
+
+    _running = False       # one bake at a time
+
+    @classmethod
+    def poll(cls, context):
+        return not SGPRT_OT_bake_visibility._running and context.scene is not None
+
+    def _resolve_options(self, context):
+        settings = getattr(context.scene, "sgprt_bake", None)
+        for name in OPTION_NAMES:
+            if settings is not None and not self.properties.is_property_set(name):
+                setattr(self, name, getattr(settings, name))
+
+    def _prepare(self, context):
+        """The BakeJob, or None after reporting why not."""
+        self._resolve_options(context)
+        objects = _mesh_objects(context, self.target)
+        if not objects:
+            self.report({"ERROR"}, "SG-PRT bake: no mesh object selected" if self.target == "SELECTED"
+                        else "SG-PRT bake: no visible mesh object")
+            return None
+        depsgraph = context.evaluated_depsgraph_get()
+        receivers, seen = [], set()
+        for obj in objects:
+            if obj.data.name in seen:
+                self.report({"WARNING"}, f"'{obj.name}' shares its mesh with an object baked already; "
+                                         "the bake is stored once per mesh")
+                continue
+            try:
+                vertices, normals, triangles = receiver_arrays(obj, depsgraph)
+            except ValueError as error:
+                self.report({"WARNING"}, f"SG-PRT bake skips {error}")
+                continue
+            seen.add(obj.data.name)
+            receivers.append((obj.data.name, obj.name, vertices, normals, triangles))
+        if not receivers:
+            self.report({"ERROR"}, "SG-PRT bake: none of the objects can be baked (see the warnings)")
+            return None
+        occluder_vertices, occluder_triangles = occluder_arrays(depsgraph)
+        self._topology = {key: mesh_topology_hash(bpy.data.meshes[key]) for key, *_ in receivers}
+        return BakeJob(receivers, occluder_vertices, occluder_triangles, _bake_options(self),
+                       verbose=bpy.app.background, hook=progress_hook)
+
+    def _finish(self, context, job):
+        if job.cancelled:
+            self.report({"WARNING"}, "SG-PRT bake cancelled: nothing written, previous bakes kept")
+            return {"CANCELLED"}
+        if job.error is not None:
+            self.report({"ERROR"}, f"SG-PRT bake failed, nothing written: {job.error}")
+            return {"CANCELLED"}
+        written = []
+        for key, result in job.results.items():
+            mesh = bpy.data.meshes.get(key)
+            if mesh is None or mesh_topology_hash(mesh) != self._topology[key]:
+                self.report({"WARNING"}, f"mesh '{key}' changed during the bake: not stored")
+                continue
+            store_visibility_bake(mesh, result, job.options)
+            mesh.update()
+            written.append(f"{key} ({result.terms} terms, {np.degrees(result.rms_error):.2f} deg, "
+                           f"{result.seconds:.1f} s)")
+        if not written:
+            return {"CANCELLED"}
+        self.report({"INFO"}, "SG-PRT baked " + ", ".join(written))
+        return {"FINISHED"}
+
+    def execute(self, context):
+        job = self._prepare(context)
+        if job is None:
+            return {"CANCELLED"}
+        job.run()
+        return self._finish(context, job)
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        job = self._prepare(context)
+        if job is None:
+            return {"CANCELLED"}
+        self._job = job
+        SGPRT_OT_bake_visibility._running = True
+        job.start()
+        window_manager = context.window_manager
+        self._timer = window_manager.event_timer_add(0.25, window=context.window)
+        window_manager.progress_begin(0, 100)
+        window_manager.modal_handler_add(self)
+        self._status(context, "SG-PRT bake: starting (Esc cancels)")
+        return {"RUNNING_MODAL"}
+
+    def _status(self, context, text):
+        if context.workspace is not None:
+            context.workspace.status_text_set(text)
+
+    def _cleanup(self, context):
+        SGPRT_OT_bake_visibility._running = False
+        window_manager = context.window_manager
+        if getattr(self, "_timer", None) is not None:
+            window_manager.event_timer_remove(self._timer)
+            self._timer = None
+        window_manager.progress_end()
+        self._status(context, None)
+
+    def modal(self, context, event):
+        job = self._job
+        if event.type == "ESC" and event.value == "PRESS":
+            job.cancel()
+            self._status(context, "SG-PRT bake: cancelling...")
+            return {"RUNNING_MODAL"}
+        if event.type == "TIMER":
+            context.window_manager.progress_update(int(job.fraction * 100))
+            if not job._cancel.is_set():
+                self._status(context, f"SG-PRT bake {job.fraction * 100:.0f}%: {job.message} (Esc cancels)")
+            if not job.running:
+                job.join()
+                self._cleanup(context)
+                return self._finish(context, job)
+        return {"PASS_THROUGH"}
+
+    def cancel(self, context):
+        job = getattr(self, "_job", None)
+        if job is not None:
+            job.cancel()
+            job.join()
+        self._cleanup(context)
+
+
+class SGPRT_OT_clear_visibility(bpy.types.Operator):
+    """Remove the stored visibility bake of the selected mesh objects"""
+    bl_idname = "sgprt.clear_visibility"
+    bl_label = "Clear Visibility Bake"
+    bl_options = {"REGISTER", "UNDO"}
+
+    target: EnumProperty(name="Target", items=TARGETS, default="SELECTED")
+
+    def execute(self, context):
+        objects = _mesh_objects(context, self.target)
+        if not objects and context.active_object is not None and context.active_object.type == "MESH":
+            objects = [context.active_object]
+        if not objects:
+            self.report({"ERROR"}, "SG-PRT: no mesh object selected")
+            return {"CANCELLED"}
+        cleared = [obj.data.name for obj in objects if clear_visibility_bake(obj.data)]
+        for name in cleared:
+            bpy.data.meshes[name].update()
+        self.report({"INFO"}, f"SG-PRT cleared {len(cleared)} bake(s)")
+        return {"FINISHED"}
+
+
+class SGPRT_PT_visibility_bake(bpy.types.Panel):
+    bl_label = "SG-PRT Visibility Bake"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {"SG_PRT"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        settings = context.scene.sgprt_bake
+        layout.prop(settings, "target")
+        layout.prop(settings, "resolution")
+        layout.prop(settings, "refinement")
+        layout.prop(settings, "term_mode")
+        if settings.term_mode == "FIXED":
+            layout.prop(settings, "terms")
+        else:
+            layout.prop(settings, "error_target")
+        layout.prop(settings, "max_terms")
+        row = layout.row(align=True)
+        row.operator(SGPRT_OT_bake_visibility.bl_idname, icon="RENDER_STILL")
+        row.operator(SGPRT_OT_clear_visibility.bl_idname, text="", icon="X")
+        obj = context.active_object
+        if obj is None or obj.type != "MESH":
+            layout.label(text="Active object: not a mesh", icon="INFO")
+            return
+        try:
+            stored = visibility_for_object(obj.evaluated_get(context.evaluated_depsgraph_get()),
+                                           read_arrays=False)
+        except Exception as error:      # a panel must draw whatever the data
+            layout.label(text=f"{obj.name}: cannot read the bake ({error})", icon="ERROR")
+            return
+        column = layout.column(align=True)
+        if stored is None:
+            column.label(text=f"{obj.name}: not baked (renders unshadowed)", icon="INFO")
+        elif stored.usable:
+            column.label(text=f"{obj.name}: {stored.terms} terms, {stored.resolution}x{stored.resolution}",
+                         icon="CHECKMARK")
+            column.label(text=f"RMS error {np.degrees(stored.rms_error):.2f} deg, {stored.vertex_count} vertices")
+            column.label(text=f"Baked {stored.date}")
+        else:
+            column.alert = True
+            column.label(text=f"{obj.name}: {stored.message}", icon="ERROR")
+            column.label(text="Renders unshadowed until re-baked")
+
+
+classes = (SGPRT_PG_bake, SGPRT_OT_bake_visibility, SGPRT_OT_clear_visibility, SGPRT_PT_visibility_bake)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.sgprt_bake = PointerProperty(type=SGPRT_PG_bake, name="SG-PRT Bake",
+                                                 description="SG-PRT visibility bake settings")
+
+
+def unregister():
+    del bpy.types.Scene.sgprt_bake
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,244 @@
+"""Visibility bake operator and its storage: real bpy, real .blend files saved and reopened.
+
+A small Suzanne (507 vertices) floats over a 10 x 10 floor; bakes run at 12 x 12 samples.
+"""
+import bmesh
+import bpy
+import numpy as np
+import pytest
+
+from sg_prt_addon.bake import decode, hemisphere_map
+from sg_prt_addon.bake.pipeline import BakeOptions, bake_visibility
+from sg_prt_addon.blender import visibility_bake as vb
+
+SMALL = dict(resolution=12, refinement=3, term_mode="FIXED", terms=6, max_terms=47)
+
+
+def _scene():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "SG_PRT"
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=10, y_subdivisions=10, size=4.0)
+    floor = bpy.context.active_object
+    floor.name = "Floor"
+    bpy.ops.mesh.primitive_monkey_add(size=1.0, location=(0.0, 0.0, 1.0))
+    suzanne = bpy.context.active_object
+    suzanne.name = "Suzanne"
+    for key, value in SMALL.items():
+        setattr(scene.sgprt_bake, key, value)
+    return scene, floor, suzanne
+
+
+def _select(*objects):
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(obj in objects)
+    if objects:
+        bpy.context.view_layer.objects.active = objects[0]
+
+
+def _bits(array):
+    return np.ascontiguousarray(array, np.float32).view(np.uint32)
+
+
+def _reopen(path):
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+
+
+@pytest.fixture
+def scene(addon):
+    yield _scene()
+    vb.progress_hook = None
+
+
+def test_operator_bakes_floor_and_suzanne_and_stores_attributes(scene, capfd, tmp_path):
+    _, floor, suzanne = scene
+    capfd.readouterr()
+    assert bpy.ops.sgprt.bake_visibility(target="ALL") == {"FINISHED"}
+    printed = capfd.readouterr().out
+    assert "[sg-prt] bake" in printed and "100%" in printed
+
+    for obj in (floor, suzanne):
+        mesh = obj.data
+        layers = -(-(SMALL["terms"] + 1) // 4)
+        names = [a.name for a in mesh.attributes if a.name.startswith(vb.ATTRIBUTE_PREFIX)]
+        assert names == [vb.attribute_name(k) for k in range(layers)]
+        for name in names:
+            assert mesh.attributes[name].data_type == "FLOAT_COLOR" and mesh.attributes[name].domain == "POINT"
+        meta = mesh[vb.PROPERTY]
+        assert meta["vertex_count"] == len(mesh.vertices) and meta["terms"] == SMALL["terms"]
+        assert meta["resolution"] == SMALL["resolution"] and meta["format_version"] == vb.FORMAT_VERSION
+        assert len(meta["basis"]) == SMALL["terms"] * 12 * 12 and len(meta["mean"]) == 144
+
+    stored = vb.load_visibility_bake(floor.data)
+    assert stored.usable, stored.message
+    assert stored.packed_coefficients.shape == (len(floor.data.vertices), 8)
+    assert np.all(stored.packed_coefficients[:, 0] == 1.0)
+
+    # the floor vertex right under Suzanne: occluded straight up, open towards the low sky beside her
+    matrix = np.array(floor.matrix_world)
+    positions = np.array([matrix[:3, :3] @ v.co + matrix[:3, 3] for v in floor.data.vertices])
+    below = int(np.argmin(np.linalg.norm(positions[:, :2], axis=1)))
+    frame = hemisphere_map.local_frame(np.array([0.0, 0.0, 1.0]))
+    up = decode.decode(stored.coefficients[below], stored.basis, stored.mean, frame @ [0.0, 0.0, 1.0])
+    sky = np.array([1.0, 0.3, 0.25]) / np.linalg.norm([1.0, 0.3, 0.25])
+    open_sky = decode.decode(stored.coefficients[below], stored.basis, stored.mean, frame @ sky)
+    print("SSDF up", up, "sky", open_sky)
+    assert up < -0.1 and open_sky > 0.05, (up, open_sky)
+    # a floor corner far from Suzanne sees sky straight up
+    corner = int(np.argmax(np.linalg.norm(positions[:, :2], axis=1)))
+    assert decode.decode(stored.coefficients[corner], stored.basis, stored.mean, frame @ [0.0, 0.0, 1.0]) > 0.5
+
+    before = {obj.name: vb.load_visibility_bake(obj.data) for obj in (floor, suzanne)}
+    _reopen(tmp_path / "baked.blend")
+    for name, old in before.items():
+        new = vb.load_visibility_bake(bpy.data.objects[name].data)
+        assert new.usable, new.message
+        for field in ("packed_coefficients", "basis", "mean"):
+            assert np.array_equal(_bits(getattr(new, field)), _bits(getattr(old, field))), (name, field)
+        assert (new.terms, new.rms_error, new.topology_hash, new.date) == (old.terms, old.rms_error,
+                                                                           old.topology_hash, old.date)
+        assert np.array_equal(new.frame_reference_axis, hemisphere_map.FRAME_REFERENCE_AXIS)
+
+
+def test_store_is_bit_exact_against_the_bake_result(scene, tmp_path):
+    _, floor, suzanne = scene
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    vertices, normals, triangles = vb.receiver_arrays(suzanne, depsgraph)
+    occluder_vertices, occluder_triangles = vb.occluder_arrays(depsgraph)
+    assert len(occluder_triangles) == len(floor.data.loop_triangles) + len(suzanne.data.loop_triangles)
+    result = bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_triangles,
+                             BakeOptions(resolution=8, refinement=1, terms=None, error_target=0.05, max_terms=9))
+    vb.store_visibility_bake(suzanne.data, result)
+    assert result.topology_hash == vb.mesh_topology_hash(suzanne.data)
+    _reopen(tmp_path / "direct.blend")
+    stored = vb.load_visibility_bake(bpy.data.objects["Suzanne"].data)
+    assert stored.usable and stored.terms == result.terms
+    assert np.array_equal(_bits(stored.coefficients), _bits(result.coefficients))
+    assert np.array_equal(_bits(stored.basis), _bits(result.basis))
+    assert np.array_equal(_bits(stored.mean), _bits(result.mean))
+    assert stored.rms_error == pytest.approx(result.rms_error, rel=1e-12)
+
+
+def test_cancelled_rebake_keeps_the_previous_bake(scene, tmp_path):
+    _, floor, suzanne = scene
+    _select(suzanne)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    previous = vb.load_visibility_bake(suzanne.data)
+    calls = []
+
+    def cancel_midway(fraction, message):
+        calls.append(fraction)
+        return fraction > 0.2
+
+    vb.progress_hook = cancel_midway
+    # a different setting: had anything been written, the data would differ
+    assert bpy.ops.sgprt.bake_visibility(resolution=8, terms=3) == {"CANCELLED"}
+    vb.progress_hook = None
+    assert calls and max(calls) < 1.0
+    _reopen(tmp_path / "cancelled.blend")
+    kept = vb.load_visibility_bake(bpy.data.objects["Suzanne"].data)
+    assert kept.usable and kept.resolution == 12 and kept.terms == SMALL["terms"]
+    for field in ("packed_coefficients", "basis", "mean"):
+        assert np.array_equal(_bits(getattr(kept, field)), _bits(getattr(previous, field))), field
+    assert kept.date == previous.date
+    assert vb.load_visibility_bake(bpy.data.objects["Floor"].data) is None
+
+
+def test_threaded_job_cancels_and_writes_nothing(scene):
+    _, floor, suzanne = scene
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    vertices, normals, triangles = vb.receiver_arrays(floor, depsgraph)
+    job = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles)], *vb.occluder_arrays(depsgraph),
+                     BakeOptions(resolution=8, refinement=1, terms=2), hook=lambda f, m: f > 0.0)
+    job.start()
+    job.join(30)
+    assert not job.running and job.cancelled and job.results == {} and job.error is None
+    done = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles)], *vb.occluder_arrays(depsgraph),
+                      BakeOptions(resolution=8, refinement=1, terms=2))
+    done.start()
+    done.join(30)
+    assert not done.cancelled and done.results["Floor"].coefficients.shape == (len(vertices), 2)
+    assert done.fraction == 1.0
+
+
+def test_topology_edits_make_the_bake_stale(scene, tmp_path):
+    _, floor, suzanne = scene
+    _select(floor)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    assert vb.load_visibility_bake(floor.data).usable
+    obj_eval = floor.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    assert vb.visibility_for_object(obj_eval).usable
+
+    # same vertex count, one face fewer: the topology hash catches it
+    bm = bmesh.new()
+    bm.from_mesh(floor.data)
+    bm.faces.ensure_lookup_table()
+    bmesh.ops.delete(bm, geom=[bm.faces[0]], context="FACES_ONLY")
+    bm.to_mesh(floor.data)
+    bm.free()
+    floor.data.update()
+    stale = vb.load_visibility_bake(floor.data)
+    assert stale.status == "STALE" and "topology" in stale.message
+    assert stale.packed_coefficients is None and not stale.usable
+    with pytest.raises(ValueError):
+        stale.corner_coefficients([0, 1, 2])
+
+    # one vertex more
+    floor.data.vertices.add(1)
+    floor.data.update()
+    _reopen(tmp_path / "stale.blend")
+    stale = vb.load_visibility_bake(bpy.data.objects["Floor"].data)
+    assert stale.status == "STALE" and "vertices" in stale.message and stale.coefficients is None
+
+    # a topology-changing modifier added after the bake: the engine's evaluated mesh is stale
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    _, floor, suzanne = _scene()
+    _select(suzanne)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    suzanne.modifiers.new("Subdivision", "SUBSURF").levels = 1
+    obj_eval = suzanne.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    assert vb.visibility_for_object(obj_eval).status == "STALE"
+    assert vb.load_visibility_bake(suzanne.data).usable          # the datablock itself is intact
+    # ...and baking through that modifier is refused with a report
+    with pytest.raises(RuntimeError, match="can be baked"):
+        bpy.ops.sgprt.bake_visibility()
+
+    assert bpy.ops.sgprt.clear_visibility() == {"FINISHED"}
+    assert vb.load_visibility_bake(suzanne.data) is None
+    assert not any(a.name.startswith(vb.ATTRIBUTE_PREFIX) for a in suzanne.data.attributes)
+
+
+def test_bad_input_reports_instead_of_raising_tracebacks(scene, capfd):
+    _, floor, suzanne = scene
+    _select()
+    with pytest.raises(RuntimeError, match="no mesh object selected"):
+        bpy.ops.sgprt.bake_visibility()
+    points = bpy.data.objects.new("Points", bpy.data.meshes.new("Points"))
+    points.data.vertices.add(3)
+    bpy.context.scene.collection.objects.link(points)
+    _select(points)
+    capfd.readouterr()
+    with pytest.raises(RuntimeError, match="none of the objects can be baked"):
+        bpy.ops.sgprt.bake_visibility()
+    assert "has no faces" in capfd.readouterr().out + capfd.readouterr().err
+    assert vb.load_visibility_bake(points.data) is None
+    # a faceless object among good ones is skipped, the others are baked
+    _select(points, suzanne)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    assert vb.load_visibility_bake(suzanne.data).usable and vb.load_visibility_bake(points.data) is None
+
+
+def test_damaged_storage_is_invalid_not_out_of_bounds(scene):
+    _, floor, suzanne = scene
+    _select(suzanne)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    stored = vb.load_visibility_bake(suzanne.data)
+    with pytest.raises(IndexError):
+        stored.corner_coefficients([0, len(suzanne.data.vertices)])
+    suzanne.data.attributes.remove(suzanne.data.attributes[vb.attribute_name(1)])
+    damaged = vb.load_visibility_bake(suzanne.data)
+    assert damaged.status == "INVALID" and damaged.packed_coefficients is None
+    suzanne.data[vb.PROPERTY]["format_version"] = 99
+    assert "format" in vb.load_visibility_bake(suzanne.data).message
