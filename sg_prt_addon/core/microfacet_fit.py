@@ -370,7 +370,7 @@ def _ndf_normalization(ndf, ndf_theta):
 
 
 def factorize(wo, wi, rho, weights=None, valid=None, eta=PAPER_ETA, ndf_theta=None, shadowing_theta=None,
-              iterations=3, polish_iterations=4, smoothness=1e-4, shadowing_smoothness=0.1, chunk=256, progress=None):
+              iterations=4, polish_iterations=2, smoothness=1e-4, shadowing_smoothness=0.1, chunk=256, progress=None):
     """Recover (kd, ks, eta, D, S) per texel from samples (see module doc).
 
     wo, wi (N, 3) shared direction pairs above the horizon; rho (B, N, 3) (or (N, 3));

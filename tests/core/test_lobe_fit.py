@@ -30,9 +30,10 @@ def test_factorization_recovers_known_ndf_and_shadowing(synthetic):
     gauge = true_shadowing[:, table.shadowing_theta < np.radians(60)].mean(axis=1)
     true_shadowing /= gauge[:, None]
     # the smoothing that keeps out-of-class data stable (microfacet_fit.POLISH_SMOOTHNESS_RATIO)
-    # costs the roughest texels (roughness ~0.6, S curved everywhere) most: measured 0.106, 0.069
+    # costs the roughest texels (roughness ~0.6, S curved everywhere) most: measured max 0.065,
+    # median 0.026 (a tilt of S that D nearly compensates: the residual stays < 0.8%)
     shadowing_error = np.max(np.abs(result.shadowing - true_shadowing), axis=1)
-    assert np.max(shadowing_error) < 0.12 and np.median(shadowing_error) < 0.04
+    assert np.max(shadowing_error) < 0.09 and np.median(shadowing_error) < 0.035
     true_specular_ndf = (table.flat("specular").mean(1) * gauge ** 2)[:, None] * table.flat("ndf")[..., 0]
     theta, quadrature = microfacet_fit._ndf_quadrature(table.ndf_theta)
     fitted = microfacet_fit._interpolate_rows(result.specular.mean(1, keepdims=True) * result.ndf, table.ndf_theta,
