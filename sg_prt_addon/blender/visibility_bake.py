@@ -325,6 +325,18 @@ def visibility_for_object(object_eval, read_arrays=True):
     return load_visibility_bake(original.data, evaluated_mesh=object_eval.data, read_arrays=read_arrays)
 
 
+def unusable_bakes(scene, depsgraph):
+    """[(object name, message)] of the scene's visible mesh objects whose stored bake is stale or damaged
+    (they render unshadowed): what the operator and the panel warn about."""
+    found = []
+    for obj in scene.objects:
+        if obj.type == "MESH" and obj.visible_get() and PROPERTY in obj.data.keys():
+            stored = visibility_for_object(obj.evaluated_get(depsgraph), read_arrays=False)
+            if stored is not None and not stored.usable:
+                found.append((obj.name, stored.message))
+    return found
+
+
 # --------------------------------------------------------------------------- the bake job (no bpy)
 
 class BakeJob:
@@ -517,8 +529,11 @@ class SGPRT_OT_bake_visibility(bpy.types.Operator):
                 continue
             store_visibility_bake(mesh, result, job.options)
             mesh.update()
-            written.append(f"{key} ({result.terms} terms, {np.degrees(result.rms_error):.2f} deg, "
+            label = next(label for k, label, *_ in job.receivers if k == key)
+            written.append(f"{label} ({result.terms} terms, {np.degrees(result.rms_error):.2f} deg, "
                            f"{result.seconds:.1f} s)")
+        for name, message in unusable_bakes(context.scene, context.evaluated_depsgraph_get()):
+            self.report({"WARNING"}, f"SG-PRT: '{name}' renders unshadowed, its bake is {message}")
         if not written:
             return {"CANCELLED"}
         self.report({"INFO"}, "SG-PRT baked " + ", ".join(written))

@@ -163,7 +163,7 @@ def test_threaded_job_cancels_and_writes_nothing(scene):
     assert done.fraction == 1.0
 
 
-def test_topology_edits_make_the_bake_stale(scene, tmp_path):
+def test_topology_edits_make_the_bake_stale(scene, tmp_path, capfd):
     _, floor, suzanne = scene
     _select(floor)
     assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
@@ -184,6 +184,15 @@ def test_topology_edits_make_the_bake_stale(scene, tmp_path):
     assert stale.packed_coefficients is None and not stale.usable
     with pytest.raises(ValueError):
         stale.corner_coefficients([0, 1, 2])
+
+    # the next bake (of another object) warns about the stale one
+    _select(suzanne)
+    capfd.readouterr()
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    warned = capfd.readouterr()
+    assert "'Floor' renders unshadowed" in warned.out + warned.err
+    assert [name for name, _ in vb.unusable_bakes(bpy.context.scene, bpy.context.evaluated_depsgraph_get())] \
+        == ["Floor"]
 
     # one vertex more
     floor.data.vertices.add(1)
@@ -242,3 +251,14 @@ def test_damaged_storage_is_invalid_not_out_of_bounds(scene):
     assert damaged.status == "INVALID" and damaged.packed_coefficients is None
     suzanne.data[vb.PROPERTY]["format_version"] = 99
     assert "format" in vb.load_visibility_bake(suzanne.data).message
+
+
+def test_invoke_runs_synchronously_headless_and_the_panel_is_registered(scene):
+    _, floor, suzanne = scene
+    _select(suzanne)
+    assert bpy.ops.sgprt.bake_visibility("INVOKE_DEFAULT", resolution=8, terms=2) == {"FINISHED"}
+    stored = vb.load_visibility_bake(suzanne.data)
+    assert stored.usable and stored.resolution == 8 and stored.terms == 2
+    panel = bpy.types.SGPRT_PT_visibility_bake
+    assert panel.bl_context == "render" and panel.COMPAT_ENGINES == {"SG_PRT"}
+    assert bpy.context.scene.sgprt_bake.resolution == SMALL["resolution"]   # operator options do not leak
