@@ -375,7 +375,8 @@ def factorize(wo, wi, rho, weights=None, valid=None, eta=PAPER_ETA, ndf_theta=No
 
     wo, wi (N, 3) shared direction pairs above the horizon; rho (B, N, 3) (or (N, 3));
     weights (N,) quadrature weights (default 1); valid (B, N) or (N,) bool (default all);
-    eta a float, or a sequence of candidates (each texel keeps the best residual).
+    eta a float, or a sequence of candidates (each texel keeps the one whose screening fit has
+    the smallest residual).
     Returns a MicrofacetFactorization, or None if ``progress`` returned True.
     """
     wo, wi = np.asarray(wo, np.float64), np.asarray(wi, np.float64)
@@ -394,37 +395,53 @@ def factorize(wo, wi, rho, weights=None, valid=None, eta=PAPER_ETA, ndf_theta=No
     out = {"ndf": np.empty((batch, len(ndf_theta))), "shadowing": np.empty((batch, len(shadowing_theta))),
            "eta": np.empty(batch), "residual": np.full(batch, np.inf),
            "diffuse": np.empty((batch, 3)), "specular": np.empty((batch, 3))}
-    steps = len(candidates) * ((batch + chunk - 1) // chunk)
+    # several eta: a cheap screening pass (one log-domain step, no polish) picks each texel's
+    # eta, then one full fit per chosen value (measured: same choice and error as full fits of
+    # every candidate, at about a third of the cost for 5 candidates)
+    screening = len(candidates) > 1
+    steps = (2 * len(candidates) if screening else 1) * ((batch + chunk - 1) // chunk)
     done = 0
     for start in range(0, batch, chunk):
-        part = slice(start, min(start + chunk, batch))
+        part = np.arange(start, min(start + chunk, batch))
         texel_rho = rho[part]
         texel_weights = pairs.weights * valid[part]
         grey = texel_rho.mean(axis=-1)
-        for candidate in candidates:
+        choice = np.zeros(len(part), int)
+        if screening:
+            screen = np.empty((len(part), len(candidates)))
+            for index, candidate in enumerate(candidates):
+                if progress is not None and progress(done / steps):
+                    return None
+                done += 1
+                screen[:, index] = _factorize_chunk(pairs, grey, texel_weights, candidate, 1, smoothness,
+                                                    shadowing_smoothness, 0)[3]
+            choice = np.argmin(screen, axis=1)
+        for index, candidate in enumerate(candidates):
+            chosen = np.nonzero(choice == index)[0]
             if progress is not None and progress(done / steps):
                 return None
             done += 1
-            ndf, shadowing, shape, residual = _factorize_chunk(pairs, grey, texel_weights, candidate, iterations,
-                                                               smoothness, shadowing_smoothness, polish_iterations)
-            better = residual < out["residual"][part]
-            rows = np.arange(part.start, part.stop)[better]
+            if len(chosen) == 0:
+                continue
+            ndf, shadowing, shape, residual = _factorize_chunk(pairs, grey[chosen], texel_weights[chosen], candidate,
+                                                               iterations, smoothness, shadowing_smoothness,
+                                                               polish_iterations)
+            rows = part[chosen]
             # per channel: rho_c = kd_c / pi + ks_c * shape, a 2x2 weighted least squares
-            w = texel_weights[better]
-            g = shape[better]
-            sw, sg, sgg = w.sum(1), (w * g).sum(1), (w * g * g).sum(1)
-            y = texel_rho[better]
-            sy, sgy = np.einsum("bn,bnc->bc", w, y), np.einsum("bn,bnc->bc", w * g, y)
+            w = texel_weights[chosen]
+            sw, sg, sgg = w.sum(1), (w * shape).sum(1), (w * shape * shape).sum(1)
+            y = texel_rho[chosen]
+            sy, sgy = np.einsum("bn,bnc->bc", w, y), np.einsum("bn,bnc->bc", w * shape, y)
             determinant = np.maximum(sw * sgg - sg * sg, 1e-300)[:, None]
             ks = np.maximum((sw[:, None] * sgy - sg[:, None] * sy) / determinant, 0)
             kd_over_pi = np.maximum((sy - ks * sg[:, None]) / np.maximum(sw, 1e-300)[:, None], 0)
-            normalization = np.maximum(_ndf_normalization(ndf[better], ndf_theta), 1e-300)
-            out["ndf"][rows] = ndf[better] / normalization[:, None]
+            normalization = np.maximum(_ndf_normalization(ndf, ndf_theta), 1e-300)
+            out["ndf"][rows] = ndf / normalization[:, None]
             out["specular"][rows] = ks * normalization[:, None]
             out["diffuse"][rows] = kd_over_pi * np.pi
-            out["shadowing"][rows] = shadowing[better]
+            out["shadowing"][rows] = shadowing
             out["eta"][rows] = candidate
-            out["residual"][rows] = residual[better]
+            out["residual"][rows] = residual
     if progress is not None and progress(1.0):
         return None
     return MicrofacetFactorization(ndf_theta=ndf_theta, shadowing_theta=shadowing_theta, **out)
