@@ -6,8 +6,8 @@ from .properties import ANISOTROPIC_MODELS, MODEL_PARAMETERS
 ENGINE_ID = "SG_PRT"
 
 
-class SGPRT_PT_material(bpy.types.Panel):
-    bl_label = "SG-PRT Surface"
+class _MaterialPanel:
+    """Placement and poll shared by the material panels: shown while SG-PRT renders."""
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "material"
@@ -16,6 +16,10 @@ class SGPRT_PT_material(bpy.types.Panel):
     @classmethod
     def poll(cls, context):
         return context.engine in cls.COMPAT_ENGINES and context.material is not None
+
+
+class SGPRT_PT_material(_MaterialPanel, bpy.types.Panel):
+    bl_label = "SG-PRT Surface"
 
     def draw(self, context):
         settings = context.material.sgprt
@@ -31,18 +35,10 @@ class SGPRT_PT_material(bpy.types.Panel):
         layout.prop(settings, "show_textures")
 
 
-class SGPRT_PT_material_geometry(bpy.types.Panel):
+class SGPRT_PT_material_geometry(_MaterialPanel, bpy.types.Panel):
     bl_label = "Normal and Tangent"
     bl_parent_id = "SGPRT_PT_material"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
-    bl_context = "material"
     bl_options = {"DEFAULT_CLOSED"}
-    COMPAT_ENGINES = {ENGINE_ID}
-
-    @classmethod
-    def poll(cls, context):
-        return context.engine in cls.COMPAT_ENGINES and context.material is not None
 
     def draw(self, context):
         settings = context.material.sgprt
