@@ -4,7 +4,7 @@
 
 Stages, each timed on a size x size material (default 16):
   factorize   per-texel samples (a 'measured' SVBRDF: 32x16x16 half/difference pairs a
-              texel, 2% noise) -> kd, ks, D, S (one eta; the eta search multiplies the cost)
+              texel, 2% noise) -> kd, ks, D, S, with one eta or 5 candidates screened
   iso 1, 2    SG lobes around z+ of the tabulated D (batched Levenberg-Marquardt) + PCA of S
   free 4      4 free-axis lobes (batched Levenberg-Marquardt), on the first 64 texels
 """
@@ -41,6 +41,9 @@ def main(size=16):
     print(f"{texels} texels, {len(wo)} direction pairs a texel", flush=True)
     factorization, wall, cpu = _timed(lambda: microfacet_fit.factorize(wo, wi, rho, weights, eta=1.5))
     _report("factorize (1 eta)", texels, wall, cpu)
+    _, wall, cpu = _timed(lambda: microfacet_fit.factorize(wo, wi, rho, weights,
+                                                           eta=microfacet_fit.DEFAULT_ETA_CANDIDATES))
+    _report("factorize (5 eta screened)", texels, wall, cpu)
     table = factorization.to_table((size, size))
     for lobe_count in (1, 2):
         _, wall, cpu = _timed(lambda: microfacet_fit.fit_lobes(table, lobe_count))
