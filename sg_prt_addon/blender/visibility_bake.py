@@ -116,6 +116,8 @@ def receiver_arrays(obj, depsgraph):
     geometry; ValueError with a message for the user when it cannot be baked."""
     if obj.type != "MESH":
         raise ValueError(f"'{obj.name}' is not a mesh")
+    if obj.data.library is not None or getattr(obj.data, "override_library", None) is not None:
+        raise ValueError(f"'{obj.name}' uses a linked mesh, which cannot store a bake")
     if obj.mode == "EDIT":
         raise ValueError(f"'{obj.name}' is in Edit Mode: leave it before baking")
     if len(obj.data.polygons) == 0:
@@ -251,7 +253,10 @@ def store_visibility_bake(mesh, result, options=None):
 
 
 def _float_array(value):
-    return np.asarray(value.to_list() if hasattr(value, "to_list") else list(value), np.float64)
+    try:
+        return np.array(value, np.float64).ravel()          # IDPropertyArray: buffer protocol, no list
+    except (TypeError, ValueError):
+        return np.asarray(value.to_list() if hasattr(value, "to_list") else list(value), np.float64).ravel()
 
 
 def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
@@ -576,6 +581,16 @@ class SGPRT_OT_bake_visibility(bpy.types.Operator):
         self._status(context, None)
 
     def modal(self, context, event):
+        try:
+            return self._modal(context, event)
+        except Exception as error:      # never leave the thread running or the button disabled
+            self._job.cancel()
+            self._job.join()
+            self._cleanup(context)
+            self.report({"ERROR"}, f"SG-PRT bake failed, nothing written: {error}")
+            return {"CANCELLED"}
+
+    def _modal(self, context, event):
         job = self._job
         if event.type == "ESC" and event.value == "PRESS":
             job.cancel()
@@ -653,8 +668,8 @@ class SGPRT_PT_visibility_bake(bpy.types.Panel):
             layout.label(text="Active object: not a mesh", icon="INFO")
             return
         try:
-            stored = visibility_for_object(obj.evaluated_get(context.evaluated_depsgraph_get()),
-                                           read_arrays=False)
+            # the view layer's depsgraph as last evaluated: drawing must not trigger an evaluation
+            stored = visibility_for_object(obj.evaluated_get(context.view_layer.depsgraph), read_arrays=False)
         except Exception as error:      # a panel must draw whatever the data
             layout.label(text=f"{obj.name}: cannot read the bake ({error})", icon="ERROR")
             return

@@ -259,6 +259,9 @@ def test_invoke_runs_synchronously_headless_and_the_panel_is_registered(scene):
     assert bpy.ops.sgprt.bake_visibility("INVOKE_DEFAULT", resolution=8, terms=2) == {"FINISHED"}
     stored = vb.load_visibility_bake(suzanne.data)
     assert stored.usable and stored.resolution == 8 and stored.terms == 2
+    # what the panel reads: status only, from the view layer's depsgraph, no arrays
+    status = vb.visibility_for_object(suzanne.evaluated_get(bpy.context.view_layer.depsgraph), read_arrays=False)
+    assert status.usable and status.packed_coefficients is None and "2 terms" in status.message
     panel = bpy.types.SGPRT_PT_visibility_bake
     assert panel.bl_context == "render" and panel.COMPAT_ENGINES == {"SG_PRT"}
     assert bpy.context.scene.sgprt_bake.resolution == SMALL["resolution"]   # operator options do not leak
