@@ -487,14 +487,15 @@ def _interpolate_rows(values, grid, theta):
 
 
 def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_count=None, progress=None,
-                  chunk=1024, max_iterations=50):
+                  chunk=1024, max_iterations=50, method="lm"):
     """SG mixtures of tabulated NDFs ndf (B, T) (isotropic) or (B, T, P) on (ndf_theta, ndf_phi).
 
     free_axes False (default for isotropic tables and K <= 2): K lobes around z+ by batched
     Levenberg-Marquardt (ndf_fit.fit_isotropic_batch); True: K free-axis lobes by batched
     Levenberg-Marquardt (fit_free_axes_batch) on a hemisphere quadrature with phi_count
     azimuths (default 12 for isotropic tables, where more did not lower the error, else 32),
-    at most max_iterations steps.  Returns (axis (B, K, 3),
+    at most max_iterations steps.  method "L-BFGS-B" or "TNC" runs the paper's per-texel
+    quasi-Newton fit instead (ndf_fit.fit_anisotropic, same start and quadrature; slower).  Returns (axis (B, K, 3),
     sharpness (B, K), amplitude (B, K), relative L2 of D (B,)), lobes sorted by increasing
     sharpness, or None if cancelled.
     """
@@ -513,7 +514,7 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
         sharpness, amplitude, error = np.ones((batch, lobe_count)), np.zeros((batch, lobe_count)), np.zeros(batch)
         if not empty.all():
             fitted = fit_ndf_lobes(ndf_theta, table[~empty], lobe_count, ndf_phi, free_axes, phi_count, progress,
-                                   chunk, max_iterations)
+                                   chunk, max_iterations, method)
             if fitted is None:
                 return None
             axis[~empty], sharpness[~empty], amplitude[~empty], error[~empty] = fitted
@@ -560,8 +561,14 @@ def fit_ndf_lobes(ndf_theta, ndf, lobe_count, ndf_phi=None, free_axes=None, phi_
                 initial = _tilted_start(start_sharpness, start_amplitude, lobe_count)
             else:
                 initial = _moment_start(values, directions, solid_angle, table[part, 0].mean(axis=1), lobe_count)
-            axis[part], sharpness[part], amplitude[part], error[part] = fit_free_axes_batch(
-                values, directions, solid_angle, initial, max_iterations)
+            if method == "lm":
+                axis[part], sharpness[part], amplitude[part], error[part] = fit_free_axes_batch(
+                    values, directions, solid_angle, initial, max_iterations)
+                continue
+            for offset, texel in enumerate(range(start, min(start + small_chunk, batch))):
+                axis[texel], sharpness[texel], amplitude[texel], error[texel] = ndf_fit.fit_anisotropic(
+                    values[offset], directions, solid_angle, lobe_count,
+                    initial=tuple(a[offset] for a in initial), max_iterations=max_iterations, method=method)
     if progress is not None and progress(1.0):
         return None
     return axis, sharpness, amplitude, error

@@ -116,7 +116,8 @@ def test_merl_ggx_two_lobes_within_five_percent(ggx_merl):
     np.testing.assert_allclose(factorization.diffuse[0], [0.2, 0.15, 0.1], atol=0.01)
 
 
-def test_free_axis_lobes_of_tabulated_anisotropic_ndfs():
+@pytest.mark.parametrize("method", ["lm", "TNC"])
+def test_free_axis_lobes_of_tabulated_anisotropic_ndfs(method):
     """Tabulated anisotropic Ward NDFs (theta x 32 azimuths) fitted with 4 free-axis lobes at
     least as well as the analytic anisotropy table of ndf_fit (measured 0.084 vs 0.089,
     0.174 vs 0.172, 0.017 vs 0.084)."""
@@ -127,7 +128,7 @@ def test_free_axis_lobes_of_tabulated_anisotropic_ndfs():
     h = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
     models = [brdf.WardAnisotropic(alpha_x=ax, alpha_y=ay) for ax, ay in ((0.3, 0.1), (0.2, 0.05), (0.4, 0.2))]
     axis, sharpness, amplitude, _ = microfacet_fit.fit_ndf_lobes(theta, np.stack([m.ndf(h) for m in models]), 4,
-                                                                 ndf_phi=phi)
+                                                                 ndf_phi=phi, method=method, max_iterations=150)
     for model, lobes in zip(models, zip(axis, sharpness, amplitude)):
         error = ndf_fit.ndf_l2_error(model, lobes)
         assert error < 1.05 * ndf_fit.ndf_l2_error(model, model.ndf_lobes(4)) and error < 0.2
