@@ -10,8 +10,8 @@
  * The PrefilteredEnvironment's fields are passed explicitly: `layers` is the
  * 2D texture array (uploaded as is, linear filtering, clamp to edge),
  * log2_min_sharpness and levels_per_octave its level spacing, layer_count =
- * len(sharpness), and texcoord_scale_offset[k] = (texcoord_scale[k],
- * texcoord_offset[k]).  Define ENV_PREFILTER_MAX_LAYERS before this file to
+ * len(sharpness), texcoord_scale_offset[k] = (texcoord_scale[k],
+ * texcoord_offset[k]) and mean_radiance (RGB, A unused) the lambda = 0 limit.  Define ENV_PREFILTER_MAX_LAYERS before this file to
  * change the array size (the default levels 0.125..4096, 2 per octave, are 31).
  * Returns vec4: the layers' channels (RGB, A unused).
  */
@@ -50,10 +50,11 @@ float env_prefilter_blend_parameter(float sharpness, float log2_min_sharpness, f
 
 /* SG-weighted average radiance around axis for kernel sharpness: octahedral
  * coords, per-layer scale/offset, two hardware-bilinear fetches, linear blend
- * in log2 sharpness. */
+ * in log2 sharpness; below the broadest level (lambda_0 = 2^log2_min_sharpness)
+ * linear in lambda towards mean_radiance, the exact lambda = 0 value. */
 vec4 env_prefilter_lookup(sampler2DArray layers, vec3 axis, float sharpness,
                           float log2_min_sharpness, float levels_per_octave, int layer_count,
-                          vec2 texcoord_scale_offset[ENV_PREFILTER_MAX_LAYERS])
+                          vec2 texcoord_scale_offset[ENV_PREFILTER_MAX_LAYERS], vec4 mean_radiance)
 {
   vec2 coords = oct_encode(safe_normalize(axis));
   float position = env_prefilter_blend_parameter(sharpness, log2_min_sharpness, levels_per_octave, layer_count);
@@ -65,14 +66,16 @@ vec4 env_prefilter_lookup(sampler2DArray layers, vec3 axis, float sharpness,
   vec2 upper_transform = texcoord_scale_offset[upper];
   vec4 lower_value = texture(layers, vec3(coords * lower_transform.x + lower_transform.y, float(lower)));
   vec4 upper_value = texture(layers, vec3(coords * upper_transform.x + upper_transform.y, float(upper)));
-  return lower_value + (upper_value - lower_value) * fraction;
+  vec4 value = lower_value + (upper_value - lower_value) * fraction;
+  float below = isnan(sharpness) ? 0.0 : clamp(sharpness / exp2(log2_min_sharpness), 0.0, 1.0);
+  return mean_radiance + (value - mean_radiance) * below;
 }
 
 /* <G(axis, sharpness, amplitude), L> = amplitude Gamma_L (eq. 35): the lookup times the SG's integral. */
 vec4 env_prefilter_lookup_integral(sampler2DArray layers, vec3 axis, float sharpness, float amplitude,
                                    float log2_min_sharpness, float levels_per_octave, int layer_count,
-                                   vec2 texcoord_scale_offset[ENV_PREFILTER_MAX_LAYERS])
+                                   vec2 texcoord_scale_offset[ENV_PREFILTER_MAX_LAYERS], vec4 mean_radiance)
 {
   return env_prefilter_lookup(layers, axis, sharpness, log2_min_sharpness, levels_per_octave, layer_count,
-                              texcoord_scale_offset) * sg_sphere_integral(sharpness, amplitude);
+                              texcoord_scale_offset, mean_radiance) * sg_sphere_integral(sharpness, amplitude);
 }

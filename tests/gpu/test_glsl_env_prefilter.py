@@ -27,7 +27,8 @@ def _transform_source(prefiltered):
     return (f"const vec2 TEST_TRANSFORMS[32] = vec2[32]({items});\n"
             f"const float TEST_LOG2_MIN = {prefiltered.log2_min_sharpness!r};\n"
             f"const float TEST_LEVELS_PER_OCTAVE = {prefiltered.levels_per_octave!r};\n"
-            f"const int TEST_LAYER_COUNT = {count};\n")
+            f"const int TEST_LAYER_COUNT = {count};\n"
+            f"const vec4 TEST_MEAN = vec4({', '.join(repr(float(v)) for v in prefiltered.mean_radiance)}, 0.0);\n")
 
 
 def _rgba(layers):
@@ -61,14 +62,15 @@ def test_lookup(glsl, fuzz, record_error, prefiltered, content):
         prefiltered = env_prefilter.PrefilteredEnvironment(
             fuzz.rng.random(prefiltered.layers.shape).astype(np.float32), prefiltered.sharpness,
             prefiltered.content_size, prefiltered.texcoord_scale, prefiltered.texcoord_offset,
-            prefiltered.levels_per_octave)
+            prefiltered.levels_per_octave, prefiltered.mean_radiance)
     axis, sharpness = _lookup_inputs(fuzz)
     amplitude = fuzz.uniform(0.0, 2.0, N)
     call = """
     vec4 value = env_prefilter_lookup(environment, p.xyz, p.w, TEST_LOG2_MIN, TEST_LEVELS_PER_OCTAVE,
-                                      TEST_LAYER_COUNT, TEST_TRANSFORMS);
+                                      TEST_LAYER_COUNT, TEST_TRANSFORMS, TEST_MEAN);
     vec4 integral = env_prefilter_lookup_integral(environment, p.xyz, p.w, a.x, TEST_LOG2_MIN,
-                                                  TEST_LEVELS_PER_OCTAVE, TEST_LAYER_COUNT, TEST_TRANSFORMS);
+                                                  TEST_LEVELS_PER_OCTAVE, TEST_LAYER_COUNT, TEST_TRANSFORMS,
+                                                  TEST_MEAN);
     result = a.y > 0.5 ? integral : value;
     """
     textures = {"environment": _rgba(prefiltered.layers)}

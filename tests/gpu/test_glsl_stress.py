@@ -200,8 +200,8 @@ def test_env_prefilter_stress(glsl, fuzz):
     sharpness = fuzz.stress_sharpness(ROWS)
     amplitude = fuzz.stress_amplitude(ROWS)
     transforms = "const vec2 TRANSFORMS[32] = vec2[32](vec2(0.375, 0.5), vec2(0.375, 0.5)" + ", vec2(0.0)" * 30 + ");"
-    call = ("env_prefilter_lookup(environment, p.xyz, p.w, -3.0, 2.0, 2, TRANSFORMS)"
-            " + env_prefilter_lookup_integral(environment, p.xyz, p.w, a.x, -3.0, 2.0, 2, TRANSFORMS)")
+    call = ("env_prefilter_lookup(environment, p.xyz, p.w, -3.0, 2.0, 2, TRANSFORMS, vec4(500.0))"
+            " + env_prefilter_lookup_integral(environment, p.xyz, p.w, a.x, -3.0, 2.0, 2, TRANSFORMS, vec4(500.0))")
     out = glsl(["sg.glsl", "env_prefilter.glsl", transforms], call, {"p": np.c_[axis, sharpness], "a": amplitude},
                4, {"environment": layers})
     _assert_finite(out, "env_prefilter.glsl")
