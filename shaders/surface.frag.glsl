@@ -5,6 +5,43 @@
 void main()
 {
   vec3 normal = gl_FrontFacing ? world_normal : -world_normal;
+#ifdef HAS_VISIBILITY
+  visibility_normal = world_ssdf_normal;       /* the bake's frame: not flipped for back faces */
+  visibility_rows[0] = ssdf_coefficients_0;
+#if SSDF_MAX_LAYERS > 1
+  visibility_rows[1] = ssdf_coefficients_1;
+#endif
+#if SSDF_MAX_LAYERS > 2
+  visibility_rows[2] = ssdf_coefficients_2;
+#endif
+#if SSDF_MAX_LAYERS > 3
+  visibility_rows[3] = ssdf_coefficients_3;
+#endif
+#if SSDF_MAX_LAYERS > 4
+  visibility_rows[4] = ssdf_coefficients_4;
+#endif
+#if SSDF_MAX_LAYERS > 5
+  visibility_rows[5] = ssdf_coefficients_5;
+#endif
+#if SSDF_MAX_LAYERS > 6
+  visibility_rows[6] = ssdf_coefficients_6;
+#endif
+#if SSDF_MAX_LAYERS > 7
+  visibility_rows[7] = ssdf_coefficients_7;
+#endif
+#if SSDF_MAX_LAYERS > 8
+  visibility_rows[8] = ssdf_coefficients_8;
+#endif
+#if SSDF_MAX_LAYERS > 9
+  visibility_rows[9] = ssdf_coefficients_9;
+#endif
+#if SSDF_MAX_LAYERS > 10
+  visibility_rows[10] = ssdf_coefficients_10;
+#endif
+#if SSDF_MAX_LAYERS > 11
+  visibility_rows[11] = ssdf_coefficients_11;
+#endif
+#endif
   vec3 diffuse_color = material.diffuse_color.rgb;
   vec3 specular_color = material.specular_color.rgb;
   vec4 p = material.parameters0;                  /* roughness, ior, exponent, alpha_x */
@@ -56,8 +93,9 @@ void main()
   out_diffuse = vec4(diffuse, 1.0);
   out_specular = vec4(specular, 1.0);
 #ifdef GBUFFER
-  out_position = vec4(world_position, 1.0);
-  out_normal = vec4(normal, 1.0);
+  /* w: the triangle (index into the mesh's triangle list) and object (draw order) + 1 */
+  out_position = vec4(world_position, float(gbuffer_triangle_offset + gl_PrimitiveID) + 1.0);
+  out_normal = vec4(normal, float(gbuffer_object_index) + 1.0);
   out_tangent = tangent;
   out_uv = vec4(texcoord, material.options.y, 1.0);
 #endif

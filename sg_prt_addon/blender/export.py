@@ -40,6 +40,12 @@ class MeshExport:
     triangles: np.ndarray          # (T, 3) uint32 corner indices, sorted by material index
     material_ranges: list          # [(material_index, first_triangle, triangle_count)]
     has_uv: bool = False
+    # corner (loop) -> Blender mesh vertex (mesh.vertices index): corners of a vertex share its
+    # per-vertex data (the visibility bake's coefficients); vertex_normals (vertex_count, 3) are the
+    # smooth vertex normals (MeshVertex.normal, object space), the bake's local frames
+    corner_vertex: np.ndarray = None   # (V,) uint32
+    vertex_count: int = 0
+    vertex_normals: np.ndarray = None  # (vertex_count, 3) float32
 
 
 @dataclass
@@ -191,7 +197,16 @@ def export_mesh_data(mesh):
         triangles=np.ascontiguousarray(triangles, np.uint32),
         material_ranges=ranges,
         has_uv=uv_layer is not None,
+        corner_vertex=np.ascontiguousarray(vertex_index, np.uint32),
+        vertex_count=len(mesh.vertices),
+        vertex_normals=_vertex_normals(mesh),
     )
+
+
+def _vertex_normals(mesh):
+    normals = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("normal", normals)
+    return normals.reshape(-1, 3)
 
 
 def to_world(mesh, matrix_world):
@@ -210,7 +225,10 @@ def to_world(mesh, matrix_world):
         positions=np.ascontiguousarray(mesh.positions @ linear.T + matrix[:3, 3], np.float32),
         normals=np.ascontiguousarray(unit(mesh.normals @ normal_matrix.T), np.float32),
         tangents=np.ascontiguousarray(tangents, np.float32),
-        uvs=mesh.uvs, triangles=mesh.triangles, material_ranges=list(mesh.material_ranges), has_uv=mesh.has_uv)
+        uvs=mesh.uvs, triangles=mesh.triangles, material_ranges=list(mesh.material_ranges), has_uv=mesh.has_uv,
+        corner_vertex=mesh.corner_vertex, vertex_count=mesh.vertex_count,
+        vertex_normals=None if mesh.vertex_normals is None else np.ascontiguousarray(
+            unit(mesh.vertex_normals @ normal_matrix.T), np.float32))
 
 
 def export_object_mesh(object_eval):

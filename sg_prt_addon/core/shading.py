@@ -17,6 +17,17 @@ I(p_j, lambda_j, n) / integral G_j (the clamped cosine averaged over the lobe),
 which keeps the horizon behaviour of the accurate integral; a constant world
 colour c stands for Gamma / integral = c.
 
+With a visibility bake (``Visibility``: the pixel's interpolated SSDF PCA rows and
+SSDF-frame normal, the packed basis), every clamped-cosine integral I(G, n) above is
+multiplied by ``lobe_visibility(G)``: the product lobe P = G (x) C*(n) (eq. 40's cosine
+lobe), the SSDF theta_d decoded at P's axis in the vertex's local frame
+(bake.decode's lookup), and fh(theta_d, lambda_P) / fh(theta_h, lambda_P) clamped to
+[0, 1], theta_h the axis's angle to the SSDF normal's horizon (eq. 30-31: what the
+visibility keeps of P relative to what the horizon alone keeps, since I(G, n) clamps
+the horizon already).  G is the environment lobe (eq. 39), the light (eq. 42), the
+light (x) slice lobe (eq. 43) and the slice lobe (eq. 41); a constant world colour
+uses the cosine lobe alone.
+
 Everything is computed in float32 like the GPU.  Directions: world space, all
 pointing away from the surface.
 """
@@ -74,6 +85,52 @@ class EnvironmentData:
     @property
     def has_texture(self):
         return self.prefiltered is not None
+
+
+@dataclass
+class Visibility:
+    """Per-pixel SSDF inputs of the visibility variant (shaders: HAS_VISIBILITY).
+
+    rows (N, 4 L): interpolated [1, w_0, ...] (bake.decode.pack_coefficients layout);
+    normal (N, 3): interpolated SSDF-frame normal (the bake's vertex normals, world space);
+    basis_texture (L, R, R, 4): bake.decode.pack_basis_texture.
+    """
+    rows: np.ndarray
+    normal: np.ndarray
+    basis_texture: np.ndarray
+
+
+def ssdf_decode_packed(rows, basis_texture, local_direction):
+    """ssdf.glsl's ssdf_decode in numpy: rows (N, 4L), local directions (N, K, 3) -> (N, K) float32."""
+    from ..bake import decode
+
+    layers, resolution = basis_texture.shape[0], basis_texture.shape[1]
+    texcoord, below = decode.texcoord_of(local_direction, resolution)        # (N, K, 2), (N, K)
+    images = np.asarray(basis_texture, np.float64).transpose(0, 3, 1, 2).reshape(4 * layers, resolution,
+                                                                               resolution)
+    samples = decode.sample_bilinear(images, texcoord.reshape(-1, 2)).reshape(
+        (4 * layers,) + texcoord.shape[:-1])                                    # (4L, N, K)
+    value = np.einsum("cnk,nc->nk", samples, np.asarray(rows, np.float64)[:, :4 * layers])
+    return (value - below).astype(FLOAT)
+
+
+def lobe_visibility(axis, sharpness, n, visibility):
+    """Visible fraction (N, K) of I(G, n) for lobes G with axis (N, K, 3), sharpness (N, K); n (N, 3)
+    (sg_shading.glsl's lobe_visibility)."""
+    from ..bake import hemisphere_map
+    from . import clamped_cosine, hemisphere
+
+    cosine_sharpness, _ = clamped_cosine.clamped_cosine_lobe()
+    product_axis, product_sharpness, _ = sg.product(
+        np.asarray(axis, FLOAT), np.asarray(sharpness, FLOAT), FLOAT(1),
+        np.asarray(n, FLOAT)[:, None, :], FLOAT(cosine_sharpness), FLOAT(1))
+    frame = hemisphere_map.local_frame(np.asarray(visibility.normal, np.float64))      # (N, 3, 3)
+    local = np.einsum("nij,nkj->nki", frame, np.asarray(product_axis, np.float64))
+    theta_d = ssdf_decode_packed(visibility.rows, visibility.basis_texture, local)
+    product_sharpness = np.asarray(product_sharpness, FLOAT)
+    visible = hemisphere.fh_normalized(theta_d, product_sharpness)
+    unshadowed = hemisphere.fh_normalized_from_sine(sg.normalize(local.astype(FLOAT))[..., 2], product_sharpness)
+    return np.clip(visible / np.maximum(unshadowed, FLOAT(1e-30)), 0, 1).astype(FLOAT)
 
 
 def point_light_sgs(position, light_data):
@@ -141,12 +198,13 @@ def specular_slice(model, params, lobe_count, view_local):
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
-          light_data, environment, lobe_count=1):
+          light_data, environment, lobe_count=1, visibility=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
     ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
     applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
 
     view_origin: camera position (perspective) or the camera's forward direction (orthographic).
+    visibility: a Visibility (the SSDF shadows of the HAS_VISIBILITY variant) or None (unshadowed).
     """
     position = np.asarray(position, FLOAT)
     n, t, b = shading_frame(normal, tangent)
@@ -166,6 +224,14 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     specular = np.zeros(position.shape, FLOAT)
     n_lobe = n[:, None, :]
 
+    def visible(axis, sharpness):
+        if visibility is None:
+            return FLOAT(1)
+        shape = np.shape(sharpness)
+        flat_axis = np.asarray(axis, FLOAT).reshape(shape[0], -1, 3)
+        flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
+        return lobe_visibility(flat_axis, flat_sharpness, n, visibility).reshape(shape)
+
     light_sets = []
     if len(light_data.point_radius):
         light_sets.append(point_light_sgs(position, light_data))
@@ -175,25 +241,34 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
                            np.broadcast_to(light_data.sun_sharpness[None], (len(position), count)),
                            np.broadcast_to(light_data.sun_amplitude[None], (len(position), count, 3))))
     for light_axis, light_sharpness, light_amplitude in light_sets:
-        irradiance += np.sum(light_amplitude * _clamped_cosine_integral(
-            light_axis, light_sharpness, FLOAT(1), n_lobe)[..., None], axis=1)
+        irradiance += np.sum(light_amplitude * (_clamped_cosine_integral(
+            light_axis, light_sharpness, FLOAT(1), n_lobe) * visible(light_axis, light_sharpness))[..., None], axis=1)
         # (N, P, 1) x (N, 1, J): every light against every slice lobe
         axis_m, sharpness_m, amplitude_m = sg.product(
             light_axis[:, :, None, :], light_sharpness[:, :, None], FLOAT(1),
             slice_axis[:, None, :, :], slice_sharpness[:, None, :], slice_amplitude[:, None, :])
-        weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :])
+        weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :]) * \
+            visible(axis_m, sharpness_m)
         specular += np.sum(light_amplitude * np.sum(weight, axis=2)[..., None], axis=1)
 
-    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)   # (N, J)
+    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe) * \
+        visible(slice_axis, slice_sharpness)                                                     # (N, J)
     if environment.has_texture:
         if len(environment.lobe_sharpness):
-            irradiance += np.sum(environment.lobe_amplitude[None] * _clamped_cosine_integral(
-                environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe)[..., None], axis=1)
+            lobe_count_env = len(environment.lobe_sharpness)
+            env_axis = np.broadcast_to(environment.lobe_axis[None], (len(n), lobe_count_env, 3))
+            env_sharpness = np.broadcast_to(environment.lobe_sharpness[None], (len(n), lobe_count_env))
+            irradiance += np.sum(environment.lobe_amplitude[None] * (_clamped_cosine_integral(
+                environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
+                visible(env_axis, env_sharpness))[..., None], axis=1)
         radiance = env_prefilter.lookup(environment.prefiltered, slice_axis, slice_sharpness)        # (N, J, 3)
         specular += np.sum(radiance * slice_cosine[..., None], axis=1)
     else:
         colour = np.asarray(environment.colour, FLOAT)
-        irradiance += np.pi * colour
+        if visibility is None:
+            irradiance += np.pi * colour
+        else:       # the cosine lobe alone: a zero-sharpness G at the normal
+            irradiance += np.pi * colour * visible(n_lobe, np.zeros((len(n), 1), FLOAT))
         specular += np.sum(slice_cosine, axis=1)[:, None] * colour
 
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
@@ -223,13 +298,14 @@ SCALAR_SLOTS = {"roughness": "roughness", "ior": "ior", "exponent": "exponent", 
 
 
 def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,
-                    is_perspective, light_data, environment):
+                    is_perspective, light_data, environment, visibility=None):
     """Mirror of surface.frag.glsl's main(): per-fragment inputs as the G-buffer holds them.
 
     material: an object with export.MaterialParams' fields; textures: slot name -> (H, W, 4)
     float32 image (Blender's row order) for the slots the material uses; normal: interpolated
     world normal (already flipped for back faces); tangent (N, 4): the tangent input (the UV
     map's world tangent and sign, or the object axis in world space); uv (N, 2).
+    visibility: per-fragment Visibility (HAS_VISIBILITY variant) or None.
     Returns (diffuse, specular), each (N, 3) float32.
     """
     count = len(position)
@@ -255,7 +331,8 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     model_params = {key: params[key] for key in _MODEL_PARAMETERS[model]}
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
                  diffuse_color, specular_color, light_data, environment,
-                 lobe_count=material.lobe_count if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY") else 1)
+                 lobe_count=material.lobe_count if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY") else 1,
+                 visibility=visibility)
 
 
 # The material fields each model reads (names as brdf.model_from_name takes them).

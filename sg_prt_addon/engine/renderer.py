@@ -89,6 +89,7 @@ def scene_block(camera, light_data, environment):
                    [:env_lobes] if env_lobes else []),
         vec4_array(MAX_ENV_LOBES, np.pad(environment.lobe_amplitude, ((0, 0), (0, 1)))[:env_lobes]
                    if env_lobes else []),
+        np.asarray(_column_major(camera.projection @ camera.view), np.float32).reshape(4, 4),   # mat4 columns
     ]
     return np.concatenate(parts, axis=0)
 
@@ -105,28 +106,65 @@ def material_block(params, material_id=0):
     ], np.float32)
 
 
-class MeshBuffers:
-    """Vertex buffer + one index buffer per material range of a MeshExport."""
+VISIBILITY_TEXTURE_WIDTH = 4096     # texels a row of the coefficient texture (a multiple of the layers is used)
 
-    def __init__(self, mesh):
+
+def visibility_texture_rows(packed, layers):
+    """(H, W, 4) float32 texture of per-vertex coefficient rows (V, 4 layers): vertex v's vec4 k at texel
+    (column (v % per_row) * layers + k, row v // per_row), per_row = VISIBILITY_TEXTURE_WIDTH // layers
+    (mesh.vert.glsl reads it back with texelFetch)."""
+    count = packed.shape[0]
+    per_row = max(1, VISIBILITY_TEXTURE_WIDTH // layers)
+    rows = max(1, -(-count // per_row))
+    out = np.zeros((rows * per_row, layers, 4), np.float32)
+    out[:count] = np.asarray(packed, np.float32).reshape(count, layers, 4)
+    return out.reshape(rows, per_row * layers, 4)
+
+
+class MeshBuffers:
+    """Vertex buffer + one index buffer per material range of a MeshExport; with a usable visibility
+    bake (scene_state.VisibilityData) also the corners' mesh vertex index and SSDF normal attributes,
+    the per-vertex coefficient texture and the basis texture."""
+
+    def __init__(self, mesh, visibility=None):
         import gpu
 
-        self.batches = []               # (material slot index, GPUBatch)
+        self.batches = []               # (material slot index, first triangle, GPUBatch)
+        self.visibility_layers = 0
+        self.coefficient_texture = None
+        self.basis_texture = None
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
+        if visibility is not None:
+            # scene_state.VisibilityData.from_bake checked this; check again right before the upload:
+            # texelFetch must never read past the rows uploaded
+            if (mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions)
+                    or visibility.packed.shape[0] != mesh.vertex_count
+                    or (len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= visibility.packed.shape[0])):
+                visibility = None
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="normal", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="tangent", comp_type="F32", len=4, fetch_mode="FLOAT")
         fmt.attr_add(id="uv", comp_type="F32", len=2, fetch_mode="FLOAT")
+        if visibility is not None:
+            fmt.attr_add(id="vertex_index", comp_type="I32", len=1, fetch_mode="INT")
+            fmt.attr_add(id="ssdf_normal", comp_type="F32", len=3, fetch_mode="FLOAT")
         vertices = gpu.types.GPUVertBuf(fmt, len(mesh.positions))
         vertices.attr_fill("position", mesh.positions)
         vertices.attr_fill("normal", mesh.normals)
         vertices.attr_fill("tangent", mesh.tangents)
         vertices.attr_fill("uv", mesh.uvs)
+        if visibility is not None:
+            vertices.attr_fill("vertex_index", np.ascontiguousarray(mesh.corner_vertex, np.int32))
+            vertices.attr_fill("ssdf_normal", np.ascontiguousarray(
+                mesh.vertex_normals[mesh.corner_vertex.astype(np.int64)], np.float32))
+            self.visibility_layers = visibility.layers
+            self.coefficient_texture = _texture_2d(visibility_texture_rows(visibility.packed, visibility.layers))
+            self.basis_texture = _texture_2d_array(visibility.basis_texture)
         for material_index, first, count in mesh.material_ranges:
             indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])
-            self.batches.append((material_index, gpu.types.GPUBatch(type="TRIS", buf=vertices, elem=indices)))
+            self.batches.append((material_index, first, gpu.types.GPUBatch(type="TRIS", buf=vertices, elem=indices)))
         self.vertices = vertices
 
 
@@ -158,7 +196,7 @@ class Renderer:
 
         for key in dirty.meshes:
             if key in state.meshes:
-                self.mesh_buffers[key] = MeshBuffers(state.meshes[key])
+                self.mesh_buffers[key] = MeshBuffers(state.meshes[key], state.visibility.get(key))
                 self.uploads["meshes"] += 1
         for key in list(self.mesh_buffers):
             if key not in state.meshes:
@@ -226,28 +264,33 @@ class Renderer:
 
         has_lights = state.light_data().count > 0
         has_environment = state.environment.prefiltered is not None
-        view_projection = _column_major(camera.projection @ camera.view)
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(True)
             gpu.state.face_culling_set("NONE")
             gpu.state.blend_set("NONE")
-            for entry in state.objects.values():
+            for object_index, entry in enumerate(state.objects.values()):
                 buffers = self.mesh_buffers.get(entry.mesh_key)
                 if buffers is None:
                     continue
                 model = _column_major(entry.matrix_world)
-                for slot, batch in buffers.batches:
+                for slot, first_triangle, batch in buffers.batches:
                     name = entry.material_names[slot] if slot < len(entry.material_names) else ""
                     params = state.materials.get(name) or state.materials[""]
                     if name not in self.material_buffers:
                         name = ""
-                    key = shader_variants.variant_key(params, has_lights, has_environment, self.gbuffer)
+                    key = shader_variants.variant_key(params, has_lights, has_environment, self.gbuffer,
+                                                      buffers.visibility_layers)
                     shader = shader_variants.get_shader(key)
                     shader.bind()
                     shader.uniform_float("model_matrix", model)
-                    shader.uniform_float("view_projection", view_projection)
+                    if self.gbuffer:
+                        shader.uniform_int("gbuffer_object_index", object_index)
+                        shader.uniform_int("gbuffer_triangle_offset", first_triangle)
+                    if key.visibility_layers:
+                        shader.uniform_sampler("visibility_coefficients", buffers.coefficient_texture)
+                        shader.uniform_sampler("visibility_basis", buffers.basis_texture)
                     shader.uniform_block("scene", self.scene_buffer)
                     shader.uniform_block("material", self.material_buffers[name])
                     if has_environment:

@@ -19,6 +19,73 @@ _environment_cache = {}
 ENVIRONMENT_LAYER_SIZE = 128
 ENVIRONMENT_FIT_LOBES = 8
 
+# Tests (and scripts) may set this to a callable(object_eval) -> bake or None, standing in for the
+# stored bakes: see visibility_for.
+visibility_provider = None
+
+
+def visibility_for(object_eval):
+    """The visibility bake of an evaluated object: blender.visibility_bake.visibility_for_object
+    (a StoredBake, or None without one), or what ``visibility_provider`` returns when set (a
+    StoredBake, a bake.pipeline.BakeResult or None).  Whatever comes back goes through
+    VisibilityData.from_bake, which refuses unusable (stale, damaged) bakes and any whose vertex
+    count does not match the exported mesh."""
+    if visibility_provider is not None:
+        return visibility_provider(object_eval)
+    try:
+        from ..blender import visibility_bake
+    except ImportError:
+        return None
+    return visibility_bake.visibility_for_object(object_eval)
+
+
+@dataclass
+class VisibilityData:
+    """A usable SSDF bake of one exported mesh, as the GPU takes it.
+
+    packed: (vertex_count, 4 layers) float32 rows [1, w_0, ..., w_{N-1}, 0...] per Blender mesh vertex
+    (bake.decode.pack_coefficients); basis_texture: (layers, R, R, 4) float32 (decode.pack_basis_texture).
+    The engine reads row corner_vertex[corner] for each corner (export.MeshExport).
+    """
+    packed: np.ndarray
+    basis_texture: np.ndarray
+    layers: int
+    terms: int
+    resolution: int
+
+    @classmethod
+    def from_bake(cls, bake, mesh):
+        """(VisibilityData or None, message) for a bake and the export.MeshExport it should shade."""
+        if bake is None:
+            return None, "no visibility bake"
+        if getattr(bake, "usable", True) is False:
+            return None, getattr(bake, "message", "unusable bake")
+        from ..bake import decode
+        packed = getattr(bake, "packed_coefficients", None)
+        if packed is None:
+            packed = decode.pack_coefficients(bake.coefficients)
+        packed = np.ascontiguousarray(packed, np.float32)
+        if hasattr(bake, "basis_texture") and callable(bake.basis_texture):
+            basis_texture = bake.basis_texture()
+        else:
+            basis_texture = decode.pack_basis_texture(bake.mean, bake.basis)
+        basis_texture = np.ascontiguousarray(basis_texture, np.float32)
+        layers = packed.shape[1] // 4
+        if packed.ndim != 2 or packed.shape[1] != 4 * layers or basis_texture.shape[0] != layers \
+                or not 0 < layers <= MAX_VISIBILITY_LAYERS:
+            return None, f"bake layout inconsistent ({packed.shape}, basis {basis_texture.shape})"
+        if mesh.corner_vertex is None or packed.shape[0] != mesh.vertex_count:
+            return None, f"stale bake: {packed.shape[0]} vertices baked, the mesh has {mesh.vertex_count}"
+        if len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= packed.shape[0]:
+            return None, "stale bake: corner vertex index beyond the baked vertices"
+        if not np.all(np.isfinite(packed)) or not np.all(np.isfinite(basis_texture)):
+            return None, "bake holds non-finite values"
+        return cls(packed, basis_texture, layers, int(getattr(bake, "terms", 4 * layers - 1)),
+                   int(basis_texture.shape[1])), "ok"
+
+
+MAX_VISIBILITY_LAYERS = 12
+
 
 @dataclass
 class ObjectEntry:
@@ -46,6 +113,8 @@ class SceneState:
         self.environment_layer_size = environment_layer_size or ENVIRONMENT_LAYER_SIZE
         self.objects = {}           # object name -> ObjectEntry
         self.meshes = {}            # mesh key -> export.MeshExport
+        self.visibility = {}        # mesh key -> VisibilityData (usable bakes only)
+        self.visibility_status = {}  # mesh key -> why there is (or is no) visibility
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
         self.world = export.WorldExport()
@@ -58,6 +127,8 @@ class SceneState:
         """Re-read everything visible in the evaluated scene."""
         self.objects.clear()
         self.meshes.clear()
+        self.visibility.clear()
+        self.visibility_status.clear()
         self.materials = {"": export.MaterialParams()}
         self.lights = []
         seen_meshes = set()
@@ -74,7 +145,7 @@ class SceneState:
             name = obj.name if not instance.is_instance else f"{obj.name}#{len(self.objects)}"
             mesh_key = self._mesh_key(obj)
             if mesh_key not in seen_meshes:
-                self.meshes[mesh_key] = export.export_object_mesh(obj)
+                self._export_mesh(obj, mesh_key)
                 seen_meshes.add(mesh_key)
             self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(instance.matrix_world),
                                              self._read_materials(obj))
@@ -82,6 +153,23 @@ class SceneState:
         self.environment = environment_data(self.world, self.environment_layer_size)
         self.dirty = Dirty(meshes=set(self.meshes), materials=set(self.materials), lights=True, world=True,
                            objects=True)
+
+    def _export_mesh(self, obj, mesh_key):
+        """Export an evaluated object's mesh and look up its visibility bake (see visibility_for)."""
+        mesh = export.export_object_mesh(obj)
+        self.meshes[mesh_key] = mesh
+        try:
+            bake = visibility_for(obj)
+        except Exception as error:          # a damaged bake must not stop the render: unshadowed
+            bake, data, message = None, None, f"bake unreadable: {error}"
+        else:
+            data, message = VisibilityData.from_bake(bake, mesh)
+        if data is None:
+            self.visibility.pop(mesh_key, None)
+        else:
+            self.visibility[mesh_key] = data
+        self.visibility_status[mesh_key] = message
+        return mesh
 
     @staticmethod
     def _mesh_key(obj):
@@ -148,7 +236,7 @@ class SceneState:
                     dirty.lights = True
             elif obj.type in ("MESH", "CURVE", "SURFACE", "META", "FONT") and name not in self.objects:
                 mesh_key = self._mesh_key(obj)
-                self.meshes[mesh_key] = export.export_object_mesh(obj)
+                self._export_mesh(obj, mesh_key)
                 dirty.meshes.add(mesh_key)
                 self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
                                                  self._read_materials(obj))
@@ -170,7 +258,7 @@ class SceneState:
             return
         mesh_key = self._mesh_key(obj)
         if entry is None or update.is_updated_geometry or mesh_key not in self.meshes:
-            self.meshes[mesh_key] = export.export_object_mesh(obj)
+            self._export_mesh(obj, mesh_key)
             dirty.meshes.add(mesh_key)
         self.objects[obj.name] = ObjectEntry(obj.name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
                                              self._read_materials(obj))

@@ -66,6 +66,11 @@ class VariantKey:
     has_environment: bool = False
     textures: tuple = ()            # sorted names from TEXTURE_SLOTS
     gbuffer: bool = False
+    visibility_layers: int = 0      # vec4 of SSDF coefficients per vertex (0: no visibility bake)
+
+    @property
+    def has_visibility(self):
+        return self.visibility_layers > 0
 
     def describe(self):
         parts = [self.model, f"{self.ndf_lobes} lobe(s)", "lights" if self.has_lights else "no lights",
@@ -74,11 +79,13 @@ class VariantKey:
             parts.append("textures: " + ", ".join(self.textures))
         if self.gbuffer:
             parts.append("G-buffer")
+        if self.visibility_layers:
+            parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
         return ", ".join(parts)
 
 
-def variant_key(material_params, has_lights, has_environment, gbuffer=False):
-    """VariantKey of an export.MaterialParams in a scene."""
+def variant_key(material_params, has_lights, has_environment, gbuffer=False, visibility_layers=0):
+    """VariantKey of an export.MaterialParams in a scene (visibility_layers: of the object's bake, 0 without)."""
     from ..core.shading import GGX_NDF_LOBES
 
     model = material_params.model
@@ -86,7 +93,8 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False):
     if model == "GGX":
         lobes = GGX_NDF_LOBES
     textures = tuple(sorted(name for name in material_params.textures if name in TEXTURE_SLOTS))
-    return VariantKey(model, lobes, bool(has_lights), bool(has_environment), textures, bool(gbuffer))
+    return VariantKey(model, lobes, bool(has_lights), bool(has_environment), textures, bool(gbuffer),
+                      int(visibility_layers))
 
 
 def _read(path):
@@ -133,6 +141,9 @@ def defines(key):
         out["HAS_NORMAL_MAP" if name == "normal_map" else "HAS_TEXTURE_" + name.upper()] = 1
     if key.gbuffer:
         out["GBUFFER"] = 1
+    if key.visibility_layers:
+        out["HAS_VISIBILITY"] = 1
+        out["SSDF_MAX_LAYERS"] = key.visibility_layers
     return out
 
 
@@ -149,6 +160,8 @@ def fragment_source(key):
         if file_name == "env_prefilter.glsl" and not key.has_environment:
             continue
         parts.append(library_source(file_name))
+    if key.visibility_layers:
+        parts.append(library_source("ssdf.glsl"))
     for file_name in RESOURCE_FILES:
         if file_name == "anisotropic_lobes.glsl" and key.model not in ANISOTROPIC_MODELS:
             continue
@@ -159,7 +172,7 @@ def fragment_source(key):
     return "\n".join(parts)
 
 
-def vertex_source():
+def vertex_source(key=None):
     return _read(os.path.join(SHADER_DIR, "mesh.vert.glsl"))
 
 
@@ -253,14 +266,24 @@ def create_info(key):
     info.vertex_in(1, "VEC3", "normal")
     info.vertex_in(2, "VEC4", "tangent")
     info.vertex_in(3, "VEC2", "uv")
-    interface = gpu.types.GPUStageInterfaceInfo("sgprt_surface_interface")
+    if key.visibility_layers:
+        info.vertex_in(4, "INT", "vertex_index")
+        info.vertex_in(5, "VEC3", "ssdf_normal")
+    interface = gpu.types.GPUStageInterfaceInfo(f"sgprt_surface_interface_{key.visibility_layers}")
     interface.smooth("VEC3", "world_position")
     interface.smooth("VEC3", "world_normal")
     interface.smooth("VEC4", "world_tangent")
     interface.smooth("VEC2", "texcoord")
+    if key.visibility_layers:
+        # the SSDF frame's normal and the vertex's PCA coefficients, interpolated per pixel (wang2009 5.3)
+        interface.smooth("VEC3", "world_ssdf_normal")
+        for layer in range(key.visibility_layers):
+            interface.smooth("VEC4", f"ssdf_coefficients_{layer}")
     info.vertex_out(interface)
     info.push_constant("MAT4", "model_matrix")
-    info.push_constant("MAT4", "view_projection")
+    if key.gbuffer:
+        info.push_constant("INT", "gbuffer_object_index")
+        info.push_constant("INT", "gbuffer_triangle_offset")
     info.uniform_buf(0, "SceneData", "scene")
     info.uniform_buf(1, "MaterialData", "material")
     slot = 0
@@ -275,6 +298,11 @@ def create_info(key):
         slot += 1
     for name in key.textures:
         info.sampler(slot, "FLOAT_2D", "texture_" + name)
+        slot += 1
+    if key.visibility_layers:
+        info.sampler(slot, "FLOAT_2D", "visibility_coefficients")       # read in the vertex shader
+        slot += 1
+        info.sampler(slot, "FLOAT_2D_ARRAY", "visibility_basis")
         slot += 1
     for index, name in enumerate(output_names(key.gbuffer)):
         info.fragment_out(index, "VEC4", "out_" + name)

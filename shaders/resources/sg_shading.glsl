@@ -1,6 +1,35 @@
-/* Per-pixel SG shading (wang2009 eq. 36-43 without visibility); mirrored line by line by
- * sg_prt_addon/core/shading.py.  Needs sg.glsl, brdf.glsl, warp.glsl, clamped_cosine.glsl,
- * lights.glsl and (HAS_ENVIRONMENT) env_prefilter.glsl, plus the `scene` uniform block. */
+/* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43);
+ * mirrored line by line by sg_prt_addon/core/shading.py.  Needs sg.glsl, brdf.glsl, warp.glsl,
+ * clamped_cosine.glsl, lights.glsl, (HAS_ENVIRONMENT) env_prefilter.glsl and (HAS_VISIBILITY)
+ * hemisphere.glsl + ssdf.glsl, plus the `scene` uniform block. */
+
+#ifdef HAS_VISIBILITY
+/* The pixel's interpolated SSDF coefficient rows and SSDF-frame normal: set by main(). */
+vec4 visibility_rows[SSDF_MAX_LAYERS];
+vec3 visibility_normal;
+
+/* Visible fraction of the clamped-cosine integral I(G, n) of a lobe G (wang2009 eq. 39-43 with
+ * eq. 30-31): the product lobe P = G (x) C*(n) (eq. 40's cosine lobe), theta_d = SSDF at P's axis in
+ * the vertex's local frame, and the fraction fh(theta_d, lambda_P) / fh(theta_h, lambda_P), where
+ * theta_h is the axis's angle to the horizon of the SSDF normal: what eq. 31 keeps of P relative to
+ * what the horizon alone keeps (the SSDF includes the horizon, I(G, n) already clamps it).
+ * Unoccluded (theta_d = theta_h) it is 1: the unshadowed shading; clamped to [0, 1]. */
+float lobe_visibility(vec3 axis, float sharpness, vec3 n)
+{
+  vec2 cosine_lobe = clamped_cosine_lobe();
+  vec3 product_axis;
+  float product_sharpness, product_amplitude;
+  sg_product(axis, sharpness, 1.0, n, cosine_lobe.x, 1.0, product_axis, product_sharpness, product_amplitude);
+  vec3 local = ssdf_to_local(product_axis, visibility_normal);
+  float theta_d = ssdf_decode(visibility_basis, visibility_rows, SSDF_MAX_LAYERS, local);
+  float visible = fh_normalized(theta_d, product_sharpness);
+  float unshadowed = fh_normalized_from_sine(safe_normalize(local).z, product_sharpness);
+  return clamp(visible / max(unshadowed, 1.0e-30), 0.0, 1.0);
+}
+#define LOBE_VISIBILITY(axis, sharpness) lobe_visibility(axis, sharpness, n)
+#else
+#define LOBE_VISIBILITY(axis, sharpness) 1.0
+#endif
 
 /* Unit normal, tangent by Gram-Schmidt (fallback if parallel), bitangent n x t. */
 void shading_frame(vec3 normal, vec3 tangent, out vec3 n, out vec3 t, out vec3 b)
@@ -180,21 +209,24 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_sharpness;
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
-    irradiance += light_amplitude * sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n);
+    irradiance += light_amplitude * (sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n) *
+                                     LOBE_VISIBILITY(light_axis, light_sharpness));           /* eq. 42 */
     float weight = 0.0;
     for (int j = 0; j < SLICE_LOBES; j++) {
       vec3 product_axis;
       float product_sharpness, product_amplitude;
       sg_product(light_axis, light_sharpness, 1.0, slice_axis[j], slice_sharpness[j], slice_amplitude[j],
                  product_axis, product_sharpness, product_amplitude);
-      weight += sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n);
+      weight += sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n) *
+                LOBE_VISIBILITY(product_axis, product_sharpness);                              /* eq. 43 */
     }
     radiance += light_amplitude * weight;
   }
 #endif
 
   for (int j = 0; j < SLICE_LOBES; j++) {
-    float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n);
+    float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n) *
+                         LOBE_VISIBILITY(slice_axis[j], slice_sharpness[j]);                   /* eq. 41 */
 #ifdef HAS_ENVIRONMENT
     radiance += slice_cosine * environment_radiance(slice_axis[j], slice_sharpness[j]);
 #else
@@ -205,10 +237,12 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef HAS_ENVIRONMENT
   for (int e = 0; e < scene.counts.z; e++) {
     irradiance += scene.env_amplitude[e].rgb *
-                  sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, 1.0, n);
+                  (sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, 1.0, n) *
+                   LOBE_VISIBILITY(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w));   /* eq. 39 */
   }
 #else
-  irradiance += SG_PI * scene.world_colour.rgb;
+  /* a constant world: the cosine lobe alone (a zero-sharpness G) */
+  irradiance += SG_PI * scene.world_colour.rgb * LOBE_VISIBILITY(n, 0.0);
 #endif
 
   diffuse = diffuse_color * (1.0 / SG_PI) * irradiance;

@@ -154,3 +154,103 @@ def relative_error(actual, expected, floor_fraction=1e-3):
     """|a - e| / max(|e|, floor_fraction * max |e|), per element."""
     floor = floor_fraction * max(float(np.max(np.abs(expected))), 1e-30)
     return np.abs(actual - expected) / np.maximum(np.abs(expected), floor)
+
+
+# --------------------------------------------------------------------------- visibility bakes
+
+def grid(scene, name, location, size=6.0, segments=64):
+    """A flat square grid of segments x segments quads (a finely tessellated floor for shadows)."""
+    import bmesh
+    import bpy
+
+    mesh = bpy.data.meshes.new(name)
+    bm = bmesh.new()
+    bmesh.ops.create_grid(bm, x_segments=segments, y_segments=segments, size=size / 2, calc_uvs=True)
+    bm.to_mesh(mesh)
+    bm.free()
+    obj = bpy.data.objects.new(name, mesh)
+    obj.location = location
+    return add_object(scene, obj)
+
+
+def mesh_world_arrays(obj):
+    """World-space (vertices, vertex normals, loop-triangle vertex indices) of a mesh object, as the
+    Bake Visibility operator takes them (one SSDF per Blender mesh vertex)."""
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    matrix = np.array([list(row) for row in obj.matrix_world], np.float64)
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    normals = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("normal", normals)
+    triangles = np.empty(len(mesh.loop_triangles) * 3, np.int64)
+    mesh.loop_triangles.foreach_get("vertices", triangles)
+    vertices = co.reshape(-1, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+    normals = normals.reshape(-1, 3).astype(np.float64) @ np.linalg.inv(matrix[:3, :3])
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    return vertices, normals, triangles.reshape(-1, 3)
+
+
+def bake_objects(scene, receivers, resolution=16, terms=None, error_target=0.02, max_terms=47):
+    """bake.pipeline.bake_visibility of each receiver object against every mesh object of the scene;
+    returns {object name: BakeResult} and installs it as engine.scene_state.visibility_provider
+    (standing in for bakes stored in the .blend).  Call clear_bakes() afterwards."""
+    import bpy
+    from sg_prt_addon.bake.pipeline import BakeOptions, bake_visibility
+    from sg_prt_addon.engine import scene_state
+
+    bpy.context.view_layer.update()
+    arrays = {obj.name: mesh_world_arrays(obj) for obj in scene.objects if obj.type == "MESH"}
+    occluder_vertices, occluder_triangles, offset = [], [], 0
+    for vertices, _, triangles in arrays.values():
+        occluder_vertices.append(vertices)
+        occluder_triangles.append(triangles + offset)
+        offset += len(vertices)
+    occluder_vertices = np.concatenate(occluder_vertices).astype(np.float32)
+    occluder_triangles = np.concatenate(occluder_triangles).astype(np.int32)
+    options = BakeOptions(resolution=resolution, terms=terms, error_target=error_target, max_terms=max_terms)
+    bakes = {}
+    for obj in receivers:
+        vertices, normals, triangles = arrays[obj.name]
+        bakes[obj.name] = bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_triangles, options)
+    scene_state.visibility_provider = lambda object_eval: bakes.get(object_eval.name)
+    return bakes
+
+
+def clear_bakes():
+    from sg_prt_addon.engine import scene_state
+    scene_state.visibility_provider = None
+
+
+def pixel_visibility(result, mask):
+    """core.shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
+    as the GPU interpolates: the triangle (position.w - 1) of the object (normal.w - 1), barycentric
+    weights from the interpolated world position, the corners' vertex rows and SSDF normals.
+    None when the object has no usable bake."""
+    from sg_prt_addon.blender import export
+    from sg_prt_addon.core import shading
+
+    passes, state = result["passes"], result["state"]
+    object_index = np.unique(np.rint(passes["gbuffer_normal"][mask][:, 3]).astype(int) - 1)
+    assert len(object_index) == 1, "pixels of one object"
+    entry = list(state.objects.values())[object_index[0]]
+    data = state.visibility.get(entry.mesh_key)
+    if data is None:
+        return None
+    mesh = export.to_world(state.meshes[entry.mesh_key], entry.matrix_world)
+    triangle = np.rint(passes["gbuffer_position"][mask][:, 3]).astype(np.int64) - 1
+    corners = mesh.triangles[triangle].astype(np.int64)                    # (N, 3)
+    p = mesh.positions.astype(np.float64)[corners]                          # (N, 3, 3)
+    x = passes["gbuffer_position"][mask][:, :3].astype(np.float64)
+    e1, e2, d = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], x - p[:, 0]
+    d11, d12, d22 = (e1 * e1).sum(1), (e1 * e2).sum(1), (e2 * e2).sum(1)
+    d1, d2 = (d * e1).sum(1), (d * e2).sum(1)
+    det = d11 * d22 - d12 * d12
+    b1 = (d22 * d1 - d12 * d2) / det
+    b2 = (d11 * d2 - d12 * d1) / det
+    weights = np.stack([1 - b1 - b2, b1, b2], axis=1)                       # (N, 3)
+    vertex = mesh.corner_vertex.astype(np.int64)[corners]                   # (N, 3) mesh vertices
+    rows = np.einsum("nk,nkc->nc", weights, data.packed[vertex].astype(np.float64))
+    normal = np.einsum("nk,nkc->nc", weights, mesh.vertex_normals[vertex].astype(np.float64))
+    return shading.Visibility(rows=rows.astype(np.float32), normal=normal.astype(np.float32),
+                              basis_texture=data.basis_texture)

@@ -30,17 +30,21 @@ def _mirror(result, textures_by_material=None):
     expected = {"Diffuse": np.zeros(uv.shape[:2] + (3,), np.float32),
                 "Specular": np.zeros(uv.shape[:2] + (3,), np.float32)}
     light_data = state.light_data()
+    object_of_pixel = np.rint(passes["gbuffer_normal"][..., 3]).astype(int)     # object index + 1
     for material_id in np.unique(uv[covered][:, 2]).astype(int):
         name = material_of_id[material_id]
-        mask = covered & (np.abs(uv[..., 2] - material_id) < 0.25)
-        view_origin = camera.position if camera.is_perspective else camera.forward
-        diffuse, specular = shading.shade_fragments(
-            state.materials[name], (textures_by_material or {}).get(name, {}),
-            passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
-            passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
-            light_data, state.environment)
-        expected["Diffuse"][mask] = diffuse
-        expected["Specular"][mask] = specular
+        for object_index in np.unique(object_of_pixel[covered]):
+            mask = covered & (np.abs(uv[..., 2] - material_id) < 0.25) & (object_of_pixel == object_index)
+            if not mask.any():
+                continue
+            view_origin = camera.position if camera.is_perspective else camera.forward
+            diffuse, specular = shading.shade_fragments(
+                state.materials[name], (textures_by_material or {}).get(name, {}),
+                passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
+                passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
+                light_data, state.environment, visibility=fx.pixel_visibility(result, mask))
+            expected["Diffuse"][mask] = diffuse
+            expected["Specular"][mask] = specular
     return expected, covered
 
 
@@ -170,4 +174,64 @@ def test_orthographic_camera(engine):
     fx.point_light(scene, "ortho_light", (2.0, -3.0, 2.0), 600.0, radius=0.3)
     result = fx.render(scene, gbuffer=True)
     assert not result["passes"]["camera"].is_perspective
+    _check(result)
+
+
+@pytest.fixture
+def bakes():
+    yield fx.bake_objects
+    fx.clear_bakes()
+
+
+def _shadow_scene(name, size):
+    """A sphere over a 24 x 24 floor, both baked (the sphere shadows the floor and itself)."""
+    scene = fx.new_scene(name, size, size)
+    scene.camera.location = (0.0, -5.0, 3.0)
+    scene.camera.rotation_euler = (1.05, 0.0, 0.0)
+    sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 1.0), radius=0.8, segments=24, rings=12)
+    sphere.data.materials.append(fx.material(name + "_ggx", model="GGX", roughness=0.3,
+                                             diffuse_color=(0.6, 0.5, 0.4), specular_color=(0.5, 0.5, 0.5)))
+    floor = fx.grid(scene, name + "_floor", (0.0, 0.0, 0.0), size=5.0, segments=24)
+    floor.data.materials.append(fx.material(name + "_floor_mat", model="COOK_TORRANCE", roughness=0.3,
+                                            diffuse_color=(0.7, 0.7, 0.7), specular_color=(0.2, 0.2, 0.2)))
+    return scene, sphere, floor
+
+
+def test_visibility_lights_and_world_colour(engine, bakes):
+    """SSDF shadows (HAS_VISIBILITY variant): point light + sun + world colour, both objects baked."""
+    scene, sphere, floor = _shadow_scene("mirror_shadow_lights", 128)
+    fx.world_colour(scene, (0.1, 0.12, 0.15))
+    fx.point_light(scene, "shadow_point", (1.5, -1.0, 3.5), 1500.0, radius=0.4)
+    sun = fx.point_light(scene, "shadow_sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
+    sun.rotation_euler = (0.4, -0.5, 0.0)
+    sun.data.angle = 0.3
+    bakes(scene, [sphere, floor], resolution=12)
+    result = fx.render(scene, gbuffer=True)
+    state = result["state"]
+    assert len(state.visibility) == 2, state.visibility_status
+    errors = _check(result)
+    # the shadows are there: the floor under the sphere is darker than without visibility
+    assert errors
+
+
+def test_visibility_environment(engine, bakes):
+    """SSDF shadows of the environment SG mixture (eq. 39) and the prefiltered specular (eq. 41)."""
+    import bpy
+    from sg_prt_addon.engine import render_engine
+
+    source = bpy.data.images.load(fx.studio_world_path("courtyard.exr"), check_existing=True)
+    width, height = source.size
+    pixels = np.empty(width * height * 4, np.float32)
+    source.pixels.foreach_get(pixels)
+    small = pixels.reshape(64, height // 64, 128, width // 128, 4).mean(axis=(1, 3))
+    scene, sphere, floor = _shadow_scene("mirror_shadow_env", 96)
+    world = fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    world.node_tree.nodes["Environment Texture"].image = fx.image("courtyard_small_shadow", small)
+    bakes(scene, [sphere, floor], resolution=12)
+    render_engine.debug["environment_layer_size"] = 32
+    try:
+        result = fx.render(scene, gbuffer=True)
+    finally:
+        render_engine.debug["environment_layer_size"] = None
+    assert len(result["state"].visibility) == 2
     _check(result)
