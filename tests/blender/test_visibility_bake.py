@@ -293,3 +293,50 @@ def test_example_scene_floor_under_suzanne_is_shadowed(addon):
     assert up < -0.3 and np.median(low) > 0.03 and np.sum(low > 0) >= 12, (up, low)
     suzanne = vb.load_visibility_bake(bpy.data.objects["Suzanne"].data)
     assert suzanne.usable and suzanne.vertex_count == len(bpy.data.objects["Suzanne"].data.vertices) > 7000
+
+
+BAKE_IN_OTHER_BLENDER = """
+import sys
+import bpy
+import numpy as np
+import sg_prt_addon
+sg_prt_addon.register()
+from sg_prt_addon.blender import visibility_bake as vb
+bpy.ops.wm.read_factory_settings(use_empty=True)
+bpy.ops.mesh.primitive_grid_add(x_subdivisions=6, y_subdivisions=6, size=4.0)
+bpy.ops.mesh.primitive_monkey_add(size=1.0, location=(0, 0, 1))
+bpy.ops.mesh.primitive_cylinder_add(location=(2, 0, 1))     # 32-gon caps: polyfill triangulation
+assert bpy.ops.sgprt.bake_visibility(target="ALL", resolution=6, refinement=1, term_mode="FIXED",
+                                     terms=5) == {"FINISHED"}
+bpy.ops.wm.save_as_mainfile(filepath=sys.argv[-1] + "/old.blend")
+np.savez(sys.argv[-1] + "/old.npz", **{m.name: vb.load_visibility_bake(m).packed_coefficients
+                                        for m in bpy.data.meshes})
+sys.stdout.flush()
+import os
+os._exit(0)     # pip bpy 4.2.23 segfaults at interpreter exit once any Operator or Panel class is registered
+"""
+
+
+def test_a_bake_from_blender_4_2_loads_bit_exactly_in_this_blender(addon, tmp_path):
+    """Users upgrade: a .blend baked by Blender 4.2 LTS (the second venv) opens here with the bake
+    valid (same topology hash, n-gons included) and bit-identical coefficients."""
+    import os
+    import pathlib
+    import subprocess
+    import sys
+    root = pathlib.Path(__file__).resolve().parents[2]
+    python = root / ".venv-bpy42" / "bin" / "python"
+    if not python.exists() or bpy.app.version < (4, 3, 0):
+        pytest.skip("needs the bpy 4.2 venv, and a newer Blender running the test")
+    script = tmp_path / "bake_old.py"
+    script.write_text(BAKE_IN_OTHER_BLENDER)
+    done = subprocess.run([str(python), str(script), str(tmp_path)], cwd=root, capture_output=True, text=True,
+                          timeout=120, env={**os.environ, "PYTHONPATH": str(root)})
+    assert done.returncode == 0, done.stderr[-2000:]
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "old.blend"))
+    expected = np.load(tmp_path / "old.npz")
+    assert sorted(expected.files) == sorted(m.name for m in bpy.data.meshes) and len(expected.files) == 3
+    for mesh in bpy.data.meshes:
+        stored = vb.load_visibility_bake(mesh)
+        assert stored.usable, (mesh.name, stored.message)
+        assert np.array_equal(_bits(stored.packed_coefficients), _bits(expected[mesh.name])), mesh.name
