@@ -36,7 +36,7 @@ Storage, per mesh datablock (format version 1)
   ``vertex_count``, ``topology_hash`` (``bake.pipeline.topology_hash`` of the
   vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``),
   ``frame_reference_axis`` (3), ``date`` (ISO 8601 UTC), ``seconds``,
-  ``resolution``, ``refinement``, ``error_target``, ``rays_traced``, and the
+  ``refinement``, ``error_target`` (-1 for fixed terms), ``rays_traced``, and the
   basis ``basis`` (N R R) and ``mean`` (R R) as float arrays (stored as double:
   the float32 values round-trip bit-exactly through save and reopen).
 
@@ -517,7 +517,7 @@ class SGPRT_OT_bake_visibility(bpy.types.Operator):
         occluder_vertices, occluder_triangles = occluder_arrays(depsgraph)
         self._topology = {key: mesh_topology_hash(bpy.data.meshes[key]) for key, *_ in receivers}
         return BakeJob(receivers, occluder_vertices, occluder_triangles, _bake_options(self),
-                       verbose=bpy.app.background, hook=progress_hook)
+                       hook=progress_hook)
 
     def _finish(self, context, job):
         if job.cancelled:
@@ -548,6 +548,7 @@ class SGPRT_OT_bake_visibility(bpy.types.Operator):
         job = self._prepare(context)
         if job is None:
             return {"CANCELLED"}
+        job.verbose = True          # the synchronous path prints "[sg-prt] bake 40% ..." lines
         job.run()
         return self._finish(context, job)
 
