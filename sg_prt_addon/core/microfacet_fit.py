@@ -655,12 +655,17 @@ def fit_free_axes_batch(values, directions, weights, initial, max_iterations=150
         r, axis, length, sharp, cosine, lobes = _free_axes_residual(p, directions, root_weights, target[rows],
                                                                     scale[rows])
         factor = (root_weights / scale[rows])[:, None, :] * lobes  # (b, K, M)
-        tangential = directions[None, None] - cosine[..., None] * axis[:, :, None]  # d(cosine)/d(axis) * |raw|
-        d_axis = (factor * sharp[..., None])[..., None] * tangential
-        jacobian = np.concatenate([d_axis / length[..., None, None],
-                                   (factor * sharp[..., None] * (cosine - 1))[..., None],
-                                   factor[..., None]], axis=-1)  # (b, K, M, 5)
-        jacobian = np.moveaxis(jacobian, 2, 1).reshape(len(rows), -1, lobe_count * 5)
+        # Jacobian (b, M, K * 5) filled in place: d/d raw axis = factor lambda (d - c axis) / |raw|,
+        # d/d log lambda = factor lambda (c - 1), d/d log mu = factor
+        jacobian = np.empty((len(rows), directions.shape[0], lobe_count, 5))
+        sharp_factor = factor * sharp[..., None]
+        scaled = sharp_factor / length[..., None]
+        for component in range(3):
+            jacobian[..., component] = np.swapaxes(
+                scaled * (directions[:, component] - cosine * axis[:, :, component, None]), 1, 2)
+        jacobian[..., 3] = np.swapaxes(sharp_factor * (cosine - 1), 1, 2)
+        jacobian[..., 4] = np.swapaxes(factor, 1, 2)
+        jacobian = jacobian.reshape(len(rows), -1, lobe_count * 5)
         normal = np.swapaxes(jacobian, 1, 2) @ jacobian
         gradient = (np.swapaxes(jacobian, 1, 2) @ r[..., None])[..., 0]
         diagonal = np.einsum("bpp->bp", normal)
