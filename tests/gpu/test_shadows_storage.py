@@ -1,0 +1,88 @@
+"""Bakes stored in the .blend reach the engine (blender.visibility_bake.visibility_for_object, the
+default of engine.scene_state.visibility_for); stale bakes and bakes of another vertex count
+render unshadowed, never read out of bounds."""
+import numpy as np
+import pytest
+
+import engine_fixtures as fx
+
+
+@pytest.fixture(scope="module")
+def engine(blender):
+    fx.ensure_registered()
+    return blender
+
+
+def _scene(name):
+    scene = fx.new_scene(name, 64, 64)
+    scene.camera.location = (0.0, -5.5, 4.0)
+    scene.camera.rotation_euler = (np.radians(52.0), 0.0, 0.0)
+    fx.world_colour(scene, (0.02, 0.02, 0.02))
+    sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 0.9), radius=0.8, segments=16, rings=8)
+    floor = fx.grid(scene, name + "_floor", (0.0, 0.0, 0.0), size=6.0, segments=16)
+    fx.point_light(scene, name + "_light", (1.2, -0.6, 3.6), 600.0, radius=0.05)
+    return scene, sphere, floor
+
+
+def test_stored_bakes_shadow_and_stale_bakes_do_not(engine):
+    import bmesh
+    from sg_prt_addon.blender import visibility_bake
+
+    scene, sphere, floor = _scene("stored_bakes")
+    unshadowed = fx.render(scene)["passes"]["Combined"]
+    try:
+        bakes = fx.bake_objects(scene, [sphere, floor], resolution=8)
+    finally:
+        fx.clear_bakes()
+    for obj in (sphere, floor):
+        visibility_bake.store_visibility_bake(obj.data, bakes[obj.name])
+    result = fx.render(scene)
+    assert "error" not in result, result.get("error")
+    state = result["state"]
+    assert len(state.visibility) == 2, state.visibility_status
+    shadowed = result["passes"]["Combined"]
+    darker = shadowed[..., 0] < 0.5 * unshadowed[..., 0]
+    assert darker.mean() > 0.03             # the sphere's shadow on the floor (and its own dark side)
+    assert np.all(shadowed[..., :3] <= unshadowed[..., :3] * 1.001 + 1e-6)
+
+    # the floor gains a vertex: its bake is stale, the floor renders exactly as without a bake
+    bm = bmesh.new()
+    bm.from_mesh(floor.data)
+    bm.verts.new((10.0, 10.0, 0.0))
+    bm.to_mesh(floor.data)
+    bm.free()
+    floor.data.update()
+    result = fx.render(scene)
+    assert "error" not in result, result.get("error")
+    state = result["state"]
+    floor_key = next(key for key in state.meshes if key.startswith(floor.name))
+    assert floor_key not in state.visibility
+    assert "stale" in state.visibility_status[floor_key]
+    assert len(state.visibility) == 1                      # the sphere keeps its shadows
+
+
+def test_a_bake_of_another_vertex_count_is_refused(engine):
+    from sg_prt_addon.bake.pipeline import BakeResult
+    from sg_prt_addon.engine import scene_state
+
+    scene, sphere, floor = _scene("mismatched_bake")
+    vertex_count = len(floor.data.vertices)
+    resolution, terms = 8, 3
+    rng = np.random.default_rng(0)
+
+    def fake(count):
+        return BakeResult(coefficients=rng.normal(size=(count, terms)).astype(np.float32),
+                          basis=rng.normal(size=(terms, resolution, resolution)).astype(np.float32),
+                          mean=np.ones((resolution, resolution), np.float32), resolution=resolution, terms=terms,
+                          rms_error=0.0, rms_error_by_terms=np.zeros(terms + 1), vertex_count=count,
+                          topology_hash="")
+    bakes = {floor.name: fake(vertex_count - 1), sphere.name: fake(vertex_count * 10)}
+    scene_state.visibility_provider = lambda object_eval: bakes.get(object_eval.name)
+    try:
+        result = fx.render(scene)
+    finally:
+        fx.clear_bakes()
+    assert "error" not in result, result.get("error")
+    state = result["state"]
+    assert state.visibility == {}
+    assert all("stale" in message for message in state.visibility_status.values()), state.visibility_status
