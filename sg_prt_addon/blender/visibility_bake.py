@@ -60,7 +60,7 @@ from typing import Optional
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 from ..bake import decode
 from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility, topology_hash

@@ -323,7 +323,6 @@ def test_a_bake_from_blender_4_2_loads_bit_exactly_in_this_blender(addon, tmp_pa
     import os
     import pathlib
     import subprocess
-    import sys
     root = pathlib.Path(__file__).resolve().parents[2]
     python = root / ".venv-bpy42" / "bin" / "python"
     if not python.exists() or bpy.app.version < (4, 3, 0):
