@@ -233,6 +233,14 @@ def test_bad_input_reports_instead_of_raising_tracebacks(scene, capfd):
         bpy.ops.sgprt.bake_visibility()
     assert "has no faces" in capfd.readouterr().out + capfd.readouterr().err
     assert vb.load_visibility_bake(points.data) is None
+    # a mesh in Edit Mode would lose the attributes when Edit Mode writes the mesh back: refused
+    _select(suzanne)
+    bpy.ops.object.mode_set(mode="EDIT")
+    capfd.readouterr()
+    with pytest.raises(RuntimeError, match="none of the objects can be baked"):
+        bpy.ops.sgprt.bake_visibility()
+    assert "leave it before baking" in "".join(capfd.readouterr())
+    bpy.ops.object.mode_set(mode="OBJECT")
     # a faceless object among good ones is skipped, the others are baked
     _select(points, suzanne)
     assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
