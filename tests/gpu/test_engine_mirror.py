@@ -18,7 +18,7 @@ def engine(blender):
     return blender
 
 
-def _mirror(result, textures_by_material=None):
+def _mirror(result, textures_by_material=None, use_visibility=True):
     """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask."""
     from sg_prt_addon.core import shading
 
@@ -42,7 +42,8 @@ def _mirror(result, textures_by_material=None):
                 state.materials[name], (textures_by_material or {}).get(name, {}),
                 passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
                 passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
-                light_data, state.environment, visibility=fx.pixel_visibility(result, mask))
+                light_data, state.environment,
+                visibility=fx.pixel_visibility(result, mask) if use_visibility else None)
             expected["Diffuse"][mask] = diffuse
             expected["Specular"][mask] = specular
     return expected, covered
@@ -209,9 +210,17 @@ def test_visibility_lights_and_world_colour(engine, bakes):
     result = fx.render(scene, gbuffer=True)
     state = result["state"]
     assert len(state.visibility) == 2, state.visibility_status
-    errors = _check(result)
-    # the shadows are there: the floor under the sphere is darker than without visibility
-    assert errors
+    _check(result)
+    _assert_shadows(result)
+
+
+def _assert_shadows(result):
+    """The visibility variant really shadows: many pixels lose over 20% of their diffuse light."""
+    shadowed, covered = _mirror(result)
+    unshadowed, _ = _mirror(result, use_visibility=False)
+    darker = shadowed["Diffuse"][covered].sum(-1) < 0.8 * unshadowed["Diffuse"][covered].sum(-1)
+    print("pixels darkened by the shadows", darker.mean())
+    assert darker.mean() > 0.05
 
 
 def test_visibility_environment(engine, bakes):
@@ -235,3 +244,4 @@ def test_visibility_environment(engine, bakes):
         render_engine.debug["environment_layer_size"] = None
     assert len(result["state"].visibility) == 2
     _check(result)
+    _assert_shadows(result)
