@@ -753,9 +753,10 @@ class LobeFit:
         return out
 
 
-def fit_lobes(factorization, lobe_count, shadowing_components=8, free_axes=None, progress=None):
-    """SG lobes + PCA shadowing from a MicrofacetFactorization (or an isotropic SvbrdfTable).
-    Returns a LobeFit, or None if cancelled."""
+def fit_lobes(factorization, lobe_count, shadowing_components=8, free_axes=None, progress=None, **lobe_options):
+    """SG lobes + PCA shadowing from a MicrofacetFactorization or an SvbrdfTable (isotropic or
+    anisotropic NDF); lobe_options (phi_count, max_iterations, method) go to fit_ndf_lobes.
+    Texels are flattened (B = H * W).  Returns a LobeFit, or None if cancelled."""
     if isinstance(factorization, SvbrdfTable):
         table = factorization
         factorization = MicrofacetFactorization(
@@ -768,7 +769,7 @@ def fit_lobes(factorization, lobe_count, shadowing_components=8, free_axes=None,
     else:
         ndf_phi = None
     lobes = fit_ndf_lobes(factorization.ndf_theta, factorization.ndf, lobe_count, ndf_phi=ndf_phi,
-                          free_axes=free_axes, progress=progress)
+                          free_axes=free_axes, progress=progress, **lobe_options)
     if lobes is None:
         return None
     axis, sharpness, amplitude, error = lobes
