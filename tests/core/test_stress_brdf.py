@@ -10,9 +10,9 @@ import pytest
 
 from sg_prt_addon.core import brdf
 
-# 1e6 inputs per kernel: 71 s for the file on the loaded 2-core machine (all pass); the default keeps it fast
-# on the shared machine.  SGPRT_STRESS_COUNT=1000000 runs the full-size version.
-TOTAL = int(os.environ.get("SGPRT_STRESS_COUNT", 100_000))
+# 1e6 inputs per kernel, as the core issue asks (16 s of CPU for the file); SGPRT_STRESS_COUNT
+# runs a smaller or larger version.
+TOTAL = int(os.environ.get("SGPRT_STRESS_COUNT", 1_000_000))
 
 
 def hostile_directions(rng, count, dtype):
