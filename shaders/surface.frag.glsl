@@ -6,7 +6,7 @@ void main()
 {
   vec3 normal = gl_FrontFacing ? world_normal : -world_normal;
 #ifdef HAS_VISIBILITY
-  visibility_normal = world_ssdf_normal;       /* the bake's frame: not flipped for back faces */
+  set_visibility_frame(world_ssdf_normal);     /* the bake's frame: not flipped for back faces */
   visibility_rows[0] = ssdf_coefficients_0;
 #if SSDF_MAX_LAYERS > 1
   visibility_rows[1] = ssdf_coefficients_1;
