@@ -26,7 +26,8 @@ lobe), the SSDF theta_d decoded at P's axis in the vertex's local frame
 visibility keeps of P relative to what the horizon alone keeps, since I(G, n) clamps
 the horizon already).  G is the environment lobe (eq. 39), the light (eq. 42), the
 light (x) slice lobe (eq. 43) and the slice lobe (eq. 41); a constant world colour
-uses the cosine lobe alone.
+uses the cosine lobe alone.  Light (x) slice products below VISIBILITY_SKIP_FRACTION of the
+light's own I(G, n) stay unshadowed (the shader skips their decode).
 
 Everything is computed in float32 like the GPU.  Directions: world space, all
 pointing away from the surface.
@@ -41,6 +42,9 @@ FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
 # GGX's projected area at roughness 0.3-0.5 (its long tail), two lobes 0.93-0.97.
 GGX_NDF_LOBES = 2
+# Light (x) slice products (eq. 43) whose clamped-cosine integral is below this fraction of the light's own
+# (away from the highlight) skip the SSDF decode and stay unshadowed (the GLSL branches: it saves decodes).
+VISIBILITY_SKIP_FRACTION = 1e-4
 # Local frame fallback when a tangent is parallel to the normal.
 _FALLBACK_TANGENT = np.array([1.0, 0.0, 0.0], FLOAT)
 
@@ -241,14 +245,16 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
                            np.broadcast_to(light_data.sun_sharpness[None], (len(position), count)),
                            np.broadcast_to(light_data.sun_amplitude[None], (len(position), count, 3))))
     for light_axis, light_sharpness, light_amplitude in light_sets:
-        irradiance += np.sum(light_amplitude * (_clamped_cosine_integral(
-            light_axis, light_sharpness, FLOAT(1), n_lobe) * visible(light_axis, light_sharpness))[..., None], axis=1)
+        light_cosine = _clamped_cosine_integral(light_axis, light_sharpness, FLOAT(1), n_lobe)      # (N, P)
+        irradiance += np.sum(light_amplitude * (light_cosine * visible(light_axis, light_sharpness))[..., None], axis=1)
         # (N, P, 1) x (N, 1, J): every light against every slice lobe
         axis_m, sharpness_m, amplitude_m = sg.product(
             light_axis[:, :, None, :], light_sharpness[:, :, None], FLOAT(1),
             slice_axis[:, None, :, :], slice_sharpness[:, None, :], slice_amplitude[:, None, :])
-        weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :]) * \
-            visible(axis_m, sharpness_m)
+        weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :])
+        if visibility is not None:
+            decoded = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
+            weight = np.where(decoded, weight * visible(axis_m, sharpness_m), weight)
         specular += np.sum(light_amplitude * np.sum(weight, axis=2)[..., None], axis=1)
 
     slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe) * \

@@ -116,7 +116,9 @@ def _constants_source(key):
     from ..core import brdf
 
     rf0 = brdf.AshikhminShirley.__dataclass_fields__["rf0"].default
-    return f"const float BRDF_AS_RF0 = {_float_literal(rf0)};\n"
+    from ..core import shading
+    return (f"const float BRDF_AS_RF0 = {_float_literal(rf0)};\n"
+            f"const float VISIBILITY_SKIP_FRACTION = {_float_literal(shading.VISIBILITY_SKIP_FRACTION)};\n")
 
 
 def warp_mode():

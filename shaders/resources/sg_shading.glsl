@@ -226,16 +226,23 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_sharpness;
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
-    irradiance += light_amplitude * (sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n) *
-                                     LOBE_VISIBILITY(light_axis, light_sharpness));           /* eq. 42 */
+    float light_cosine = sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n);
+    irradiance += light_amplitude * (light_cosine * LOBE_VISIBILITY(light_axis, light_sharpness));   /* eq. 42 */
     float weight = 0.0;
     for (int j = 0; j < SLICE_LOBES; j++) {
       vec3 product_axis;
       float product_sharpness, product_amplitude;
       sg_product(light_axis, light_sharpness, 1.0, slice_axis[j], slice_sharpness[j], slice_amplitude[j],
                  product_axis, product_sharpness, product_amplitude);
-      weight += sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n) *
-                LOBE_VISIBILITY(product_axis, product_sharpness);                              /* eq. 43 */
+      float product_cosine = sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n);
+#ifdef HAS_VISIBILITY
+      /* eq. 43; products negligible next to the light's irradiance (away from the highlight) skip the
+       * SSDF decode (left unshadowed: at most VISIBILITY_SKIP_FRACTION of the light's cosine integral) */
+      if (product_cosine > VISIBILITY_SKIP_FRACTION * light_cosine) {
+        product_cosine *= lobe_visibility(product_axis, product_sharpness, n);
+      }
+#endif
+      weight += product_cosine;
     }
     radiance += light_amplitude * weight;
   }
