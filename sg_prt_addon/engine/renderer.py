@@ -109,13 +109,22 @@ def material_block(params, material_id=0):
 VISIBILITY_TEXTURE_WIDTH = 4096     # texels a row of the coefficient texture (a multiple of the layers is used)
 
 
+MAX_TEXTURE_SIZE = 16384              # GPUTexture side limit measured here (DESIGN.md)
+
+
+def visibility_texture_shape(vertex_count, layers):
+    """(rows, texels a row) of the coefficient texture of vertex_count vertices."""
+    per_row = max(1, VISIBILITY_TEXTURE_WIDTH // layers)
+    return max(1, -(-vertex_count // per_row)), per_row * layers
+
+
 def visibility_texture_rows(packed, layers):
     """(H, W, 4) float32 texture of per-vertex coefficient rows (V, 4 layers): vertex v's vec4 k at texel
     (column (v % per_row) * layers + k, row v // per_row), per_row = VISIBILITY_TEXTURE_WIDTH // layers
     (mesh.vert.glsl reads it back with texelFetch)."""
     count = packed.shape[0]
     per_row = max(1, VISIBILITY_TEXTURE_WIDTH // layers)
-    rows = max(1, -(-count // per_row))
+    rows = visibility_texture_shape(count, layers)[0]
     out = np.zeros((rows * per_row, layers, 4), np.float32)
     out[:count] = np.asarray(packed, np.float32).reshape(count, layers, 4)
     return out.reshape(rows, per_row * layers, 4)
@@ -140,7 +149,8 @@ class MeshBuffers:
             # texelFetch must never read past the rows uploaded
             if (mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions)
                     or visibility.packed.shape[0] != mesh.vertex_count
-                    or (len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= visibility.packed.shape[0])):
+                    or (len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= visibility.packed.shape[0])
+                    or visibility_texture_shape(visibility.packed.shape[0], visibility.layers)[0] > MAX_TEXTURE_SIZE):
                 visibility = None
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
