@@ -7,7 +7,9 @@ numpy mirror (core/shading.py) see exactly the same numbers:
   tangent sign flips need no vertex splitting logic; triangles index corners;
   positions/normals/tangents are in object space, with the object's
   matrix_world alongside (a transform edit then needs no re-export);
-  `to_world` gives the world-space arrays;
+  `to_world` gives the world-space arrays; `corner_vertex` maps each corner to its Blender
+  mesh vertex (per-vertex data such as the visibility bake's coefficients is shared by the
+  vertex's corners) and `vertex_normals` are the smooth vertex normals (the bake's frames);
 - materials: `material.sgprt` read into `MaterialParams` (defaults when the
   material has no settings or the slot is empty);
 - lights in Blender units, converted to the quantities core/lights.py takes;
