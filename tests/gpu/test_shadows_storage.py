@@ -134,3 +134,20 @@ def test_viewport_update_picks_up_a_new_bake_and_its_removal(blender):
         bpy.app.handlers.depsgraph_update_post.remove(on_update)
         for obj in list(scene.objects):
             bpy.data.objects.remove(obj)
+
+
+def test_bake_operator_to_render(engine):
+    """End to end: the Bake Visibility operator (execute) stores bakes that the next render shadows with."""
+    import bpy
+
+    scene, sphere, floor = _scene("operator_bakes")
+    unshadowed = fx.render(scene)["passes"]["Combined"]
+    with bpy.context.temp_override(scene=scene, view_layer=scene.view_layers[0]):
+        outcome = bpy.ops.sgprt.bake_visibility(target="ALL", resolution=8, term_mode="FIXED", terms=8)
+    assert outcome == {"FINISHED"}
+    result = fx.render(scene)
+    assert "error" not in result, result.get("error")
+    assert len(result["state"].visibility) == 2, result["state"].visibility_status
+    assert {data.terms for data in result["state"].visibility.values()} == {8}
+    shadowed = result["passes"]["Combined"]
+    assert (shadowed[..., 0] < 0.5 * unshadowed[..., 0]).mean() > 0.03
