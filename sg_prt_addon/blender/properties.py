@@ -5,8 +5,8 @@ shaded value is the property times the texture sample (RGB for colours, the
 red channel for scalars), like a factor next to a texture in Blender's nodes.
 """
 import bpy
-from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty,
-                       PointerProperty)
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
+                       IntProperty, PointerProperty, StringProperty)
 
 MODELS = (
     ("GGX", "GGX", "Microfacet GGX matching Blender's Glossy BSDF (alpha = roughness^2, "
@@ -46,6 +46,33 @@ def _texture(name):
         type=bpy.types.Image, update=_tag_material_changed, name=f"{name.replace('_', ' ').title()} Texture",
         description=f"Image over the active UV map multiplying {name.replace('_', ' ')} "
                     "(RGB for colours, red channel for scalars)")
+
+
+class SGPRT_PG_lobe_fit_image(bpy.types.PropertyGroup):
+    """One packed FLOAT image of a fitted material (layout: blender/lobe_fit.py)."""
+    role: StringProperty(name="Role", description="What the image holds: base, lobe_K_axis, lobe_K_amplitude, "
+                                                  "shadowing_K, shadowing_table, error")
+    image: PointerProperty(type=bpy.types.Image, name="Image")
+
+
+class SGPRT_PG_lobe_fit(bpy.types.PropertyGroup):
+    """A measured BRDF fitted to SG lobes by sgprt.fit_lobes: metadata and its images."""
+    format_version: IntProperty(name="Format Version", default=0, description="0: no fit stored")
+    source_file: StringProperty(name="Source File", description="File name the fit was made from")
+    source_path: StringProperty(name="Source Path", description="Full path the fit was made from")
+    source_kind: StringProperty(name="Source Kind", description="MERL or SVBRDF_TABLE")
+    lobe_count: IntProperty(name="Lobes", default=0, min=0)
+    free_axes: BoolProperty(name="Free Axes", default=False, description="Lobe axes fitted freely (else z+)")
+    shadowing_components: IntProperty(name="Shadowing Components", default=0, min=0)
+    shadowing_samples: IntProperty(name="Shadowing Samples", default=0, min=0)
+    width: IntProperty(name="Width", default=0, min=0)
+    height: IntProperty(name="Height", default=0, min=0)
+    fit_error: FloatProperty(name="Fit Error", default=0.0, description="Mean relative RMSE of the fitted BRDF")
+    fit_error_max: FloatProperty(name="Max Fit Error", default=0.0)
+    ndf_error: FloatProperty(name="NDF Error", default=0.0, description="Mean relative L2 error of the SG fit of D")
+    date: StringProperty(name="Date", description="When the fit was stored (ISO 8601 UTC)")
+    seconds: FloatProperty(name="Seconds", default=0.0)
+    images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
 
 
 class SGPRT_PG_material(bpy.types.PropertyGroup):
@@ -97,9 +124,13 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                                     description="Rotation of the tangent about the normal")
     show_textures: BoolProperty(update=_tag_material_changed, name="Show Textures", default=True,
                                 description="Show the texture slot next to each parameter")
+    use_fitted_lobes: BoolProperty(update=_tag_material_changed, name="Use Fitted Lobes", default=False,
+                                   description="Render the stored lobe fit (lobe_fit) instead of the model")
+    lobe_fit: PointerProperty(type=SGPRT_PG_lobe_fit, name="Lobe Fit",
+                              description="SG lobes fitted to a measured BRDF (sgprt.fit_lobes)")
 
 
-classes = (SGPRT_PG_material,)
+classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_material)
 
 
 def register():

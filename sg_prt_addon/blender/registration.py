@@ -1,7 +1,7 @@
 """Register and unregister everything the add-on adds to Blender, in dependency order."""
 import bpy
 
-from . import panels, properties, visibility_bake
+from . import lobe_fit, panels, properties, visibility_bake
 
 
 def _engine_classes():
@@ -20,6 +20,7 @@ def register():
     properties.register()
     panels.register()
     visibility_bake.register()
+    lobe_fit.register()           # after panels: its panel's parent is SGPRT_PT_material
     for cls in engine_classes:
         bpy.utils.register_class(cls)
         _registered_engine_classes.append(cls)
@@ -28,6 +29,7 @@ def register():
 def unregister():
     while _registered_engine_classes:
         bpy.utils.unregister_class(_registered_engine_classes.pop())
+    lobe_fit.unregister()
     visibility_bake.unregister()
     panels.unregister()
     properties.unregister()
