@@ -2,7 +2,8 @@
 
 The engine's own export (engine.scene_state.SceneState) is converted, so the
 reference and the engine score the same geometry, materials, textures (same
-bilinear sampler), lights, world and camera; only the light transport differs.
+pixels, colour space and bilinear sampler), lights, world and camera; only the
+light transport differs.
 """
 import numpy as np
 
@@ -34,13 +35,14 @@ def _texture_lookup(params, images):
     return lookup
 
 
-def reference_material(params, image_pixels_by_name):
-    """core.reference.Material of an export.MaterialParams."""
+def reference_material(params, texture_pixels):
+    """core.reference.Material of an export.MaterialParams; texture_pixels(image name, slot) gives
+    what the shader samples for that slot (export.texture_pixels), or None for a missing image."""
     constant = {name: float(getattr(params, name)) for name in _MODEL_PARAMETERS[params.model]}
     material = reference.Material(np.asarray(params.diffuse_color, float), np.asarray(params.specular_color, float),
                                   brdf.model_from_name(params.model, **constant))
-    images = {name: image_pixels_by_name[image] for name, image in params.textures.items()
-              if name != "normal_map" and image in image_pixels_by_name}
+    images = {slot: texture_pixels(image, slot) for slot, image in params.textures.items() if slot != "normal_map"}
+    images = {slot: pixels for slot, pixels in images.items() if pixels is not None}
     if images:
         material.textures = _texture_lookup(params, images)
     return material
@@ -60,11 +62,10 @@ def reference_lights(light_exports):
     return lights
 
 
-def reference_scene(state, images):
-    """core.reference.Scene of a synced engine SceneState; ``images``: image name -> pixels
-    (export.image_pixels orientation) for the textures the materials use."""
+def reference_scene(state, texture_pixels):
+    """core.reference.Scene of a synced engine SceneState; texture_pixels as reference_material takes it."""
     material_names = list(state.materials)
-    materials = [reference_material(state.materials[name], images) for name in material_names]
+    materials = [reference_material(state.materials[name], texture_pixels) for name in material_names]
     vertices, normals, uvs, tangents, triangles, material_index = [], [], [], [], [], []
     offset = 0
     for entry in state.objects.values():
@@ -99,8 +100,11 @@ def reference_inputs(depsgraph, width, height):
 
     state = SceneState()
     state.sync(depsgraph)
-    names = {image for params in state.materials.values() for image in params.textures.values()}
-    images = {name: export.image_pixels(bpy.data.images[name]) for name in names if name in bpy.data.images}
+
+    def texture_pixels(name, slot):
+        image = bpy.data.images.get(name)
+        return None if image is None else export.texture_pixels(image, slot)
+
     scene = depsgraph.scene
     camera = export.export_camera(scene.camera.evaluated_get(depsgraph), depsgraph, width, height)
-    return reference_scene(state, images), Camera(camera.view, camera.projection, width, height)
+    return reference_scene(state, texture_pixels), Camera(camera.view, camera.projection, width, height)

@@ -19,7 +19,22 @@ def engine(blender):
     return blender
 
 
+def _srgb_checker(name):
+    """An 8-bit sRGB image (Blender's default for byte images): the engine and the reference
+    must both decode it to scene-linear colour."""
+    import bpy
+
+    image = bpy.data.images.new(name, 8, 8, alpha=False)
+    checker = (np.add.outer(np.arange(8), np.arange(8)) % 2).astype(np.float32)
+    rgba = np.stack([0.2 + 0.7 * checker, 0.5 * np.ones((8, 8)), 0.9 - 0.7 * checker, np.ones((8, 8))], -1)
+    image.pixels.foreach_set(rgba.astype(np.float32).ravel())
+    assert not image.is_float and image.colorspace_settings.name == "sRGB"
+    return image
+
+
 def _sphere_scene(name, model, **settings):
+    if settings.pop("srgb_texture", False):
+        settings["diffuse_color_texture"] = _srgb_checker(name + "_checker")
     scene = fx.new_scene(name, SIZE, SIZE)
     fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
     sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 1.0), radius=1.0, segments=64, rings=32)
@@ -50,9 +65,12 @@ def _score(scene):
 @pytest.mark.parametrize("model, settings, rmse_bound", [
     ("GGX", dict(roughness=0.4, diffuse_color=(0.5, 0.5, 0.5), specular_color=(0.3, 0.3, 0.3)), 0.07),
     ("COOK_TORRANCE", dict(roughness=0.2, diffuse_color=(0.2, 0.3, 0.6), specular_color=(0.5, 0.5, 0.5)), 0.03),
+    ("GGX", dict(roughness=0.6, diffuse_color=(1.0, 1.0, 1.0), specular_color=(0.1, 0.1, 0.1),
+                 srgb_texture=True), 0.05),
 ])
 def test_unshadowed_sphere_matches_the_reference(engine, model, settings, rmse_bound):
-    rmse, bias, noise_floor = _score(_sphere_scene(f"score_{model.lower()}", model, **settings))
+    name = f"score_{model.lower()}" + ("_textured" if "srgb_texture" in settings else "")
+    rmse, bias, noise_floor = _score(_sphere_scene(name, model, **dict(settings)))
     print(f"{model}: relative RMSE {rmse:.4f} (reference noise floor {noise_floor:.4f}), bias {bias:+.4f}")
     assert noise_floor < 0.025
     assert rmse < rmse_bound
