@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Set up and run the main job: build the example scene, render it with SG-PRT, score it
+# Set up and run the main job: build the example scene, bake its visibility, render it with SG-PRT, score it
 # against the Monte Carlo reference; writes out/demo.png, out/reference.png, out/report.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
