@@ -9,12 +9,13 @@ material (``context.material``, else the active object's active material):
 The kind is told by content (a .npz is a zip: it starts with ``PK``), not by the name.
 
 execute(): synchronous, printing ``[sg-prt] fit 30% ...`` lines (``blender -b``, tests).
-invoke(): the file browser when no filepath was given (its confirmation re-invokes the
-operator with the path), then a background thread polled by a timer with the window
-manager's progress bar; Esc cancels.  The thread reads and fits files only: it never
-touches bpy.  Nothing is written unless the fit completes: an unreadable, truncated,
-corrupt or wrong-size file is reported (the message names the problem) and a cancelled
-or failed fit leaves the previous fit of the material intact.
+invoke(): the file browser when no filepath was given (its confirmation calls execute(),
+which then goes modal as invoke() does with a path): a background thread polled by a
+timer, with the window manager's progress bar and status text; Esc cancels.  The
+thread reads and fits files only: it never touches bpy.  Nothing is written unless the
+fit completes: an unreadable, truncated, corrupt or wrong-size file is reported (the
+message names the problem) and a cancelled or failed fit leaves the previous fit of the
+material intact.
 
 Storage (format version 1), the engine's input
 ----------------------------------------------
@@ -285,6 +286,10 @@ def clear_lobe_fit(material):
     return found
 
 
+def image_name(material, role):
+    return f"{IMAGE_PREFIX} {material.name} {role}"
+
+
 def store_lobe_fit(material, result, path, free_axes=None):
     """Write a finished FitJob result to a material, replacing any previous fit.  New images are
     made first; on any error they are removed and the previous fit stays."""
@@ -293,8 +298,8 @@ def store_lobe_fit(material, result, path, free_axes=None):
     made = []
     try:
         for role, array in result["layers"].items():
-            made.append((role, _new_image(f"{IMAGE_PREFIX} {material.name} {role}", array[::-1])))
-        made.append(("shadowing_table", _new_image(f"{IMAGE_PREFIX} {material.name} shadowing_table",
+            made.append((role, _new_image(image_name(material, role), array[::-1])))
+        made.append(("shadowing_table", _new_image(image_name(material, "shadowing_table"),
                                                    result["shadowing_table"])))
     except Exception:
         for _, image in made:
@@ -303,6 +308,7 @@ def store_lobe_fit(material, result, path, free_axes=None):
     clear_lobe_fit(material)
     settings = material.sgprt.lobe_fit
     for role, image in made:
+        image.name = image_name(material, role)      # the previous fit's images are gone: take their names
         item = settings.images.add()
         item.role, item.image = role, image
     errors = np.asarray(result["errors"], np.float64)
@@ -464,10 +470,10 @@ class SGPRT_OT_fit_lobes(bpy.types.Operator):
 
     def execute(self, context):
         if getattr(self, "_from_browser", False) and not bpy.app.background and context.window is not None:
-            # the file browser confirms through execute(): continue as a modal job with progress
+            # the file browser confirms through execute(); Blender keeps an operator whose execute
+            # returns RUNNING_MODAL (it frees it only on FINISHED / CANCELLED): go on as a modal job
             self._from_browser = False
-            return bpy.ops.sgprt.fit_lobes("INVOKE_DEFAULT", filepath=self.filepath, lobe_count=self.lobe_count,
-                                           axes=self.axes, shadowing_components=self.shadowing_components)
+            return self._start_modal(context)
         prepared = self._prepare(context)
         if prepared is None:
             return {"CANCELLED"}
@@ -477,12 +483,15 @@ class SGPRT_OT_fit_lobes(bpy.types.Operator):
         return self._finish(context, job)
 
     def invoke(self, context, event):
-        if not self.filepath and not bpy.app.background and context.window is not None:
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        if not self.filepath:
             self._from_browser = True
             context.window_manager.fileselect_add(self)
             return {"RUNNING_MODAL"}
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
+        return self._start_modal(context)
+
+    def _start_modal(self, context):
         prepared = self._prepare(context)
         if prepared is None:
             return {"CANCELLED"}

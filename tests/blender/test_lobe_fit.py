@@ -204,6 +204,7 @@ def test_refit_replaces_images_and_clear_removes_them(material, data):
     names = {image.name for image in bpy.data.images}
     assert second <= names and not (first - second) & names  # the old fit's extra images are gone
     assert len(material.sgprt.lobe_fit.images) == len(lf.expected_roles(1, 5))
+    assert all(item.image.name == lf.image_name(material, item.role) for item in material.sgprt.lobe_fit.images)
     assert bpy.ops.sgprt.clear_lobe_fit() == {"FINISHED"}
     assert lf.fit_status(material)[0] == "NONE" and not material.sgprt.use_fitted_lobes
     assert not second & {image.name for image in bpy.data.images}
@@ -238,3 +239,47 @@ def test_invoke_in_background_runs_synchronously_and_panel_is_registered(materia
     assert panel.bl_parent_id == "SGPRT_PT_material" and panel.bl_context == "material"
     with pytest.raises(RuntimeError, match="no file given"):
         bpy.ops.sgprt.fit_lobes(filepath="")
+
+
+FIT_IN_OTHER_BLENDER = """
+import sys
+import bpy
+import numpy as np
+import sg_prt_addon
+from sg_prt_addon.blender import lobe_fit
+out, table = sys.argv[1], sys.argv[2]
+sg_prt_addon.register()
+bpy.ops.wm.read_factory_settings(use_empty=True)
+bpy.ops.mesh.primitive_cube_add()
+material = bpy.data.materials.new("Old")
+bpy.context.active_object.data.materials.append(material)
+assert bpy.ops.sgprt.fit_lobes(filepath=table, lobe_count=3) == {"FINISHED"}
+np.savez(out + "/old.npz", **lobe_fit.lobe_fit_images(material))
+bpy.ops.wm.save_as_mainfile(filepath=out + "/old.blend")
+import os
+os._exit(0)
+"""
+
+
+def test_a_fit_from_blender_4_2_loads_bit_exactly_in_this_blender(addon, data, tmp_path):
+    """A .blend fitted by Blender 4.2 LTS (the second venv) opens here with the fit valid and
+    every stored float bit-identical."""
+    import pathlib
+    import subprocess
+    root = pathlib.Path(__file__).resolve().parents[2]
+    python = root / ".venv-bpy42" / "bin" / "python"
+    if not python.exists() or bpy.app.version < (4, 3, 0):
+        pytest.skip("needs the bpy 4.2 venv, and a newer Blender running the test")
+    script = tmp_path / "fit_old.py"
+    script.write_text(FIT_IN_OTHER_BLENDER)
+    done = subprocess.run([str(python), str(script), str(tmp_path), data["table"]], cwd=root, capture_output=True,
+                          text=True, timeout=120, env={**os.environ, "PYTHONPATH": str(root)})
+    assert done.returncode == 0, done.stderr[-2000:]
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "old.blend"))
+    material = bpy.data.materials["Old"]
+    assert lf.fit_status(material)[0] == "VALID" and material.sgprt.lobe_fit.lobe_count == 3
+    expected = np.load(tmp_path / "old.npz")
+    arrays = lf.lobe_fit_images(material)
+    assert sorted(expected.files) == sorted(arrays) == sorted(lf.expected_roles(3, 5))
+    for role in arrays:
+        assert np.array_equal(_bits(arrays[role]), _bits(expected[role])), role
