@@ -21,9 +21,10 @@ N above 1024 x 1024 rows is split into several draws inside one render().
 import hashlib
 import os
 import re
-import tempfile
 
 import numpy as np
+
+from .shader_variants import create_capturing_log
 
 ENGINE_IDNAME = "SG_PRT_GLSL_HARNESS"
 SCENE_NAME = "SG_PRT_GLSL_HARNESS"
@@ -111,32 +112,6 @@ def _compile_error_message(log, source):
     return "GLSL compile error\n" + "\n\n".join(quoted)
 
 
-def _create_shader_capturing_log(info):
-    """gpu.shader.create_from_info writes the driver log to the C stdio streams: capture them."""
-    import sys
-    import gpu
-
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = [os.dup(1), os.dup(2)]
-    with tempfile.TemporaryFile(mode="w+b") as capture:
-        os.dup2(capture.fileno(), 1)
-        os.dup2(capture.fileno(), 2)
-        try:
-            shader = gpu.shader.create_from_info(info)
-            error = None
-        except Exception as exception:  # Blender raises a bare Exception
-            shader, error = None, exception
-        finally:
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            for fd in saved:
-                os.close(fd)
-        capture.seek(0)
-        log = capture.read().decode("utf-8", "replace")
-    return shader, error, log
-
-
 def _get_shader(library_sources, call, input_names, textures):
     import gpu
     from gpu_extras.batch import batch_for_shader
@@ -159,7 +134,7 @@ def _get_shader(library_sources, call, input_names, textures):
     source = _fragment_source(library_sources, call, input_names)
     info.vertex_source(VERTEX_SOURCE)
     info.fragment_source(source)
-    shader, error, log = _create_shader_capturing_log(info)
+    shader, error, log = create_capturing_log(info)
     if shader is None:
         raise GlslCompileError(_compile_error_message(log, source)) from error
     # One triangle covering the viewport: no diagonal seam, every texel centre covered once.

@@ -233,7 +233,7 @@ def _error_message(key, log, sources):
     return f"SG-PRT shader variant [{key.describe()}] failed to compile\n" + "\n\n".join(quoted)
 
 
-def _create_capturing_log(info):
+def create_capturing_log(info):
     """create_from_info prints the driver log on the C stdio streams: capture it for the error."""
     import gpu
 
@@ -320,7 +320,7 @@ def get_shader(key):
     """Compiled shader of a variant (cached for the process; the GPU context is Blender's)."""
     shader = _cache.get(key)
     if shader is None:
-        shader, error, log = _create_capturing_log(create_info(key))
+        shader, error, log = create_capturing_log(create_info(key))
         if shader is None:
             raise ShaderCompileError(_error_message(
                 key, log, [("fragment", fragment_source(key)), ("vertex", vertex_source())])) from error
@@ -385,7 +385,7 @@ def get_background_shader(has_environment):
     shader = _cache.get(key)
     if shader is None:
         info = background_create_info(has_environment)
-        shader, error, log = _create_capturing_log(info)
+        shader, error, log = create_capturing_log(info)
         if shader is None:
             raise ShaderCompileError(f"SG-PRT background shader failed to compile\n{log.strip()}") from error
         _cache[key] = shader
