@@ -195,7 +195,7 @@ class FitJob:
         decile = int(fraction * 10)
         if self.verbose and decile > self._printed_decile:
             self._printed_decile = decile
-            print(f"[sg-prt] fit {fraction * 100:3.0f}% {message}", flush=True)
+            print(f"[sg-prt] fit {fraction * 100:.0f}% {message}", flush=True)
         if self.hook is not None and self.hook(fraction, message):
             self._cancel.set()
         return self._cancel.is_set()
