@@ -238,8 +238,9 @@ class FitJob:
             if self.verbose:
                 print(f"[sg-prt] fit failed: {self.error}", flush=True)
             return
+        invalid = sum(source.counts.values()) if kind == "MERL" else 0
         self.result = dict(kind=kind, shape=shape, fit=fit, layers=layers, shadowing_table=table, errors=errors,
-                           seconds=time.perf_counter() - started)
+                           invalid_samples=invalid, seconds=time.perf_counter() - started)
 
 
 class _Cancelled(Exception):
@@ -346,6 +347,8 @@ def fit_status(material):
                 else (settings.width, settings.height))
         if tuple(roles[role].size) != size:
             return "INVALID", f"fit image '{roles[role].name}' has the wrong size: re-fit"
+        if not roles[role].is_float:
+            return "INVALID", f"fit image '{roles[role].name}' is not a float image: re-fit"
     return "VALID", (f"{settings.lobe_count} lobe(s), {settings.width}x{settings.height} texel(s), "
                      f"error {settings.fit_error:.3f}")
 
@@ -465,7 +468,9 @@ class SGPRT_OT_fit_lobes(bpy.types.Operator):
         settings = material.sgprt.lobe_fit
         self.report({"INFO"}, f"SG-PRT fitted {settings.lobe_count} lobe(s) to {settings.source_file} on "
                               f"'{material.name}' ({settings.width}x{settings.height}, error "
-                              f"{settings.fit_error:.3f}, {settings.seconds:.1f} s)")
+                              f"{settings.fit_error:.3f}, {settings.seconds:.1f} s)"
+                    + (f"; {job.result['invalid_samples']} negative/NaN/Inf samples ignored"
+                       if job.result["invalid_samples"] else ""))
         return {"FINISHED"}
 
     def execute(self, context):

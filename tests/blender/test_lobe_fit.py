@@ -208,7 +208,11 @@ def test_refit_replaces_images_and_clear_removes_them(material, data):
     assert bpy.ops.sgprt.clear_lobe_fit() == {"FINISHED"}
     assert lf.fit_status(material)[0] == "NONE" and not material.sgprt.use_fitted_lobes
     assert not second & {image.name for image in bpy.data.images}
-    # a removed image makes a stored fit invalid, not a crash
+    # an 8-bit image in place of a float one, or a removed image, makes a stored fit invalid, not a crash
+    assert bpy.ops.sgprt.fit_lobes(filepath=data["table"], lobe_count=1) == {"FINISHED"}
+    material.sgprt.lobe_fit.images[1].image = bpy.data.images.new("bytes", 5, 6)
+    state, message = lf.fit_status(material)
+    assert state == "INVALID" and "not a float image" in message
     assert bpy.ops.sgprt.fit_lobes(filepath=data["table"], lobe_count=1) == {"FINISHED"}
     bpy.data.images.remove(material.sgprt.lobe_fit.images[0].image)
     state, message = lf.fit_status(material)
