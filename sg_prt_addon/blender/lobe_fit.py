@@ -416,7 +416,9 @@ class SGPRT_OT_fit_lobes(bpy.types.Operator):
     bl_label = "Fit Lobes"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: StringProperty(name="File", subtype="FILE_PATH", description="MERL .binary or SVBRDF table .npz")
+    # SKIP_SAVE: the panel's button must open the file browser, not silently re-fit the last file
+    filepath: StringProperty(name="File", subtype="FILE_PATH", options={"SKIP_SAVE"},
+                             description="MERL .binary or SVBRDF table .npz")
     filter_glob: StringProperty(default="*.binary;*.npz", options={"HIDDEN"})
     lobe_count: IntProperty(name="Lobes", default=2, min=1, max=MAX_LOBES, description="SG lobes per texel")
     axes: EnumProperty(name="Axes", items=AXES, default="AUTO", description="Where the lobe axes may point")
