@@ -58,7 +58,6 @@ rebuilds a core.microfacet_fit.LobeFit from the images (what a renderer mirrors)
 """
 import datetime
 import os
-import threading
 import time
 
 import bpy
@@ -67,6 +66,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 
 from ..core import merl as merl_format
 from ..core import microfacet_fit, svbrdf_table
+from .background_job import BackgroundJob, ModalJobOperator
 
 FORMAT_VERSION = 1
 IMAGE_PREFIX = "SGPRT fit"
@@ -148,70 +148,33 @@ def pack_layers(fit, shape, error):
     return layers, table
 
 
-class FitJob:
+class FitJob(BackgroundJob):
     """Reads and fits one file; run() synchronously or start() a thread.  Never touches bpy.
 
     After run(): ``result`` = dict(kind, shape, fit, layers, shadowing_table, errors, seconds)
     on success; else ``cancelled`` or ``error`` (a message) and result None."""
 
+    verb = "fit"
+    thread_name = "sgprt-lobe-fit"
+
     def __init__(self, path, lobe_count, free_axes=None, shadowing_components=8, verbose=False, hook=None):
+        super().__init__(verbose, hook)
         self.path, self.lobe_count, self.free_axes = path, lobe_count, free_axes
         self.shadowing_components = shadowing_components
-        self.verbose, self.hook = verbose, hook
         self.result = None
-        self.cancelled = False
-        self.error = None
-        self.fraction = 0.0
-        self.message = "starting"
-        self._cancel = threading.Event()
-        self._lock = threading.Lock()
-        self._printed_decile = -1
-        self._thread = None
-
-    def cancel(self):
-        self._cancel.set()
-
-    @property
-    def cancelling(self):
-        return self._cancel.is_set()
-
-    @property
-    def running(self):
-        return self._thread is not None and self._thread.is_alive()
-
-    def start(self):
-        self._thread = threading.Thread(target=self.run, name="sgprt-lobe-fit", daemon=True)
-        self._thread.start()
-
-    def join(self, timeout=None):
-        if self._thread is not None:
-            self._thread.join(timeout)
-
-    def _report(self, fraction, message):
-        """Record progress, print it by deciles when verbose; True when cancelled."""
-        fraction = min(max(float(fraction), 0.0), 1.0)
-        with self._lock:
-            self.fraction, self.message = fraction, message
-        decile = int(fraction * 10)
-        if self.verbose and decile > self._printed_decile:
-            self._printed_decile = decile
-            print(f"[sg-prt] fit {fraction * 100:.0f}% {message}", flush=True)
-        if self.hook is not None and self.hook(fraction, message):
-            self._cancel.set()
-        return self._cancel.is_set()
 
     def run(self):
         started = time.perf_counter()
         name = os.path.basename(self.path)
         try:
-            if self._report(0.0, f"reading {name}"):
+            if self.record_progress(0.0, f"reading {name}"):
                 raise _Cancelled
             kind, source = read_source(self.path)
-            if self._report(0.05, f"read {name}"):
+            if self.record_progress(0.05, f"read {name}"):
                 raise _Cancelled
 
             def progress(fraction):
-                return self._report(0.05 + 0.85 * fraction, f"fitting {self.lobe_count} lobe(s) to {name}")
+                return self.record_progress(0.05 + 0.85 * fraction, f"fitting {self.lobe_count} lobe(s) to {name}")
 
             if kind == "MERL":
                 fit = microfacet_fit.fit_merl(source, self.lobe_count, free_axes=self.free_axes, progress=progress)
@@ -220,13 +183,13 @@ class FitJob:
                 fit = microfacet_fit.fit_lobes(source, self.lobe_count, self.shadowing_components,
                                                free_axes=self.free_axes, progress=progress)
                 shape = source.shape
-            if fit is None or self._report(0.9, "measuring the fit error"):
+            if fit is None or self.record_progress(0.9, "measuring the fit error"):
                 raise _Cancelled
             errors = fit_error(kind, source, fit)
             layers, table = pack_layers(fit, shape, errors)
             if not all(np.all(np.isfinite(a)) for a in list(layers.values()) + [table]):
                 raise FitError(f"the fit of {name} produced NaN or Inf values")
-            if self._report(1.0, f"fitted {name}"):
+            if self.record_progress(1.0, f"fitted {name}"):
                 raise _Cancelled
         except _Cancelled:
             self.cancelled = True
@@ -410,7 +373,7 @@ AXES = (("AUTO", "Auto", "Lobes around the normal for 1-2 lobes and isotropic da
         ("FREE", "Free", "Every lobe's axis fitted freely"))
 
 
-class SGPRT_OT_fit_lobes(bpy.types.Operator):
+class SGPRT_OT_fit_lobes(ModalJobOperator, bpy.types.Operator):
     """Fit SG lobes to a measured BRDF (MERL .binary) or an SVBRDF table (.npz) and store them in the active material"""
     bl_idname = "sgprt.fit_lobes"
     bl_label = "Fit Lobes"
@@ -425,6 +388,7 @@ class SGPRT_OT_fit_lobes(bpy.types.Operator):
     shadowing_components: IntProperty(name="Shadowing Components", default=8, min=1, max=16,
                                       description="PCA components of the shadowing S(theta) (tables)")
 
+    job_label = "SG-PRT fit"
     _running = False        # one fit at a time
 
     @classmethod
@@ -502,59 +466,7 @@ class SGPRT_OT_fit_lobes(bpy.types.Operator):
         prepared = self._prepare(context)
         if prepared is None:
             return {"CANCELLED"}
-        _, job = prepared
-        self._job = job
-        SGPRT_OT_fit_lobes._running = True
-        job.start()
-        window_manager = context.window_manager
-        self._timer = window_manager.event_timer_add(0.2, window=context.window)
-        window_manager.progress_begin(0, 100)
-        window_manager.modal_handler_add(self)
-        self._status(context, "SG-PRT fit: starting (Esc cancels)")
-        return {"RUNNING_MODAL"}
-
-    def _status(self, context, text):
-        if context.workspace is not None:
-            context.workspace.status_text_set(text)
-
-    def _cleanup(self, context):
-        SGPRT_OT_fit_lobes._running = False
-        window_manager = context.window_manager
-        if getattr(self, "_timer", None) is not None:
-            window_manager.event_timer_remove(self._timer)
-            self._timer = None
-        window_manager.progress_end()
-        self._status(context, None)
-
-    def modal(self, context, event):
-        job = self._job
-        try:
-            if event.type == "ESC" and event.value == "PRESS":
-                job.cancel()
-                self._status(context, "SG-PRT fit: cancelling...")
-                return {"RUNNING_MODAL"}
-            if event.type == "TIMER":
-                context.window_manager.progress_update(int(job.fraction * 100))
-                if not job.cancelling:
-                    self._status(context, f"SG-PRT fit {job.fraction * 100:.0f}%: {job.message} (Esc cancels)")
-                if not job.running:
-                    job.join()
-                    self._cleanup(context)
-                    return self._finish(context, job)
-            return {"PASS_THROUGH"}
-        except Exception as error:      # never leave the thread running or the button disabled
-            job.cancel()
-            job.join()
-            self._cleanup(context)
-            self.report({"ERROR"}, f"SG-PRT fit failed, nothing written: {error}")
-            return {"CANCELLED"}
-
-    def cancel(self, context):
-        job = getattr(self, "_job", None)
-        if job is not None:
-            job.cancel()
-            job.join()
-            self._cleanup(context)
+        return self.start_modal(context, prepared[1], interval=0.2)
 
 
 class SGPRT_OT_clear_lobe_fit(bpy.types.Operator):

@@ -54,7 +54,6 @@ Results are written only after every receiver finished: a cancelled or failed
 bake leaves the previous bakes untouched.  The bake thread never touches bpy.
 """
 import datetime
-import threading
 from dataclasses import dataclass
 from typing import Optional
 
@@ -64,6 +63,7 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 from ..bake import decode
 from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility, topology_hash
+from .background_job import BackgroundJob, ModalJobOperator
 
 FORMAT_VERSION = 1
 PROPERTY = "sgprt_ssdf"
@@ -344,60 +344,30 @@ def unusable_bakes(scene, depsgraph):
 
 # --------------------------------------------------------------------------- the bake job (no bpy)
 
-class BakeJob:
+class BakeJob(BackgroundJob):
     """Bakes receivers one after another; run() synchronously or start() a thread.  Never touches bpy.
 
     receivers: [(key, label, vertices, normals, triangles)], world space.  results: {key: BakeResult}
     once every receiver finished; cancelled / error otherwise (results then empty).
     """
 
+    verb = "bake"
+    thread_name = "sgprt-visibility-bake"
+
     def __init__(self, receivers, occluder_vertices, occluder_triangles, options, verbose=False, hook=None):
+        super().__init__(verbose, hook)
         self.receivers = receivers
         self.occluder_vertices = occluder_vertices
         self.occluder_triangles = occluder_triangles
         self.options = options
-        self.verbose = verbose
-        self.hook = hook
         self.results = {}
-        self.cancelled = False
-        self.error = None
-        self.fraction = 0.0
-        self.message = "starting"
-        self._cancel = threading.Event()
-        self._lock = threading.Lock()
-        self._printed_decile = -1
-        self._thread = None
-
-    def cancel(self):
-        self._cancel.set()
-
-    @property
-    def running(self):
-        return self._thread is not None and self._thread.is_alive()
-
-    def start(self):
-        self._thread = threading.Thread(target=self.run, name="sgprt-visibility-bake", daemon=True)
-        self._thread.start()
-
-    def join(self, timeout=None):
-        if self._thread is not None:
-            self._thread.join(timeout)
 
     def _progress_for(self, index, label):
         count = len(self.receivers)
 
         def progress(fraction, message):
             overall = (index + min(max(fraction, 0.0), 1.0)) / count
-            text = f"{label}: {message}"
-            with self._lock:
-                self.fraction, self.message = overall, text
-            decile = int(overall * 10)
-            if self.verbose and (decile > self._printed_decile or fraction >= 1.0):
-                self._printed_decile = decile
-                print(f"[sg-prt] bake {overall * 100:3.0f}% {text}", flush=True)
-            if self.hook is not None and self.hook(overall, text):
-                self._cancel.set()
-            return self._cancel.is_set()
+            return self.record_progress(overall, f"{label}: {message}", always_print=fraction >= 1.0)
         return progress
 
     def run(self):
@@ -407,7 +377,7 @@ class BakeJob:
                 results[key] = bake_visibility(vertices, triangles, normals, self.occluder_vertices,
                                                self.occluder_triangles, self.options,
                                                progress=self._progress_for(index, label))
-                if self._cancel.is_set():
+                if self.cancelling:
                     raise BakeCancelled("cancelled after a receiver finished")
         except BakeCancelled:
             self.cancelled = True
@@ -470,13 +440,14 @@ def _mesh_objects(context, target):
     return [obj for obj in context.selected_objects if obj.type == "MESH"]
 
 
-class SGPRT_OT_bake_visibility(bpy.types.Operator):
+class SGPRT_OT_bake_visibility(ModalJobOperator, bpy.types.Operator):
     """Bake all-frequency visibility (PCA-compressed SSDFs) at the vertices of mesh objects"""
     bl_idname = "sgprt.bake_visibility"
     bl_label = "Bake Visibility"
     bl_options = {"REGISTER", "UNDO"}
     __annotations__ = _option_properties()
 
+    job_label = "SG-PRT bake"
     _running = False       # one bake at a time
 
     @classmethod
@@ -558,61 +529,7 @@ class SGPRT_OT_bake_visibility(bpy.types.Operator):
         job = self._prepare(context)
         if job is None:
             return {"CANCELLED"}
-        self._job = job
-        SGPRT_OT_bake_visibility._running = True
-        job.start()
-        window_manager = context.window_manager
-        self._timer = window_manager.event_timer_add(0.25, window=context.window)
-        window_manager.progress_begin(0, 100)
-        window_manager.modal_handler_add(self)
-        self._status(context, "SG-PRT bake: starting (Esc cancels)")
-        return {"RUNNING_MODAL"}
-
-    def _status(self, context, text):
-        if context.workspace is not None:
-            context.workspace.status_text_set(text)
-
-    def _cleanup(self, context):
-        SGPRT_OT_bake_visibility._running = False
-        window_manager = context.window_manager
-        if getattr(self, "_timer", None) is not None:
-            window_manager.event_timer_remove(self._timer)
-            self._timer = None
-        window_manager.progress_end()
-        self._status(context, None)
-
-    def modal(self, context, event):
-        try:
-            return self._modal(context, event)
-        except Exception as error:      # never leave the thread running or the button disabled
-            self._job.cancel()
-            self._job.join()
-            self._cleanup(context)
-            self.report({"ERROR"}, f"SG-PRT bake failed, nothing written: {error}")
-            return {"CANCELLED"}
-
-    def _modal(self, context, event):
-        job = self._job
-        if event.type == "ESC" and event.value == "PRESS":
-            job.cancel()
-            self._status(context, "SG-PRT bake: cancelling...")
-            return {"RUNNING_MODAL"}
-        if event.type == "TIMER":
-            context.window_manager.progress_update(int(job.fraction * 100))
-            if not job._cancel.is_set():
-                self._status(context, f"SG-PRT bake {job.fraction * 100:.0f}%: {job.message} (Esc cancels)")
-            if not job.running:
-                job.join()
-                self._cleanup(context)
-                return self._finish(context, job)
-        return {"PASS_THROUGH"}
-
-    def cancel(self, context):
-        job = getattr(self, "_job", None)
-        if job is not None:
-            job.cancel()
-            job.join()
-        self._cleanup(context)
+        return self.start_modal(context, job)
 
 
 class SGPRT_OT_clear_visibility(bpy.types.Operator):

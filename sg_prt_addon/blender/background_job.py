@@ -1,0 +1,126 @@
+"""Long operators (bake, fit) that run synchronously under `blender -b` and in a thread,
+with a progress bar and Esc, in the UI.
+
+BackgroundJob: the work, in a thread that never touches bpy; progress and cancellation
+are shared through a lock and an event.  ModalJobOperator: the operator side of the UI
+path (timer, progress bar, status text, Esc, clean-up on every exit).
+"""
+import threading
+
+
+class BackgroundJob:
+    """Subclasses implement run() (call it directly for the synchronous path) and report
+    progress through record_progress(), which answers whether to stop."""
+
+    verb = "job"            # in the printed progress lines: "[sg-prt] <verb> 40% ..."
+    thread_name = "sgprt-job"
+
+    def __init__(self, verbose=False, hook=None):
+        self.verbose = verbose
+        self.hook = hook                # hook(fraction, message) -> True cancels (tests)
+        self.cancelled = False
+        self.error = None
+        self.fraction = 0.0
+        self.message = "starting"
+        self._cancel = threading.Event()
+        self._lock = threading.Lock()
+        self._printed_decile = -1
+        self._thread = None
+
+    def cancel(self):
+        self._cancel.set()
+
+    @property
+    def cancelling(self):
+        return self._cancel.is_set()
+
+    @property
+    def running(self):
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self):
+        self._thread = threading.Thread(target=self.run, name=self.thread_name, daemon=True)
+        self._thread.start()
+
+    def join(self, timeout=None):
+        if self._thread is not None:
+            self._thread.join(timeout)
+
+    def record_progress(self, fraction, message, always_print=False):
+        """Share progress; print it by deciles when verbose; True when the job must stop."""
+        fraction = min(max(float(fraction), 0.0), 1.0)
+        with self._lock:
+            self.fraction, self.message = fraction, message
+        decile = int(fraction * 10)
+        if self.verbose and (decile > self._printed_decile or always_print):
+            self._printed_decile = decile
+            print(f"[sg-prt] {self.verb} {fraction * 100:3.0f}% {message}", flush=True)
+        if self.hook is not None and self.hook(fraction, message):
+            self._cancel.set()
+        return self._cancel.is_set()
+
+    def run(self):
+        raise NotImplementedError
+
+
+class ModalJobOperator:
+    """Mixin for a bpy.types.Operator whose invoke() starts a BackgroundJob: call
+    start_modal(context, job); implement _finish(context, job) -> the operator's result.
+    The class attribute `_running` is shared by all instances: one job of a kind at a time."""
+
+    job_label = "SG-PRT job"
+    _running = False
+
+    def start_modal(self, context, job, interval=0.25):
+        self._job = job
+        type(self)._running = True
+        job.start()
+        window_manager = context.window_manager
+        self._timer = window_manager.event_timer_add(interval, window=context.window)
+        window_manager.progress_begin(0, 100)
+        window_manager.modal_handler_add(self)
+        self._status(context, f"{self.job_label}: starting (Esc cancels)")
+        return {"RUNNING_MODAL"}
+
+    def _status(self, context, text):
+        if context.workspace is not None:
+            context.workspace.status_text_set(text)
+
+    def _cleanup(self, context):
+        type(self)._running = False
+        window_manager = context.window_manager
+        if getattr(self, "_timer", None) is not None:
+            window_manager.event_timer_remove(self._timer)
+            self._timer = None
+        window_manager.progress_end()
+        self._status(context, None)
+
+    def modal(self, context, event):
+        job = self._job
+        try:
+            if event.type == "ESC" and event.value == "PRESS":
+                job.cancel()
+                self._status(context, f"{self.job_label}: cancelling...")
+                return {"RUNNING_MODAL"}
+            if event.type == "TIMER":
+                context.window_manager.progress_update(int(job.fraction * 100))
+                if not job.cancelling:
+                    self._status(context, f"{self.job_label} {job.fraction * 100:.0f}%: {job.message} (Esc cancels)")
+                if not job.running:
+                    job.join()
+                    self._cleanup(context)
+                    return self._finish(context, job)
+            return {"PASS_THROUGH"}
+        except Exception as error:      # never leave the thread running or the button disabled
+            job.cancel()
+            job.join()
+            self._cleanup(context)
+            self.report({"ERROR"}, f"{self.job_label} failed, nothing written: {error}")
+            return {"CANCELLED"}
+
+    def cancel(self, context):
+        job = getattr(self, "_job", None)
+        if job is not None:
+            job.cancel()
+            job.join()
+        self._cleanup(context)
