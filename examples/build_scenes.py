@@ -50,7 +50,8 @@ def _add_camera(scene, location, target, lens=50.0):
 
 def _world_with_hdri(scene, hdri_path, strength=1.0):
     world = bpy.data.worlds.new("World")
-    world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):      # Blender 5 worlds always use nodes
+        world.use_nodes = True
     nodes, links = world.node_tree.nodes, world.node_tree.links
     background = next(node for node in nodes if node.type == "BACKGROUND")
     background.inputs["Strength"].default_value = strength
@@ -63,7 +64,8 @@ def _world_with_hdri(scene, hdri_path, strength=1.0):
 
 def _world_with_colour(scene, colour):
     world = bpy.data.worlds.new("World")
-    world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):      # Blender 5 worlds always use nodes
+        world.use_nodes = True
     background = next(node for node in world.node_tree.nodes if node.type == "BACKGROUND")
     background.inputs["Color"].default_value = (*colour, 1.0)
     world.color = colour

@@ -78,5 +78,22 @@ def main(argv=None):
     return clock.durations
 
 
+def exit_process(status):
+    """Exit with ``status``.  The pip bpy 4.2 module segfaults at interpreter exit once a
+    RenderEngine was registered (4.3+ exits cleanly), so there the process ends at once."""
+    import bpy
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if bpy.app.version < (4, 3, 0):
+        import os
+        os._exit(status)
+    sys.exit(status)
+
+
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except (FileNotFoundError, RuntimeError) as error:
+        print(f"python -m sg_prt_addon.render: error: {error}", file=sys.stderr)
+        exit_process(1)
+    exit_process(0)
