@@ -46,6 +46,14 @@ void main()
   vec3 specular_color = material.specular_color.rgb;
   vec4 p = material.parameters0;                  /* roughness, ior, exponent, alpha_x */
   vec4 q = vec4(material.parameters1.xyz, BRDF_AS_RF0);   /* alpha_y, nu, nv, rf0 */
+#ifdef MODEL_FITTED
+  /* the stored fit at the UV's nearest texel: kd and eta from the base layer, the colour in the lobes */
+  fitted_select_texel(texcoord);
+  vec4 fitted_base = fitted_layer(0);
+  diffuse_color = fitted_base.rgb;
+  specular_color = vec3(1.0);
+  p.y = fitted_base.w;
+#endif
 #ifdef HAS_TEXTURE_DIFFUSE_COLOR
   diffuse_color *= texture(texture_diffuse_color, texcoord).rgb;
 #endif

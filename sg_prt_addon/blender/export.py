@@ -70,10 +70,50 @@ class MaterialParams:
     tangent_axis: tuple = (1.0, 0.0, 0.0)
     tangent_rotation: float = 0.0
     textures: dict = field(default_factory=dict)     # parameter name or "normal_map" -> image name
+    fitted: object = None          # FittedLobes when use_fitted_lobes and the stored fit is VALID
 
     def values_key(self):
         """Everything but textures, hashable: the material UBO is rebuilt when this changes."""
-        return tuple((k, v) for k, v in self.__dict__.items() if k != "textures")
+        return tuple((k, v.signature if k == "fitted" and v is not None else v)
+                     for k, v in self.__dict__.items() if k != "textures")
+
+
+@dataclass(eq=False)
+class FittedLobes:
+    """A material's stored lobe fit (blender.lobe_fit, format 1) as the engine uploads it.
+
+    layers (L, H, W, 4) float32, Blender row order (row 0 at the bottom, texture t = 0): 0 base
+    (kd RGB, eta), 1 + 2k lobe k (axis xyz, sharpness), 2 + 2k lobe k amplitude RGB, then the
+    shadowing PCA coefficient layers (4 a layer); table (C + 2, S, 4): row 0 theta_s, row 1 the
+    mean, rows 2.. the basis (value in R).  signature: hashable identity of the fit."""
+    lobe_count: int
+    components: int
+    layers: np.ndarray
+    table: np.ndarray
+    signature: tuple = ()
+
+    @property
+    def shadowing_layers(self):
+        return -(-self.components // 4)
+
+
+def export_fitted_lobes(material):
+    """FittedLobes of a material with use_fitted_lobes and a VALID fit, else None."""
+    from . import lobe_fit
+
+    settings = getattr(material, "sgprt", None)
+    if settings is None or not settings.use_fitted_lobes or lobe_fit.fit_status(material)[0] != "VALID":
+        return None
+    fit = settings.lobe_fit
+    arrays = lobe_fit.lobe_fit_images(material)
+    count, components = int(fit.lobe_count), int(fit.shadowing_components)
+    roles = ["base"] + [f"lobe_{k}_{part}" for k in range(count) for part in ("axis", "amplitude")]
+    roles += [f"shadowing_{j}" for j in range(-(-components // 4))]
+    layers = np.stack([arrays[role][::-1] for role in roles]).astype(np.float32)
+    signature = (fit.date, fit.source_path, fit.seconds, count, components, fit.width, fit.height,
+                 tuple(item.image.name for item in fit.images if item.image is not None))
+    return FittedLobes(count, components, np.ascontiguousarray(layers),
+                       np.ascontiguousarray(arrays["shadowing_table"], np.float32), signature)
 
 
 @dataclass
@@ -273,6 +313,7 @@ def export_material(material):
             params.textures[name] = image.name
     if settings.normal_map is not None:
         params.textures["normal_map"] = settings.normal_map.name
+    params.fitted = export_fitted_lobes(material)
     return params
 
 

@@ -193,8 +193,74 @@ def ndf_lobes(model, params, lobe_count=1):
     return instance.ndf_lobes()
 
 
+FITTED_MODEL = "FITTED"
+
+
+def fitted_texel_values(fitted, uv):
+    """surface.frag.glsl's fitted_select_texel + fetches: the nearest texel of the UV (floor(uv * size),
+    clamped) in an export.FittedLobes; returns the shade() params of model FITTED and (kd (N, 3), eta (N,))."""
+    layers = np.asarray(fitted.layers, FLOAT)                       # (L, H, W, 4), row 0 at t = 0
+    height, width = layers.shape[1:3]
+    uv = np.asarray(uv, FLOAT)
+    x = np.clip(np.floor(uv[:, 0] * FLOAT(width)).astype(np.int64), 0, width - 1)
+    y = np.clip(np.floor(uv[:, 1] * FLOAT(height)).astype(np.int64), 0, height - 1)
+    texel = layers[:, y, x]                                         # (L, N, 4)
+    count = fitted.lobe_count
+    lobes = np.stack([texel[1 + 2 * k] for k in range(count)], axis=1)        # (N, K, 4)
+    colour = np.stack([texel[2 + 2 * k, :, :3] for k in range(count)], axis=1)
+    coefficients = np.concatenate([texel[1 + 2 * count + j] for j in range(fitted.shadowing_layers)],
+                                  axis=1)[:, :fitted.components]
+    table = np.asarray(fitted.table, np.float64)[..., 0]
+    from .microfacet_fit import decompress_shadowing
+    shadowing = decompress_shadowing(table[1], table[2:2 + fitted.components], coefficients.astype(np.float64))
+    params = {"axis": sg.normalize(lobes[..., :3]), "sharpness": lobes[..., 3], "colour": colour,
+              "eta": texel[0, :, 3], "shadowing": shadowing, "shadowing_theta": table[0]}
+    return params, texel[0, :, :3]
+
+
+def fitted_shadowing(params, direction):
+    """S of each pixel's texel at local directions (N, M, 3) -> (N, M) (sg_shading.glsl's fitted_shadowing_of)."""
+    from .svbrdf_table import interpolate_shadowing
+    w = sg.normalize(np.asarray(direction, FLOAT)).astype(np.float64)
+    theta = np.arctan2(np.hypot(w[..., 0], w[..., 1]), np.maximum(w[..., 2], 0))
+    return interpolate_shadowing(params["shadowing"], params["shadowing_theta"], theta)
+
+
+def fitted_slice(params, view_local):
+    """Slice lobes of the stored fit: its NDF lobes (amplitude 1) warped to the view, times
+    M_o(i) = F_eta(|i.h|) S(o) S(i) / (pi (i.n)(o.n)); the RGB lobe amplitudes come separately."""
+    axis, sharpness = params["axis"], params["sharpness"]
+    shadowing_o = fitted_shadowing(params, np.asarray(view_local)[:, None, :])[:, 0]          # (N,)
+    eta = np.asarray(params["eta"], np.float64)
+
+    def m_factor(wo, wi):          # (K', N, 3), lobe index leading
+        wo = sg.normalize(np.asarray(wo, FLOAT)).astype(np.float64)
+        wi = sg.normalize(np.asarray(wi, FLOAT)).astype(np.float64)
+        h = sg.normalize(wo + wi)
+        fresnel = brdf.fresnel_dielectric(np.sum(wi * h, axis=-1), eta[None])
+        shadowing_i = fitted_shadowing(params, np.moveaxis(wi, 0, 1)).T                        # (K', N)
+        above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
+        with np.errstate(all="ignore"):
+            value = fresnel * shadowing_o[None] * shadowing_i / (np.pi * wi[..., 2] * wo[..., 2])
+        return np.where(above, value, 0.0)
+
+    return warp.brdf_slice_lobes(axis, sharpness, np.ones_like(sharpness), view_local, m_factor,
+                                 mode=warp.DEFAULT_MODE)
+
+
+def slice_colours(model, params, slice_count):
+    """(N, J, 3) RGB factor of each slice lobe: the fit's lobe amplitudes (WARP nodes of lobe k at
+    nodes k .. nodes k + nodes - 1), else 1."""
+    if model != FITTED_MODEL:
+        return None
+    colour = np.asarray(params["colour"], FLOAT)
+    return np.repeat(colour, slice_count // colour.shape[1], axis=1)
+
+
 def specular_slice(model, params, lobe_count, view_local):
     """BRDF slice lobes (local frame) for the view: warped NDF lobes times M_o at their centres."""
+    if model == FITTED_MODEL:
+        return fitted_slice(params, view_local)
     axis, sharpness, amplitude = ndf_lobes(model, params, lobe_count)
     # brdf_slice_lobes calls m_factor with the lobe index leading, so per-pixel parameters broadcast
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
@@ -223,6 +289,9 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     slice_axis = np.einsum("nij,nkj->nki", frame, slice_axis).astype(FLOAT)    # to world
     slice_sharpness = slice_sharpness.astype(FLOAT)
     slice_amplitude = slice_amplitude.astype(FLOAT)
+    slice_colour = slice_colours(model, params, slice_sharpness.shape[1])
+    if slice_colour is None:
+        slice_colour = np.ones(slice_sharpness.shape + (3,), FLOAT)
 
     irradiance = np.zeros(position.shape, FLOAT)
     specular = np.zeros(position.shape, FLOAT)
@@ -255,7 +324,7 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
         if visibility is not None:
             decoded = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
             weight = np.where(decoded, weight * visible(axis_m, sharpness_m), weight)
-        specular += np.sum(light_amplitude * np.sum(weight, axis=2)[..., None], axis=1)
+        specular += np.sum(light_amplitude * np.sum(weight[..., None] * slice_colour[:, None], axis=2), axis=1)
 
     slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe) * \
         visible(slice_axis, slice_sharpness)                                                     # (N, J)
@@ -268,14 +337,14 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
                 visible(env_axis, env_sharpness))[..., None], axis=1)
         radiance = env_prefilter.lookup(environment.prefiltered, slice_axis, slice_sharpness)        # (N, J, 3)
-        specular += np.sum(radiance * slice_cosine[..., None], axis=1)
+        specular += np.sum(radiance * (slice_cosine[..., None] * slice_colour), axis=1)
     else:
         colour = np.asarray(environment.colour, FLOAT)
         if visibility is None:
             irradiance += np.pi * colour
         else:       # the cosine lobe alone: a zero-sharpness G at the normal
             irradiance += np.pi * colour * visible(n_lobe, np.zeros((len(n), 1), FLOAT))
-        specular += np.sum(slice_cosine, axis=1)[:, None] * colour
+        specular += np.sum(slice_cosine[..., None] * slice_colour, axis=1) * colour
 
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
     return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * specular).astype(FLOAT)
@@ -315,6 +384,19 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     Returns (diffuse, specular), each (N, 3) float32.
     """
     count = len(position)
+    fitted = getattr(material, "fitted", None)
+    if fitted is not None:         # the stored lobe fit (MODEL_FITTED): only a normal map applies
+        model_params, diffuse_color = fitted_texel_values(fitted, uv)
+        shading_normal = np.asarray(normal, FLOAT)
+        tangent = np.asarray(tangent, FLOAT)
+        if "normal_map" in textures:
+            shading_normal = apply_normal_map(shading_normal, tangent,
+                                              sample_bilinear(textures["normal_map"], uv)[:, :3],
+                                              FLOAT(material.normal_strength))
+        shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+        return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
+                     model_params, diffuse_color, np.ones((count, 3), FLOAT), light_data, environment,
+                     visibility=visibility)
     diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
     specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
     if "diffuse_color" in textures:

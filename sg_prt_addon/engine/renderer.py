@@ -187,6 +187,7 @@ class Renderer:
         self.material_buffers = {}      # material name -> GPUUniformBuf
         self.material_ids = {}          # material name -> id written to the G-buffer (uv.z)
         self.textures = {}              # (image name, slot is a colour) -> GPUTexture
+        self.fitted_textures = {}       # material name -> (layers, shadowing table) of its lobe fit
         self.scene_buffer = None
         self.environment_texture = None
         self.equirect_texture = None
@@ -223,6 +224,10 @@ class Renderer:
             material_id = self.material_ids.setdefault(name, len(self.material_ids))
             self.material_buffers[name] = _uniform_buffer(material_block(params, material_id))
             self.uploads["materials"] += 1
+            self.fitted_textures.pop(name, None)
+            if params.fitted is not None:
+                self.fitted_textures[name] = (_texture_2d_array(params.fitted.layers),
+                                              _texture_2d(params.fitted.table))
             for slot, image_name in params.textures.items():
                 key = _texture_key(image_name, slot)
                 if key not in self.textures and image_name in bpy.data.images:
@@ -311,6 +316,11 @@ class Renderer:
                         if self.ggx_texture is None:
                             self.ggx_texture = _texture_2d(shader_variants.ggx_table())
                         shader.uniform_sampler("ggx_table", self.ggx_texture)
+                    if key.model == shader_variants.FITTED_MODEL:
+                        layers, table = self.fitted_textures[params.name if params.name in self.fitted_textures
+                                                             else name]
+                        shader.uniform_sampler("fitted_layers", layers)
+                        shader.uniform_sampler("fitted_shadowing", table)
                     for texture_name in key.textures:
                         shader.uniform_sampler("texture_" + texture_name, self.textures[
                             _texture_key(params.textures[texture_name], texture_name)])
@@ -364,6 +374,7 @@ class Renderer:
         self.mesh_buffers.clear()
         self.material_buffers.clear()
         self.textures.clear()
+        self.fitted_textures.clear()
         self.targets = []
         self.framebuffer = None
         self.size = None

@@ -41,6 +41,8 @@ LIMITS = {"SGPRT_MAX_POINT_LIGHTS": MAX_POINT_LIGHTS, "SGPRT_MAX_SUNS": MAX_SUNS
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
                  "alpha_x", "alpha_y", "nu", "nv", "normal_map")
 ANISOTROPIC_MODELS = ("WARD_ANISO", "ASHIKHMIN_SHIRLEY")
+# Variant model of materials rendered from their stored lobe fit (blender.lobe_fit, export.FittedLobes)
+FITTED_MODEL = "FITTED"
 GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
 # Library files in dependency order; env_prefilter only with an environment texture.
 LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
@@ -67,6 +69,7 @@ class VariantKey:
     textures: tuple = ()            # sorted names from TEXTURE_SLOTS
     gbuffer: bool = False
     visibility_layers: int = 0      # vec4 of SSDF coefficients per vertex (0: no visibility bake)
+    shadowing_components: int = 0   # model FITTED: PCA components of the stored shadowing
 
     @property
     def has_visibility(self):
@@ -79,6 +82,8 @@ class VariantKey:
             parts.append("textures: " + ", ".join(self.textures))
         if self.gbuffer:
             parts.append("G-buffer")
+        if self.model == FITTED_MODEL:
+            parts.append(f"{self.shadowing_components} shadowing component(s)")
         if self.visibility_layers:
             parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
         return ", ".join(parts)
@@ -88,6 +93,11 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False, vis
     """VariantKey of an export.MaterialParams in a scene (visibility_layers: of the object's bake, 0 without)."""
     from ..core.shading import GGX_NDF_LOBES
 
+    fitted = getattr(material_params, "fitted", None)
+    if fitted is not None:      # the stored lobe fit: its lobes, shadowing and base; only a normal map applies
+        textures = ("normal_map",) if "normal_map" in material_params.textures else ()
+        return VariantKey(FITTED_MODEL, int(fitted.lobe_count), bool(has_lights), bool(has_environment), textures,
+                          bool(gbuffer), int(visibility_layers), int(fitted.components))
     model = material_params.model
     lobes = int(material_params.lobe_count) if model in ANISOTROPIC_MODELS else 1
     if model == "GGX":
@@ -143,6 +153,9 @@ def defines(key):
         out["HAS_NORMAL_MAP" if name == "normal_map" else "HAS_TEXTURE_" + name.upper()] = 1
     if key.gbuffer:
         out["GBUFFER"] = 1
+    if key.model == FITTED_MODEL:
+        out["FITTED_COMPONENTS"] = key.shadowing_components
+        out["FITTED_SHADOWING_LAYERS"] = -(-key.shadowing_components // 4)
     if key.visibility_layers:
         out["HAS_VISIBILITY"] = 1
         out["SSDF_MAX_LAYERS"] = key.visibility_layers
@@ -297,6 +310,11 @@ def create_info(key):
         slot += 1
     if uses_ggx_table(key):
         info.sampler(slot, "FLOAT_2D", "ggx_table")
+        slot += 1
+    if key.model == FITTED_MODEL:
+        info.sampler(slot, "FLOAT_2D_ARRAY", "fitted_layers")     # texelFetch: the nearest texel
+        slot += 1
+        info.sampler(slot, "FLOAT_2D", "fitted_shadowing")
         slot += 1
     for name in key.textures:
         info.sampler(slot, "FLOAT_2D", "texture_" + name)

@@ -108,6 +108,100 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
 #endif
 }
 
+#ifdef MODEL_FITTED
+/* The stored lobe fit (blender.lobe_fit format 1, export.FittedLobes; mirrored by core.shading's
+ * fitted_* functions).  fitted_layers: 0 base (kd RGB, eta), 1 + 2k lobe k (axis xyz local,
+ * sharpness), 2 + 2k lobe k amplitude RGB, 1 + 2K + j shadowing PCA coefficients 4j..4j+3; read
+ * with texelFetch at the nearest texel of the UV (the paper's per-texel free-axis lobes).
+ * fitted_shadowing: S x (C + 2) texels, R: row 0 theta_s, row 1 the mean, rows 2.. the basis. */
+ivec2 fitted_texel;
+float fitted_coefficients[4 * FITTED_SHADOWING_LAYERS];
+
+vec4 fitted_layer(int layer)
+{
+  return texelFetch(fitted_layers, ivec3(fitted_texel, layer), 0);
+}
+
+void fitted_select_texel(vec2 uv)
+{
+  ivec2 size = textureSize(fitted_layers, 0).xy;
+  fitted_texel = clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1);
+  for (int j = 0; j < FITTED_SHADOWING_LAYERS; j++) {
+    vec4 c = fitted_layer(1 + 2 * NDF_LOBES + j);
+    fitted_coefficients[4 * j] = c.x;
+    fitted_coefficients[4 * j + 1] = c.y;
+    fitted_coefficients[4 * j + 2] = c.z;
+    fitted_coefficients[4 * j + 3] = c.w;
+  }
+}
+
+/* Node s of the shadowing grid (svbrdf_table.shadowing_with_horizon: a node S(pi/2) = 0 after the
+ * stored ones when they stop short of the horizon). */
+float fitted_node_theta(int s, int stored)
+{
+  return s >= stored ? 0.5 * SG_PI : texelFetch(fitted_shadowing, ivec2(s, 0), 0).x;
+}
+
+float fitted_node_value(int s, int stored)
+{
+  if (s >= stored) {
+    return 0.0;
+  }
+  float value = texelFetch(fitted_shadowing, ivec2(s, 1), 0).x;
+  for (int c = 0; c < FITTED_COMPONENTS; c++) {
+    value += fitted_coefficients[c] * texelFetch(fitted_shadowing, ivec2(s, 2 + c), 0).x;
+  }
+  return max(value, 0.0);       /* microfacet_fit.decompress_shadowing */
+}
+
+/* S(theta) of the texel: linear between nodes (binary search), clamped below the first
+ * (svbrdf_table.interpolate_shadowing). */
+float fitted_shadowing_at(float theta)
+{
+  int stored = textureSize(fitted_shadowing, 0).x;
+  int nodes = stored + (fitted_node_theta(stored - 1, stored) < 0.5 * SG_PI - 1.0e-6 ? 1 : 0);
+  if (theta <= fitted_node_theta(0, stored)) {
+    return fitted_node_value(0, stored);
+  }
+  int low = 0;
+  int high = nodes - 1;
+  float theta_high = fitted_node_theta(high, stored);
+  if (theta >= theta_high) {
+    return fitted_node_value(high, stored);
+  }
+  while (high - low > 1) {
+    int middle = (low + high) / 2;
+    if (fitted_node_theta(middle, stored) <= theta) {
+      low = middle;
+    }
+    else {
+      high = middle;
+    }
+  }
+  float theta_low = fitted_node_theta(low, stored);
+  float t = (theta - theta_low) / (fitted_node_theta(high, stored) - theta_low);
+  return (1.0 - t) * fitted_node_value(low, stored) + t * fitted_node_value(high, stored);
+}
+
+float fitted_shadowing_of(vec3 w)
+{
+  w = safe_normalize(w);
+  return fitted_shadowing_at(atan(length(w.xy), max(w.z, 0.0)));
+}
+
+/* M_o(i) = F_eta(|i.h|) S(o) S(i) / (pi (i.n)(o.n)), S(o) given (once a pixel). */
+float fitted_m_factor(vec3 wo, vec3 wi, float eta, float shadowing_o)
+{
+  wo = safe_normalize(wo);
+  wi = safe_normalize(wi);
+  if (!(wo.z > 0.0 && wi.z > 0.0)) {
+    return 0.0;
+  }
+  vec3 h = safe_normalize(wo + wi);
+  return fresnel_dielectric(dot(wi, h), eta) * shadowing_o * fitted_shadowing_of(wi) / (SG_PI * wi.z * wo.z);
+}
+#endif
+
 /* M_o(i) of the model (brdf.glsl's <model>_m_factor). */
 float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
 {
@@ -123,6 +217,10 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
   return ward_anisotropic_m_factor(wo, wi);
 #elif defined(MODEL_ASHIKHMIN_SHIRLEY)
   return ashikhmin_shirley_m_factor(wo, wi, q.y, q.z, q.w);
+#elif defined(MODEL_FITTED)
+  return fitted_m_factor(wo, wi, p.y, p.z);     /* p.y eta, p.z S(o) (shade_surface) */
+#else
+  return 0.0;
 #endif
 }
 
@@ -176,6 +274,7 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
   }
 }
 
+
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
 
 /* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer. */
@@ -194,10 +293,23 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   vec3 slice_axis[SLICE_LOBES];
   float slice_sharpness[SLICE_LOBES];
   float slice_amplitude[SLICE_LOBES];
+  vec3 slice_colour[SLICE_LOBES];              /* RGB lobe amplitude of the fit, else 1 */
+#ifdef MODEL_FITTED
+  p.z = fitted_shadowing_of(view_local);       /* S(o), for model_m_factor */
+#endif
   for (int k = 0; k < NDF_LOBES; k++) {
     vec3 ndf_axis;
     float ndf_sharpness, ndf_amplitude;
+#ifdef MODEL_FITTED
+    vec4 fitted_lobe = fitted_layer(1 + 2 * k);
+    ndf_axis = safe_normalize(fitted_lobe.xyz);
+    ndf_sharpness = fitted_lobe.w;
+    ndf_amplitude = 1.0;
+    vec3 colour = fitted_layer(2 + 2 * k).rgb;
+#else
     model_ndf_lobe(p, q, k, ndf_axis, ndf_sharpness, ndf_amplitude);
+    vec3 colour = vec3(1.0);
+#endif
     /* warp.DEFAULT_MODE: WARP_FUNCTION with WARP_NODES lobes per NDF lobe (defines from the variant) */
     vec3 warped_axis[WARP_NODES];
     float warped_sharpness[WARP_NODES], warped_amplitude[WARP_NODES];
@@ -213,6 +325,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
       slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
                                                 model_m_factor(view_local, warped_axis[node], p, q));
       slice_axis[j] = frame * warped_axis[node];
+      slice_colour[j] = colour;
       slice_sharpness[j] = warped_sharpness[node];
     }
   }
@@ -228,7 +341,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
     float light_cosine = sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n);
     irradiance += light_amplitude * (light_cosine * LOBE_VISIBILITY(light_axis, light_sharpness));   /* eq. 42 */
-    float weight = 0.0;
+    vec3 weight = vec3(0.0);
     for (int j = 0; j < SLICE_LOBES; j++) {
       vec3 product_axis;
       float product_sharpness, product_amplitude;
@@ -242,7 +355,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
         product_cosine *= lobe_visibility(product_axis, product_sharpness, n);
       }
 #endif
-      weight += product_cosine;
+      weight += product_cosine * slice_colour[j];
     }
     radiance += light_amplitude * weight;
   }
@@ -252,9 +365,9 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n) *
                          LOBE_VISIBILITY(slice_axis[j], slice_sharpness[j]);                   /* eq. 41 */
 #ifdef HAS_ENVIRONMENT
-    radiance += slice_cosine * environment_radiance(slice_axis[j], slice_sharpness[j]);
+    radiance += slice_cosine * slice_colour[j] * environment_radiance(slice_axis[j], slice_sharpness[j]);
 #else
-    radiance += slice_cosine * scene.world_colour.rgb;
+    radiance += slice_cosine * slice_colour[j] * scene.world_colour.rgb;
 #endif
   }
 
