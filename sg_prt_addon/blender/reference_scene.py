@@ -108,3 +108,33 @@ def reference_inputs(depsgraph, width, height):
     scene = depsgraph.scene
     camera = export.export_camera(scene.camera.evaluated_get(depsgraph), depsgraph, width, height)
     return reference_scene(state, texture_pixels), Camera(camera.view, camera.projection, width, height)
+
+
+class AnalyticSpecular:
+    """core.reference's specular-model protocol for a core.brdf_generators.AnalyticMaterial's
+    glossy part (F_eta(i.h) x GGX, height-correlated Smith): specular(wo, wi) is its exact
+    specular_scalar; sample / pdf are GGX's visible-normal sampling with its exact density
+    (the estimator is unbiased whatever the proposal, as long as pdf is the proposal's)."""
+
+    def __init__(self, analytic):
+        self.analytic = analytic
+        self.proposal = brdf.GGX(roughness=float(analytic.roughness))
+
+    def specular(self, wo, wi):
+        return self.analytic.specular_scalar(wo, wi)
+
+    def sample(self, wo, u):
+        return self.proposal.sample(wo, u)
+
+    def pdf(self, wo, wi):
+        return self.proposal.pdf(wo, wi)
+
+
+def analytic_reference_material(analytic):
+    """core.reference.Material rendering an AnalyticMaterial exactly, for the materials the
+    reference's (kd, ks x scalar specular) form holds: Lambert diffuse (oren_nayar_sigma 0) and
+    no retro-reflection; ValueError otherwise."""
+    if float(np.max(analytic.oren_nayar_sigma)) != 0.0 or float(np.max(analytic.retro)) != 0.0:
+        raise ValueError("the reference renders AnalyticMaterial with oren_nayar_sigma = 0 and retro = 0 only")
+    return reference.Material(np.asarray(analytic.diffuse, float), np.asarray(analytic.specular, float),
+                              AnalyticSpecular(analytic))
