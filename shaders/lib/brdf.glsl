@@ -100,49 +100,41 @@ const float BECKMANN_SHARPNESS[8] = float[8](2.0002526198839767, -0.018562042324
 const float BECKMANN_AMPLITUDE[8] = float[8](1.0000788099487423, -0.00562487537421968, 0.45936658759780197, -0.4782415853046627, 1.8768790206320416, -0.723505986830146, -1.093140907789823, 0.6774600689844926);
 const float BLINN_PHONG_SHARPNESS[8] = float[8](2.001247483300024, -0.0704030099405333, 1.8252868204860242, -3.7366710387171747, 7.990337405162444, -7.976517234021651, 3.6090854215670936, -0.6165165884429983);
 const float BLINN_PHONG_AMPLITUDE[8] = float[8](1.0001482120242338, -0.009229085969026461, 0.24259176162034488, -0.5769981443748883, 1.304434552867832, -1.4708046288958752, 0.7476278795213421, -0.1413828848427673);
-const float WARD_ISO_SHARPNESS[7] = float[7](2.0000452113496068, -0.002050309015127145, 3.0147624933803696, 0.02079098217477974, -1.5775218851571589, 1.4289044928620722, -0.4515437794950395);
-const float WARD_ISO_AMPLITUDE[7] = float[7](1.0000361029442135, -0.002018784963236324, 0.39782446238486135, -0.08061386777996582, -0.513448758758516, 0.5383190127812337, -0.17224374461564965);
-const float GGX_SHARPNESS[7] = float[7](2.2949071322803056, -1.8169547610727137, 17.634426696713284, -89.52143467300904, 162.11135492098055, -126.49092884708091, 35.775580872045374);
-const float GGX_AMPLITUDE[7] = float[7](0.868594309075077, -0.47084346810594657, 5.078988403062825, -20.927444128961213, 34.85993749976531, -24.56259538488302, 6.147831356435162);
+const float WARD_ISO_SHARPNESS[8] = float[8](2.0000452113496068, -0.002050309015127145, 3.0147624933803696, 0.02079098217477974, -1.5775218851571589, 1.4289044928620722, -0.4515437794950395, 0.0);
+const float WARD_ISO_AMPLITUDE[8] = float[8](1.0000361029442135, -0.002018784963236324, 0.39782446238486135, -0.08061386777996582, -0.513448758758516, 0.5383190127812337, -0.17224374461564965, 0.0);
+const float GGX_SHARPNESS[8] = float[8](2.2949071322803056, -1.8169547610727137, 17.634426696713284, -89.52143467300904, 162.11135492098055, -126.49092884708091, 35.775580872045374, 0.0);
+const float GGX_AMPLITUDE[8] = float[8](0.868594309075077, -0.47084346810594657, 5.078988403062825, -20.927444128961213, 34.85993749976531, -24.56259538488302, 6.147831356435162, 0.0);
+
+/* Horner evaluation of a (sharpness, amplitude) polynomial pair in the lobe width (degree 7;
+ * the degree-6 tables carry a zero top coefficient). Clamped at 0: GGX's sharpness dips to
+ * -1e-3 at alpha = 1. */
+vec2 isotropic_polynomial(float sharpness[8], float amplitude[8], float width)
+{
+  vec2 r = vec2(sharpness[7], amplitude[7]);
+  for (int k = 6; k >= 0; k--) {
+    r = r * width + vec2(sharpness[k], amplitude[k]);
+  }
+  return max(r, vec2(0.0));
+}
 
 vec2 isotropic_mapping_beckmann(float width)
 {
-  float w = clamp(width, 0.0, 1.0);
-  vec2 r = vec2(BECKMANN_SHARPNESS[7], BECKMANN_AMPLITUDE[7]);
-  for (int k = 6; k >= 0; k--) {
-    r = r * w + vec2(BECKMANN_SHARPNESS[k], BECKMANN_AMPLITUDE[k]);
-  }
-  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
+  return isotropic_polynomial(BECKMANN_SHARPNESS, BECKMANN_AMPLITUDE, clamp(width, 0.0, 1.0));
 }
 
 vec2 isotropic_mapping_blinn_phong(float width)
 {
-  float w = clamp(width, 0.0, 1.5);
-  vec2 r = vec2(BLINN_PHONG_SHARPNESS[7], BLINN_PHONG_AMPLITUDE[7]);
-  for (int k = 6; k >= 0; k--) {
-    r = r * w + vec2(BLINN_PHONG_SHARPNESS[k], BLINN_PHONG_AMPLITUDE[k]);
-  }
-  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
+  return isotropic_polynomial(BLINN_PHONG_SHARPNESS, BLINN_PHONG_AMPLITUDE, clamp(width, 0.0, 1.5));
 }
 
 vec2 isotropic_mapping_ward_iso(float width)
 {
-  float w = clamp(width, 0.0, 1.0);
-  vec2 r = vec2(WARD_ISO_SHARPNESS[6], WARD_ISO_AMPLITUDE[6]);
-  for (int k = 5; k >= 0; k--) {
-    r = r * w + vec2(WARD_ISO_SHARPNESS[k], WARD_ISO_AMPLITUDE[k]);
-  }
-  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
+  return isotropic_polynomial(WARD_ISO_SHARPNESS, WARD_ISO_AMPLITUDE, clamp(width, 0.0, 1.0));
 }
 
 vec2 isotropic_mapping_ggx(float width)
 {
-  float w = clamp(width, 0.0, 1.0);
-  vec2 r = vec2(GGX_SHARPNESS[6], GGX_AMPLITUDE[6]);
-  for (int k = 5; k >= 0; k--) {
-    r = r * w + vec2(GGX_SHARPNESS[k], GGX_AMPLITUDE[k]);
-  }
-  return max(r, vec2(0.0));  /* GGX's sharpness dips to -1e-3 at alpha = 1 */
+  return isotropic_polynomial(GGX_SHARPNESS, GGX_AMPLITUDE, clamp(width, 0.0, 1.0));
 }
 
 /* ---- shared pieces ---- */
