@@ -69,10 +69,9 @@ def measure():
     return rows
 
 
-def _visibility_product_rows(n=2000):
-    """eq. 31: lobe G, second SG H, visibility hemisphere m near G's horizon; reference
-    mu_m fh_exact of the product lobe G (x) H over the hemisphere (exact)."""
-    rng = np.random.default_rng(9)
+def triple_product_case(n, seed):
+    """Lobe G, second lobe H, visibility hemisphere m with m.p = sin(theta_d) near G's horizon."""
+    rng = np.random.default_rng(seed)
     p = sg.normalize(rng.normal(size=(n, 3)))
     q = sg.normalize(p + rng.normal(size=(n, 3)) * rng.uniform(0, 1, (n, 1)))
     lam_g = np.exp(rng.uniform(np.log(0.1), np.log(1e4), n))
@@ -80,6 +79,13 @@ def _visibility_product_rows(n=2000):
     theta = np.clip(rng.normal(0, 1.5 / np.sqrt(lam_g)), -np.pi / 2, np.pi / 2)
     tangent = sg.normalize(np.cross(p, rng.normal(size=(n, 3))))
     m = np.sin(theta)[:, None] * p + np.cos(theta)[:, None] * tangent
+    return p, q, lam_g, lam_h, theta, m
+
+
+def _visibility_product_rows(n=2000):
+    """eq. 31: lobe G, second SG H, visibility hemisphere m near G's horizon; reference
+    mu_m fh_exact of the product lobe G (x) H over the hemisphere (exact)."""
+    p, q, lam_g, lam_h, theta, m = triple_product_case(n, 9)
     axis, lam, mu = sg.product(p, lam_g, 1.0, q, lam_h, 1.0)
     full = sg.inner_product(p, lam_g, 1.0, q, lam_h, 1.0)
     keep = full > 1e-250

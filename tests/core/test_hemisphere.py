@@ -5,6 +5,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from scipy import integrate, special
 
+from benchmarks.accuracy.hemisphere import triple_product_case
 from sg_prt_addon.core import hemisphere, sg
 
 SETTINGS = settings(max_examples=15, deadline=None)
@@ -144,23 +145,10 @@ def test_visibility_product_eq31():
     assert np.allclose(saturated, mu * hemisphere.fh_normalized(np.array([1, -1, 1]) * np.pi / 2, lam))
 
 
-def _triple_product_case(n, seed):
-    """Lobe G, second lobe H, visibility hemisphere m with m.p = sin(theta_d) near G's horizon."""
-    rng = np.random.default_rng(seed)
-    p = sg.normalize(rng.normal(size=(n, 3)))
-    q = sg.normalize(p + rng.normal(size=(n, 3)) * rng.uniform(0, 1, (n, 1)))
-    lam_g = np.exp(rng.uniform(np.log(0.1), np.log(1e4), n))
-    lam_h = np.exp(rng.uniform(np.log(1e-3), np.log(1e4), n))
-    theta = np.clip(rng.normal(0, 1.5 / np.sqrt(lam_g)), -np.pi / 2, np.pi / 2)
-    tangent = sg.normalize(np.cross(p, rng.normal(size=(n, 3))))
-    m = np.sin(theta)[:, None] * p + np.cos(theta)[:, None] * tangent
-    return p, q, lam_g, lam_h, theta, m
-
-
 def test_visibility_product_needs_the_final_lobe():
     """eq. 31 on the lobe integrated last (G (x) H) is exact up to fh and to the printed
     normalization's 1 + e^-lambda; applied to G before multiplying by H it is not."""
-    p, q, lam_g, lam_h, theta, m = _triple_product_case(400, 21)
+    p, q, lam_g, lam_h, theta, m = triple_product_case(400, 21)
     axis, lam, mu = sg.product(p, lam_g, 1.0, q, lam_h, 1.0)
     full = sg.inner_product(p, lam_g, 1.0, q, lam_h, 1.0)
     keep = full > 1e-250
