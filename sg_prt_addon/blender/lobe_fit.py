@@ -67,6 +67,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from ..core import merl as merl_format
 from ..core import microfacet_fit, svbrdf_table
 from .background_job import BackgroundJob, ModalJobOperator
+from .panels import MaterialPanel
 
 FORMAT_VERSION = 1
 IMAGE_PREFIX = "SGPRT fit"
@@ -489,18 +490,10 @@ class SGPRT_OT_clear_lobe_fit(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class SGPRT_PT_material_lobe_fit(bpy.types.Panel):
+class SGPRT_PT_material_lobe_fit(MaterialPanel, bpy.types.Panel):
     bl_label = "Measured BRDF (Lobe Fit)"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
-    bl_context = "material"
     bl_parent_id = "SGPRT_PT_material"
     bl_options = {"DEFAULT_CLOSED"}
-    COMPAT_ENGINES = {"SG_PRT"}
-
-    @classmethod
-    def poll(cls, context):
-        return context.engine in cls.COMPAT_ENGINES and context.material is not None
 
     def draw(self, context):
         layout = self.layout

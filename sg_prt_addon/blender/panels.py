@@ -6,7 +6,7 @@ from .properties import ANISOTROPIC_MODELS, MODEL_PARAMETERS
 ENGINE_ID = "SG_PRT"
 
 
-class _MaterialPanel:
+class MaterialPanel:
     """Placement and poll shared by the material panels: shown while SG-PRT renders."""
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
@@ -18,7 +18,7 @@ class _MaterialPanel:
         return context.engine in cls.COMPAT_ENGINES and context.material is not None
 
 
-class SGPRT_PT_material(_MaterialPanel, bpy.types.Panel):
+class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
     bl_label = "SG-PRT Surface"
 
     def draw(self, context):
@@ -35,7 +35,7 @@ class SGPRT_PT_material(_MaterialPanel, bpy.types.Panel):
         layout.prop(settings, "show_textures")
 
 
-class SGPRT_PT_material_geometry(_MaterialPanel, bpy.types.Panel):
+class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
     bl_label = "Normal and Tangent"
     bl_parent_id = "SGPRT_PT_material"
     bl_options = {"DEFAULT_CLOSED"}
