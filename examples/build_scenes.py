@@ -98,11 +98,12 @@ def _tile_pattern(size=256, tiles=8, seed=1):
     return colour, np.repeat(roughness[..., None], 3, axis=-1)
 
 
-def _link(scene, obj, material=None):
-    scene.collection.objects.link(obj)
-    if material is not None:
-        obj.data.materials.append(material)
-    return obj
+def _material(name, **settings):
+    """A material with its SG-PRT settings."""
+    material = bpy.data.materials.new(name)
+    for key, value in settings.items():
+        setattr(material.sgprt, key, value)
+    return material
 
 
 def _grid(name, size, subdivisions):
@@ -120,20 +121,13 @@ def build_suzanne_courtyard(resolution=512):
     scene.render.resolution_x = scene.render.resolution_y = resolution
     _world_with_hdri(scene, bundled_hdri("courtyard"))
 
-    floor_material = bpy.data.materials.new("Tiles")
     colour, roughness = _tile_pattern()
-    floor_material.sgprt.model = "COOK_TORRANCE"
-    floor_material.sgprt.diffuse_color = (1.0, 1.0, 1.0)
-    floor_material.sgprt.diffuse_color_texture = _image_from_array("tiles_colour", colour)
-    floor_material.sgprt.specular_color = (0.3, 0.3, 0.3)
-    floor_material.sgprt.roughness = 0.5
-    floor_material.sgprt.roughness_texture = _image_from_array("tiles_roughness", roughness)
-
-    suzanne_material = bpy.data.materials.new("Glaze")
-    suzanne_material.sgprt.model = "COOK_TORRANCE"
-    suzanne_material.sgprt.diffuse_color = (0.6, 0.12, 0.05)
-    suzanne_material.sgprt.specular_color = (0.5, 0.5, 0.5)
-    suzanne_material.sgprt.roughness = 0.2
+    floor_material = _material("Tiles", model="COOK_TORRANCE", diffuse_color=(1.0, 1.0, 1.0),
+                               diffuse_color_texture=_image_from_array("tiles_colour", colour),
+                               specular_color=(0.3, 0.3, 0.3), roughness=0.5,
+                               roughness_texture=_image_from_array("tiles_roughness", roughness))
+    suzanne_material = _material("Glaze", model="COOK_TORRANCE", diffuse_color=(0.6, 0.12, 0.05),
+                                 specular_color=(0.5, 0.5, 0.5), roughness=0.2)
 
     floor = _grid("Floor", size=6.0, subdivisions=64)
     floor.data.materials.append(floor_material)
@@ -158,20 +152,11 @@ def build_brushed_metal(resolution=512):
     scene.render.resolution_x = scene.render.resolution_y = resolution
     _world_with_colour(scene, (0.02, 0.02, 0.025))
 
-    metal = bpy.data.materials.new("Brushed Metal")
-    metal.sgprt.model = "ASHIKHMIN_SHIRLEY"
-    metal.sgprt.diffuse_color = (0.02, 0.02, 0.02)
-    metal.sgprt.specular_color = (0.9, 0.85, 0.75)
-    metal.sgprt.nu, metal.sgprt.nv = 50.0, 800.0
-    metal.sgprt.lobe_count = 6
-    metal.sgprt.tangent_source = "OBJECT_AXIS"
-    metal.sgprt.tangent_axis = (0.0, 0.0, 1.0)
-
-    floor_material = bpy.data.materials.new("Floor")
-    floor_material.sgprt.model = "GGX"
-    floor_material.sgprt.diffuse_color = (0.4, 0.4, 0.4)
-    floor_material.sgprt.specular_color = (0.1, 0.1, 0.1)
-    floor_material.sgprt.roughness = 0.4
+    metal = _material("Brushed Metal", model="ASHIKHMIN_SHIRLEY", diffuse_color=(0.02, 0.02, 0.02),
+                      specular_color=(0.9, 0.85, 0.75), nu=50.0, nv=800.0, lobe_count=6,
+                      tangent_source="OBJECT_AXIS", tangent_axis=(0.0, 0.0, 1.0))
+    floor_material = _material("Floor", model="GGX", diffuse_color=(0.4, 0.4, 0.4),
+                               specular_color=(0.1, 0.1, 0.1), roughness=0.4)
 
     floor = _grid("Floor", size=8.0, subdivisions=64)
     floor.data.materials.append(floor_material)
