@@ -71,6 +71,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
                 # GPU shaders still alive at interpreter exit crash Blender's teardown (no context
                 # then): batch renders drop them while the render's context is current.
                 shader_variants.clear_cache()
+        for warning in dict.fromkeys(state.warnings):
+            self.report({"WARNING"}, f"SG-PRT: {warning}")
         dropped = state.dropped_lights(shader_variants.MAX_POINT_LIGHTS, shader_variants.MAX_SUNS)
         if dropped:
             self.report({"WARNING"}, f"SG-PRT: {len(dropped)} dimmest light(s) left out (at most "

@@ -120,6 +120,8 @@ class SceneState:
         self.world = export.WorldExport()
         self.environment = shading.EnvironmentData()
         self.dirty = Dirty()
+        # bad input met while exporting (NaN texels, degenerate normals...): said once a render/redraw
+        self.warnings = []
 
     # ----------------------------------------------------------------- full sync
 
