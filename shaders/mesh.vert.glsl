@@ -2,6 +2,7 @@
  * HAS_VISIBILITY: the corner's Blender mesh vertex (vertex_index) selects its row of SSDF PCA
  * coefficients in `visibility_coefficients` (SSDF_MAX_LAYERS texels a vertex, vertices packed
  * row after row, renderer.VisibilityBuffers), passed on as varyings: interpolated per pixel. */
+invariant gl_Position;    /* the depth pre-pass (resources/depth.vert.glsl) computes the same */
 #ifdef HAS_VISIBILITY
 #define SSDF_FETCH(k) texelFetch(visibility_coefficients, ivec2(column + k, row), 0)
 #endif

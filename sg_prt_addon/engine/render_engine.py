@@ -14,7 +14,9 @@ from .shader_variants import ShaderCompileError
 # Debug hooks for tests and benchmarks (no UI): when `capture_gbuffer` is True the next
 # final render also writes the shading inputs; every final render leaves its float
 # passes, the G-buffer and the SceneState in `last_render`.
-debug = {"capture_gbuffer": False, "environment_layer_size": None, "timed_redraws": 0}
+# `after_frame(state, camera, width, height)` runs inside the render's GPU context after the
+# frame (its result: last_render["after_frame"]), e.g. to time the viewport's redraws.
+debug = {"capture_gbuffer": False, "environment_layer_size": None, "timed_redraws": 0, "after_frame": None}
 last_render = {}
 
 
@@ -29,7 +31,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self.viewport_state = None
-        self.viewport_renderer = None
+        self.viewport_frame = None
         self.viewport_error = None
 
     # ----------------------------------------------------------------- passes
@@ -92,7 +94,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         self.end_result(result)
         last_render.clear()
         last_render.update(passes=passes, state=state, timings=timings, size=(width, height),
-                           written_passes=written)
+                           written_passes=written, after_frame=passes.pop("after_frame", None))
 
     # ----------------------------------------------------------------- viewport
 
@@ -110,16 +112,14 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         width, height = region.width, region.height
         if self.viewport_state is None:
             self.view_update(context, depsgraph)
-        if self.viewport_renderer is None:
-            self.viewport_renderer = renderer_module.Renderer()
+        if self.viewport_frame is None:
+            self.viewport_frame = ViewportFrame()
         region_3d = context.region_data
         camera = export.camera_from_view(region_3d.view_matrix, region_3d.window_matrix,
                                          region_3d.is_perspective)
         try:
-            self.viewport_renderer.upload(self.viewport_state, self.viewport_state.consume_dirty(), camera)
-            self.viewport_renderer.ensure_targets(width, height)
-            self.viewport_renderer.draw(self.viewport_state, camera,
-                                        background_alpha=0.0 if depsgraph.scene.render.film_transparent else 1.0)
+            self.viewport_frame.update(self.viewport_state, camera, width, height,
+                                       0.0 if depsgraph.scene.render.film_transparent else 1.0)
         except ShaderCompileError as error:
             if str(error) != self.viewport_error:
                 print(error)
@@ -127,9 +127,72 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             return
         gpu.state.blend_set("ALPHA_PREMULT")
         self.bind_display_space_shader(depsgraph.scene)
-        draw_texture_2d(self.viewport_renderer.targets[0], width, height)
+        draw_texture_2d(self.viewport_frame.texture, width, height)
         self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
+
+
+class ViewportFrame:
+    """view_draw's work, which needs no window: the scene is drawn again only when something changed
+    (the scene's dirty set, the view, the region's size or the film); otherwise the last image is
+    shown again, a texture blit (Blender redraws the viewport for overlays, cursor moves, UI...)."""
+
+    def __init__(self):
+        self.renderer = renderer_module.Renderer()
+        self.signature = None
+        self.draws = 0
+
+    def update(self, state, camera, width, height, background_alpha=1.0):
+        """Draw if needed; returns whether it drew."""
+        signature = (width, height, float(background_alpha), bool(camera.is_perspective),
+                     np.asarray(camera.view, np.float64).tobytes(), np.asarray(camera.projection, np.float64).tobytes())
+        if signature == self.signature and not state.dirty.any():
+            return False
+        self.signature = None           # a failed draw (shader error) is tried again on the next redraw
+        self.renderer.upload(state, state.consume_dirty(), camera)
+        self.renderer.ensure_targets(width, height)
+        self.renderer.draw(state, camera, background_alpha=background_alpha)
+        self.signature = signature
+        self.draws += 1
+        return True
+
+    @property
+    def texture(self):
+        return self.renderer.targets[0]
+
+
+def time_viewport_redraws(state, camera, width, height, count, edit=None):
+    """Seconds of a new viewport's first draw and of `count` redraws, each one the ViewportFrame update
+    plus the blit of its image into a target of the region's size (one pixel read back, so the GPU has
+    finished): view_draw's work minus the window.  edit(state), if given, runs before every redraw
+    (nothing changes without it).  Returns (first, [redraw seconds], scene draws, the image)."""
+    import gpu
+    from gpu_extras.presets import draw_texture_2d as preset_draw_texture_2d
+    from mathutils import Matrix
+
+    state.dirty = scene_state.Dirty(meshes=set(state.meshes), materials=set(state.materials), lights=True,
+                                    world=True, objects=True)      # a new viewport uploads everything
+    frame = ViewportFrame()
+    offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA16F")
+    times = []
+    try:
+        for index in range(count + 1):
+            if index and edit is not None:
+                edit(state)
+            start = time.perf_counter()
+            frame.update(state, camera, width, height)
+            with offscreen.bind(), gpu.matrix.push_pop(), gpu.matrix.push_pop_projection():
+                gpu.matrix.load_identity()
+                gpu.matrix.load_projection_matrix(Matrix.Identity(4))
+                gpu.state.blend_set("ALPHA_PREMULT")
+                preset_draw_texture_2d(frame.texture, (-1.0, -1.0), 2.0, 2.0)    # the whole target
+                gpu.state.blend_set("NONE")
+                gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+            times.append(time.perf_counter() - start)
+        image = frame.renderer.read_output("combined")
+    finally:
+        offscreen.free()
+    return times[0], times[1:], frame.draws, image
 
 
 def draw_texture_2d(texture, width, height):
@@ -176,6 +239,8 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
         frame_times.append(time.perf_counter() - start)
     if frame_times:
         timings["frames"] = frame_times
+    if debug.get("after_frame") is not None:
+        passes["after_frame"] = debug["after_frame"](state, camera, width, height)
     passes["camera"] = camera
     passes["material_ids"] = dict(renderer.material_ids)
     return passes, state, timings

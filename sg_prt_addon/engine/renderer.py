@@ -181,6 +181,8 @@ class MeshBuffers:
 class Renderer:
     """Owns the GPU resources of one SceneState and draws it."""
 
+    depth_prepass = True        # False: shade every surface in draw order (benchmarks compare the two)
+
     def __init__(self, gbuffer=False):
         self.gbuffer = gbuffer
         self.mesh_buffers = {}          # mesh key -> MeshBuffers
@@ -285,6 +287,9 @@ class Renderer:
             gpu.state.depth_mask_set(True)
             gpu.state.face_culling_set("NONE")
             gpu.state.blend_set("NONE")
+            if self.depth_prepass:
+                self._draw_depth(state)
+                gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
             for object_index, entry in enumerate(state.objects.values()):
                 buffers = self.mesh_buffers.get(entry.mesh_key)
                 if buffers is None:
@@ -329,6 +334,24 @@ class Renderer:
                 self._draw_background(camera, has_environment, background_alpha)
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
+
+    def _draw_depth(self, state):
+        """Depth of every surface, no colour: the surface shaders then shade each pixel once instead of
+        every surface drawn over it (they are the frame's whole cost; the pre-pass is vertex work)."""
+        import gpu
+
+        shader = shader_variants.get_depth_shader()
+        shader.bind()
+        shader.uniform_block("scene", self.scene_buffer)
+        gpu.state.color_mask_set(False, False, False, False)
+        for entry in state.objects.values():
+            buffers = self.mesh_buffers.get(entry.mesh_key)
+            if buffers is None:
+                continue
+            shader.uniform_float("model_matrix", _column_major(entry.matrix_world))
+            for _slot, _first_triangle, batch in buffers.batches:
+                batch.draw(shader)
+        gpu.state.color_mask_set(True, True, True, True)
 
     def _draw_background(self, camera, has_environment, alpha):
         """Full-screen triangle at the far plane: only where no surface was drawn (depth test)."""

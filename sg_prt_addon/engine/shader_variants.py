@@ -408,3 +408,27 @@ def get_background_shader(has_environment):
             raise ShaderCompileError(f"SG-PRT background shader failed to compile\n{log.strip()}") from error
         _cache[key] = shader
     return shader
+
+
+def get_depth_shader():
+    """Position-only shader of the depth pre-pass (resources/depth.vert.glsl), cached like the others."""
+    import gpu
+
+    key = ("depth",)
+    shader = _cache.get(key)
+    if shader is None:
+        info = gpu.types.GPUShaderCreateInfo()
+        for name, value in LIMITS.items():
+            info.define(name, str(value))
+        info.typedef_source(typedef_source())
+        info.vertex_in(0, "VEC3", "position")
+        info.push_constant("MAT4", "model_matrix")
+        info.uniform_buf(0, "SceneData", "scene")
+        info.fragment_out(0, "VEC4", "out_unused")
+        info.vertex_source(_read(os.path.join(RESOURCE_DIR, "depth.vert.glsl")))
+        info.fragment_source("void main()\n{\n  out_unused = vec4(0.0);\n}\n")
+        shader, error, log = create_capturing_log(info)
+        if shader is None:
+            raise ShaderCompileError(f"SG-PRT depth pre-pass shader failed to compile\n{log.strip()}") from error
+        _cache[key] = shader
+    return shader
