@@ -7,6 +7,7 @@ a transform update only replaces its matrix, a material edit only re-reads the
 material, lights and world are re-read when they changed.  `dirty` tells the
 GPU side (renderer.py) what to re-upload.
 """
+import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -14,8 +15,10 @@ import numpy as np
 from ..blender import export
 from ..core import shading
 
-# Prefiltered environments and SG fits by (image name, pixel checksum): prefiltering takes seconds.
+# Prefiltered environments and SG fits by pixel content (prefiltering takes seconds); the most
+# recently used few only, since an artist editing the world makes a new one each edit.
 _environment_cache = {}
+ENVIRONMENT_CACHE_SIZE = 4
 ENVIRONMENT_LAYER_SIZE = 128
 ENVIRONMENT_FIT_LOBES = 8
 
@@ -333,15 +336,19 @@ def environment_data(world, layer_size=None):
         return shading.EnvironmentData(colour=colour)
     layer_size = layer_size or ENVIRONMENT_LAYER_SIZE
     image = world.equirect
-    key = (world.image_name, image.shape, float(np.sum(image, dtype=np.float64)), layer_size)
-    cached = _environment_cache.get(key)
+    # keyed by the pixels themselves: a renamed or reloaded image with the same content hits the cache
+    key = (image.shape, str(image.dtype), hashlib.blake2b(np.ascontiguousarray(image).data, digest_size=16).digest(),
+           layer_size)
+    cached = _environment_cache.pop(key, None)
     if cached is None:
         from ..core import env_prefilter
         prefiltered = env_prefilter.prefilter_environment(image, size=layer_size)
         lobes = _fit_environment(image)
         cached = shading.EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
                                          lobe_sharpness=lobes[1], lobe_amplitude=lobes[2])
-        _environment_cache[key] = cached
+    _environment_cache[key] = cached                 # (re)inserted last: the most recent
+    while len(_environment_cache) > ENVIRONMENT_CACHE_SIZE:
+        del _environment_cache[next(iter(_environment_cache))]
     return cached
 
 
