@@ -18,12 +18,56 @@ numpy mirror (core/shading.py) see exactly the same numbers:
 `export_counter` counts mesh exports: the viewport's update logic is tested
 with it (a material edit must not re-export meshes).
 """
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
 
 # Mesh exports since import; tests read it to check what an update re-exported.
 export_counter = {"meshes": 0}
+
+# --------------------------------------------------------------------------- bad input
+
+# Bad input met (and repaired) while exporting: NaN/Inf texels, zero-length normals, textures or UV
+# tangents on meshes without UVs.  The messages go to the list given to collect_warnings() in the
+# calling thread: SceneState.sync() gives its SceneState.warnings, so the texture reads of the upload
+# that follows in the same render add to it too (the final render and the viewport run in different
+# threads, each with its own list).
+_warning_target = threading.local()
+
+
+def collect_warnings(messages):
+    """Send this thread's export warnings to the list `messages` (returned); None stops collecting."""
+    _warning_target.messages = messages
+    return messages
+
+
+def warn(message):
+    messages = getattr(_warning_target, "messages", None)
+    if messages is not None and message not in messages:
+        messages.append(message)
+
+
+# Texel values beyond this magnitude are clamped to it: a few float32 texels near 3e38 summed by the
+# environment prefilter (or scaled by the lighting) overflow to Inf.
+MAX_TEXEL_VALUE = 1e30
+
+
+def finite_texels(pixels, what):
+    """pixels (..., C) with every texel holding a NaN or +-Inf set to 0 (all channels) and values
+    beyond +-MAX_TEXEL_VALUE clamped (a copy only when needed), with a warning each:
+    `what: N NaN/Inf texels replaced by 0`, `what: N texels beyond 1e+30 clamped`."""
+    if pixels.size == 0 or (pixels.max() <= MAX_TEXEL_VALUE and pixels.min() >= -MAX_TEXEL_VALUE):
+        return pixels                                        # (a NaN fails both comparisons)
+    bad = ~np.isfinite(pixels).all(axis=-1)
+    huge = ~bad & (np.abs(pixels) > MAX_TEXEL_VALUE).any(axis=-1)
+    pixels = np.where(bad[..., None], np.float32(0.0), pixels)
+    pixels = np.clip(pixels, -MAX_TEXEL_VALUE, MAX_TEXEL_VALUE).astype(np.float32)
+    if bad.any():
+        warn(f"{what}: {int(np.count_nonzero(bad))} NaN/Inf texels replaced by 0")
+    if huge.any():
+        warn(f"{what}: {int(np.count_nonzero(huge))} texels beyond {MAX_TEXEL_VALUE:g} clamped")
+    return pixels
 
 MODELS = ("COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX")
 ANISOTROPIC_MODELS = ("WARD_ANISO", "ASHIKHMIN_SHIRLEY")
@@ -172,8 +216,8 @@ def _any_perpendicular(normals):
     return t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-30)
 
 
-def export_mesh_data(mesh):
-    """MeshExport of a bpy Mesh (already evaluated), object space."""
+def export_mesh_data(mesh, name=None):
+    """MeshExport of a bpy Mesh (already evaluated), object space; `name` (the object's) in warnings."""
     export_counter["meshes"] += 1
     mesh.calc_loop_triangles()
     loop_count = len(mesh.loops)
@@ -190,7 +234,7 @@ def export_mesh_data(mesh):
     else:
         mesh.calc_normals_split()
         mesh.loops.foreach_get("normal", normals)
-    normals = normals.reshape(-1, 3)
+    normals = _usable_normals(normals.reshape(-1, 3), vertex_index, mesh, name or mesh.name)
 
     triangles = np.empty(triangle_count * 3, np.int64)
     mesh.loop_triangles.foreach_get("loops", triangles)
@@ -222,6 +266,8 @@ def export_mesh_data(mesh):
     if tangents is None:
         tangents = np.concatenate([_any_perpendicular(normals.astype(np.float64)),
                                    np.ones((loop_count, 1))], axis=1)
+    else:
+        tangents = _usable_tangents(tangents, normals)
 
     order = np.argsort(material_index, kind="stable")
     triangles = triangles[order]
@@ -243,6 +289,40 @@ def export_mesh_data(mesh):
         vertex_count=len(mesh.vertices),
         vertex_normals=_vertex_normals(mesh),
     )
+
+
+def _usable_normals(normals, vertex_index, mesh, name):
+    """Corner normals with the zero-length or non-finite ones (degenerate faces: Blender gives them
+    (0, 0, 0)) replaced by their vertex's normal, else object +Z; warns with the count."""
+    length = np.linalg.norm(normals, axis=1)
+    bad = ~(length > 1e-12)                       # zero, NaN
+    bad |= ~np.isfinite(length)
+    if not bad.any():
+        return normals
+    normals = normals.copy()
+    vertex_normals = _vertex_normals(mesh)[vertex_index[bad]] if len(mesh.vertices) else np.zeros((0, 3))
+    vertex_length = np.linalg.norm(vertex_normals, axis=1)
+    usable = np.isfinite(vertex_length) & (vertex_length > 1e-12)
+    replacement = np.tile(np.array([0.0, 0.0, 1.0], np.float32), (int(bad.sum()), 1))
+    replacement[usable] = vertex_normals[usable] / vertex_length[usable, None]
+    normals[bad] = replacement
+    warn(f"object '{name}': {int(bad.sum())} corner normal(s) of zero length or not finite (degenerate "
+         f"faces) replaced by the vertex normal ({int(usable.sum())}) or object +Z ({int((~usable).sum())})")
+    return normals
+
+
+def _usable_tangents(tangents, normals):
+    """UV tangents (calc_tangents) with the zero-length or non-finite ones (degenerate UVs or faces)
+    replaced by a unit vector perpendicular to the normal, sign +1."""
+    tangents = np.asarray(tangents)
+    length = np.linalg.norm(tangents[:, :3], axis=1)
+    bad = ~(np.isfinite(length) & (length > 1e-12)) | ~np.isfinite(tangents[:, 3])
+    if not bad.any():
+        return tangents
+    tangents = np.array(tangents, np.float64)
+    tangents[bad, :3] = _any_perpendicular(np.asarray(normals, np.float64)[bad])
+    tangents[bad, 3] = 1.0
+    return tangents
 
 
 def _vertex_normals(mesh):
@@ -277,9 +357,31 @@ def export_object_mesh(object_eval):
     """MeshExport of an evaluated object (mesh, curve, text... anything with to_mesh)."""
     mesh = object_eval.to_mesh()
     try:
-        return export_mesh_data(mesh)
+        exported = export_mesh_data(mesh, object_eval.name)
     finally:
         object_eval.to_mesh_clear()
+    if not exported.has_uv and len(exported.triangles):
+        _warn_missing_uvs(object_eval)
+    return exported
+
+
+def _warn_missing_uvs(object_eval):
+    """A mesh without a UV map whose materials sample textures (they read texel (0, 0) everywhere)
+    or take anisotropy tangents from the UV map (they get tangents from the object's axes)."""
+    for slot in getattr(object_eval, "material_slots", ()):
+        material = slot.material
+        settings = getattr(material, "sgprt", None) if material is not None else None
+        if settings is None:
+            continue
+        textures = [name for name in TEXTURED_PARAMETERS if getattr(settings, name + "_texture", None) is not None]
+        if settings.normal_map is not None:
+            textures.append("normal_map")
+        if textures:
+            warn(f"object '{object_eval.name}' has no UV map: material '{material.name}' samples its textures "
+                 f"({', '.join(textures)}) at UV (0, 0)")
+        if settings.model in ANISOTROPIC_MODELS and settings.tangent_source == "UV_MAP":
+            warn(f"object '{object_eval.name}' has no UV map: material '{material.name}' (anisotropic, tangent "
+                 f"source UV Map) gets tangents from the object's axes instead")
 
 
 def matrix_to_numpy(matrix):
@@ -314,7 +416,21 @@ def export_material(material):
     if settings.normal_map is not None:
         params.textures["normal_map"] = settings.normal_map.name
     params.fitted = export_fitted_lobes(material)
+    _finite_settings(params)
     return params
+
+
+def _finite_settings(params):
+    """Non-finite scalar or colour settings (scripts can store them) -> the defaults, warned."""
+    defaults = MaterialParams()
+    for name in COLOUR_PARAMETERS + SCALAR_PARAMETERS + ("normal_strength", "tangent_rotation", "tangent_axis"):
+        value = getattr(params, name)
+        if not np.all(np.isfinite(value)):
+            setattr(params, name, getattr(defaults, name))
+            warn(f"material '{params.name}': {name} {value} not finite, the default {getattr(defaults, name)} used")
+    if params.fitted is not None:
+        params.fitted.layers = finite_texels(params.fitted.layers, f"material '{params.name}': stored lobe fit")
+        params.fitted.table = finite_texels(params.fitted.table, f"material '{params.name}': stored lobe fit table")
 
 
 def image_pixels(image):
@@ -346,8 +462,9 @@ def srgb_to_linear(values):
 def texture_pixels(image, slot):
     """What the shader samples for `slot`: image_pixels, with the RGB of colour slots made
     scene-linear when the image holds sRGB-encoded bytes (float images are linear already;
-    data slots such as roughness or the normal map are used as stored, like Non-Color)."""
-    pixels = image_pixels(image)
+    data slots such as roughness or the normal map are used as stored, like Non-Color).  NaN/Inf
+    texels become 0, with a warning (finite_texels): the upload reads each image once."""
+    pixels = finite_texels(image_pixels(image), f"image '{image.name}'")
     if slot in COLOUR_SLOTS and not image.is_float and image.colorspace_settings.name == "sRGB":
         pixels = pixels.copy()
         pixels[..., :3] = srgb_to_linear(pixels[..., :3])
@@ -356,8 +473,26 @@ def texture_pixels(image, slot):
 
 # --------------------------------------------------------------------------- lights
 
+# Radiant intensity [W/sr] (point, spot, area) and irradiance [W/m^2] (sun) beyond this are clamped to
+# it: the shader multiplies them by the light's SG amplitude (up to ~1e17 at a shading point on the
+# light) and the BRDF lobe's, and float32 ends at 3.4e38.  1e20 W/sr is a 1.3e21 W lamp.
+MAX_LIGHT_INTENSITY = 1e20
+
+
+def _clamped_intensity(values, name):
+    """Per-channel intensity (or irradiance) with NaN set to 0 and magnitudes beyond
+    MAX_LIGHT_INTENSITY (Inf included) clamped to it, warned."""
+    values = np.asarray(values, np.float64)
+    if np.all(np.abs(values) <= MAX_LIGHT_INTENSITY):           # (False with a NaN)
+        return values
+    warn(f"light '{name}': intensity {tuple(float(v) for v in values)} clamped to "
+         f"+-{MAX_LIGHT_INTENSITY:g} (NaN to 0): float32 shading would overflow")
+    return np.clip(np.nan_to_num(values, nan=0.0), -MAX_LIGHT_INTENSITY, MAX_LIGHT_INTENSITY)
+
+
 def export_light(object_eval):
-    """LightExport of an evaluated light object in Blender's units; None for unsupported types."""
+    """LightExport of an evaluated light object in Blender's units; None for unsupported types.
+    Intensities are finite and at most MAX_LIGHT_INTENSITY in magnitude (warned otherwise)."""
     from ..core import lights as core_lights
 
     light = object_eval.data
@@ -367,10 +502,12 @@ def export_light(object_eval):
     direction = tuple(direction / max(np.linalg.norm(direction), 1e-30))
     colour = np.asarray(light.color, np.float64)
     if light.type == "SUN":
-        return LightExport(object_eval.name, "SUN", position, direction,
-                           tuple(colour * float(core_lights.blender_sun_irradiance(light.energy))),
+        irradiance = _clamped_intensity(colour * float(core_lights.blender_sun_irradiance(light.energy)),
+                                        object_eval.name)
+        return LightExport(object_eval.name, "SUN", position, direction, tuple(irradiance),
                            angle=float(light.angle))
-    intensity = colour * float(core_lights.blender_point_light_intensity(light.energy))
+    intensity = _clamped_intensity(colour * float(core_lights.blender_point_light_intensity(light.energy)),
+                                   object_eval.name)
     if light.type in ("POINT", "SPOT"):
         radius = float(getattr(light, "shadow_soft_size", 0.0))
         export = LightExport(object_eval.name, "POINT", position, direction, tuple(intensity), radius=radius)
@@ -410,8 +547,12 @@ def export_world(world):
         for node in world.node_tree.nodes:
             if node.type == "TEX_ENVIRONMENT" and node.image is not None:
                 pixels = image_pixels(node.image)[::-1, :, :3]      # numpy orientation, row 0 at the top
+                with np.errstate(over="ignore", invalid="ignore"):      # huge x strength: Inf, repaired below
+                    pixels = pixels * np.float32(strength)
+                pixels = finite_texels(pixels,
+                                       f"world '{world.name}': image '{node.image.name}'")
                 return WorldExport(colour=colour, image_name=node.image.name,
-                                   equirect=np.ascontiguousarray(pixels * strength, np.float32),
+                                   equirect=np.ascontiguousarray(pixels, np.float32),
                                    strength=strength)
     return WorldExport(colour=tuple(float(c) * strength for c in colour[:3]), strength=strength)
 

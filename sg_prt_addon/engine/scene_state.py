@@ -130,6 +130,8 @@ class SceneState:
 
     def sync(self, depsgraph):
         """Re-read everything visible in the evaluated scene."""
+        # export warnings of this sync and of the upload that follows it (export.collect_warnings)
+        self.warnings = export.collect_warnings([])
         self.objects.clear()
         self.meshes.clear()
         self.visibility.clear()
@@ -199,6 +201,7 @@ class SceneState:
         """Apply depsgraph.updates; returns the Dirty set (also kept in self.dirty until consumed)."""
         import bpy
 
+        export.collect_warnings(self.warnings)
         dirty = self.dirty
         membership_changed = False
         for update in depsgraph.updates:
