@@ -206,3 +206,472 @@ def test_env_prefilter_stress(glsl, fuzz):
                4, {"environment": layers})
     _assert_finite(out, "env_prefilter.glsl")
     assert out.min() >= 0
+
+
+# =========================================================================== every kernel
+# The kernels above are the ones the shaders call per pixel; the tests below fuzz every other
+# function of shaders/lib/*.glsl (helpers included) and the per-pixel pieces of shaders/resources that
+# can be called alone, over the numpy stress suite's own inputs (tests/core/test_stress_*.py: its
+# hostile SG set and BRDF directions, sub-sampled), in float32 on llvmpipe.  test_every_kernel_is_fuzzed
+# parses the function names of shaders/lib and fails when one is missing from COVERED.
+
+import functools
+import importlib.util
+import inspect
+import os
+import re
+
+SMALL_ROWS = 1 << 17
+SHADERS = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders")
+
+
+def _f32(values):
+    """float64 values exactly representable in float32 (what the kernels see)."""
+    return np.asarray(values, np.float32).astype(np.float64)
+
+
+def _numpy_suite(name):
+    """tests/core/<name>.py, imported by path (its generators are the numpy stress inputs)."""
+    path = os.path.join(os.path.dirname(__file__), os.pardir, "core", name + ".py")
+    spec = importlib.util.spec_from_file_location("_numpy_" + name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@functools.lru_cache(maxsize=1)
+def _sg_inputs():
+    """test_stress_sg's hostile set (opposite / nearly opposite / equal axes, grazing, zero and
+    opposite normals, theta_d at +-pi/2 and beyond, sharpness 0, 1e-4..1e6), every 8th row, float32."""
+    inputs = _numpy_suite("test_stress_sg")._hostile_inputs_float64()
+    return {key: np.asarray(value[::8], np.float32).astype(np.float64) for key, value in inputs.items()}
+
+
+@functools.lru_cache(maxsize=1)
+def _brdf_inputs():
+    """test_stress_brdf's hostile directions (grazing at 0, +-1e-8, 1e-4, 1e-30, the pole, zero,
+    tiny 1e-20 vectors, opposite pairs) and parameters (roughness 1e-4..1, exponents 1e-2..1e8)."""
+    suite = _numpy_suite("test_stress_brdf")
+    rng = np.random.default_rng(11)
+    wo, kind = suite.hostile_directions(rng, SMALL_ROWS, np.float32)
+    wi, _ = suite.hostile_directions(rng, SMALL_ROWS, np.float32)
+    wi = np.where((kind == 5)[:, None], -wo, wi)
+    h, _ = suite.hostile_directions(rng, SMALL_ROWS, np.float32)
+    roughness = suite.log_uniform(rng, 1e-4, 1.0, SMALL_ROWS).astype(np.float32)
+    roughness[::9] = 0.0
+    exponent = suite.log_uniform(rng, 1e-2, 1e8, SMALL_ROWS).astype(np.float32)
+    exponent[::11] = 0.0
+    f = lambda a: np.asarray(a, np.float32).astype(np.float64)       # noqa: E731
+    return f(wo), f(wi), f(h), f(roughness), f(exponent), rng
+
+
+def _light_inputs(count):
+    """test_stress_lighting's point/sphere light set: scales 1e-6..1e6, zero distance, radius 0,
+    shading points on the light's surface, intensities 1e-3..1e6."""
+    rng = np.random.default_rng(1)
+    scale = 10.0 ** rng.uniform(-6, 6, (count, 1))
+    light = rng.normal(size=(count, 3)) * scale
+    offset = rng.normal(size=(count, 3)) * scale * 10.0 ** rng.uniform(-8, 2, (count, 1))
+    x = light + offset
+    x[:1000] = light[:1000]
+    radius = scale[:, 0] * 10.0 ** rng.uniform(-3, 1, count)
+    radius[1000:2000] = 0
+    radius[2000:3000] = np.linalg.norm(offset[2000:3000], axis=1)
+    intensity = 10.0 ** rng.uniform(-3, 6, count)
+    f = lambda a: np.asarray(a, np.float32).astype(np.float64)       # noqa: E731
+    return f(x), f(light), f(radius), f(intensity), rng
+
+
+def _glsl_function(source, name):
+    """The full definition of GLSL function `name` (first overload) cut out of `source`."""
+    match = re.search(r"^[A-Za-z_][\w]*\s+" + name + r"\s*\(", source, re.M)
+    assert match, name
+    depth, position = 0, source.index("{", match.end())
+    for index in range(position, len(source)):
+        depth += {"{": 1, "}": -1}.get(source[index], 0)
+        if depth == 0:
+            return source[match.start():index + 1] + "\n"
+    raise AssertionError(f"unbalanced {name}")
+
+
+def _resource(file_name):
+    with open(os.path.join(SHADERS, "resources", file_name), encoding="utf-8") as handle:
+        return handle.read()
+
+
+def test_sg_helpers_stress(glsl):
+    x = _sg_inputs()
+    positive = np.maximum(x["sharpness"], 1e-4)     # the support area of sharpness > 0 (as numpy's suite)
+    epsilon = np.where(np.arange(len(positive)) % 2 == 0, 0.1, 1e-6)
+    inputs = {"p": np.c_[x["axis1"], positive], "e": epsilon}
+    body = """
+    vec3 r = sg_rotate(p.xyz, mat3(0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0));
+    float area = sg_support_area(p.w, e.x);
+    result = vec4(r.x + r.y + r.z, area, sg_sharpness_from_area(area, e.x), length(r));
+    """
+    out = glsl(["sg.glsl"], body, inputs, 4)
+    _assert_finite(out, "sg_rotate / sg_support_area / sg_sharpness_from_area")
+    assert out[:, 1].min() > 0 and np.abs(out[:, 3] - 1).max() < 1e-5
+
+
+def test_hemisphere_helpers_stress(glsl):
+    x = _sg_inputs()
+    inputs = {"t": np.c_[x["theta_d"], x["sharpness"], x["theta_d"] * x["sharpness"]]}
+    out = glsl(["sg.glsl", "hemisphere.glsl"], "vec4(erf_approx(t.z), fh_k(t.y), fh_normalized(t.x, t.y), 0.0)",
+               inputs, 3)
+    _assert_finite(out, "erf_approx / fh_k / fh_normalized")
+    assert np.abs(out[:, 0]).max() <= 1 and out[:, 1].min() > 0.59
+    assert out[:, 2].min() >= 0 and out[:, 2].max() <= 1
+
+
+def test_clamped_cosine_helpers_stress(glsl):
+    x = _sg_inputs()
+    cosine = np.clip(np.sum(x["axis1"] * x["normal"], axis=1), -1, 1)
+    inputs = {"s": np.c_[x["sharpness"], cosine]}
+    body = """
+    vec2 lobe = clamped_cosine_lobe();
+    vec2 poles = clamped_cosine_pole_integrals(s.x);
+    vec2 moments = clamped_cosine_langevin_moments(s.x);
+    float positive = clamped_cosine_gaussian_positive_mean(s.y * moments.x, s.y * s.y * moments.y);
+    float at_zero_variance = clamped_cosine_gaussian_positive_mean(s.y, 0.0);
+    result = vec4(poles.x + poles.y, moments.x + moments.y, positive + at_zero_variance, lobe.x * lobe.y);
+    """
+    out = glsl(["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl"], body, inputs, 4)
+    _assert_finite(out, "clamped_cosine pole integrals / Langevin moments / Gaussian positive mean")
+    # E[max(0, X)] through erf_approx (1e-4 absolute) dips a few 1e-8 below 0; its caller clamps
+    assert out[:, [0, 1, 3]].min() >= 0 and out[:, 2].min() >= -1e-6
+
+
+def test_brdf_helpers_stress(glsl):
+    wo, wi, h, roughness, exponent, rng = _brdf_inputs()
+    width = _f32(np.where(rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, np.exp(rng.uniform(np.log(1e-6), np.log(10.0), SMALL_ROWS))))
+    alpha_y = _f32(np.exp(rng.uniform(np.log(1e-6), 0.0, SMALL_ROWS)))
+    inputs = {"wo": np.c_[wo, roughness], "wi": np.c_[wi, exponent], "h": np.c_[h, width], "a": alpha_y}
+    body = """
+    vec3 half_vector = brdf_half_vector(wo.xyz, wi.xyz);
+    vec3 reflected = reflect_about(safe_normalize(wo.xyz), half_vector);
+    float alpha = ggx_alpha(wo.w);
+    vec2 mappings = isotropic_mapping_beckmann(h.w) + isotropic_mapping_blinn_phong(h.w)
+                  + isotropic_mapping_ward_iso(h.w) + isotropic_mapping_ggx(h.w)
+                  + isotropic_polynomial(GGX_SHARPNESS, GGX_AMPLITUDE, min(h.w, 1.0));
+    result = vec4(dot(reflected, vec3(1.0)) + brdf_theta(h.xyz) + brdf_log_cosine(max(h.z, BRDF_FLOAT_TINY)),
+                  shadowing_cook_torrance(safe_normalize(wo.xyz), safe_normalize(wi.xyz), half_vector)
+                  + ward_isotropic_m_factor(wo.xyz, wi.xyz),
+                  beckmann_ndf(h.xyz, max(wo.w, 1.0e-6), max(a.x, 1.0e-6))
+                  + ggx_smith_lambda(safe_normalize(wo.xyz), alpha) + ggx_smith_lambda(wi.xyz, alpha),
+                  mappings.x + mappings.y);
+    """
+    out = glsl(["sg.glsl", "brdf.glsl"], body, inputs, 4)
+    _assert_finite(out, "brdf helpers")
+    assert out[:, 1:].min() >= 0
+
+
+def test_warp_helpers_stress(glsl):
+    x = _sg_inputs()
+    wo = x["normal"]          # zero, grazing, on and opposite the axis
+    inputs = {"p": np.c_[x["axis1"], x["sharpness"]], "wo": np.c_[wo, x["amplitude1"]]}
+    body = """
+    vec3 unit_axis, unit_wo, in_plane;
+    float offset;
+    warp_split_frame(p.xyz, p.w, wo.xyz, unit_axis, unit_wo, in_plane, offset);
+    vec3 node_axis; float node_sharpness, node_amplitude;
+    warp_split_node(unit_axis, in_plane, unit_wo, offset, 1.7320508075688772, 1.0 / 6.0, p.w, wo.w,
+                    node_axis, node_sharpness, node_amplitude);
+    vec3 at_axis; float at_sharpness;
+    warp_at(unit_axis, p.w, unit_wo, clamp(dot(unit_axis, unit_wo), -1.0, 1.0), at_axis, at_sharpness);
+    result = vec4(dot(in_plane + node_axis + at_axis, vec3(1.0)) + offset, node_sharpness + at_sharpness,
+                  node_amplitude, offset);
+    """
+    out = glsl(["sg.glsl", "brdf.glsl", "warp.glsl"], body, inputs, 4)
+    _assert_finite(out, "warp_split_frame / warp_split_node / warp_at")
+    assert out[:, 1:].min() >= 0 and out[:, 1].max() <= 2e6 * (1 + 1e-6)
+
+
+def test_lights_helpers_stress(glsl):
+    x, light, radius, intensity, rng = _light_inputs(SMALL_ROWS)
+    sin2 = _f32(np.where(rng.integers(0, 4, SMALL_ROWS) == 0, 0.0, rng.uniform(0.0, 1.0, SMALL_ROWS)))
+    inputs = {"x": np.c_[x, sin2], "l": np.c_[light, radius], "i": intensity}
+    body = """
+    float effective2; vec3 cap_axis;
+    float cap = sphere_light_cap(x.xyz, l.xyz, l.w, effective2, cap_axis);
+    float cap_sharpness, cap_amplitude;
+    light_cap_energy_lobe(x.w, blender_point_light_intensity(i.x * 12.566370614359172), cap_sharpness, cap_amplitude);
+    vec3 axis; float sharpness, amplitude;
+    point_light_sg(x.xyz, l.xyz, i.x, l.w, axis, sharpness, amplitude);
+    result = vec4(cap + effective2 + dot(cap_axis + axis, vec3(1.0)), cap_sharpness + sharpness,
+                  cap_amplitude + amplitude, 0.0);
+    """
+    out = glsl(["sg.glsl", "lights.glsl"], body, inputs, 3)
+    _assert_finite(out, "sphere_light_cap / light_cap_energy_lobe / point_light_sg")
+    assert out[:, 1].min() > 0 and out[:, 2].min() >= 0
+
+
+def test_env_prefilter_helpers_stress(glsl, fuzz):
+    axis = fuzz.stress_vectors(SMALL_ROWS)
+    axis[:1000] = 0
+    axis[1000:2000] = [0, 0, -1]
+    axis[2000:3000] = [1, 0, 0]
+    sharpness = _f32(10.0 ** fuzz.rng.uniform(-12, 9, SMALL_ROWS))   # test_stress_lighting's lookups
+    sharpness[:500] = 0
+    body = """
+    vec2 coords = oct_encode(safe_normalize(p.xyz));
+    vec2 raw = oct_encode(p.xyz);
+    result = vec4(coords + raw + env_sign_not_zero(p.xy), env_prefilter_blend_parameter(p.w, -3.0, 2.0, 31), 0.0);
+    """
+    out = glsl(["sg.glsl", "env_prefilter.glsl"], body, {"p": np.c_[axis, sharpness]}, 3)
+    _assert_finite(out, "oct_encode / env_sign_not_zero / env_prefilter_blend_parameter")
+    assert out[:, 2].min() >= 0 and out[:, 2].max() <= 30
+
+
+def _ssdf_basis(rng, resolution=8, terms=9):
+    from sg_prt_addon.bake import decode
+
+    basis = np.asarray(rng.normal(size=(terms, resolution, resolution)) * 0.3, np.float32)
+    mean = np.asarray(rng.uniform(-1.5, 1.5, (resolution, resolution)), np.float32)
+    return decode.pack_basis_texture(mean, basis)
+
+
+def test_ssdf_stress(glsl, fuzz):
+    """Every function of ssdf.glsl: degenerate directions and normals (zero, tiny, huge, poles, the
+    frame's reference axis), points on the disc's axes and centre, any sharpness and theta_d."""
+    from sg_prt_addon.bake import hemisphere_map
+
+    x = _sg_inputs()
+    count = len(x["sharpness"])
+    direction = fuzz.stress_vectors(count)
+    normal = fuzz.stress_vectors(count)
+    normal[::17] = hemisphere_map.FRAME_REFERENCE_AXIS
+    disc = fuzz.uniform(-1.0, 1.0, 2 * count).reshape(count, 2)
+    disc[::5, 0] = 0.0
+    disc[::7] = 0.0
+    unit = direction / np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-300)
+    coefficients = _f32(fuzz.rng.normal(size=(count, 12)))
+    coefficients[:, 0] = 1.0
+    inputs = {"d": np.c_[direction, x["sharpness"]], "n": np.c_[normal, x["theta_d"]], "u": np.c_[_f32(unit), np.zeros(count)],
+              "q": np.c_[disc, x["amplitude1"], np.zeros(count)], "c0": coefficients[:, :4], "c1": coefficients[:, 4:8],
+              "c2": coefficients[:, 8:]}
+    body = """
+    vec4 c[SSDF_MAX_LAYERS];
+    c[0] = c0; c[1] = c1; c[2] = c2;
+    vec3 t, b, unit_normal;
+    ssdf_local_frame(n.xyz, t, b, unit_normal);
+    vec3 local = ssdf_to_local(d.xyz, n.xyz);
+    vec3 lookup = ssdf_horizon_lookup(u.xyz);
+    vec2 square = ssdf_disc_to_square(q.xy) + ssdf_hemisphere_to_square(vec3(u.xy, abs(u.z)));
+    float theta_d = ssdf_decode(ssdf_basis, c, 3, local);
+    result = vec4(dot(t + b + unit_normal + local + lookup, vec3(1.0)) + square.x + square.y,
+                  theta_d,
+                  ssdf_visibility_amplitude(d.w, q.z, n.w) + ssdf_visibility_amplitude(d.w, q.z, theta_d),
+                  ssdf_shadowed_integral(local, d.w, q.z, ssdf_basis, c, 3));
+    """
+    library = ["sg.glsl", "hemisphere.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl"]
+    out = glsl(library, body, inputs, 4, textures={"ssdf_basis": _ssdf_basis(fuzz.rng)})
+    _assert_finite(out, "ssdf.glsl")
+    assert out[:, 2:].min() >= 0
+
+
+# ---- shaders/resources: the per-pixel pieces that can be called alone
+
+RESOURCE_KERNELS = {
+    "sg_shading.glsl": ["set_visibility_frame", "lobe_visibility", "shading_frame", "apply_normal_map",
+                        "rotate_tangent", "model_ndf_lobe", "model_m_factor"],
+    "anisotropic_lobes.glsl": ["anisotropic_lobes"],
+    "ggx_two_lobes.glsl": ["ggx_two_lobes"],
+}
+LIBRARY_ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl", "warp.glsl", "lights.glsl"]
+
+
+def test_lobe_visibility_stress(glsl, fuzz):
+    """sg_shading.glsl's lobe_visibility (HAS_VISIBILITY) after set_visibility_frame: any lobe, any
+    normal and SSDF normal (zero, tiny, huge, opposite), random bake rows: a fraction in [0, 1]."""
+    x = _sg_inputs()
+    count = len(x["sharpness"])
+    rows = _f32(fuzz.rng.normal(size=(count, 12)))
+    rows[:, 0] = 1.0
+    ssdf_normal = fuzz.stress_vectors(count)
+    ssdf_normal[::3] = x["normal"][::3]
+    shading = _resource("sg_shading.glsl")
+    source = ("vec4 visibility_rows[SSDF_MAX_LAYERS];\nmat3 visibility_frame;\n"
+              + _glsl_function(shading, "set_visibility_frame") + _glsl_function(shading, "lobe_visibility"))
+    body = """
+    visibility_rows[0] = c0; visibility_rows[1] = c1; visibility_rows[2] = c2;
+    set_visibility_frame(s.xyz);
+    result = vec4(lobe_visibility(p.xyz, p.w, n.xyz), 0.0, 0.0, 0.0);
+    """
+    library = LIBRARY_ORDER + ["#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl", source]
+    inputs = {"p": np.c_[x["axis1"], x["sharpness"]], "n": x["normal"], "s": ssdf_normal,
+              "c0": rows[:, :4], "c1": rows[:, 4:8], "c2": rows[:, 8:]}
+    out = glsl(library, body, inputs, 1, textures={"visibility_basis": _ssdf_basis(fuzz.rng)})
+    _assert_finite(out, "lobe_visibility")
+    assert out.min() >= 0 and out.max() <= 1
+
+
+def test_shading_frame_stress(glsl, fuzz):
+    """shading_frame, apply_normal_map and rotate_tangent with zero / parallel / huge tangents, zero
+    normals, any normal-map sample (also outside [0, 1]) and strength 0..10."""
+    normal = fuzz.stress_vectors(SMALL_ROWS)
+    tangent = fuzz.stress_vectors(SMALL_ROWS)
+    parallel = fuzz.rng.integers(0, 8, SMALL_ROWS) == 0
+    tangent[parallel] = normal[parallel] * 3.0
+    sign = np.where(fuzz.rng.integers(0, 2, SMALL_ROWS) == 0, -1.0, 1.0)
+    sample = fuzz.uniform(-1.0, 2.0, 3 * SMALL_ROWS).reshape(-1, 3)
+    sample[::5] = 0.5                                   # maps to the zero vector
+    strength = fuzz.uniform(0.0, 10.0, SMALL_ROWS)
+    rotation = fuzz.uniform(-100.0, 100.0, SMALL_ROWS)
+    shading = _resource("sg_shading.glsl")
+    source = "".join(_glsl_function(shading, name) for name in ("shading_frame", "apply_normal_map", "rotate_tangent"))
+    body = """
+    vec3 n, t, b;
+    shading_frame(n_in.xyz, t_in.xyz, n, t, b);
+    vec3 mapped = apply_normal_map(n_in.xyz, vec4(t_in.xyz, t_in.w), m.xyz, m.w);
+    vec3 rotated = rotate_tangent(n_in.xyz, t_in.xyz, n_in.w);
+    result = vec4(length(n) + length(t) + length(b), length(mapped), length(rotated), abs(dot(n, t)));
+    """
+    inputs = {"n_in": np.c_[normal, rotation], "t_in": np.c_[tangent, sign], "m": np.c_[sample, strength]}
+    out = glsl(["sg.glsl", source], body, inputs, 4)
+    _assert_finite(out, "shading_frame / apply_normal_map / rotate_tangent")
+    np.testing.assert_allclose(out[:, 1], 1.0, atol=1e-5)
+    assert out[:, 2].max() <= 1 + 1e-5
+    # a tangent parallel to the normal leaves a rounding residual that Gram-Schmidt normalises into an
+    # arbitrary, not quite perpendicular direction (finite; see the stress report): orthonormal elsewhere
+    np.testing.assert_allclose(out[~parallel, :3], np.broadcast_to([3.0, 1.0, 1.0], out[~parallel, :3].shape), atol=1e-4)
+    assert out[~parallel, 3].max() < 1e-3          # float32 Gram-Schmidt of nearly parallel vectors
+
+
+MODEL_VARIANTS = [("GGX", 1), ("GGX", 2), ("COOK_TORRANCE", 1), ("BLINN_PHONG", 1), ("WARD_ISO", 1),
+                  ("WARD_ANISO", 3), ("ASHIKHMIN_SHIRLEY", 3)]
+
+
+@pytest.mark.parametrize("model,lobes", MODEL_VARIANTS, ids=[f"{m}-{k}" for m, k in MODEL_VARIANTS])
+def test_model_lobes_stress(glsl, model, lobes):
+    """sg_shading.glsl's model_ndf_lobe (through ggx_two_lobes / anisotropic_lobes and their tables)
+    and model_m_factor, per model, over the numpy suite's parameters (0 included) and directions."""
+    from sg_prt_addon.engine import shader_variants
+
+    wo, wi, h, roughness, exponent, rng = _brdf_inputs()
+    alpha_y = _f32(np.where(rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, np.exp(rng.uniform(np.log(1e-4), 0.0, SMALL_ROWS))))
+    nv = _f32(np.exp(rng.uniform(np.log(1e-2), np.log(1e8), SMALL_ROWS)))
+    rf0 = _f32(rng.uniform(0.0, 1.0, SMALL_ROWS))
+    ior = _f32(rng.uniform(0.0, 4.0, SMALL_ROWS))
+    # p = (roughness, ior, exponent, alpha_x), q = (alpha_y, nu, nv, rf0)
+    inputs = {"p": np.c_[roughness, ior, exponent, roughness], "q": np.c_[alpha_y, exponent, nv, rf0],
+              "wo": wo, "wi": wi}
+    shading = _resource("sg_shading.glsl")
+    defines = f"#define MODEL_{model} 1\n#define NDF_LOBES {lobes}\n"
+    pieces = [defines]
+    textures = {}
+    if model == "GGX" and lobes == 2:
+        pieces.append(_resource("ggx_two_lobes.glsl"))
+        textures["ggx_table"] = shader_variants.ggx_table()
+    if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY"):
+        pieces.append(_resource("anisotropic_lobes.glsl"))
+        textures["anisotropy_table"] = shader_variants.anisotropy_table(lobes)
+    pieces += [_glsl_function(shading, "model_ndf_lobe"), _glsl_function(shading, "model_m_factor")]
+    body = """
+    vec3 axis_sum = vec3(0.0);
+    float sharpness_sum = 0.0, amplitude_sum = 0.0;
+    for (int k = 0; k < NDF_LOBES; k++) {
+      vec3 axis; float sharpness, amplitude;
+      model_ndf_lobe(p, q, k, axis, sharpness, amplitude);
+      axis_sum += axis; sharpness_sum += sharpness; amplitude_sum += amplitude;
+    }
+    result = vec4(dot(axis_sum, vec3(1.0)), sharpness_sum, amplitude_sum, model_m_factor(wo.xyz, wi.xyz, p, q));
+    """
+    out = glsl(LIBRARY_ORDER + pieces, body, inputs, 4, textures)
+    _assert_finite(out, f"model_ndf_lobe / model_m_factor ({model}, {lobes} lobes)")
+    assert out[:, 1:].min() >= 0
+
+
+def test_table_lobes_stress(glsl, fuzz):
+    """ggx_two_lobes and anisotropic_lobes called alone: roughness / widths 0..1e3, any peak."""
+    from sg_prt_addon.engine import shader_variants
+
+    roughness = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 10.0, SMALL_ROWS)))
+    width_x = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 1e3, SMALL_ROWS)))
+    width_y = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 1e3, SMALL_ROWS)))
+    peak = fuzz.stress_amplitude(SMALL_ROWS)
+    body = """
+    float s0, a0, s1, a1;
+    ggx_two_lobes(ggx_table, a.x, 0, s0, a0);
+    ggx_two_lobes(ggx_table, a.x, 1, s1, a1);
+    vec3 axis; float sharpness, amplitude;
+    anisotropic_lobes(anisotropy_table, a.y, a.z, a.w, 1, axis, sharpness, amplitude);
+    result = vec4(s0 + s1, a0 + a1, sharpness + amplitude, length(axis));
+    """
+    library = ["sg.glsl", "brdf.glsl", _resource("ggx_two_lobes.glsl"), _resource("anisotropic_lobes.glsl")]
+    out = glsl(library, body, {"a": np.c_[roughness, width_x, width_y, peak]}, 4,
+               {"ggx_table": shader_variants.ggx_table(), "anisotropy_table": shader_variants.anisotropy_table(2)})
+    _assert_finite(out, "ggx_two_lobes / anisotropic_lobes")
+    assert out[:, :3].min() >= 0 and np.abs(out[:, 3] - 1).max() < 1e-5
+
+
+# ---- coverage: every function of shaders/lib is fuzzed
+
+COVERED = {
+    test_sg_stress: ["sg_product", "sg_inner_product", "sg_evaluate", "sg_sphere_integral",
+                     "sg_axis_hemisphere_integral", "one_minus_exp_over_x"],
+    test_safe_normalize_stress: ["safe_normalize"],
+    test_hemisphere_stress: ["fh_normalized_from_sine", "fh", "hemisphere_integral", "visibility_product_amplitude",
+                             "visibility_product_integral_preserving_amplitude"],
+    test_brdf_stress: ["cook_torrance_ndf", "cook_torrance_beckmann_ndf", "ggx_ndf", "blinn_phong_ndf",
+                       "ashikhmin_shirley_ndf", "ward_isotropic_ndf", "ward_anisotropic_ndf", "fresnel_dielectric",
+                       "fresnel_schlick", "cook_torrance_m_factor", "cook_torrance_beckmann_m_factor",
+                       "blinn_phong_m_factor", "ward_anisotropic_m_factor", "ashikhmin_shirley_m_factor",
+                       "ggx_m_factor", "lambert_m_factor", "cook_torrance_ndf_lobe",
+                       "cook_torrance_beckmann_ndf_lobe", "blinn_phong_ndf_lobe", "ward_isotropic_ndf_lobe",
+                       "ggx_ndf_lobe"],
+    test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "spot_light_sg", "directional_light_sg"],
+    test_clamped_cosine_stress: ["sg_clamped_cosine_integral", "sg_clamped_cosine_integral_paper",
+                                 "clamped_cosine_from_cosine", "clamped_cosine_lobe_evaluate"],
+    test_warp_stress: ["warp_lobes_split2", "warp_lobes_split3", "warp_lobes_paper", "brdf_slice_amplitude"],
+    test_env_prefilter_stress: ["env_prefilter_lookup", "env_prefilter_lookup_integral"],
+    test_sg_helpers_stress: ["sg_rotate", "sg_support_area", "sg_sharpness_from_area"],
+    test_hemisphere_helpers_stress: ["erf_approx", "fh_k", "fh_normalized"],
+    test_clamped_cosine_helpers_stress: ["clamped_cosine_lobe", "clamped_cosine_pole_integrals",
+                                         "clamped_cosine_langevin_moments", "clamped_cosine_gaussian_positive_mean"],
+    test_brdf_helpers_stress: ["brdf_half_vector", "reflect_about", "brdf_theta", "brdf_log_cosine",
+                               "shadowing_cook_torrance", "isotropic_polynomial", "isotropic_mapping_beckmann",
+                               "isotropic_mapping_blinn_phong", "isotropic_mapping_ward_iso", "isotropic_mapping_ggx",
+                               "beckmann_ndf", "ward_isotropic_m_factor", "ggx_alpha", "ggx_smith_lambda"],
+    test_warp_helpers_stress: ["warp_at", "warp_split_frame", "warp_split_node"],
+    test_lights_helpers_stress: ["blender_point_light_intensity", "light_cap_energy_lobe", "sphere_light_cap",
+                                 "point_light_sg"],
+    test_env_prefilter_helpers_stress: ["env_sign_not_zero", "oct_encode", "env_prefilter_blend_parameter"],
+    test_ssdf_stress: ["ssdf_disc_to_square", "ssdf_hemisphere_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",
+                       "ssdf_to_local", "ssdf_decode", "ssdf_visibility_amplitude", "ssdf_shadowed_integral"],
+    test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility"],
+    test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
+    test_model_lobes_stress: ["model_ndf_lobe", "model_m_factor"],
+    test_table_lobes_stress: ["ggx_two_lobes", "anisotropic_lobes"],
+}
+
+_DEFINITION = re.compile(r"^\s*(?:float|int|uint|bool|void|vec[234]|ivec[234]|mat[234])\s+([A-Za-z_]\w*)\s*\(", re.M)
+
+
+def _defined_functions(path):
+    with open(path, encoding="utf-8") as handle:
+        return set(_DEFINITION.findall(handle.read()))
+
+
+def test_every_kernel_is_fuzzed():
+    """Every function defined in shaders/lib/*.glsl (and the listed per-pixel pieces of
+    shaders/resources) is in COVERED, and every name COVERED gives a test is called in that test's
+    GLSL: a new kernel without a stress test fails here."""
+    library_dir = os.path.join(SHADERS, "lib")
+    defined = set()
+    for file_name in sorted(os.listdir(library_dir)):
+        if file_name.endswith(".glsl"):
+            defined |= _defined_functions(os.path.join(library_dir, file_name))
+    assert len(defined) > 80, sorted(defined)          # the parse found the library
+    for file_name, names in RESOURCE_KERNELS.items():
+        missing = set(names) - _defined_functions(os.path.join(SHADERS, "resources", file_name))
+        assert not missing, f"resources/{file_name} no longer defines {sorted(missing)}"
+        defined |= set(names)
+    covered = set()
+    for test, names in COVERED.items():
+        source = inspect.getsource(test)
+        not_called = [name for name in names if not re.search(r"\b" + name + r"\s*\(", source)]
+        assert not not_called, f"{test.__name__} does not call {not_called}"
+        covered |= set(names)
+    assert not defined - covered, f"GLSL kernels without a stress test: {sorted(defined - covered)}"
+    assert not covered - defined, f"COVERED names no kernel: {sorted(covered - defined)}"
