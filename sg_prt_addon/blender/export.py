@@ -216,6 +216,10 @@ def _any_perpendicular(normals):
     return t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-30)
 
 
+# Vertex coordinates beyond this (object space) are treated as NaN/Inf: float32 transforms overflow.
+MAX_COORDINATE = 1e30
+
+
 def export_mesh_data(mesh, name=None):
     """MeshExport of a bpy Mesh (already evaluated), object space; `name` (the object's) in warnings."""
     export_counter["meshes"] += 1
@@ -241,6 +245,16 @@ def export_mesh_data(mesh, name=None):
     triangles = triangles.reshape(-1, 3)
     material_index = np.empty(triangle_count, np.int64)
     mesh.loop_triangles.foreach_get("material_index", material_index)
+    finite = (np.abs(positions) <= MAX_COORDINATE).all(axis=1)          # (False with a NaN)
+    if not finite.all():
+        # NaN/Inf coordinates (scripts, broken modifiers; Blender stores Inf as 3.4e38): leave their
+        # triangles out (the vertex transform would overflow), zero the positions
+        keep = finite[triangles].all(axis=1)
+        triangles, material_index = triangles[keep], material_index[keep]
+        triangle_count = len(triangles)
+        positions = np.where(finite[:, None], positions, np.float32(0.0))
+        warn(f"object '{name or mesh.name}': {len(np.unique(vertex_index[~finite]))} vertices with NaN/Inf "
+             f"coordinates (or beyond {MAX_COORDINATE:g}): their {int((~keep).sum())} triangle(s) left out")
 
     # the UV map renders use (camera icon in the UI), else the active one
     uv_layer = next((layer for layer in mesh.uv_layers if layer.active_render), mesh.uv_layers.active)
@@ -328,6 +342,8 @@ def _usable_tangents(tangents, normals):
 def _vertex_normals(mesh):
     normals = np.empty(len(mesh.vertices) * 3, np.float32)
     mesh.vertices.foreach_get("normal", normals)
+    if not np.isfinite(normals).all():             # vertices at NaN/Inf: zero (the shaders' fallback: +Z)
+        normals = np.where(np.isfinite(normals), normals, np.float32(0.0))
     return normals.reshape(-1, 3)
 
 

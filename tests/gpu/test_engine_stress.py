@@ -163,7 +163,8 @@ def _mesh_object(scene, name, vertices, faces, location=(0.0, 0.0, 1.0), uv=Fals
 
 def test_degenerate_geometry(engine):
     """Zero-area triangles (collapsed to a point and to a line), a fan whose vertices have zero
-    normals (every face degenerate), custom split normals of zero length, next to a normal sphere."""
+    normals (every face degenerate), custom split normals of zero length, vertices at NaN / Inf /
+    1e30, objects scaled by 0 along one axis and along all three."""
     import bpy
 
     scene = fx.new_scene("stress_degenerate", SIZE, SIZE)
@@ -185,10 +186,22 @@ def test_degenerate_geometry(engine):
     sphere.data.materials.append(material)
     if hasattr(sphere.data, "normals_split_custom_set"):
         sphere.data.normals_split_custom_set([(0.0, 0.0, 0.0)] * len(sphere.data.loops))
+    # vertices at NaN / Inf / 1e30 (a script or a broken modifier)
+    broken = _uv_sphere(scene, "stress_nan_vertices", (-1.5, 1.0, 1.0), radius=0.6, segments=12, rings=6)
+    broken.data.materials.append(material)
+    broken.data.vertices[5].co = (math.nan, 0.0, 0.0)
+    broken.data.vertices[9].co = (math.inf, 0.0, 1.0)
+    broken.data.vertices[20].co = (1e30, -1e30, 0.0)
+    # transforms that flatten (scale 0 along y) or collapse an object (scale 0)
+    for name, scale in (("stress_flattened", (1.0, 0.0, 1.0)), ("stress_collapsed_scale", (0.0, 0.0, 0.0))):
+        flat = _uv_sphere(scene, name, (1.5, 1.0, 1.0), radius=0.6, segments=12, rings=6)
+        flat.data.materials.append(material)
+        flat.scale = scale
     result = _render(scene)
     assert _covered(result).mean() > 0.05
     state = result["state"]
-    for obj in ("stress_collapsed", "stress_zero_normals", "stress_custom_normals"):
+    assert _warned(result, "object 'stress_nan_vertices'", "2 vertices with NaN/Inf coordinates"), _warnings(result)
+    for obj in ("stress_collapsed", "stress_zero_normals", "stress_custom_normals", "stress_nan_vertices"):
         mesh = state.meshes[state.objects[obj].mesh_key]
         for array in (mesh.positions, mesh.normals, mesh.tangents, mesh.uvs, mesh.vertex_normals):
             assert np.all(np.isfinite(array)), obj
