@@ -506,13 +506,27 @@ def _clamped_intensity(values, name):
     return np.clip(np.nan_to_num(values, nan=0.0), -MAX_LIGHT_INTENSITY, MAX_LIGHT_INTENSITY)
 
 
+def _finite_setting(value, default, what):
+    """float(value), or `default` with a warning when it is NaN/Inf (Blender stores what scripts set)."""
+    value = float(value)
+    if np.isfinite(value):
+        return value
+    warn(f"{what} {value} not finite, {default:g} used")
+    return default
+
+
 def export_light(object_eval):
-    """LightExport of an evaluated light object in Blender's units; None for unsupported types.
-    Intensities are finite and at most MAX_LIGHT_INTENSITY in magnitude (warned otherwise)."""
+    """LightExport of an evaluated light object in Blender's units; None for unsupported types (and
+    for a light whose transform is not finite).  Intensities are finite and at most
+    MAX_LIGHT_INTENSITY in magnitude, sizes and angles finite (warned otherwise)."""
     from ..core import lights as core_lights
 
     light = object_eval.data
     matrix = matrix_to_numpy(object_eval.matrix_world)
+    if not np.all(np.isfinite(matrix)):
+        warn(f"light '{object_eval.name}': transform not finite, left out")
+        return None
+    what = f"light '{object_eval.name}':"
     position = tuple(matrix[:3, 3])
     direction = -matrix[:3, 2]
     direction = tuple(direction / max(np.linalg.norm(direction), 1e-30))
@@ -521,21 +535,21 @@ def export_light(object_eval):
         irradiance = _clamped_intensity(colour * float(core_lights.blender_sun_irradiance(light.energy)),
                                         object_eval.name)
         return LightExport(object_eval.name, "SUN", position, direction, tuple(irradiance),
-                           angle=float(light.angle))
+                           angle=_finite_setting(light.angle, 0.0, what + " angle"))
     intensity = _clamped_intensity(colour * float(core_lights.blender_point_light_intensity(light.energy)),
                                    object_eval.name)
     if light.type in ("POINT", "SPOT"):
-        radius = float(getattr(light, "shadow_soft_size", 0.0))
+        radius = _finite_setting(getattr(light, "shadow_soft_size", 0.0), 0.0, what + " radius")
         export = LightExport(object_eval.name, "POINT", position, direction, tuple(intensity), radius=radius)
         if light.type == "SPOT":
             export.is_spot = True
-            export.spot_size = float(light.spot_size)
-            export.spot_blend = float(light.spot_blend)
+            export.spot_size = _finite_setting(light.spot_size, np.pi, what + " spot size")
+            export.spot_blend = _finite_setting(light.spot_blend, 0.0, what + " spot blend")
         return export
     if light.type == "AREA":
         # An area light becomes a sphere of the same area (4 pi r^2 = A) and power.
-        size_x = float(light.size)
-        size_y = float(light.size_y) if light.shape in ("RECTANGLE", "ELLIPSE") else size_x
+        size_x = _finite_setting(light.size, 0.0, what + " size")
+        size_y = _finite_setting(light.size_y, 0.0, what + " size y") if light.shape in ("RECTANGLE", "ELLIPSE") else size_x
         area = size_x * size_y * (np.pi / 4 if light.shape in ("DISK", "ELLIPSE") else 1.0)
         return LightExport(object_eval.name, "POINT", position, direction, tuple(intensity),
                            radius=float(np.sqrt(area / (4 * np.pi))))
@@ -559,7 +573,12 @@ def export_world(world):
             if node.type == "BACKGROUND":
                 if not node.inputs["Color"].is_linked:
                     colour = tuple(node.inputs["Color"].default_value)[:3]
-                strength = float(node.inputs["Strength"].default_value)
+                strength = _finite_setting(node.inputs["Strength"].default_value, 0.0,
+                                           f"world '{world.name}': strength")
+    if not np.all(np.isfinite(colour[:3])):
+        warn(f"world '{world.name}': colour {tuple(colour[:3])} not finite, 0 used there")
+        colour = tuple(float(c) if np.isfinite(c) else 0.0 for c in colour[:3])
+    if uses_nodes:
         for node in world.node_tree.nodes:
             if node.type == "TEX_ENVIRONMENT" and node.image is not None:
                 pixels = image_pixels(node.image)[::-1, :, :3]      # numpy orientation, row 0 at the top

@@ -393,3 +393,47 @@ def test_light_extremes(engine):
     assert _covered(result).mean() > 0.3
     assert result["passes"]["Combined"][..., :3].max() > 1e10
     assert _warned(result, "light 'stress_max_point'", "clamped to +-1e+20"), _warnings(result)
+
+
+@pytest.mark.parametrize("world", ["colour", "hdri"])
+def test_non_finite_light_and_world_settings(engine, world):
+    """NaN light power, colour, radius, spot size / blend, area size, sun angle, a light at a NaN
+    location, a NaN world colour and strength (Blender stores what scripts set): finite, warned."""
+    import bpy
+
+    scene = fx.new_scene(f"stress_nan_lights_{world}", 32, 32)
+    if world == "hdri":
+        world_data = _world_image(scene, _hdri(f"stress_nan_lights_hdri"))
+    else:
+        world_data = fx.world_colour(scene, (0.2, 0.2, 0.2))
+    background = next(node for node in world_data.node_tree.nodes if node.type == "BACKGROUND")
+    if world == "colour":
+        background.inputs["Color"].default_value = (math.nan, 0.2, 0.2, 1.0)
+    background.inputs["Strength"].default_value = math.nan
+    name = scene.name
+    fx.point_light(scene, f"{name}_ok", (1.0, -3.0, 3.0), 1000.0)
+    fx.point_light(scene, f"{name}_power", (-1.0, -3.0, 3.0), math.nan)
+    fx.point_light(scene, f"{name}_colour", (-1.0, -3.0, 2.0), 100.0, colour=(math.nan, 1.0, 1.0))
+    fx.point_light(scene, f"{name}_radius", (0.0, -3.0, 3.0), 100.0, radius=math.nan)
+    spot = fx.point_light(scene, f"{name}_spot", (0.0, -3.0, 4.0), 100.0, kind="SPOT")
+    spot.data.spot_size = math.nan
+    spot.data.spot_blend = math.nan
+    area = fx.point_light(scene, f"{name}_area", (2.0, -2.0, 3.0), 100.0, kind="AREA")
+    area.data.size = math.nan
+    sun = fx.point_light(scene, f"{name}_sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
+    sun.data.angle = math.nan
+    fx.point_light(scene, f"{name}_nowhere", (math.nan, 0.0, 3.0), 100.0)
+    _uv_sphere(scene, f"{name}_sphere", (0.0, 0.0, 1.0), radius=1.2).data.materials.append(
+        fx.material(f"{name}_material", model="GGX"))
+    result = _render(scene)
+    assert _covered(result).mean() > 0.15
+    expected = [(f"light '{name}_power'", "clamped"), (f"light '{name}_colour'", "clamped"),
+                (f"light '{name}_radius'", "radius nan not finite"), (f"light '{name}_spot'", "spot size nan"),
+                (f"light '{name}_spot'", "spot blend nan"), (f"light '{name}_area'", "size nan"),
+                (f"light '{name}_sun'", "angle nan"), (f"light '{name}_nowhere'", "transform not finite"),
+                (f"world '{world_data.name}'", "strength nan not finite")]
+    if world == "colour":
+        expected.append((f"world '{world_data.name}'", "colour", "not finite"))
+    for words in expected:
+        assert _warned(result, *words), (words, _warnings(result))
+    del bpy
