@@ -241,7 +241,8 @@ def fitted_slice(params, view_local):
         shadowing_i = fitted_shadowing(params, np.moveaxis(wi, 0, 1)).T                        # (K', N)
         above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
         with np.errstate(all="ignore"):
-            value = fresnel * shadowing_o[None] * shadowing_i / (np.pi * wi[..., 2] * wo[..., 2])
+            value = fresnel * shadowing_o[None] * shadowing_i / (
+                np.pi * np.maximum(wi[..., 2], brdf.COSINE_EPSILON) * np.maximum(wo[..., 2], brdf.COSINE_EPSILON))
         return np.where(above, value, 0.0)
 
     return warp.brdf_slice_lobes(axis, sharpness, np.ones_like(sharpness), view_local, m_factor,

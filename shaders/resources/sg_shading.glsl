@@ -198,7 +198,8 @@ float fitted_m_factor(vec3 wo, vec3 wi, float eta, float shadowing_o)
     return 0.0;
   }
   vec3 h = safe_normalize(wo + wi);
-  return fresnel_dielectric(dot(wi, h), eta) * shadowing_o * fitted_shadowing_of(wi) / (SG_PI * wi.z * wo.z);
+  return fresnel_dielectric(dot(wi, h), eta) * shadowing_o * fitted_shadowing_of(wi)
+         / (SG_PI * max(wi.z, BRDF_COSINE_EPSILON) * max(wo.z, BRDF_COSINE_EPSILON));   /* grazing: no 0/0 */
 }
 #endif
 

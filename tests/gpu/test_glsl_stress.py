@@ -470,11 +470,54 @@ def test_ssdf_stress(glsl, fuzz):
     assert out[:, 2:].min() >= 0
 
 
+def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
+    """The kernels the shaders call per pixel (fuzzed above with this file's generators) over the
+    numpy suite's own hostile sets too: SG algebra, fh, clamped cosine, the split warp, M_o."""
+    x = _sg_inputs()
+    inputs = {"p1": np.c_[x["axis1"], x["sharpness"]], "p2": np.c_[x["axis2"], x["sharpness2"]],
+              "n": np.c_[x["normal"], x["theta_d"]], "m": np.c_[x["amplitude1"], x["amplitude2"]]}
+    body = """
+    vec3 axis; float sharpness, amplitude;
+    sg_product(p1.xyz, p1.w, m.x, p2.xyz, p2.w, m.y, axis, sharpness, amplitude);
+    vec3 axes[3]; float sharpnesses[3], amplitudes[3];
+    warp_lobes_split3(p1.xyz, p1.w, m.x, n.xyz, axes, sharpnesses, amplitudes);
+    float slice = 0.0;
+    for (int j = 0; j < 3; j++) {
+      slice += brdf_slice_amplitude(amplitudes[j], ggx_m_factor(n.xyz, axes[j], 0.5))
+             * sg_clamped_cosine_integral(axes[j], sharpnesses[j], 1.0, p2.xyz);
+    }
+    result = vec4(sg_inner_product(p1.xyz, p1.w, m.x, p2.xyz, p2.w, m.y) + sg_evaluate(p2.xyz, p1.xyz, p1.w, m.x),
+                  sg_clamped_cosine_integral(axis, sharpness, amplitude, n.xyz)
+                  + sg_clamped_cosine_integral_paper(axis, sharpness, amplitude, n.xyz),
+                  hemisphere_integral(p1.xyz, p1.w, m.x, n.xyz) + fh(n.w, p1.w)
+                  + visibility_product_integral_preserving_amplitude(p1.w, m.x, n.w),
+                  slice);
+    """
+    out = glsl(LIBRARY_ORDER, body, inputs, 4)
+    _assert_finite(out, "per-pixel kernels over the numpy suite's SG inputs")
+    assert out.min() >= 0
+    wo, wi, h, roughness, exponent, _ = _brdf_inputs()
+    inputs = {"wo": np.c_[wo, roughness], "wi": np.c_[wi, exponent], "h": h}
+    body = """
+    float r = wo.w, e = wi.w;
+    result = vec4(ggx_m_factor(wo.xyz, wi.xyz, r) + cook_torrance_m_factor(wo.xyz, wi.xyz, r, 1.5)
+                  + blinn_phong_m_factor(wo.xyz, wi.xyz, e) + ashikhmin_shirley_m_factor(wo.xyz, wi.xyz, e, e, 0.04),
+                  ggx_ndf(h.xyz, r) + cook_torrance_ndf(h.xyz, r) + blinn_phong_ndf(h.xyz, e)
+                  + ashikhmin_shirley_ndf(h.xyz, e, 1.0) + ward_anisotropic_ndf(h.xyz, r, 0.5),
+                  ggx_ndf_lobe(r) + blinn_phong_ndf_lobe(e));
+    """
+    out = glsl(LIBRARY_ORDER, body, inputs, 4)
+    _assert_finite(out, "BRDF kernels over the numpy suite's directions")
+    assert out[:, :2].min() >= 0
+
+
 # ---- shaders/resources: the per-pixel pieces that can be called alone
 
 RESOURCE_KERNELS = {
     "sg_shading.glsl": ["set_visibility_frame", "lobe_visibility", "shading_frame", "apply_normal_map",
-                        "rotate_tangent", "model_ndf_lobe", "model_m_factor"],
+                        "rotate_tangent", "model_ndf_lobe", "model_m_factor", "fitted_layer",
+                        "fitted_select_texel", "fitted_node_theta", "fitted_node_value", "fitted_shadowing_at",
+                        "fitted_shadowing_of", "fitted_m_factor"],
     "anisotropic_lobes.glsl": ["anisotropic_lobes"],
     "ggx_two_lobes.glsl": ["ggx_two_lobes"],
 }
@@ -605,6 +648,43 @@ def test_table_lobes_stress(glsl, fuzz):
     assert out[:, :3].min() >= 0 and np.abs(out[:, 3] - 1).max() < 1e-5
 
 
+def test_fitted_pieces_stress(glsl, fuzz):
+    """sg_shading.glsl's MODEL_FITTED pieces with a random 2-lobe, 5-component fit (shadowing nodes
+    stopping short of the horizon, so the appended S(pi/2) = 0 node is used): any UV (outside [0, 1]
+    too), the numpy suite's directions, eta 0..4."""
+    wo, wi, _, _, _, rng = _brdf_inputs()
+    lobes, components, nodes = 2, 5, 16
+    shadowing_layers = -(-components // 4)
+    layers = rng.normal(size=(1 + 2 * lobes + shadowing_layers, 8, 8, 4)).astype(np.float32)
+    table = np.zeros((components + 2, nodes, 4), np.float32)
+    table[0, :, 0] = np.linspace(0.0, 1.4, nodes)
+    table[1, :, 0] = np.linspace(1.0, 0.2, nodes)
+    table[2:, :, 0] = rng.normal(size=(components, nodes)) * 0.1
+    uv = _f32(rng.uniform(-0.5, 1.5, (SMALL_ROWS, 2)))
+    eta = _f32(rng.uniform(0.0, 4.0, SMALL_ROWS))
+    shading = _resource("sg_shading.glsl")
+    source = (f"#define NDF_LOBES {lobes}\n#define FITTED_COMPONENTS {components}\n"
+              f"#define FITTED_SHADOWING_LAYERS {shadowing_layers}\n"
+              "ivec2 fitted_texel;\nfloat fitted_coefficients[4 * FITTED_SHADOWING_LAYERS];\n"
+              + "".join(_glsl_function(shading, name) for name in (
+                  "fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
+                  "fitted_shadowing_at", "fitted_shadowing_of", "fitted_m_factor")))
+    body = """
+    fitted_select_texel(t.xy);
+    vec4 lobe = fitted_layer(1);
+    float s_o = fitted_shadowing_of(wo.xyz);
+    float theta = t.z * 2.0;
+    result = vec4(fitted_m_factor(wo.xyz, wi.xyz, t.w, s_o), fitted_shadowing_at(theta) + s_o,
+                  fitted_node_theta(nodes_count(), nodes_count()) + fitted_node_value(3, nodes_count()),
+                  dot(lobe, vec4(1.0)));
+    """.replace("nodes_count()", str(nodes))
+    inputs = {"t": np.c_[uv, _f32(rng.uniform(-1.0, 2.0, SMALL_ROWS)), eta], "wo": wo, "wi": wi}
+    out = glsl(["sg.glsl", "brdf.glsl", source], body, inputs, 4,
+               {"fitted_layers": layers, "fitted_shadowing": table})
+    _assert_finite(out, "fitted_* (MODEL_FITTED)")
+    assert out[:, :3].min() >= 0
+
+
 # ---- coverage: every function of shaders/lib is fuzzed
 
 COVERED = {
@@ -643,6 +723,8 @@ COVERED = {
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
     test_model_lobes_stress: ["model_ndf_lobe", "model_m_factor"],
     test_table_lobes_stress: ["ggx_two_lobes", "anisotropic_lobes"],
+    test_fitted_pieces_stress: ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
+                                "fitted_shadowing_at", "fitted_shadowing_of", "fitted_m_factor"],
 }
 
 _DEFINITION = re.compile(r"^\s*(?:float|int|uint|bool|void|vec[234]|ivec[234]|mat[234])\s+([A-Za-z_]\w*)\s*\(", re.M)
