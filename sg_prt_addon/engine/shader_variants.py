@@ -2,7 +2,19 @@
 
 A variant is keyed by what changes the code (not the values): the BRDF model,
 its NDF lobe count, whether lights / an environment texture are present, which
-material textures are bound, and whether the debug G-buffer is written.
+material textures are bound, whether the debug G-buffer is written, and which of
+the material's diffuse and specular terms can be non-zero.  A variant leaves out
+what its scene does not need: no lights, no light loop; a world colour, no
+prefiltered-environment fetch; no visibility bake, no SSDF decode; a zero
+specular colour (without its texture), no BRDF slice (NDF lobes, warp, light x
+slice products, prefiltered fetch and their SSDF decodes); a zero diffuse
+colour (without its texture), no irradiance (environment SG mixture, the lights'
+diffuse terms and their decodes).  A skipped term is exactly zero in the full
+variant (its colour is zero), so the image does not change.
+
+Compiled shaders are cached by a hash of everything the GPUShaderCreateInfo is
+made of (defines, interfaces, samplers, vertex and fragment source):
+VariantKeys that assemble to the same shader share one compile (content_hash).
 
 Fragment source = generated header (constants from core/) + the GLSL mirrors
 of core/ (shaders/lib/<name>.glsl) + our resources (anisotropic_lobes.glsl,
@@ -10,6 +22,7 @@ sg_shading.glsl) + surface.frag.glsl.
 A compile error raises ShaderCompileError naming the variant and quoting the
 offending lines of the numbered assembled source.
 """
+import hashlib
 import os
 import re
 import sys
@@ -70,6 +83,8 @@ class VariantKey:
     gbuffer: bool = False
     visibility_layers: int = 0      # vec4 of SSDF coefficients per vertex (0: no visibility bake)
     shadowing_components: int = 0   # model FITTED: PCA components of the stored shadowing
+    has_diffuse: bool = True        # False: zero diffuse colour, no texture: no irradiance code
+    has_specular: bool = True       # False: zero specular colour, no texture: no BRDF slice code
 
     @property
     def has_visibility(self):
@@ -86,7 +101,29 @@ class VariantKey:
             parts.append(f"{self.shadowing_components} shadowing component(s)")
         if self.visibility_layers:
             parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
+        if not self.has_diffuse:
+            parts.append("no diffuse")
+        if not self.has_specular:
+            parts.append("no specular")
         return ", ".join(parts)
+
+
+# Material textures that only the specular term reads (left out of a variant without it)
+SPECULAR_ONLY_TEXTURES = ("specular_color", "roughness", "ior", "exponent", "alpha_x", "alpha_y", "nu", "nv")
+
+
+def material_terms(material_params):
+    """(has_diffuse, has_specular) of an export.MaterialParams: False when that colour is zero and no
+    texture scales it, so the term (colour x irradiance / pi, colour x radiance) is exactly zero and the
+    variant leaves its code out.  A stored lobe fit keeps both (its colours are per texel)."""
+    if getattr(material_params, "fitted", None) is not None:
+        return True, True
+
+    def present(colour, slot):      # NaN counts as present: the full variant shows it
+        return slot in material_params.textures or any(not float(c) == 0.0 for c in tuple(colour)[:3])
+
+    return (present(material_params.diffuse_color, "diffuse_color"),
+            present(material_params.specular_color, "specular_color"))
 
 
 def variant_key(material_params, has_lights, has_environment, gbuffer=False, visibility_layers=0):
@@ -102,9 +139,11 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False, vis
     lobes = int(material_params.lobe_count) if model in ANISOTROPIC_MODELS else 1
     if model == "GGX":
         lobes = GGX_NDF_LOBES
-    textures = tuple(sorted(name for name in material_params.textures if name in TEXTURE_SLOTS))
+    has_diffuse, has_specular = material_terms(material_params)
+    textures = tuple(sorted(name for name in material_params.textures if name in TEXTURE_SLOTS
+                            and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
     return VariantKey(model, lobes, bool(has_lights), bool(has_environment), textures, bool(gbuffer),
-                      int(visibility_layers))
+                      int(visibility_layers), has_diffuse=has_diffuse, has_specular=has_specular)
 
 
 def _read(path):
@@ -141,14 +180,19 @@ def warp_mode():
 
 def defines(key):
     out = dict(LIMITS)
-    out["WARP_FUNCTION"], out["WARP_NODES"] = warp_mode()
-    out["MODEL_" + key.model] = 1
-    out["NDF_LOBES"] = key.ndf_lobes
+    if key.has_specular:        # the model only shapes the BRDF slice
+        out["HAS_SPECULAR"] = 1
+        out["WARP_FUNCTION"], out["WARP_NODES"] = warp_mode()
+        out["MODEL_" + key.model] = 1
+        out["NDF_LOBES"] = key.ndf_lobes
+    if key.has_diffuse:
+        out["HAS_DIFFUSE"] = 1
     if key.has_lights:
         out["HAS_LIGHTS"] = 1
     if key.has_environment:
         out["HAS_ENVIRONMENT"] = 1
-        out["ENV_PREFILTER_MAX_LAYERS"] = MAX_LAYERS
+        if key.has_specular:    # the prefiltered fetch; diffuse reads the SG mixture in the scene block
+            out["ENV_PREFILTER_MAX_LAYERS"] = MAX_LAYERS
     for name in key.textures:
         out["HAS_NORMAL_MAP" if name == "normal_map" else "HAS_TEXTURE_" + name.upper()] = 1
     if key.gbuffer:
@@ -169,16 +213,29 @@ def typedef_source():
     return source
 
 
+def library_files(key):
+    """shaders/lib files of a variant, in dependency order: the BRDF, warp and prefiltered environment
+    only for the specular term, the lights only with lights, the SSDF decode only with a bake."""
+    files = []
+    for file_name in LIBRARY_FILES:
+        if file_name in ("brdf.glsl", "warp.glsl") and not key.has_specular:
+            continue
+        if file_name == "lights.glsl" and not key.has_lights:
+            continue
+        if file_name == "env_prefilter.glsl" and not (key.has_environment and key.has_specular):
+            continue
+        files.append(file_name)
+    if key.visibility_layers:
+        files.append("ssdf.glsl")
+    return files
+
+
 def fragment_source(key):
     parts = [_constants_source(key)]
-    for file_name in LIBRARY_FILES:
-        if file_name == "env_prefilter.glsl" and not key.has_environment:
-            continue
+    for file_name in library_files(key):
         parts.append(library_source(file_name))
-    if key.visibility_layers:
-        parts.append(library_source("ssdf.glsl"))
     for file_name in RESOURCE_FILES:
-        if file_name == "anisotropic_lobes.glsl" and key.model not in ANISOTROPIC_MODELS:
+        if file_name == "anisotropic_lobes.glsl" and (key.model not in ANISOTROPIC_MODELS or not key.has_specular):
             continue
         if file_name == "ggx_two_lobes.glsl" and not uses_ggx_table(key):
             continue
@@ -270,88 +327,100 @@ def create_capturing_log(info):
     return shader, error, log
 
 
+def create_info_calls(key):
+    """What a variant's GPUShaderCreateInfo is made of, as (method, arguments) calls in order
+    ("vertex_out": (interface name, its (method, arguments) calls)).  create_info replays them;
+    content_hash hashes them."""
+    calls = [("define", (name, str(value))) for name, value in sorted(defines(key).items())]
+    calls.append(("typedef_source", (typedef_source(),)))
+    calls += [("vertex_in", (0, "VEC3", "position")), ("vertex_in", (1, "VEC3", "normal")),
+              ("vertex_in", (2, "VEC4", "tangent")), ("vertex_in", (3, "VEC2", "uv"))]
+    if key.visibility_layers:
+        calls += [("vertex_in", (4, "INT", "vertex_index")), ("vertex_in", (5, "VEC3", "ssdf_normal"))]
+    interface = [("smooth", ("VEC3", "world_position")), ("smooth", ("VEC3", "world_normal")),
+                 ("smooth", ("VEC4", "world_tangent")), ("smooth", ("VEC2", "texcoord"))]
+    if key.visibility_layers:
+        # the SSDF frame's normal and the vertex's PCA coefficients, interpolated per pixel (wang2009 5.3)
+        interface.append(("smooth", ("VEC3", "world_ssdf_normal")))
+        interface += [("smooth", ("VEC4", f"ssdf_coefficients_{layer}")) for layer in range(key.visibility_layers)]
+    calls.append(("vertex_out", (f"sgprt_surface_interface_{key.visibility_layers}", tuple(interface))))
+    calls.append(("push_constant", ("MAT4", "model_matrix")))
+    if key.gbuffer:
+        calls += [("push_constant", ("INT", "gbuffer_object_index")),
+                  ("push_constant", ("INT", "gbuffer_triangle_offset"))]
+    calls += [("uniform_buf", (0, "SceneData", "scene")), ("uniform_buf", (1, "MaterialData", "material"))]
+    samplers = []
+    if key.has_environment:
+        samplers.append(("FLOAT_2D_ARRAY", "environment_texture"))
+    if key.model in ANISOTROPIC_MODELS:
+        samplers.append(("FLOAT_2D", "anisotropy_table"))
+    if uses_ggx_table(key):
+        samplers.append(("FLOAT_2D", "ggx_table"))
+    if key.model == FITTED_MODEL:
+        samplers.append(("FLOAT_2D_ARRAY", "fitted_layers"))     # texelFetch: the nearest texel
+        samplers.append(("FLOAT_2D", "fitted_shadowing"))
+    samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+    if key.visibility_layers:
+        samplers.append(("FLOAT_2D", "visibility_coefficients"))       # read in the vertex shader
+        samplers.append(("FLOAT_2D_ARRAY", "visibility_basis"))
+    calls += [("sampler", (slot, kind, name)) for slot, (kind, name) in enumerate(samplers)]
+    calls += [("fragment_out", (index, "VEC4", "out_" + name)) for index, name in enumerate(output_names(key.gbuffer))]
+    calls.append(("vertex_source", (vertex_source(),)))
+    calls.append(("fragment_source", (fragment_source(key),)))
+    return calls
+
+
 def create_info(key):
     import gpu
 
     info = gpu.types.GPUShaderCreateInfo()
-    for name, value in defines(key).items():
-        info.define(name, str(value))
-    info.typedef_source(typedef_source())
-    info.vertex_in(0, "VEC3", "position")
-    info.vertex_in(1, "VEC3", "normal")
-    info.vertex_in(2, "VEC4", "tangent")
-    info.vertex_in(3, "VEC2", "uv")
-    if key.visibility_layers:
-        info.vertex_in(4, "INT", "vertex_index")
-        info.vertex_in(5, "VEC3", "ssdf_normal")
-    interface = gpu.types.GPUStageInterfaceInfo(f"sgprt_surface_interface_{key.visibility_layers}")
-    interface.smooth("VEC3", "world_position")
-    interface.smooth("VEC3", "world_normal")
-    interface.smooth("VEC4", "world_tangent")
-    interface.smooth("VEC2", "texcoord")
-    if key.visibility_layers:
-        # the SSDF frame's normal and the vertex's PCA coefficients, interpolated per pixel (wang2009 5.3)
-        interface.smooth("VEC3", "world_ssdf_normal")
-        for layer in range(key.visibility_layers):
-            interface.smooth("VEC4", f"ssdf_coefficients_{layer}")
-    info.vertex_out(interface)
-    info.push_constant("MAT4", "model_matrix")
-    if key.gbuffer:
-        info.push_constant("INT", "gbuffer_object_index")
-        info.push_constant("INT", "gbuffer_triangle_offset")
-    info.uniform_buf(0, "SceneData", "scene")
-    info.uniform_buf(1, "MaterialData", "material")
-    slot = 0
-    if key.has_environment:
-        info.sampler(slot, "FLOAT_2D_ARRAY", "environment_texture")
-        slot += 1
-    if key.model in ANISOTROPIC_MODELS:
-        info.sampler(slot, "FLOAT_2D", "anisotropy_table")
-        slot += 1
-    if uses_ggx_table(key):
-        info.sampler(slot, "FLOAT_2D", "ggx_table")
-        slot += 1
-    if key.model == FITTED_MODEL:
-        info.sampler(slot, "FLOAT_2D_ARRAY", "fitted_layers")     # texelFetch: the nearest texel
-        slot += 1
-        info.sampler(slot, "FLOAT_2D", "fitted_shadowing")
-        slot += 1
-    for name in key.textures:
-        info.sampler(slot, "FLOAT_2D", "texture_" + name)
-        slot += 1
-    if key.visibility_layers:
-        info.sampler(slot, "FLOAT_2D", "visibility_coefficients")       # read in the vertex shader
-        slot += 1
-        info.sampler(slot, "FLOAT_2D_ARRAY", "visibility_basis")
-        slot += 1
-    for index, name in enumerate(output_names(key.gbuffer)):
-        info.fragment_out(index, "VEC4", "out_" + name)
-    info.vertex_source(vertex_source())
-    info.fragment_source(fragment_source(key))
+    for method, arguments in create_info_calls(key):
+        if method == "vertex_out":
+            name, interface_calls = arguments
+            interface = gpu.types.GPUStageInterfaceInfo(name)
+            for interface_method, interface_arguments in interface_calls:
+                getattr(interface, interface_method)(*interface_arguments)
+            info.vertex_out(interface)
+        else:
+            getattr(info, method)(*arguments)
     return info
 
 
-_cache = {}
+def content_hash(key):
+    """sha256 of everything a variant's shader is made of (create_info_calls): equal hashes, one shader."""
+    return hashlib.sha256(repr(create_info_calls(key)).encode("utf-8")).hexdigest()
+
+
+_cache = {}             # content hash (surface variants) or ("background", ...) / ("depth",) -> GPUShader
+_content_hashes = {}    # VariantKey -> content_hash(key): the sources are assembled once per key
+# Surface shader compiles since the process started (clear_cache does not reset it): tests and
+# benchmarks read it to see that keys sharing a content hash share one compile.
+compile_count = {"surface": 0}
 
 
 def get_shader(key):
-    """Compiled shader of a variant (cached for the process; the GPU context is Blender's)."""
-    shader = _cache.get(key)
+    """Compiled shader of a variant (cached for the process by content hash; the GPU context is Blender's)."""
+    digest = _content_hashes.get(key)
+    if digest is None:
+        digest = _content_hashes[key] = content_hash(key)
+    shader = _cache.get(digest)
     if shader is None:
         shader, error, log = create_capturing_log(create_info(key))
         if shader is None:
             raise ShaderCompileError(_error_message(
                 key, log, [("fragment", fragment_source(key)), ("vertex", vertex_source())])) from error
-        _cache[key] = shader
+        _cache[digest] = shader
+        compile_count["surface"] += 1
     return shader
 
 
 def clear_cache():
     _cache.clear()
+    _content_hashes.clear()
 
 
 def uses_ggx_table(key):
-    return key.model == "GGX" and key.ndf_lobes == 2
+    return key.model == "GGX" and key.ndf_lobes == 2 and key.has_specular
 
 
 def ggx_table():

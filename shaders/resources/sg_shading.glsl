@@ -1,7 +1,9 @@
 /* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43);
- * mirrored line by line by sg_prt_addon/core/shading.py.  Needs sg.glsl, brdf.glsl, warp.glsl,
- * clamped_cosine.glsl, lights.glsl, (HAS_ENVIRONMENT) env_prefilter.glsl and (HAS_VISIBILITY)
- * hemisphere.glsl + ssdf.glsl, plus the `scene` uniform block. */
+ * mirrored line by line by sg_prt_addon/core/shading.py.  Needs sg.glsl, hemisphere.glsl,
+ * clamped_cosine.glsl, (HAS_LIGHTS) lights.glsl, (HAS_SPECULAR) brdf.glsl + warp.glsl,
+ * (HAS_ENVIRONMENT and HAS_SPECULAR) env_prefilter.glsl and (HAS_VISIBILITY) ssdf.glsl, plus the
+ * `scene` uniform block.  HAS_DIFFUSE / HAS_SPECULAR (shader_variants.material_terms): without one,
+ * its term is left out (its colour is zero, so the full variant's term is exactly zero). */
 
 #ifdef HAS_VISIBILITY
 /* The pixel's interpolated SSDF coefficient rows and the bake's local frame of its interpolated
@@ -77,6 +79,7 @@ vec3 rotate_tangent(vec3 normal, vec3 tangent, float rotation)
   return cos(rotation) * t + sin(rotation) * b;
 }
 
+#ifdef HAS_SPECULAR
 /* NDF lobe k of the model (brdf.glsl's <model>_ndf_lobe, or the anisotropy table), local
  * frame.  p = (roughness, ior, exponent, alpha_x), q = (alpha_y, nu, nv, rf0). */
 void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude)
@@ -224,8 +227,9 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
   return 0.0;
 #endif
 }
+#endif
 
-#ifdef HAS_ENVIRONMENT
+#if defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
 /* env_prefilter_lookup (env_prefilter.glsl) step for step, with the per-layer texcoord
  * transforms read from the scene block in place: passing them as the library's array
  * argument copies the whole array for every lobe of every fragment. */
@@ -251,6 +255,7 @@ vec3 environment_radiance(vec3 axis, float sharpness)
 }
 #endif
 
+#ifdef HAS_LIGHTS
 /* Light l (point/spot first, then suns) as an SG at the shading position. */
 void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, out vec3 amplitude)
 {
@@ -274,17 +279,23 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
     amplitude = scene.sun_amplitude[s].rgb;
   }
 }
+#endif
 
 
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
 
-/* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer. */
+/* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer.  Without HAS_DIFFUSE
+ * the irradiance stays 0, without HAS_SPECULAR the radiance (the variant's colour is zero). */
 void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
                    vec3 diffuse_color, vec3 specular_color,
                    out vec3 diffuse, out vec3 specular)
 {
   vec3 n, t, b;
   shading_frame(normal, tangent, n, t, b);
+  vec3 irradiance = vec3(0.0);
+  vec3 radiance = vec3(0.0);
+
+#ifdef HAS_SPECULAR
   vec3 view = scene.camera.w > 0.5 ? safe_normalize(scene.camera.xyz - position)
                                    : -safe_normalize(scene.camera.xyz);
   mat3 frame = mat3(t, b, n);                    /* local -> world */
@@ -330,9 +341,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
       slice_sharpness[j] = warped_sharpness[node];
     }
   }
-
-  vec3 irradiance = vec3(0.0);
-  vec3 radiance = vec3(0.0);
+#endif
 
 #ifdef HAS_LIGHTS
   for (int l = 0; l < scene.counts.x + scene.counts.y; l++) {
@@ -340,8 +349,13 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_sharpness;
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
+#if defined(HAS_DIFFUSE) || (defined(HAS_SPECULAR) && defined(HAS_VISIBILITY))
     float light_cosine = sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n);
+#endif
+#ifdef HAS_DIFFUSE
     irradiance += light_amplitude * (light_cosine * LOBE_VISIBILITY(light_axis, light_sharpness));   /* eq. 42 */
+#endif
+#ifdef HAS_SPECULAR
     vec3 weight = vec3(0.0);
     for (int j = 0; j < SLICE_LOBES; j++) {
       vec3 product_axis;
@@ -359,9 +373,11 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
       weight += product_cosine * slice_colour[j];
     }
     radiance += light_amplitude * weight;
+#endif
   }
 #endif
 
+#ifdef HAS_SPECULAR
   for (int j = 0; j < SLICE_LOBES; j++) {
     float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n) *
                          LOBE_VISIBILITY(slice_axis[j], slice_sharpness[j]);                   /* eq. 41 */
@@ -371,7 +387,9 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     radiance += slice_cosine * slice_colour[j] * scene.world_colour.rgb;
 #endif
   }
+#endif
 
+#ifdef HAS_DIFFUSE
 #ifdef HAS_ENVIRONMENT
   for (int e = 0; e < scene.counts.z; e++) {
     irradiance += scene.env_amplitude[e].rgb *
@@ -381,6 +399,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #else
   /* a constant world: the cosine lobe alone (a zero-sharpness G) */
   irradiance += SG_PI * scene.world_colour.rgb * LOBE_VISIBILITY(n, 0.0);
+#endif
 #endif
 
   diffuse = diffuse_color * (1.0 / SG_PI) * irradiance;
