@@ -27,7 +27,9 @@ visibility keeps of P relative to what the horizon alone keeps, since I(G, n) cl
 the horizon already).  G is the environment lobe (eq. 39), the light (eq. 42), the
 light (x) slice lobe (eq. 43) and the slice lobe (eq. 41); a constant world colour
 uses the cosine lobe alone.  Light (x) slice products below VISIBILITY_SKIP_FRACTION of the
-light's own I(G, n) stay unshadowed (the shader skips their decode).
+light's own I(G, n) stay unshadowed (the shader skips their decode).  The warped lobes of one NDF
+lobe (warp.DEFAULT_MODE's nodes, close together) share one visibility: the centre node's
+(``visibility_node_indices``), a third of the decodes of split3 for the slice terms.
 
 Everything is computed in float32 like the GPU.  Directions: world space, all
 pointing away from the surface.
@@ -268,6 +270,13 @@ def specular_slice(model, params, lobe_count, view_local):
     return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, instance.m_factor, mode=warp.DEFAULT_MODE)
 
 
+def visibility_node_indices(slice_count, mode=None):
+    """Indices of the slice lobes whose visibility the NDF lobe's warped nodes share: the centre node
+    of each group (warp nodes per NDF lobe // 2; node 0 of the paper's one-node warp)."""
+    nodes = warp.nodes_per_lobe(mode or warp.DEFAULT_MODE)
+    return np.arange(slice_count // nodes) * nodes + nodes // 2
+
+
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
           light_data, environment, lobe_count=1, visibility=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
@@ -306,6 +315,12 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
         flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
         return lobe_visibility(flat_axis, flat_sharpness, n, visibility).reshape(shape)
 
+    nodes = warp.nodes_per_lobe()
+    centre = visibility_node_indices(slice_sharpness.shape[1])
+
+    def per_node(group_values):         # (..., K) -> (..., K * nodes): each NDF lobe's to its warped nodes
+        return np.repeat(group_values, nodes, axis=-1)
+
     light_sets = []
     if len(light_data.point_radius):
         light_sets.append(point_light_sgs(position, light_data))
@@ -322,13 +337,16 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             light_axis[:, :, None, :], light_sharpness[:, :, None], FLOAT(1),
             slice_axis[:, None, :, :], slice_sharpness[:, None, :], slice_amplitude[:, None, :])
         weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :])
-        if visibility is not None:
-            decoded = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
-            weight = np.where(decoded, weight * visible(axis_m, sharpness_m), weight)
+        if visibility is not None:      # one decode per NDF lobe, if any of its products is not negligible
+            above = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
+            decoded = per_node(above.reshape(above.shape[:2] + (-1, nodes)).any(axis=-1))
+            weight = np.where(decoded, weight * per_node(visible(axis_m[:, :, centre], sharpness_m[:, :, centre])),
+                              weight)
         specular += np.sum(light_amplitude * np.sum(weight[..., None] * slice_colour[:, None], axis=2), axis=1)
 
-    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe) * \
-        visible(slice_axis, slice_sharpness)                                                     # (N, J)
+    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)    # (N, J)
+    if visibility is not None:
+        slice_cosine = slice_cosine * per_node(visible(slice_axis[:, centre], slice_sharpness[:, centre]))
     if environment.has_texture:
         if len(environment.lobe_sharpness):
             lobe_count_env = len(environment.lobe_sharpness)

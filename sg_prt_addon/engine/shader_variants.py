@@ -173,9 +173,7 @@ def _constants_source(key):
 def warp_mode():
     """(GLSL function, lobes per NDF lobe) of core.warp's default mode, which the mirror uses."""
     from ..core import warp
-    mode = warp.DEFAULT_MODE
-    nodes = 1 if mode == "paper" else len(warp.SPLIT_RULES[mode][0])
-    return f"warp_lobes_{mode}", nodes
+    return f"warp_lobes_{warp.DEFAULT_MODE}", warp.nodes_per_lobe()
 
 
 def defines(key):

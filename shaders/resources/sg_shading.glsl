@@ -283,6 +283,9 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
 
 
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
+/* The warped lobes of one NDF lobe lie close together: they share the visibility of the centre one
+ * (core.shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3. */
+#define VISIBILITY_NODE (WARP_NODES / 2)
 
 /* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer.  Without HAS_DIFFUSE
  * the irradiance stays 0, without HAS_SPECULAR the radiance (the variant's colour is zero). */
@@ -357,20 +360,37 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
 #ifdef HAS_SPECULAR
     vec3 weight = vec3(0.0);
-    for (int j = 0; j < SLICE_LOBES; j++) {
-      vec3 product_axis;
-      float product_sharpness, product_amplitude;
-      sg_product(light_axis, light_sharpness, 1.0, slice_axis[j], slice_sharpness[j], slice_amplitude[j],
-                 product_axis, product_sharpness, product_amplitude);
-      float product_cosine = sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n);
+    for (int k = 0; k < NDF_LOBES; k++) {
+      vec3 lobe_weight = vec3(0.0);
 #ifdef HAS_VISIBILITY
-      /* eq. 43; products negligible next to the light's irradiance (away from the highlight) skip the
-       * SSDF decode (left unshadowed: at most VISIBILITY_SKIP_FRACTION of the light's cosine integral) */
-      if (product_cosine > VISIBILITY_SKIP_FRACTION * light_cosine) {
-        product_cosine *= lobe_visibility(product_axis, product_sharpness, n);
+      bool decode = false;
+      vec3 centre_axis = vec3(0.0, 0.0, 1.0);
+      float centre_sharpness = 0.0;
+#endif
+      for (int node = 0; node < WARP_NODES; node++) {
+        int j = WARP_NODES * k + node;
+        vec3 product_axis;
+        float product_sharpness, product_amplitude;
+        sg_product(light_axis, light_sharpness, 1.0, slice_axis[j], slice_sharpness[j], slice_amplitude[j],
+                   product_axis, product_sharpness, product_amplitude);
+        float product_cosine = sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n);
+        lobe_weight += product_cosine * slice_colour[j];
+#ifdef HAS_VISIBILITY
+        /* products negligible next to the light's irradiance (away from the highlight) need no decode:
+         * left unshadowed, at most VISIBILITY_SKIP_FRACTION of the light's cosine integral each */
+        decode = decode || product_cosine > VISIBILITY_SKIP_FRACTION * light_cosine;
+        if (node == VISIBILITY_NODE) {
+          centre_axis = product_axis;
+          centre_sharpness = product_sharpness;
+        }
+#endif
+      }
+#ifdef HAS_VISIBILITY
+      if (decode) {               /* eq. 43, one decode an NDF lobe: at its centre node's product */
+        lobe_weight *= lobe_visibility(centre_axis, centre_sharpness, n);
       }
 #endif
-      weight += product_cosine * slice_colour[j];
+      weight += lobe_weight;
     }
     radiance += light_amplitude * weight;
 #endif
@@ -378,14 +398,19 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
 
 #ifdef HAS_SPECULAR
-  for (int j = 0; j < SLICE_LOBES; j++) {
-    float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n) *
-                         LOBE_VISIBILITY(slice_axis[j], slice_sharpness[j]);                   /* eq. 41 */
+  for (int k = 0; k < NDF_LOBES; k++) {
+    int centre = WARP_NODES * k + VISIBILITY_NODE;
+    float visibility = LOBE_VISIBILITY(slice_axis[centre], slice_sharpness[centre]);      /* eq. 41 */
+    for (int node = 0; node < WARP_NODES; node++) {
+      int j = WARP_NODES * k + node;
+      float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n) *
+                           visibility;
 #ifdef HAS_ENVIRONMENT
-    radiance += slice_cosine * slice_colour[j] * environment_radiance(slice_axis[j], slice_sharpness[j]);
+      radiance += slice_cosine * slice_colour[j] * environment_radiance(slice_axis[j], slice_sharpness[j]);
 #else
-    radiance += slice_cosine * slice_colour[j] * scene.world_colour.rgb;
+      radiance += slice_cosine * slice_colour[j] * scene.world_colour.rgb;
 #endif
+    }
   }
 #endif
 
