@@ -51,6 +51,7 @@ def uv_sphere(scene, name, location, radius=1.0, segments=32, rings=16):
 
     mesh = bpy.data.meshes.new(name)
     bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")         # calc_uvs fills an existing layer, it makes none
     bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius, calc_uvs=True)
     bm.to_mesh(mesh)
     bm.free()
@@ -67,6 +68,7 @@ def plane(scene, name, location, size=6.0):
 
     mesh = bpy.data.meshes.new(name)
     bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")
     bmesh.ops.create_grid(bm, x_segments=4, y_segments=4, size=size / 2, calc_uvs=True)
     bm.to_mesh(mesh)
     bm.free()
@@ -165,6 +167,7 @@ def grid(scene, name, location, size=6.0, segments=64):
 
     mesh = bpy.data.meshes.new(name)
     bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")
     bmesh.ops.create_grid(bm, x_segments=segments, y_segments=segments, size=size / 2, calc_uvs=True)
     bm.to_mesh(mesh)
     bm.free()

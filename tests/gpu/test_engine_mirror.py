@@ -130,6 +130,11 @@ def test_anisotropic_models_textures_and_normal_map(engine):
     }
     # the engine uploads exactly what export.image_pixels reads
     np.testing.assert_array_equal(export.texture_pixels(images["colour"], "diffuse_color"), colour)
+    # the spheres carry a UV map: the lookups cover many texels, not one
+    uv = result["passes"]["gbuffer_uv"]
+    covered = uv[..., 3] > 0.5
+    texels = np.unique(np.floor(uv[covered][:, :2] * 16).astype(int), axis=0)
+    assert len(texels) > 100, len(texels)
     _check(result, textures)
 
 
