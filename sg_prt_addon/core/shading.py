@@ -47,8 +47,8 @@ GGX_NDF_LOBES = 2
 # Light (x) slice products (eq. 43) whose clamped-cosine integral is below this fraction of the light's own
 # (away from the highlight) skip the SSDF decode and stay unshadowed (the GLSL branches: it saves decodes).
 VISIBILITY_SKIP_FRACTION = 1e-4
-# Local frame fallback when a tangent is parallel to the normal.
-_FALLBACK_TANGENT = np.array([1.0, 0.0, 0.0], FLOAT)
+# Below this sine of the tangent's angle to the normal, shading_frame takes its fallback tangent.
+SHADING_FRAME_MIN_SINE = 1e-3
 
 
 def _clamped_cosine_integral(axis, sharpness, amplitude, normal):
@@ -159,12 +159,13 @@ def point_light_sgs(position, light_data):
 def shading_frame(normal, tangent):
     """Unit normal, tangent (Gram-Schmidt; fallback if parallel), bitangent = n x t."""
     n = sg.normalize(np.asarray(normal, FLOAT))
-    t = np.asarray(tangent, FLOAT)[..., :3]
+    t = sg.normalize(np.asarray(tangent, FLOAT)[..., :3], fallback=(0.0, 0.0, 0.0))
     t = t - n * np.sum(n * t, axis=-1, keepdims=True)
+    # within 0.06 degrees of the normal (or zero) what is left is rounding: take the fallback
     fallback = np.cross(n, np.where(np.abs(n[..., :1]) < 0.9, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])).astype(FLOAT)
-    t = sg.normalize(t, fallback=(0.0, 0.0, 0.0))
-    degenerate = np.sum(t * t, axis=-1, keepdims=True) < 0.5
-    t = np.where(degenerate, sg.normalize(fallback), t)
+    degenerate = np.sum(t * t, axis=-1, keepdims=True) < FLOAT(SHADING_FRAME_MIN_SINE) ** 2
+    t = sg.normalize(np.where(degenerate, fallback, t))
+    t = sg.normalize(t - n * np.sum(n * t, axis=-1, keepdims=True))    # a second pass takes out the rounding
     return n, t, np.cross(n, t).astype(FLOAT)
 
 

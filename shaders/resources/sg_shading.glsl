@@ -54,12 +54,15 @@ float lobe_visibility(vec3 axis, float sharpness, vec3 n)
 void shading_frame(vec3 normal, vec3 tangent, out vec3 n, out vec3 t, out vec3 b)
 {
   n = safe_normalize(normal);
-  t = tangent - n * dot(n, tangent);
-  vec3 fallback = cross(n, abs(n.x) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0));
-  t = safe_normalize(t, vec3(0.0));
-  if (dot(t, t) < 0.5) {
-    t = safe_normalize(fallback);
+  vec3 unit_tangent = safe_normalize(tangent, vec3(0.0));
+  t = unit_tangent - n * dot(n, unit_tangent);
+  /* within 0.06 degrees of the normal (or zero) what is left is rounding: take the fallback
+   * (1e-6 = core.shading.SHADING_FRAME_MIN_SINE squared) */
+  if (dot(t, t) < 1.0e-6) {
+    t = cross(n, abs(n.x) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0));
   }
+  t = safe_normalize(t);
+  t = safe_normalize(t - n * dot(n, t));     /* a second pass takes the first one's rounding out */
   b = cross(n, t);
 }
 
