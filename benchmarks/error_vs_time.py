@@ -235,6 +235,52 @@ def merge_runs(runs):
 
 # ----------------------------------------------------------------------------- measuring (bpy)
 
+def reference_inputs_with_axis_tangents(depsgraph, width, height):
+    """blender.reference_scene.reference_inputs, plus the anisotropy frame of tangent_source OBJECT_AXIS
+    materials, which reference_scene leaves out (it always passes the UV tangents; the engine uses
+    mat3(model) x tangent_axis, projected onto the surface and rotated by tangent_rotation).  Returns
+    (scene, camera, [material names whose tangents were replaced])."""
+    import bpy
+    import numpy as np
+
+    from sg_prt_addon.blender import export, reference_scene
+    from sg_prt_addon.core.camera import Camera
+    from sg_prt_addon.engine.scene_state import SceneState
+
+    state = SceneState()
+    state.sync(depsgraph)
+
+    def texture_pixels(name, slot):
+        image = bpy.data.images.get(name)
+        return None if image is None else export.texture_pixels(image, slot)
+
+    scene = reference_scene.reference_scene(state, texture_pixels)
+    camera = export.export_camera(depsgraph.scene.camera.evaluated_get(depsgraph), depsgraph, width, height)
+    fixed, offset = set(), 0
+    tangents = np.array(scene.tangents, np.float64)
+    for entry in state.objects.values():        # reference_scene's order: one block of corners per object
+        mesh = state.meshes[entry.mesh_key]
+        linear = np.asarray(entry.matrix_world, np.float64)[:3, :3]
+        for slot, first, count in mesh.material_ranges:
+            name = entry.material_names[min(slot, len(entry.material_names) - 1)]
+            params = state.materials[name]
+            if getattr(params, "tangent_source", "UV_MAP") != "OBJECT_AXIS":
+                continue
+            corners = np.unique(mesh.triangles[first:first + count]).astype(np.int64) + offset
+            normals = scene.normals[corners]
+            axis = linear @ np.asarray(params.tangent_axis, np.float64)
+            tangent = axis - normals * (normals @ axis)[:, None]
+            tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-30)
+            angle = float(params.tangent_rotation)
+            if angle:                          # about the normal, as the engine's rotate_tangent
+                tangent = tangent * np.cos(angle) + np.cross(normals, tangent) * np.sin(angle)
+            tangents[corners] = tangent
+            fixed.add(name)
+        offset += len(mesh.positions)
+    scene.tangents = tangents
+    return scene, Camera(camera.view, camera.projection, width, height), sorted(fixed)
+
+
 def _load():
     return round(os.getloadavg()[0], 2)
 
@@ -310,7 +356,6 @@ class SceneRun:
 
         from examples import build_scenes
         from sg_prt_addon import render
-        from sg_prt_addon.blender.reference_scene import reference_inputs
         from sg_prt_addon.core.raytrace import RayTracer
 
         render.ensure_registered()
@@ -320,7 +365,8 @@ class SceneRun:
         scene.render.resolution_x = scene.render.resolution_y = size
         scene.render.resolution_percentage = 100
         depsgraph = bpy.context.evaluated_depsgraph_get()
-        self.reference_scene, self.camera = reference_inputs(depsgraph, size, size)
+        self.reference_scene, self.camera, fixed = reference_inputs_with_axis_tangents(depsgraph, size, size)
+        self.info["reference_object_axis_tangents"] = fixed
         self.tracer = RayTracer(self.reference_scene.vertices, self.reference_scene.triangles)
         origins, directions = self.camera.primary_rays()
         hits = self.tracer.intersect(origins.reshape(-1, 3), directions.reshape(-1, 3))
