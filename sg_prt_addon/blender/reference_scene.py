@@ -62,6 +62,29 @@ def reference_lights(light_exports):
     return lights
 
 
+def anisotropy_tangents(mesh, entry, materials):
+    """(corners, 3) world tangents of a world-space MeshExport as the engine shades with them: per
+    material, the UV tangent or (tangent_source OBJECT_AXIS) the object's axis in world space, on the
+    surface, turned by tangent_rotation about the normal (surface.frag.glsl, rotate_tangent)."""
+    tangents = np.array(mesh.tangents[:, :3], np.float64)
+    normals = np.asarray(mesh.normals, np.float64)
+    linear = np.asarray(entry.matrix_world, np.float64)[:3, :3]
+    for slot, first, count in mesh.material_ranges:
+        params = materials[entry.material_names[min(slot, len(entry.material_names) - 1)]]
+        object_axis = getattr(params, "tangent_source", "UV_MAP") == "OBJECT_AXIS"
+        angle = float(getattr(params, "tangent_rotation", 0.0))
+        if not object_axis and not angle:
+            continue
+        corners = np.unique(mesh.triangles[first:first + count]).astype(np.int64)
+        n = normals[corners]
+        tangent = np.broadcast_to(linear @ np.asarray(params.tangent_axis, np.float64), n.shape) if object_axis \
+            else tangents[corners]
+        tangent = tangent - n * np.sum(n * tangent, axis=1, keepdims=True)
+        tangent = tangent / np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-30)
+        tangents[corners] = tangent * np.cos(angle) + np.cross(n, tangent) * np.sin(angle)
+    return tangents
+
+
 def reference_scene(state, texture_pixels):
     """core.reference.Scene of a synced engine SceneState; texture_pixels as reference_material takes it."""
     material_names = list(state.materials)
@@ -77,7 +100,7 @@ def reference_scene(state, texture_pixels):
         vertices.append(mesh.positions)
         normals.append(mesh.normals)
         uvs.append(mesh.uvs)
-        tangents.append(mesh.tangents[:, :3])
+        tangents.append(anisotropy_tangents(mesh, entry, state.materials))
         triangles.append(mesh.triangles.astype(np.int64) + offset)
         material_index.append(per_triangle)
         offset += len(mesh.positions)
