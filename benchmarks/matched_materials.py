@@ -34,8 +34,8 @@ Mapping per model (ours -> nodes) and the mismatches left:
   place of Schlick at h.k).  Tangent: the object axis (tangent_source OBJECT_AXIS) through a
   Vector Transform to world space (the BSDF projects it onto the surface, as we do), or the
   UV map's tangent; tangent_rotation becomes the node's Rotation.  Measured (Cycles 64 spp,
-  brushed_metal at 96 px, torus pixels, relative RMSE against the reference with the object-axis
-  frame, see error_vs_time.reference_inputs_with_axis_tangents): 3.25 with this quarter turn,
+  brushed_metal at 96 px, torus pixels, relative RMSE against the reference in the engine's
+  object-axis frame): 3.25 with this quarter turn,
   3.67 without it, but 2.18 with anisotropy 0 (the geometric-mean width) and 0.55 for SG-PRT
   unshadowed: Cycles' anisotropic lobe here does not match ours (its highlight spreads into a
   ring around the torus) and we could not find the mapping that does; kept anisotropic as
