@@ -267,18 +267,13 @@ def _read_render_result(scene, folder):
     import bpy
     import numpy as np
 
+    from sg_prt_addon import render
+
     settings = scene.render.image_settings
     settings.file_format, settings.color_depth = "OPEN_EXR", "32"
     path = os.path.join(folder, "render.exr")
     bpy.data.images["Render Result"].save_render(path, scene=scene)
-    image = bpy.data.images.load(path)
-    try:
-        width, height = image.size
-        pixels = np.empty(width * height * 4, np.float32)
-        image.pixels.foreach_get(pixels)
-    finally:
-        bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[::-1, :, :3].astype(np.float64)
+    return render.read_float_image(path).astype(np.float64)
 
 
 class SceneRun:

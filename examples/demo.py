@@ -27,18 +27,6 @@ from sg_prt_addon.core.reference import mean_relative_error, render_to_noise  # 
 SCENE = "suzanne_courtyard"
 
 
-def load_float_image(path):
-    """(H, W, 3) float pixels of an image file, row 0 at the top."""
-    image = bpy.data.images.load(str(path))
-    try:
-        width, height = image.size
-        pixels = np.empty(width * height * 4, np.float32)
-        image.pixels.foreach_get(pixels)
-    finally:
-        bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[::-1, :, :3]
-
-
 def save_display_png(rgb, path, scene):
     """A linear (H, W, 3) image written as PNG through the scene's colour management."""
     height, width = rgb.shape[:2]
@@ -83,7 +71,7 @@ def main(argv=None):
     # The first render pays for prefiltering the environment; the second is the frame time.
     clock.run("engine render (first, prefilters)", render.render_to_file, scene, output / "demo.exr")
     exr = clock.run("engine render", render.render_to_file, scene, output / "demo.exr")
-    engine_image = load_float_image(exr)
+    engine_image = render.read_float_image(exr)
     save_display_png(engine_image, output / "demo.png", scene)
 
     depsgraph = bpy.context.evaluated_depsgraph_get()

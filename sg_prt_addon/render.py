@@ -62,6 +62,21 @@ def render_to_file(scene, output, width=None, height=None):
     return output
 
 
+def read_float_image(path):
+    """(H, W, 3) float32 pixels of an image file (an EXR keeps linear values), row 0 at the top."""
+    import bpy
+    import numpy as np
+
+    image = bpy.data.images.load(str(path))
+    try:
+        width, height = image.size
+        pixels = np.empty(width * height * 4, np.float32)
+        image.pixels.foreach_get(pixels)
+    finally:
+        bpy.data.images.remove(image)
+    return pixels.reshape(height, width, 4)[::-1, :, :3]
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m sg_prt_addon.render", description=__doc__.splitlines()[0])
     parser.add_argument("blend", help=".blend file to render")
