@@ -138,17 +138,23 @@ def world_texture(scene, path, strength=1.0):
     return world
 
 
-def render(scene, gbuffer=False):
-    """Final render of `scene` with the engine; returns render_engine.last_render."""
+def render(scene, gbuffer=False, environment_layer_size=None):
+    """Final render of `scene` with the engine; returns render_engine.last_render.
+    environment_layer_size: the prefilter's layer size for this render (small: fast), else the
+    current setting."""
     import bpy
     from sg_prt_addon.engine import render_engine
 
+    layer_size = render_engine.debug["environment_layer_size"]
     render_engine.debug["capture_gbuffer"] = gbuffer
+    if environment_layer_size is not None:
+        render_engine.debug["environment_layer_size"] = environment_layer_size
     try:
         with bpy.context.temp_override(scene=scene):
             bpy.ops.render.render(scene=scene.name, write_still=False)
     finally:
         render_engine.debug["capture_gbuffer"] = False
+        render_engine.debug["environment_layer_size"] = layer_size
     return render_engine.last_render
 
 

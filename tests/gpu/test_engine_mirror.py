@@ -141,7 +141,6 @@ def test_anisotropic_models_textures_and_normal_map(engine):
 def test_environment_texture(engine):
     """Prefiltered environment (specular) and SG mixture (diffuse) from a world Environment Texture."""
     import bpy
-    from sg_prt_addon.engine import render_engine
 
     # Blender's courtyard, box-filtered to 128 x 64 so the prefilter takes a moment, as a float image
     source = bpy.data.images.load(fx.studio_world_path("courtyard.exr"), check_existing=True)
@@ -160,11 +159,7 @@ def test_environment_texture(engine):
     fx.uv_sphere(scene, "glossy", (-1.2, 0.0, 1.0), radius=0.7).data.materials.append(glossy)
     fx.uv_sphere(scene, "brushed", (0.4, 0.0, 1.0), radius=0.7).data.materials.append(shirley)
     fx.uv_sphere(scene, "rough", (1.6, 0.0, 1.4), radius=0.5).data.materials.append(rough)
-    render_engine.debug["environment_layer_size"] = 32
-    try:
-        result = fx.render(scene, gbuffer=True)
-    finally:
-        render_engine.debug["environment_layer_size"] = None
+    result = fx.render(scene, gbuffer=True, environment_layer_size=32)
     assert result["state"].environment.prefiltered is not None
     _check(result)
 
@@ -231,7 +226,6 @@ def _assert_shadows(result):
 def test_visibility_environment(engine, bakes):
     """SSDF shadows of the environment SG mixture (eq. 39) and the prefiltered specular (eq. 41)."""
     import bpy
-    from sg_prt_addon.engine import render_engine
 
     source = bpy.data.images.load(fx.studio_world_path("courtyard.exr"), check_existing=True)
     width, height = source.size
@@ -242,11 +236,7 @@ def test_visibility_environment(engine, bakes):
     world = fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
     world.node_tree.nodes["Environment Texture"].image = fx.image("courtyard_small_shadow", small)
     bakes(scene, [sphere, floor], resolution=12)
-    render_engine.debug["environment_layer_size"] = 32
-    try:
-        result = fx.render(scene, gbuffer=True)
-    finally:
-        render_engine.debug["environment_layer_size"] = None
+    result = fx.render(scene, gbuffer=True, environment_layer_size=32)
     assert len(result["state"].visibility) == 2
     _check(result)
     _assert_shadows(result)

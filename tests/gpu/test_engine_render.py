@@ -119,7 +119,6 @@ def test_environment_background_follows_blender_mapping(engine):
     """Background pixels = the world image bilinearly sampled along each pixel's view ray with
     Blender's equirect mapping (core.equirect): orientation and flips end to end."""
     from sg_prt_addon.core import equirect, shading
-    from sg_prt_addon.engine import render_engine
 
     rng = np.random.default_rng(5)
     pixels = np.ones((32, 64, 4), np.float32)
@@ -128,11 +127,7 @@ def test_environment_background_follows_blender_mapping(engine):
     world = fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
     world.node_tree.nodes["Environment Texture"].image = fx.image("background_env", pixels)
     scene.camera.rotation_euler = (1.2, 0.0, 0.7)
-    render_engine.debug["environment_layer_size"] = 16
-    try:
-        result = fx.render(scene)
-    finally:
-        render_engine.debug["environment_layer_size"] = None
+    result = fx.render(scene, environment_layer_size=16)
     assert "error" not in result, result.get("error")
     camera = result["passes"]["camera"]
     height, width = 48, 64
@@ -231,8 +226,6 @@ def test_furnace(engine, textured_world):
     """Uniform lighting c: a white Lambertian surface returns c (exactly for the world colour,
     within the SG mixture fit for an environment image), and a white GGX lobe returns c times
     its directional albedo (the SG approximations lose some of it: bounded below)."""
-    from sg_prt_addon.engine import render_engine
-
     c = 0.5
     scene = fx.new_scene(f"furnace_{textured_world}", 48, 48)
     if textured_world:
@@ -243,11 +236,7 @@ def test_furnace(engine, textured_world):
     sphere = fx.uv_sphere(scene, "furnace_sphere", (0.0, 0.0, 1.0), radius=1.5)
     sphere.data.materials.append(fx.material("furnace", model="GGX", roughness=0.5,
                                              diffuse_color=(1.0, 1.0, 1.0), specular_color=(1.0, 1.0, 1.0)))
-    render_engine.debug["environment_layer_size"] = 16
-    try:
-        result = fx.render(scene)
-    finally:
-        render_engine.debug["environment_layer_size"] = None
+    result = fx.render(scene, environment_layer_size=16)
     assert "error" not in result, result.get("error")
     passes = result["passes"]
     surface = passes["Diffuse"][..., 3] > 0.5
