@@ -1,4 +1,5 @@
 """Scenes for the engine tests, built from Blender primitives with real bpy."""
+import contextlib
 import math
 import os
 
@@ -156,6 +157,29 @@ def render(scene, gbuffer=False, environment_layer_size=None):
         render_engine.debug["capture_gbuffer"] = False
         render_engine.debug["environment_layer_size"] = layer_size
     return render_engine.last_render
+
+
+@contextlib.contextmanager
+def tracked_state(scene, view_layer):
+    """A SceneState synced to the evaluated `view_layer` (dirty set consumed), fed every later edit of
+    `scene` through a depsgraph_update_post handler, as view_update feeds it; yields the state."""
+    import bpy
+    from sg_prt_addon.engine import scene_state
+
+    view_layer.update()             # evaluate the scene once, before tracking edits
+    state = scene_state.SceneState()
+    state.sync(view_layer.depsgraph)
+    state.consume_dirty()
+
+    def on_update(updated_scene, depsgraph):
+        if updated_scene == scene:
+            state.update(depsgraph)
+
+    bpy.app.handlers.depsgraph_update_post.append(on_update)
+    try:
+        yield state
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(on_update)
 
 
 def relative_error(actual, expected, floor_fraction=1e-3):

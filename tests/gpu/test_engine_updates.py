@@ -12,8 +12,6 @@ import engine_fixtures as fx
 @pytest.fixture()
 def tracked_scene(blender):
     """A scene with two spheres and a light, a synced SceneState and a handler feeding it updates."""
-    from sg_prt_addon.engine import scene_state
-
     fx.ensure_registered()
     bpy = blender
     # the context's scene: its depsgraph is the one Blender evaluates and reports updates for
@@ -26,21 +24,11 @@ def tracked_scene(blender):
     second = fx.uv_sphere(scene, "updates_b", (2.0, 0.0, 1.0), segments=12, rings=6)
     fx.point_light(scene, "updates_light", (0.0, -2.0, 3.0), 100.0)
     view_layer = bpy.context.view_layer
-    view_layer.update()             # evaluate the new scene once, before tracking edits
-    state = scene_state.SceneState()
-    state.sync(view_layer.depsgraph)
-    assert set(state.objects) == {first.name, second.name} and len(state.lights) == 1
-    state.consume_dirty()
-
-    def on_update(updated_scene, depsgraph):
-        if updated_scene == scene:
-            state.update(depsgraph)
-
-    bpy.app.handlers.depsgraph_update_post.append(on_update)
     try:
-        yield bpy, scene, view_layer, state, material, first, second
+        with fx.tracked_state(scene, view_layer) as state:
+            assert set(state.objects) == {first.name, second.name} and len(state.lights) == 1
+            yield bpy, scene, view_layer, state, material, first, second
     finally:
-        bpy.app.handlers.depsgraph_update_post.remove(on_update)
         for obj in list(scene.objects):
             bpy.data.objects.remove(obj)
 

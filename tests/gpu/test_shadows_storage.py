@@ -92,7 +92,6 @@ def test_viewport_update_picks_up_a_new_bake_and_its_removal(blender):
     """SceneState.update (view_update's logic) after the bake operator's mesh.update(): the object is
     re-exported with its new bake; clearing the bake drops it again."""
     from sg_prt_addon.blender import visibility_bake
-    from sg_prt_addon.engine import scene_state
 
     fx.ensure_registered()
     bpy = blender
@@ -102,36 +101,26 @@ def test_viewport_update_picks_up_a_new_bake_and_its_removal(blender):
     sphere = fx.uv_sphere(scene, "viewport_bake_sphere", (0.0, 0.0, 1.0), segments=12, rings=6)
     floor = fx.grid(scene, "viewport_bake_floor", (0.0, 0.0, 0.0), size=4.0, segments=8)
     view_layer = bpy.context.view_layer
-    view_layer.update()
-    state = scene_state.SceneState()
-    state.sync(view_layer.depsgraph)
-    assert state.visibility == {}
-    state.consume_dirty()
-
-    def on_update(updated_scene, depsgraph):
-        if updated_scene == scene:
-            state.update(depsgraph)
-
-    bpy.app.handlers.depsgraph_update_post.append(on_update)
     try:
-        try:
-            bakes = fx.bake_objects(scene, [floor], resolution=8)
-        finally:
-            fx.clear_bakes()
-        visibility_bake.store_visibility_bake(floor.data, bakes[floor.name])
-        floor.data.update()                 # as the operator does after storing
-        view_layer.update()
-        floor_key = next(key for key in state.meshes if key.startswith(floor.name))
-        assert floor_key in state.visibility, state.visibility_status
-        assert floor_key in state.dirty.meshes
-        state.consume_dirty()
-        visibility_bake.clear_visibility_bake(floor.data)
-        floor.data.update()
-        view_layer.update()
-        assert floor_key not in state.visibility
-        assert floor_key in state.dirty.meshes
+        with fx.tracked_state(scene, view_layer) as state:
+            assert state.visibility == {}
+            try:
+                bakes = fx.bake_objects(scene, [floor], resolution=8)
+            finally:
+                fx.clear_bakes()
+            visibility_bake.store_visibility_bake(floor.data, bakes[floor.name])
+            floor.data.update()                 # as the operator does after storing
+            view_layer.update()
+            floor_key = next(key for key in state.meshes if key.startswith(floor.name))
+            assert floor_key in state.visibility, state.visibility_status
+            assert floor_key in state.dirty.meshes
+            state.consume_dirty()
+            visibility_bake.clear_visibility_bake(floor.data)
+            floor.data.update()
+            view_layer.update()
+            assert floor_key not in state.visibility
+            assert floor_key in state.dirty.meshes
     finally:
-        bpy.app.handlers.depsgraph_update_post.remove(on_update)
         for obj in list(scene.objects):
             bpy.data.objects.remove(obj)
 
