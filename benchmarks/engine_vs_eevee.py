@@ -60,7 +60,8 @@ def viewport_redraws(redraws):
     """(first draw, median redraw with nothing changed, median redraw after a material edit) seconds."""
     from sg_prt_addon.engine import render_engine
 
-    def measure(state, camera, width, height):
+    def measure(depsgraph, state, renderer, camera):
+        width, height = renderer.size
         first, unchanged, draws, _ = render_engine.time_viewport_redraws(state, camera, width, height, redraws)
         assert draws == 1, "a redraw with nothing changed drew the scene again"
         name = next(iter(state.materials))

@@ -251,7 +251,7 @@ def render_frames(scene, redraws, force=None):
 
 
 def measure_updates(scene, repeats, environment_repeats):
-    """Update rows, timed inside one render (wrapped render_frame): see the module docstring."""
+    """Update rows, timed inside one render (render_engine.debug["after_frame"]): see the module docstring."""
     import bpy
     from sg_prt_addon.blender import export
     from sg_prt_addon.engine import render_engine, renderer as renderer_module, scene_state
@@ -259,14 +259,10 @@ def measure_updates(scene, repeats, environment_repeats):
     forest = world_with_image("skip_forest", bpy.data.images.load(
         os.path.join(bpy.utils.system_resource("DATAFILES"), "studiolights", "world", "forest.exr")))
     times = {}
-    original = render_engine.render_frame
 
-    def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None):
+    def after_frame(depsgraph, state, renderer, camera):
         import gpu
 
-        renderer = renderer_module.Renderer(gbuffer=gbuffer)
-        out = original(depsgraph, width, height, gbuffer, state, renderer)
-        state, camera = out[1], out[0]["camera"]
         times["gl_renderer"] = gpu.platform.renderer_get()
         # what view_update hands SceneState.update when nothing changed: a depsgraph with no updates
         # (the render depsgraph lists every datablock as updated once)
@@ -301,14 +297,13 @@ def measure_updates(scene, repeats, environment_repeats):
         for index in range(2 * environment_repeats):
             hits.append(switch(worlds[index % 2]))
         times["environment miss"], times["environment hit"] = misses, hits
-        return out
 
-    render_engine.render_frame = render_frame
+    render_engine.debug["after_frame"] = after_frame
     try:
         with bpy.context.temp_override(scene=scene):
             bpy.ops.render.render(scene=scene.name, write_still=False)
     finally:
-        render_engine.render_frame = original
+        render_engine.debug["after_frame"] = None
     if "error" in render_engine.last_render:
         raise SystemExit(render_engine.last_render["error"])
     return times

@@ -14,8 +14,8 @@ from .shader_variants import ShaderCompileError
 # Debug hooks for tests and benchmarks (no UI): when `capture_gbuffer` is True the next
 # final render also writes the shading inputs; every final render leaves its float
 # passes, the G-buffer and the SceneState in `last_render`.
-# `after_frame(state, camera, width, height)` runs inside the render's GPU context after the
-# frame (its result: last_render["after_frame"]), e.g. to time the viewport's redraws.
+# `after_frame(depsgraph, state, renderer, camera)` runs inside the render's GPU context after the
+# frame (its result: last_render["after_frame"]), e.g. to time the viewport's redraws or re-uploads.
 debug = {"capture_gbuffer": False, "environment_layer_size": None, "timed_redraws": 0, "after_frame": None}
 last_render = {}
 
@@ -240,7 +240,7 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     if frame_times:
         timings["frames"] = frame_times
     if debug.get("after_frame") is not None:
-        passes["after_frame"] = debug["after_frame"](state, camera, width, height)
+        passes["after_frame"] = debug["after_frame"](depsgraph, state, renderer, camera)
     passes["camera"] = camera
     passes["material_ids"] = dict(renderer.material_ids)
     return passes, state, timings

@@ -351,16 +351,11 @@ def test_upload_skips_unchanged_inputs(engine, monkeypatch):
     GPU objects); a material edit -> that material only; an environment change -> the environment
     texture re-created once, not again while it stays the same (prefilter from the content cache)."""
     from sg_prt_addon.blender import export
-    from sg_prt_addon.engine import render_engine, renderer as renderer_module, scene_state
+    from sg_prt_addon.engine import render_engine, scene_state
 
     probes = {}
-    original = render_engine.render_frame
 
-    def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None):
-        renderer = renderer_module.Renderer(gbuffer=gbuffer)
-        out = original(depsgraph, width, height, gbuffer, state, renderer)
-        state, camera = out[1], out[0]["camera"]
-
+    def after_frame(depsgraph, state, renderer, camera):
         def snapshot():
             return (dict(renderer.uploads), dict(renderer.mesh_buffers), dict(renderer.material_buffers),
                     renderer.environment_texture, renderer.equirect_texture)
@@ -381,9 +376,8 @@ def test_upload_skips_unchanged_inputs(engine, monkeypatch):
         state.environment = scene_state.environment_data(world, ENV_LAYER_SIZE)
         renderer.upload(state, state.consume_dirty(), camera)
         probes["same_environment"] = snapshot()
-        return out
 
-    monkeypatch.setattr(render_engine, "render_frame", render_frame)
+    monkeypatch.setitem(render_engine.debug, "after_frame", after_frame)
     _render(_scene("uploads", {}))
     uploads, meshes, materials, environment, equirect = probes["first"]
     assert uploads == {"meshes": 2, "materials": 2} and environment is not None     # "" and the material

@@ -39,8 +39,8 @@ def test_unchanged_redraws_reuse_the_image(viewport_scene):
 
     scene, _ = viewport_scene
 
-    def redraw(state, camera, width, height):
-        return render_engine.time_viewport_redraws(state, camera, width, height, count=4)
+    def redraw(depsgraph, state, renderer, camera):
+        return render_engine.time_viewport_redraws(state, camera, *renderer.size, count=4)
 
     result = _render_with(scene, redraw)
     first, redraws, draws, image = result["after_frame"]
@@ -57,7 +57,8 @@ def test_edits_and_view_changes_redraw(viewport_scene):
     def edit_material(state):
         state.dirty.materials.add(material.name)        # what view_update records after an edit
 
-    def check(state, camera, width, height):
+    def check(depsgraph, state, renderer, camera):
+        width, height = renderer.size
         edited = render_engine.time_viewport_redraws(state, camera, width, height, count=3, edit=edit_material)
         frame = render_engine.ViewportFrame()
         drew = [frame.update(state, camera, width, height)]
