@@ -170,8 +170,7 @@ def time_viewport_redraws(state, camera, width, height, count, edit=None):
     from gpu_extras.presets import draw_texture_2d as preset_draw_texture_2d
     from mathutils import Matrix
 
-    state.dirty = scene_state.Dirty(meshes=set(state.meshes), materials=set(state.materials), lights=True,
-                                    world=True, objects=True)      # a new viewport uploads everything
+    state.mark_all_dirty()                 # a new viewport uploads everything
     frame = ViewportFrame()
     offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA16F")
     times = []

@@ -158,8 +158,7 @@ class SceneState:
                                              self._read_materials(obj))
         self.world = export.export_world(depsgraph.scene.world)
         self.environment = environment_data(self.world, self.environment_layer_size)
-        self.dirty = Dirty(meshes=set(self.meshes), materials=set(self.materials), lights=True, world=True,
-                           objects=True)
+        self.mark_all_dirty()
 
     def _export_mesh(self, obj, mesh_key):
         """Export an evaluated object's mesh and look up its visibility bake (see visibility_for)."""
@@ -271,6 +270,11 @@ class SceneState:
         self.objects[obj.name] = ObjectEntry(obj.name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
                                              self._read_materials(obj))
         dirty.objects = True
+
+    def mark_all_dirty(self):
+        """Everything to upload, as for a renderer that has nothing yet."""
+        self.dirty = Dirty(meshes=set(self.meshes), materials=set(self.materials), lights=True, world=True,
+                           objects=True)
 
     def consume_dirty(self):
         dirty, self.dirty = self.dirty, Dirty()
