@@ -464,38 +464,39 @@ def background_create_info(has_environment):
     return info
 
 
-def get_background_shader(has_environment):
-    """Shader drawing the world behind the surfaces (cached like the surface variants)."""
-    key = ("background", bool(has_environment))
+def _cached_fixed_shader(key, create_info_of, what):
+    """A shader that is not a surface variant (cached by `key` like them); create_info_of() builds it."""
     shader = _cache.get(key)
     if shader is None:
-        info = background_create_info(has_environment)
-        shader, error, log = create_capturing_log(info)
+        shader, error, log = create_capturing_log(create_info_of())
         if shader is None:
-            raise ShaderCompileError(f"SG-PRT background shader failed to compile\n{log.strip()}") from error
+            raise ShaderCompileError(f"SG-PRT {what} shader failed to compile\n{log.strip()}") from error
         _cache[key] = shader
     return shader
+
+
+def get_background_shader(has_environment):
+    """Shader drawing the world behind the surfaces."""
+    return _cached_fixed_shader(("background", bool(has_environment)),
+                                lambda: background_create_info(has_environment), "background")
+
+
+def depth_create_info():
+    """Position-only shader of the depth pre-pass (resources/depth.vert.glsl)."""
+    import gpu
+
+    info = gpu.types.GPUShaderCreateInfo()
+    for name, value in LIMITS.items():
+        info.define(name, str(value))
+    info.typedef_source(typedef_source())
+    info.vertex_in(0, "VEC3", "position")
+    info.push_constant("MAT4", "model_matrix")
+    info.uniform_buf(0, "SceneData", "scene")
+    info.fragment_out(0, "VEC4", "out_unused")
+    info.vertex_source(_read(os.path.join(RESOURCE_DIR, "depth.vert.glsl")))
+    info.fragment_source("void main()\n{\n  out_unused = vec4(0.0);\n}\n")
+    return info
 
 
 def get_depth_shader():
-    """Position-only shader of the depth pre-pass (resources/depth.vert.glsl), cached like the others."""
-    import gpu
-
-    key = ("depth",)
-    shader = _cache.get(key)
-    if shader is None:
-        info = gpu.types.GPUShaderCreateInfo()
-        for name, value in LIMITS.items():
-            info.define(name, str(value))
-        info.typedef_source(typedef_source())
-        info.vertex_in(0, "VEC3", "position")
-        info.push_constant("MAT4", "model_matrix")
-        info.uniform_buf(0, "SceneData", "scene")
-        info.fragment_out(0, "VEC4", "out_unused")
-        info.vertex_source(_read(os.path.join(RESOURCE_DIR, "depth.vert.glsl")))
-        info.fragment_source("void main()\n{\n  out_unused = vec4(0.0);\n}\n")
-        shader, error, log = create_capturing_log(info)
-        if shader is None:
-            raise ShaderCompileError(f"SG-PRT depth pre-pass shader failed to compile\n{log.strip()}") from error
-        _cache[key] = shader
-    return shader
+    return _cached_fixed_shader(("depth",), depth_create_info, "depth pre-pass")
