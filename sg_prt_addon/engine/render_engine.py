@@ -68,11 +68,6 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             last_render.clear()
             last_render["error"] = traceback.format_exc()
             return
-        finally:
-            if bpy.app.background:
-                # GPU shaders still alive at interpreter exit crash Blender's teardown (no context
-                # then): batch renders drop them while the render's context is current.
-                shader_variants.clear_cache()
         for warning in dict.fromkeys(state.warnings):
             self.report({"WARNING"}, f"SG-PRT: {warning}")
         dropped = state.dropped_lights(shader_variants.MAX_POINT_LIGHTS, shader_variants.MAX_SUNS)

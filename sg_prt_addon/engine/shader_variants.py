@@ -22,6 +22,7 @@ sg_shading.glsl) + surface.frag.glsl.
 A compile error raises ShaderCompileError naming the variant and quoting the
 offending lines of the numbered assembled source.
 """
+import collections
 import hashlib
 import os
 import re
@@ -389,7 +390,11 @@ def content_hash(key):
     return hashlib.sha256(repr(create_info_calls(key)).encode("utf-8")).hexdigest()
 
 
-_cache = {}             # content hash (surface variants) or ("background", ...) / ("depth",) -> GPUShader
+# content hash (surface variants) or ("background", ...) / ("depth",) -> GPUShader, least recently used
+# first.  Kept for the process, final renders too (a batch job's later renders skip the compile and
+# llvmpipe's JIT); the oldest is dropped past MAX_CACHED_SHADERS, inside the caller's GPU context.
+MAX_CACHED_SHADERS = 64
+_cache = collections.OrderedDict()
 _content_hashes = {}    # VariantKey -> content_hash(key): the sources are assembled once per key
 # Surface shader compiles since the process started (clear_cache does not reset it): tests and
 # benchmarks read it to see that keys sharing a content hash share one compile.
@@ -401,15 +406,28 @@ def get_shader(key):
     digest = _content_hashes.get(key)
     if digest is None:
         digest = _content_hashes[key] = content_hash(key)
-    shader = _cache.get(digest)
+    shader = _cached(digest)
     if shader is None:
         shader, error, log = create_capturing_log(create_info(key))
         if shader is None:
             raise ShaderCompileError(_error_message(
                 key, log, [("fragment", fragment_source(key)), ("vertex", vertex_source())])) from error
-        _cache[digest] = shader
+        _remember(digest, shader)
         compile_count["surface"] += 1
     return shader
+
+
+def _cached(key):
+    shader = _cache.get(key)
+    if shader is not None:
+        _cache.move_to_end(key)
+    return shader
+
+
+def _remember(key, shader):
+    _cache[key] = shader
+    while len(_cache) > MAX_CACHED_SHADERS:
+        _cache.popitem(last=False)
 
 
 def clear_cache():
@@ -466,12 +484,12 @@ def background_create_info(has_environment):
 
 def _cached_fixed_shader(key, create_info_of, what):
     """A shader that is not a surface variant (cached by `key` like them); create_info_of() builds it."""
-    shader = _cache.get(key)
+    shader = _cached(key)
     if shader is None:
         shader, error, log = create_capturing_log(create_info_of())
         if shader is None:
             raise ShaderCompileError(f"SG-PRT {what} shader failed to compile\n{log.strip()}") from error
-        _cache[key] = shader
+        _remember(key, shader)
     return shader
 
 

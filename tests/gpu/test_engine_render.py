@@ -260,3 +260,34 @@ def test_furnace(engine, textured_world):
     assert 0.82 < ratio.min() and ratio.max() < 1.02
     background = passes["Combined"][~surface][:, :3]
     np.testing.assert_allclose(background, c, rtol=1e-5)
+
+
+def test_shaders_outlive_final_renders(engine, monkeypatch):
+    """A batch job's later renders reuse the compiled shaders, across scenes (each render has its own
+    GPU context); past MAX_CACHED_SHADERS the oldest is dropped and compiled again when needed."""
+    from sg_prt_addon.engine import shader_variants
+
+    scenes = []
+    for index, model in enumerate(("GGX", "BLINN_PHONG", "WARD_ISO")):
+        scene = fx.new_scene(f"cache_{model.lower()}", 48, 48)
+        fx.world_colour(scene, (0.2, 0.2, 0.2))
+        sphere = fx.uv_sphere(scene, f"cache_sphere_{index}", (0.0, 0.0, 1.0), segments=12, rings=6)
+        sphere.data.materials.append(fx.material(f"cache_material_{index}", model=model))
+        fx.point_light(scene, f"cache_light_{index}", (1.0, -3.0, 3.0), 500.0)
+        scenes.append(scene)
+    shader_variants.clear_cache()
+    first = [fx.render(scene)["passes"]["Combined"] for scene in scenes]
+    compiles = shader_variants.compile_count["surface"]
+    assert compiles >= 3
+    again = [fx.render(scene)["passes"]["Combined"] for scene in reversed(scenes)][::-1]
+    assert shader_variants.compile_count["surface"] == compiles, "a later render compiled its shader again"
+    for image, repeated in zip(first, again):
+        np.testing.assert_array_equal(image, repeated)
+
+    # room for the background and depth shaders and two surface variants: the third evicts the first
+    monkeypatch.setattr(shader_variants, "MAX_CACHED_SHADERS", 4)
+    shader_variants.clear_cache()
+    for scene, image in zip(scenes + scenes[:1], first + first[:1]):
+        np.testing.assert_array_equal(fx.render(scene)["passes"]["Combined"], image)
+        assert len(shader_variants._cache) <= 4
+    assert shader_variants.compile_count["surface"] == compiles + 4     # three, then the first again
