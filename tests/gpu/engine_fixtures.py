@@ -228,11 +228,10 @@ def bake_objects(scene, receivers, resolution=16, terms=None, error_target=0.02,
     """bake.pipeline.bake_visibility of each receiver object against every mesh object of the scene;
     returns {object name: BakeResult} and installs it as engine.scene_state.visibility_provider
     (standing in for bakes stored in the .blend).  Call clear_bakes() afterwards."""
-    import bpy
     from sg_prt_addon.bake.pipeline import BakeOptions, bake_visibility
     from sg_prt_addon.engine import scene_state
 
-    bpy.context.view_layer.update()
+    scene.view_layers[0].update()       # the scene's own: matrix_world of objects made since (not the context's)
     arrays = {obj.name: mesh_world_arrays(obj) for obj in scene.objects if obj.type == "MESH"}
     occluder_vertices, occluder_triangles, offset = [], [], 0
     for vertices, _, triangles in arrays.values():
