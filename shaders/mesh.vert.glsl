@@ -1,7 +1,9 @@
 /* Object-space corners -> world space; the fragment shader shades in world space.
  * HAS_VISIBILITY: the corner's Blender mesh vertex (vertex_index) selects its row of SSDF PCA
  * coefficients in `visibility_coefficients` (SSDF_MAX_LAYERS texels a vertex, vertices packed
- * row after row, renderer.VisibilityBuffers), passed on as varyings: interpolated per pixel. */
+ * row after row, renderer.VisibilityBuffers), passed on as varyings: interpolated per pixel.
+ * DIFFUSE_VISIBILITY_ROWS: also its broad diffuse lobes' visible fractions (`diffuse_visibility`, the
+ * same layout, resources/vertex_visibility.frag.glsl). */
 invariant gl_Position;    /* the depth pre-pass (resources/depth.vert.glsl) computes the same */
 #ifdef HAS_VISIBILITY
 #define SSDF_FETCH(k) texelFetch(visibility_coefficients, ivec2(column + k, row), 0)
@@ -55,6 +57,19 @@ void main()
 #endif
 #if SSDF_MAX_LAYERS > 11
   ssdf_coefficients_11 = SSDF_FETCH(11);
+#endif
+#ifdef DIFFUSE_VISIBILITY_ROWS
+  int diffuse_column = (vertex_index - row * per_row) * DIFFUSE_VISIBILITY_ROWS;
+  diffuse_fractions_0 = texelFetch(diffuse_visibility, ivec2(diffuse_column, row), 0);
+#if DIFFUSE_VISIBILITY_ROWS > 1
+  diffuse_fractions_1 = texelFetch(diffuse_visibility, ivec2(diffuse_column + 1, row), 0);
+#endif
+#if DIFFUSE_VISIBILITY_ROWS > 2
+  diffuse_fractions_2 = texelFetch(diffuse_visibility, ivec2(diffuse_column + 2, row), 0);
+#endif
+#if DIFFUSE_VISIBILITY_ROWS > 3
+  diffuse_fractions_3 = texelFetch(diffuse_visibility, ivec2(diffuse_column + 3, row), 0);
+#endif
 #endif
 #endif
   gl_Position = scene.view_projection * world;

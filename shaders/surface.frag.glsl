@@ -42,6 +42,18 @@ void main()
   visibility_rows[11] = ssdf_coefficients_11;
 #endif
 #endif
+#ifdef DIFFUSE_VISIBILITY_ROWS
+  diffuse_fractions[0] = diffuse_fractions_0;
+#if DIFFUSE_VISIBILITY_ROWS > 1
+  diffuse_fractions[1] = diffuse_fractions_1;
+#endif
+#if DIFFUSE_VISIBILITY_ROWS > 2
+  diffuse_fractions[2] = diffuse_fractions_2;
+#endif
+#if DIFFUSE_VISIBILITY_ROWS > 3
+  diffuse_fractions[3] = diffuse_fractions_3;
+#endif
+#endif
   vec3 diffuse_color = material.diffuse_color.rgb;
   vec3 specular_color = material.specular_color.rgb;
   vec4 p = material.parameters0;                  /* roughness, ior, exponent, alpha_x */

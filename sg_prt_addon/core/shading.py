@@ -99,11 +99,14 @@ class Visibility:
 
     rows (N, 4 L): interpolated [1, w_0, ...] (bake.decode.pack_coefficients layout);
     normal (N, 3): interpolated SSDF-frame normal (the bake's vertex normals, world space);
-    basis_texture (L, R, R, 4): bake.decode.pack_basis_texture.
+    basis_texture (L, R, R, 4): bake.decode.pack_basis_texture;
+    diffuse (N, E), optional: the broad diffuse lobes' visible fractions interpolated from the vertices
+    (vertex_diffuse_visibility; shaders: DIFFUSE_VISIBILITY_ROWS), in place of per-pixel decodes.
     """
     rows: np.ndarray
     normal: np.ndarray
     basis_texture: np.ndarray
+    diffuse: np.ndarray = None
 
 
 def ssdf_decode_packed(rows, basis_texture, local_direction):
@@ -137,6 +140,21 @@ def lobe_visibility(axis, sharpness, n, visibility):
     visible = hemisphere.fh_normalized(theta_d, product_sharpness)
     unshadowed = hemisphere.fh_normalized_from_sine(sg.normalize(local.astype(FLOAT))[..., 2], product_sharpness)
     return np.clip(visible / np.maximum(unshadowed, FLOAT(1e-30)), 0, 1).astype(FLOAT)
+
+
+def vertex_diffuse_visibility(environment, vertices):
+    """Visible fractions (V, E) of the broad diffuse lobes at mesh vertices (resources/
+    vertex_visibility.frag.glsl): the environment's SG mixture, or the constant world's cosine lobe
+    (E = 1).  vertices: a Visibility of the vertices (their coefficient rows and world SSDF normals),
+    whose normal also stands in for the shading normal in the product with the cosine lobe."""
+    n = sg.normalize(np.asarray(vertices.normal, FLOAT))
+    if environment.has_texture:
+        count = len(environment.lobe_sharpness)
+        axis = np.broadcast_to(np.asarray(environment.lobe_axis, FLOAT)[None], (len(n), count, 3))
+        sharpness = np.broadcast_to(np.asarray(environment.lobe_sharpness, FLOAT)[None], (len(n), count))
+    else:
+        axis, sharpness = n[:, None, :], np.zeros((len(n), 1), FLOAT)
+    return lobe_visibility(axis, sharpness, n, vertices)
 
 
 def point_light_sgs(position, light_data):
@@ -353,15 +371,19 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             lobe_count_env = len(environment.lobe_sharpness)
             env_axis = np.broadcast_to(environment.lobe_axis[None], (len(n), lobe_count_env, 3))
             env_sharpness = np.broadcast_to(environment.lobe_sharpness[None], (len(n), lobe_count_env))
+            env_visible = visible(env_axis, env_sharpness) if visibility is None or visibility.diffuse is None \
+                else np.asarray(visibility.diffuse, FLOAT)[:, :lobe_count_env]
             irradiance += np.sum(environment.lobe_amplitude[None] * (_clamped_cosine_integral(
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
-                visible(env_axis, env_sharpness))[..., None], axis=1)
+                env_visible)[..., None], axis=1)
         radiance = env_prefilter.lookup(environment.prefiltered, slice_axis, slice_sharpness)        # (N, J, 3)
         specular += np.sum(radiance * (slice_cosine[..., None] * slice_colour), axis=1)
     else:
         colour = np.asarray(environment.colour, FLOAT)
         if visibility is None:
             irradiance += np.pi * colour
+        elif visibility.diffuse is not None:
+            irradiance += np.pi * colour * np.asarray(visibility.diffuse, FLOAT)[:, :1]
         else:       # the cosine lobe alone: a zero-sharpness G at the normal
             irradiance += np.pi * colour * visible(n_lobe, np.zeros((len(n), 1), FLOAT))
         specular += np.sum(slice_cosine[..., None] * slice_colour, axis=1) * colour

@@ -118,22 +118,28 @@ def visibility_texture_shape(vertex_count, layers):
     return max(1, -(-vertex_count // per_row)), per_row * layers
 
 
+def per_vertex_texture(values, texels_per_vertex, per_row):
+    """(rows, per_row * texels_per_vertex, 4) float32 texture of per-vertex values (V, 4 * texels_per_vertex):
+    vertex v's texel k at (column (v % per_row) * texels_per_vertex + k, row v // per_row)."""
+    count = values.shape[0]
+    rows = max(1, -(-count // per_row))
+    out = np.zeros((rows * per_row, texels_per_vertex, 4), np.float32)
+    out[:count] = np.asarray(values, np.float32).reshape(count, texels_per_vertex, 4)
+    return out.reshape(rows, per_row * texels_per_vertex, 4)
+
+
 def visibility_texture_rows(packed, layers):
     """(H, W, 4) float32 texture of per-vertex coefficient rows (V, 4 layers): vertex v's vec4 k at texel
     (column (v % per_row) * layers + k, row v // per_row), per_row = VISIBILITY_TEXTURE_WIDTH // layers
     (mesh.vert.glsl reads it back with texelFetch)."""
-    count = packed.shape[0]
-    per_row = max(1, VISIBILITY_TEXTURE_WIDTH // layers)
-    rows = visibility_texture_shape(count, layers)[0]
-    out = np.zeros((rows * per_row, layers, 4), np.float32)
-    out[:count] = np.asarray(packed, np.float32).reshape(count, layers, 4)
-    return out.reshape(rows, per_row * layers, 4)
+    return per_vertex_texture(packed, layers, max(1, VISIBILITY_TEXTURE_WIDTH // layers))
 
 
 class MeshBuffers:
     """Vertex buffer + one index buffer per material range of a MeshExport; with a usable visibility
     bake (scene_state.VisibilityData) also the corners' mesh vertex index and SSDF normal attributes,
-    the per-vertex coefficient texture and the basis texture."""
+    the per-vertex coefficient texture, the vertex normal texture (one texel a vertex, in the same rows)
+    and the basis texture."""
 
     def __init__(self, mesh, visibility=None):
         import gpu
@@ -141,7 +147,9 @@ class MeshBuffers:
         self.batches = []               # (material slot index, first triangle, GPUBatch)
         self.visibility_layers = 0
         self.coefficient_texture = None
+        self.normal_texture = None
         self.basis_texture = None
+        self.vertex_count = 0
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
         if visibility is not None:
@@ -171,6 +179,11 @@ class MeshBuffers:
                 mesh.vertex_normals[mesh.corner_vertex.astype(np.int64)], np.float32))
             self.visibility_layers = visibility.layers
             self.coefficient_texture = _texture_2d(visibility_texture_rows(visibility.packed, visibility.layers))
+            self.vertex_count = visibility.packed.shape[0]
+            normals = np.zeros((self.vertex_count, 4), np.float32)
+            normals[:, :3] = mesh.vertex_normals
+            self.normal_texture = _texture_2d(per_vertex_texture(
+                normals, 1, max(1, VISIBILITY_TEXTURE_WIDTH // visibility.layers)))
             self.basis_texture = _texture_2d_array(visibility.basis_texture)
         for material_index, first, count in mesh.material_ranges:
             indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])
@@ -201,6 +214,8 @@ class Renderer:
         self.size = None
         self.uploads = {"meshes": 0, "materials": 0}
         self.background_batch = None
+        self.vertex_visibility = {}     # object key -> (GPUTexture, GPUFrameBuffer) of the per-vertex pass
+        self.vertex_visibility_batch = None
 
     # ----------------------------------------------------------------- uploads
 
@@ -281,6 +296,8 @@ class Renderer:
 
         has_lights = state.light_data().count > 0
         has_environment = state.environment.prefiltered is not None
+        diffuse_rows = shader_variants.diffuse_visibility_rows(state.environment)
+        self._draw_vertex_visibility(state, diffuse_rows, has_environment)
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
@@ -290,7 +307,7 @@ class Renderer:
             if self.depth_prepass:
                 self._draw_depth(state)
                 gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
-            for object_index, entry in enumerate(state.objects.values()):
+            for object_index, (object_key, entry) in enumerate(state.objects.items()):
                 buffers = self.mesh_buffers.get(entry.mesh_key)
                 if buffers is None:
                     continue
@@ -301,7 +318,7 @@ class Renderer:
                     if name not in self.material_buffers:
                         name = ""
                     key = shader_variants.variant_key(params, has_lights, has_environment, self.gbuffer,
-                                                      buffers.visibility_layers)
+                                                      buffers.visibility_layers, diffuse_rows)
                     shader = shader_variants.get_shader(key)
                     shader.bind()
                     shader.uniform_float("model_matrix", model)
@@ -311,6 +328,8 @@ class Renderer:
                     if key.visibility_layers:
                         shader.uniform_sampler("visibility_coefficients", buffers.coefficient_texture)
                         shader.uniform_sampler("visibility_basis", buffers.basis_texture)
+                    if key.diffuse_visibility_rows:
+                        shader.uniform_sampler("diffuse_visibility", self.vertex_visibility[object_key][0])
                     shader.uniform_block("scene", self.scene_buffer)
                     shader.uniform_block("material", self.material_buffers[name])
                     if has_environment:
@@ -334,6 +353,40 @@ class Renderer:
                 self._draw_background(camera, has_environment, background_alpha)
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
+
+    def _draw_vertex_visibility(self, state, rows, has_environment):
+        """The broad diffuse lobes' visibility at the vertices of every object with a bake
+        (resources/vertex_visibility.frag.glsl): one texel a vertex and vec4, for the surface shader."""
+        import gpu
+        from gpu_extras.batch import batch_for_shader
+
+        for object_key in [key for key in self.vertex_visibility if key not in state.objects]:
+            del self.vertex_visibility[object_key]
+        for object_key, entry in state.objects.items():
+            buffers = self.mesh_buffers.get(entry.mesh_key)
+            if buffers is None or not buffers.visibility_layers or not rows:
+                self.vertex_visibility.pop(object_key, None)
+                continue
+            per_row = max(1, VISIBILITY_TEXTURE_WIDTH // buffers.visibility_layers)
+            size = (per_row * rows, max(1, -(-buffers.vertex_count // per_row)))
+            target = self.vertex_visibility.get(object_key)
+            if target is None or (target[0].width, target[0].height) != size:
+                texture = gpu.types.GPUTexture(size, format="RGBA32F")
+                target = self.vertex_visibility[object_key] = (texture, gpu.types.GPUFrameBuffer(color_slots=texture))
+            shader = shader_variants.get_vertex_visibility_shader(buffers.visibility_layers, rows, has_environment)
+            if self.vertex_visibility_batch is None:
+                self.vertex_visibility_batch = batch_for_shader(
+                    shader, "TRIS", {"position": [(-1, -1), (3, -1), (-1, 3)]})
+            with target[1].bind():
+                gpu.state.depth_test_set("NONE")
+                gpu.state.blend_set("NONE")
+                shader.bind()
+                shader.uniform_float("model_matrix", _column_major(entry.matrix_world))
+                shader.uniform_block("scene", self.scene_buffer)
+                shader.uniform_sampler("visibility_coefficients", buffers.coefficient_texture)
+                shader.uniform_sampler("vertex_normals", buffers.normal_texture)
+                shader.uniform_sampler("visibility_basis", buffers.basis_texture)
+                self.vertex_visibility_batch.draw(shader)
 
     def _draw_depth(self, state):
         """Depth of every surface, no colour: the surface shaders then shade each pixel once instead of
@@ -398,6 +451,7 @@ class Renderer:
         self.material_buffers.clear()
         self.textures.clear()
         self.fitted_textures.clear()
+        self.vertex_visibility.clear()
         self.targets = []
         self.framebuffer = None
         self.size = None

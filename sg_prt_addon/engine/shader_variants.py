@@ -61,7 +61,7 @@ GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
 # Library files in dependency order; env_prefilter only with an environment texture.
 LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
 # Our own pieces (shaders/resources/), after the library.
-RESOURCE_FILES = ("anisotropic_lobes.glsl", "ggx_two_lobes.glsl", "sg_shading.glsl")
+RESOURCE_FILES = ("anisotropic_lobes.glsl", "ggx_two_lobes.glsl", "lobe_visibility.glsl", "sg_shading.glsl")
 
 
 def output_names(gbuffer):
@@ -86,6 +86,8 @@ class VariantKey:
     shadowing_components: int = 0   # model FITTED: PCA components of the stored shadowing
     has_diffuse: bool = True        # False: zero diffuse colour, no texture: no irradiance code
     has_specular: bool = True       # False: zero specular colour, no texture: no BRDF slice code
+    # vec4 of broad diffuse lobe visibility a vertex, from the per-vertex pass (0: none, or decoded per pixel)
+    diffuse_visibility_rows: int = 0
 
     @property
     def has_visibility(self):
@@ -102,6 +104,8 @@ class VariantKey:
             parts.append(f"{self.shadowing_components} shadowing component(s)")
         if self.visibility_layers:
             parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
+        if self.diffuse_visibility_rows:
+            parts.append(f"per-vertex diffuse visibility ({self.diffuse_visibility_rows} vec4)")
         if not self.has_diffuse:
             parts.append("no diffuse")
         if not self.has_specular:
@@ -127,15 +131,26 @@ def material_terms(material_params):
             present(material_params.specular_color, "specular_color"))
 
 
-def variant_key(material_params, has_lights, has_environment, gbuffer=False, visibility_layers=0):
-    """VariantKey of an export.MaterialParams in a scene (visibility_layers: of the object's bake, 0 without)."""
+def diffuse_visibility_rows(environment):
+    """vec4 a vertex of the per-vertex pass (resources/vertex_visibility.frag.glsl) for a
+    core.shading.EnvironmentData: its diffuse SG lobes four to a vec4, or the constant world's one lobe."""
+    if environment.prefiltered is None:
+        return 1
+    return -(-min(len(environment.lobe_sharpness), MAX_ENV_LOBES) // 4)
+
+
+def variant_key(material_params, has_lights, has_environment, gbuffer=False, visibility_layers=0,
+                diffuse_rows=0):
+    """VariantKey of an export.MaterialParams in a scene (visibility_layers: of the object's bake, 0 without;
+    diffuse_rows: diffuse_visibility_rows of the scene, used with a bake and a diffuse term)."""
     from ..core.shading import GGX_NDF_LOBES
 
     fitted = getattr(material_params, "fitted", None)
     if fitted is not None:      # the stored lobe fit: its lobes, shadowing and base; only a normal map applies
         textures = ("normal_map",) if "normal_map" in material_params.textures else ()
         return VariantKey(FITTED_MODEL, int(fitted.lobe_count), bool(has_lights), bool(has_environment), textures,
-                          bool(gbuffer), int(visibility_layers), int(fitted.components))
+                          bool(gbuffer), int(visibility_layers), int(fitted.components),
+                          diffuse_visibility_rows=int(diffuse_rows) if visibility_layers else 0)
     model = material_params.model
     lobes = int(material_params.lobe_count) if model in ANISOTROPIC_MODELS else 1
     if model == "GGX":
@@ -144,7 +159,8 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False, vis
     textures = tuple(sorted(name for name in material_params.textures if name in TEXTURE_SLOTS
                             and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
     return VariantKey(model, lobes, bool(has_lights), bool(has_environment), textures, bool(gbuffer),
-                      int(visibility_layers), has_diffuse=has_diffuse, has_specular=has_specular)
+                      int(visibility_layers), has_diffuse=has_diffuse, has_specular=has_specular,
+                      diffuse_visibility_rows=int(diffuse_rows) if visibility_layers and has_diffuse else 0)
 
 
 def _read(path):
@@ -202,6 +218,8 @@ def defines(key):
     if key.visibility_layers:
         out["HAS_VISIBILITY"] = 1
         out["SSDF_MAX_LAYERS"] = key.visibility_layers
+    if key.diffuse_visibility_rows:
+        out["DIFFUSE_VISIBILITY_ROWS"] = key.diffuse_visibility_rows
     return out
 
 
@@ -237,6 +255,8 @@ def fragment_source(key):
         if file_name == "anisotropic_lobes.glsl" and (key.model not in ANISOTROPIC_MODELS or not key.has_specular):
             continue
         if file_name == "ggx_two_lobes.glsl" and not uses_ggx_table(key):
+            continue
+        if file_name == "lobe_visibility.glsl" and not key.visibility_layers:
             continue
         parts.append(_read(os.path.join(RESOURCE_DIR, file_name)))
     parts.append(_read(os.path.join(SHADER_DIR, "surface.frag.glsl")))
@@ -342,7 +362,9 @@ def create_info_calls(key):
         # the SSDF frame's normal and the vertex's PCA coefficients, interpolated per pixel (wang2009 5.3)
         interface.append(("smooth", ("VEC3", "world_ssdf_normal")))
         interface += [("smooth", ("VEC4", f"ssdf_coefficients_{layer}")) for layer in range(key.visibility_layers)]
-    calls.append(("vertex_out", (f"sgprt_surface_interface_{key.visibility_layers}", tuple(interface))))
+        interface += [("smooth", ("VEC4", f"diffuse_fractions_{row}")) for row in range(key.diffuse_visibility_rows)]
+    calls.append(("vertex_out", (f"sgprt_surface_interface_{key.visibility_layers}_{key.diffuse_visibility_rows}",
+                                 tuple(interface))))
     calls.append(("push_constant", ("MAT4", "model_matrix")))
     if key.gbuffer:
         calls += [("push_constant", ("INT", "gbuffer_object_index")),
@@ -362,6 +384,8 @@ def create_info_calls(key):
     if key.visibility_layers:
         samplers.append(("FLOAT_2D", "visibility_coefficients"))       # read in the vertex shader
         samplers.append(("FLOAT_2D_ARRAY", "visibility_basis"))
+    if key.diffuse_visibility_rows:
+        samplers.append(("FLOAT_2D", "diffuse_visibility"))             # read in the vertex shader
     calls += [("sampler", (slot, kind, name)) for slot, (kind, name) in enumerate(samplers)]
     calls += [("fragment_out", (index, "VEC4", "out_" + name)) for index, name in enumerate(output_names(key.gbuffer))]
     calls.append(("vertex_source", (vertex_source(),)))
@@ -518,3 +542,41 @@ def depth_create_info():
 
 def get_depth_shader():
     return _cached_fixed_shader(("depth",), depth_create_info, "depth pre-pass")
+
+
+def vertex_visibility_create_info(visibility_layers, rows, has_environment):
+    """The per-vertex pass of the broad diffuse lobes (resources/vertex_visibility.frag.glsl), drawn as
+    one full-screen triangle over its target (one texel a vertex and vec4)."""
+    import gpu
+
+    info = gpu.types.GPUShaderCreateInfo()
+    for name, value in LIMITS.items():
+        info.define(name, str(value))
+    info.define("HAS_VISIBILITY", "1")
+    info.define("SSDF_MAX_LAYERS", str(visibility_layers))
+    info.define("DIFFUSE_VISIBILITY_ROWS", str(rows))
+    if has_environment:
+        info.define("HAS_ENVIRONMENT", "1")
+    info.typedef_source(typedef_source())
+    info.vertex_in(0, "VEC2", "position")
+    interface = gpu.types.GPUStageInterfaceInfo("sgprt_vertex_visibility_interface")
+    interface.smooth("VEC2", "ndc")
+    info.vertex_out(interface)
+    info.push_constant("MAT4", "model_matrix")
+    info.uniform_buf(0, "SceneData", "scene")
+    info.sampler(0, "FLOAT_2D", "visibility_coefficients")
+    info.sampler(1, "FLOAT_2D", "vertex_normals")
+    info.sampler(2, "FLOAT_2D_ARRAY", "visibility_basis")
+    info.fragment_out(0, "VEC4", "out_fractions")
+    info.vertex_source(_read(os.path.join(RESOURCE_DIR, "background.vert.glsl")))
+    info.fragment_source("\n".join([library_source(name) for name in
+                                    ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "ssdf.glsl")]
+                                   + [_read(os.path.join(RESOURCE_DIR, name)) for name in
+                                      ("lobe_visibility.glsl", "vertex_visibility.frag.glsl")]))
+    return info
+
+
+def get_vertex_visibility_shader(visibility_layers, rows, has_environment):
+    return _cached_fixed_shader(("vertex_visibility", int(visibility_layers), int(rows), bool(has_environment)),
+                                lambda: vertex_visibility_create_info(visibility_layers, rows, has_environment),
+                                "per-vertex visibility")

@@ -1,53 +1,23 @@
 /* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43);
  * mirrored line by line by sg_prt_addon/core/shading.py.  Needs sg.glsl, hemisphere.glsl,
  * clamped_cosine.glsl, (HAS_LIGHTS) lights.glsl, (HAS_SPECULAR) brdf.glsl + warp.glsl,
- * (HAS_ENVIRONMENT and HAS_SPECULAR) env_prefilter.glsl and (HAS_VISIBILITY) ssdf.glsl, plus the
- * `scene` uniform block.  HAS_DIFFUSE / HAS_SPECULAR (shader_variants.material_terms): without one,
+ * (HAS_ENVIRONMENT and HAS_SPECULAR) env_prefilter.glsl and (HAS_VISIBILITY) ssdf.glsl +
+ * lobe_visibility.glsl, plus the `scene` uniform block.  DIFFUSE_VISIBILITY_ROWS (with HAS_VISIBILITY and
+ * HAS_DIFFUSE): the broad diffuse lobes' visible fractions come interpolated from the vertices
+ * (diffuse_fractions, filled by surface.frag.glsl from resources/vertex_visibility.frag.glsl's pass).  HAS_DIFFUSE / HAS_SPECULAR (shader_variants.material_terms): without one,
  * its term is left out (its colour is zero, so the full variant's term is exactly zero). */
 
 #ifdef HAS_VISIBILITY
-/* The pixel's interpolated SSDF coefficient rows and the bake's local frame of its interpolated
- * SSDF normal (ssdf_local_frame, rows t, b, n): set once per pixel by set_visibility_frame(). */
-vec4 visibility_rows[SSDF_MAX_LAYERS];
-mat3 visibility_frame;
-
-void set_visibility_frame(vec3 ssdf_normal)
-{
-  vec3 t, b, n;
-  ssdf_local_frame(ssdf_normal, t, b, n);
-  visibility_frame = mat3(t, b, n);             /* columns: local = world * visibility_frame */
-}
-
-/* Visible fraction of the clamped-cosine integral I(G, n) of a lobe G (wang2009 eq. 39-43 with
- * eq. 30-31): the product lobe P = G (x) C*(n) (eq. 40's cosine lobe), theta_d = SSDF at P's axis in
- * the vertex's local frame, and the fraction fh(theta_d, lambda_P) / fh(theta_h, lambda_P), where
- * theta_h is the axis's angle to the horizon of the SSDF normal: what eq. 31 keeps of P relative to
- * what the horizon alone keeps (the SSDF includes the horizon, I(G, n) already clamps it).
- * Unoccluded (theta_d = theta_h) it is 1: the unshadowed shading; clamped to [0, 1].
- * The two fh_normalized_from_sine (hemisphere.glsl) share k(lambda), erf(k) and e^-lambda. */
-float lobe_visibility(vec3 axis, float sharpness, vec3 n)
-{
-  vec2 cosine_lobe = clamped_cosine_lobe();
-  vec3 product_axis;
-  float product_sharpness, product_amplitude;
-  sg_product(axis, sharpness, 1.0, n, cosine_lobe.x, 1.0, product_axis, product_sharpness, product_amplitude);
-  vec3 local = product_axis * visibility_frame;            /* ssdf_to_local */
-  float theta_d = ssdf_decode(visibility_basis, visibility_rows, SSDF_MAX_LAYERS, local);
-  float lam = max(product_sharpness, 0.0);
-  float k = fh_k(lam);
-  float erf_k = erf_approx(k);
-  float lower = exp(-lam);
-  float x_d = clamp(sin(clamp(theta_d, -0.5 * SG_PI, 0.5 * SG_PI)), -1.0, 1.0);
-  float x_h = clamp(safe_normalize(local).z, -1.0, 1.0);
-  float g_d = erf_approx(k * x_d * (1.0 + FH_SHAPE_B * (1.0 - x_d * x_d))) / erf_k;
-  float g_h = erf_approx(k * x_h * (1.0 + FH_SHAPE_B * (1.0 - x_h * x_h))) / erf_k;
-  float visible = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_d), 0.0, 1.0);
-  float unshadowed = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_h), 0.0, 1.0);
-  return clamp(visible / max(unshadowed, 1.0e-30), 0.0, 1.0);
-}
 #define LOBE_VISIBILITY(axis, sharpness) lobe_visibility(axis, sharpness, n)
 #else
 #define LOBE_VISIBILITY(axis, sharpness) 1.0
+#endif
+#ifdef DIFFUSE_VISIBILITY_ROWS
+/* environment lobe e (the constant world: 0), 4 a row */
+vec4 diffuse_fractions[DIFFUSE_VISIBILITY_ROWS];
+#define DIFFUSE_VISIBILITY(e, axis, sharpness) diffuse_fractions[(e) / 4][(e) % 4]
+#else
+#define DIFFUSE_VISIBILITY(e, axis, sharpness) LOBE_VISIBILITY(axis, sharpness)
 #endif
 
 /* Unit normal, tangent by Gram-Schmidt (fallback if parallel), bitangent n x t. */
@@ -422,11 +392,11 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   for (int e = 0; e < scene.counts.z; e++) {
     irradiance += scene.env_amplitude[e].rgb *
                   (sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, 1.0, n) *
-                   LOBE_VISIBILITY(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w));   /* eq. 39 */
+                   DIFFUSE_VISIBILITY(e, scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w));   /* eq. 39 */
   }
 #else
   /* a constant world: the cosine lobe alone (a zero-sharpness G) */
-  irradiance += SG_PI * scene.world_colour.rgb * LOBE_VISIBILITY(n, 0.0);
+  irradiance += SG_PI * scene.world_colour.rgb * DIFFUSE_VISIBILITY(0, n, 0.0);
 #endif
 #endif
 

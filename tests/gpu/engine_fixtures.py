@@ -257,7 +257,8 @@ def clear_bakes():
 def pixel_visibility(result, mask):
     """core.shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
     as the GPU interpolates: the triangle (position.w - 1) of the object (normal.w - 1), barycentric
-    weights from the interpolated world position, the corners' vertex rows and SSDF normals.
+    weights from the interpolated world position, the corners' vertex rows and SSDF normals, and the
+    broad diffuse lobes' visibility decoded at the corners' vertices.
     None when the object has no usable bake."""
     from sg_prt_addon.blender import export
     from sg_prt_addon.core import shading
@@ -284,5 +285,9 @@ def pixel_visibility(result, mask):
     vertex = mesh.corner_vertex.astype(np.int64)[corners]                   # (N, 3) mesh vertices
     rows = np.einsum("nk,nkc->nc", weights, data.packed[vertex].astype(np.float64))
     normal = np.einsum("nk,nkc->nc", weights, mesh.vertex_normals[vertex].astype(np.float64))
+    # the broad diffuse lobes: decoded at the vertices, interpolated (renderer's per-vertex pass)
+    at_vertices = shading.vertex_diffuse_visibility(state.environment, shading.Visibility(
+        rows=data.packed, normal=mesh.vertex_normals, basis_texture=data.basis_texture))
+    diffuse = np.einsum("nk,nke->ne", weights, at_vertices[vertex].astype(np.float64))
     return shading.Visibility(rows=rows.astype(np.float32), normal=normal.astype(np.float32),
-                              basis_texture=data.basis_texture)
+                              basis_texture=data.basis_texture, diffuse=diffuse.astype(np.float32))

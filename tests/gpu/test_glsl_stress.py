@@ -514,7 +514,8 @@ def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
 # ---- shaders/resources: the per-pixel pieces that can be called alone
 
 RESOURCE_KERNELS = {
-    "sg_shading.glsl": ["set_visibility_frame", "lobe_visibility", "shading_frame", "apply_normal_map",
+    "lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility"],
+    "sg_shading.glsl": ["shading_frame", "apply_normal_map",
                         "rotate_tangent", "model_ndf_lobe", "model_m_factor", "fitted_layer",
                         "fitted_select_texel", "fitted_node_theta", "fitted_node_value", "fitted_shadowing_at",
                         "fitted_shadowing_of", "fitted_m_factor"],
@@ -525,7 +526,7 @@ LIBRARY_ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl
 
 
 def test_lobe_visibility_stress(glsl, fuzz):
-    """sg_shading.glsl's lobe_visibility (HAS_VISIBILITY) after set_visibility_frame: any lobe, any
+    """lobe_visibility.glsl's lobe_visibility after set_visibility_frame: any lobe, any
     normal and SSDF normal (zero, tiny, huge, opposite), random bake rows: a fraction in [0, 1]."""
     x = _sg_inputs()
     count = len(x["sharpness"])
@@ -533,9 +534,7 @@ def test_lobe_visibility_stress(glsl, fuzz):
     rows[:, 0] = 1.0
     ssdf_normal = fuzz.stress_vectors(count)
     ssdf_normal[::3] = x["normal"][::3]
-    shading = _resource("sg_shading.glsl")
-    source = ("vec4 visibility_rows[SSDF_MAX_LAYERS];\nmat3 visibility_frame;\n"
-              + _glsl_function(shading, "set_visibility_frame") + _glsl_function(shading, "lobe_visibility"))
+    source = _resource("lobe_visibility.glsl")          # its globals, set_visibility_frame, lobe_visibility
     body = """
     visibility_rows[0] = c0; visibility_rows[1] = c1; visibility_rows[2] = c2;
     set_visibility_frame(s.xyz);

@@ -147,10 +147,16 @@ def test_skipped_variants_lack_the_code():
     _assert_lacks(specular_only, DIFFUSE_CODE, "HAS_DIFFUSE")
     assert "environment_radiance(" in variant_code(specular_only)
     # the light loop's SSDF decodes go with the term: specular-only decodes light x slice products only
-    def decodes(key):
-        code = variant_code(key)
-        return code.count("lobe_visibility(") + code.count("LOBE_VISIBILITY(")
+    def decodes(key):       # visibility call sites, macro definitions aside
+        code = "\n".join(line for line in variant_code(key).split("\n") if not line.lstrip().startswith("#define"))
+        return sum(code.count(name) for name in ("lobe_visibility(", "LOBE_VISIBILITY(", "DIFFUSE_VISIBILITY("))
     assert decodes(specular_only) == decodes(shader_variants.variant_key(MaterialParams(), **full)) - 2
+    # with the per-vertex pass the environment's diffuse lobes read the interpolated fractions
+    per_vertex_key = shader_variants.variant_key(MaterialParams(), **full, diffuse_rows=2)
+    assert shader_variants.defines(per_vertex_key)["DIFFUSE_VISIBILITY_ROWS"] == 2
+    assert "diffuse_fractions[1] = diffuse_fractions_1;" in variant_code(per_vertex_key)
+    assert shader_variants.variant_key(MaterialParams(diffuse_color=(0.0, 0.0, 0.0)), **full,
+                                       diffuse_rows=2).diffuse_visibility_rows == 0
     _assert_lacks(shader_variants.variant_key(MaterialParams(), False, True, False, 3), LIGHT_CODE, "HAS_LIGHTS")
     _assert_lacks(shader_variants.variant_key(MaterialParams(), True, False, False, 3), ENVIRONMENT_CODE,
                   "HAS_ENVIRONMENT")

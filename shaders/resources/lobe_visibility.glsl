@@ -1,0 +1,44 @@
+/* SSDF visibility of one SG lobe against the clamped cosine (wang2009 eq. 39-43 with eq. 30-31), shared by
+ * the surface shader (resources/sg_shading.glsl) and the per-vertex pass of the broad diffuse lobes
+ * (resources/vertex_visibility.frag.glsl).  Needs sg.glsl, hemisphere.glsl, clamped_cosine.glsl, ssdf.glsl
+ * and the `visibility_basis` sampler. */
+
+/* The pixel's (or vertex's) SSDF coefficient rows and the bake's local frame of its SSDF normal
+ * (ssdf_local_frame, rows t, b, n): set once by set_visibility_frame(). */
+vec4 visibility_rows[SSDF_MAX_LAYERS];
+mat3 visibility_frame;
+
+void set_visibility_frame(vec3 ssdf_normal)
+{
+  vec3 t, b, n;
+  ssdf_local_frame(ssdf_normal, t, b, n);
+  visibility_frame = mat3(t, b, n);             /* columns: local = world * visibility_frame */
+}
+
+/* Visible fraction of the clamped-cosine integral I(G, n) of a lobe G (wang2009 eq. 39-43 with
+ * eq. 30-31): the product lobe P = G (x) C*(n) (eq. 40's cosine lobe), theta_d = SSDF at P's axis in
+ * the vertex's local frame, and the fraction fh(theta_d, lambda_P) / fh(theta_h, lambda_P), where
+ * theta_h is the axis's angle to the horizon of the SSDF normal: what eq. 31 keeps of P relative to
+ * what the horizon alone keeps (the SSDF includes the horizon, I(G, n) already clamps it).
+ * Unoccluded (theta_d = theta_h) it is 1: the unshadowed shading; clamped to [0, 1].
+ * The two fh_normalized_from_sine (hemisphere.glsl) share k(lambda), erf(k) and e^-lambda. */
+float lobe_visibility(vec3 axis, float sharpness, vec3 n)
+{
+  vec2 cosine_lobe = clamped_cosine_lobe();
+  vec3 product_axis;
+  float product_sharpness, product_amplitude;
+  sg_product(axis, sharpness, 1.0, n, cosine_lobe.x, 1.0, product_axis, product_sharpness, product_amplitude);
+  vec3 local = product_axis * visibility_frame;            /* ssdf_to_local */
+  float theta_d = ssdf_decode(visibility_basis, visibility_rows, SSDF_MAX_LAYERS, local);
+  float lam = max(product_sharpness, 0.0);
+  float k = fh_k(lam);
+  float erf_k = erf_approx(k);
+  float lower = exp(-lam);
+  float x_d = clamp(sin(clamp(theta_d, -0.5 * SG_PI, 0.5 * SG_PI)), -1.0, 1.0);
+  float x_h = clamp(safe_normalize(local).z, -1.0, 1.0);
+  float g_d = erf_approx(k * x_d * (1.0 + FH_SHAPE_B * (1.0 - x_d * x_d))) / erf_k;
+  float g_h = erf_approx(k * x_h * (1.0 + FH_SHAPE_B * (1.0 - x_h * x_h))) / erf_k;
+  float visible = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_d), 0.0, 1.0);
+  float unshadowed = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_h), 0.0, 1.0);
+  return clamp(visible / max(unshadowed, 1.0e-30), 0.0, 1.0);
+}
