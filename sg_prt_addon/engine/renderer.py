@@ -6,12 +6,20 @@ what SceneState marks dirty is re-uploaded.  Must run where the `gpu` module
 works: inside render() with bl_use_gpu_context, or in view_update/view_draw.
 """
 
+import collections
+
 import numpy as np
 
 from . import shader_variants
 from .shader_variants import GBUFFER_OUTPUTS, MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 
 PASS_NAMES = ("Combined", "Diffuse", "Specular")
+
+# GPU copies of scene_state's environment cache entries (one EnvironmentData object per pixels and
+# layer size): a later render's new Renderer finds them here instead of uploading the map again.
+# id(EnvironmentData) -> (EnvironmentData, prefiltered layers, equirect map), least recently used first.
+ENVIRONMENT_TEXTURE_CACHE_SIZE = 2
+_environment_textures = collections.OrderedDict()
 
 
 def _column_major(matrix):
@@ -191,6 +199,26 @@ class MeshBuffers:
         self.vertices = vertices
 
 
+def environment_textures(environment, equirect):
+    """(prefiltered layers, equirect map) GPU textures of an EnvironmentData and the map it was made of,
+    shared by every Renderer while the environment cache keeps the EnvironmentData."""
+    entry = _environment_textures.get(id(environment))
+    if entry is not None and entry[0] is environment:
+        _environment_textures.move_to_end(id(environment))
+        return entry[1], entry[2]
+    layers = environment.prefiltered.layers
+    padded = np.ones(layers.shape[:3] + (4,), np.float32)
+    padded[..., :layers.shape[3]] = layers
+    # the map itself for the background, in Blender's row order (texture t = 0 at the bottom)
+    rgba = np.ones(equirect.shape[:2] + (4,), np.float32)
+    rgba[..., :3] = equirect[::-1]
+    entry = (environment, _texture_2d_array(padded), _texture_2d(rgba))
+    _environment_textures[id(environment)] = entry
+    while len(_environment_textures) > ENVIRONMENT_TEXTURE_CACHE_SIZE:
+        _environment_textures.popitem(last=False)        # freed here, in the caller's GPU context
+    return entry[1], entry[2]
+
+
 class Renderer:
     """Owns the GPU resources of one SceneState and draws it."""
 
@@ -251,16 +279,9 @@ class Renderer:
                     from ..blender import export
                     self.textures[key] = _texture_2d(export.texture_pixels(bpy.data.images[image_name], slot))
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
-            layers = state.environment.prefiltered.layers
-            padded = np.ones(layers.shape[:3] + (4,), np.float32)
-            padded[..., :layers.shape[3]] = layers
-            self.environment_texture = _texture_2d_array(padded)
+            self.environment_texture, self.equirect_texture = environment_textures(state.environment,
+                                                                                   state.world.equirect)
             self.environment_source = state.environment
-            # the map itself for the background, in Blender's row order (texture t = 0 at the bottom)
-            equirect = state.world.equirect[::-1]
-            rgba = np.ones(equirect.shape[:2] + (4,), np.float32)
-            rgba[..., :3] = equirect
-            self.equirect_texture = _texture_2d(rgba)
         block = scene_block(camera, state.light_data(), state.environment)
         if self.scene_buffer is None:
             self.scene_buffer = _uniform_buffer(block)

@@ -291,3 +291,39 @@ def test_shaders_outlive_final_renders(engine, monkeypatch):
         np.testing.assert_array_equal(fx.render(scene)["passes"]["Combined"], image)
         assert len(shader_variants._cache) <= 4
     assert shader_variants.compile_count["surface"] == compiles + 4     # three, then the first again
+
+
+def test_environment_textures_outlive_final_renders(engine):
+    """A later render of the same world reuses the GPU copies of its prefiltered layers and map (the
+    environment cache hands it the same EnvironmentData); another world uploads its own, and the
+    first world's stay cached (ENVIRONMENT_TEXTURE_CACHE_SIZE 2)."""
+    from sg_prt_addon.engine import render_engine, renderer
+
+    assert renderer.ENVIRONMENT_TEXTURE_CACHE_SIZE >= 2
+    scene = fx.new_scene("environment_textures", 32, 32)
+    node = fx.world_texture(scene, fx.studio_world_path("courtyard.exr")).node_tree.nodes["Environment Texture"]
+    fx.uv_sphere(scene, "environment_textures_sphere", (0.0, 0.0, 1.0), segments=12, rings=6)
+    courtyard_image = node.image
+
+    def render():       # last_render is overwritten by the next render: keep what this one left
+        result = fx.render(scene)
+        return result["after_frame"], result["passes"]["Combined"].copy()
+
+    render_engine.debug["after_frame"] = lambda depsgraph, state, renderer_, camera: (
+        renderer_.environment_texture, renderer_.equirect_texture)
+    try:
+        first_textures, first_image = render()
+        again_textures, again_image = render()
+        import bpy
+        node.image = bpy.data.images.load(fx.studio_world_path("forest.exr"), check_existing=True)
+        forest_textures, forest_image = render()
+        node.image = courtyard_image
+        back_textures, back_image = render()
+    finally:
+        render_engine.debug["after_frame"] = None
+    assert all(a is b for a, b in zip(first_textures, again_textures))
+    assert not any(a is b for a, b in zip(first_textures, forest_textures))
+    assert all(a is b for a, b in zip(first_textures, back_textures))
+    np.testing.assert_array_equal(first_image, again_image)
+    np.testing.assert_array_equal(first_image, back_image)
+    assert np.abs(forest_image - first_image).max() > 0.01
