@@ -179,8 +179,16 @@ def sg_clamped_cosine_integral(axis, sharpness, amplitude, normal):
 
 def clamped_cosine_from_cosine(cosine, sharpness):
     """I(c, lambda) with unit amplitude, c = n.p in [-1, 1] (fast closed form, keeps the dtype)."""
-    dtype = _float_dtype(cosine, sharpness)
-    c = np.clip(np.asarray(cosine, dtype), -1, 1)
+    return clamped_cosine_from_terms(cosine, sharpness, sharpness_terms(sharpness, _float_dtype(cosine, sharpness)))
+
+
+SHARPNESS_TERMS = ("upper", "lower", "mean", "variance", "scale", "beta", "tangential", "at_bottom")
+
+
+def sharpness_terms(sharpness, dtype=None):
+    """(..., 8) the parts of clamped_cosine_from_cosine that depend on lambda alone (SHARPNESS_TERMS):
+    computed once a lobe when many normals see the same lobe (an environment's SG mixture)."""
+    dtype = np.dtype(dtype or _float_dtype(sharpness))
     lam = np.maximum(np.asarray(sharpness, dtype), 0)
     fit_lam = np.minimum(lam, _FIT_SHARPNESS_LIMIT)
     upper, lower = _pole_integrals(lam)
@@ -188,12 +196,22 @@ def clamped_cosine_from_cosine(cosine, sharpness):
     scale = 1 + (VARIANCE_F1 * fit_lam + VARIANCE_F0) / (fit_lam * fit_lam + VARIANCE_F3 * fit_lam + VARIANCE_F2)
     lam_power = fit_lam ** dtype.type(TAIL_POWER)
     beta = lam_power / (lam_power + dtype.type(TAIL_OFFSET))
-    sin_alpha = np.sqrt(np.maximum(1 - c * c, 0))
-    across = (1 - beta) * (1 - c * c) + beta * 0.5 * (1 + sin_alpha)
     tangential = mean_cos / np.maximum(lam, np.finfo(dtype).tiny)  # E[sin^2 theta] / 2 = L / lambda
     tangential = np.where(lam > 0, tangential, dtype.type(1 / 3))
-    positive = _gaussian_positive_mean(c * mean_cos, scale * (c * c * var_cos + across * tangential))
     at_bottom = _gaussian_positive_mean(-mean_cos, scale * (var_cos + 0.5 * beta * tangential))
+    terms = np.broadcast_arrays(upper, lower, mean_cos, var_cos, scale, beta, tangential, at_bottom)
+    return np.stack(terms, axis=-1).astype(dtype, copy=False)
+
+
+def clamped_cosine_from_terms(cosine, sharpness, terms):
+    """clamped_cosine_from_cosine given the sharpness_terms of its lambda."""
+    dtype = _float_dtype(cosine, sharpness, terms)
+    c = np.clip(np.asarray(cosine, dtype), -1, 1)
+    lam = np.maximum(np.asarray(sharpness, dtype), 0)
+    upper, lower, mean_cos, var_cos, scale, beta, tangential, at_bottom = np.moveaxis(np.asarray(terms, dtype), -1, 0)
+    sin_alpha = np.sqrt(np.maximum(1 - c * c, 0))
+    across = (1 - beta) * (1 - c * c) + beta * 0.5 * (1 + sin_alpha)
+    positive = _gaussian_positive_mean(c * mean_cos, scale * (c * c * var_cos + across * tangential))
     fraction = np.clip((positive - at_bottom) / np.maximum(mean_cos, np.finfo(dtype).tiny), 0, 1)
     fraction = np.where(mean_cos > 0, fraction, 0.5 * (1 + c))  # lambda -> 0: s = (1 + c) / 2
     two_pi_over_lambda = sg.TWO_PI / np.where(lam > 0, lam, 1)

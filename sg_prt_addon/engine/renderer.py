@@ -10,6 +10,7 @@ import collections
 
 import numpy as np
 
+from ..core import clamped_cosine
 from . import shader_variants
 from .shader_variants import GBUFFER_OUTPUTS, MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 
@@ -96,6 +97,9 @@ def scene_block(camera, light_data, environment):
         vec4_array(MAX_ENV_LOBES, np.concatenate([environment.lobe_axis, environment.lobe_sharpness[:, None]], 1)
                    [:env_lobes] if env_lobes else []),
         vec4_array(MAX_ENV_LOBES, np.pad(environment.lobe_amplitude, ((0, 0), (0, 1)))[:env_lobes]
+                   if env_lobes else []),
+        # the diffuse lobes' clamped-cosine terms of lambda alone: once a frame, not once a pixel
+        vec4_array(2 * MAX_ENV_LOBES, clamped_cosine.sharpness_terms(environment.lobe_sharpness[:env_lobes], np.float32)
                    if env_lobes else []),
         np.asarray(_column_major(camera.projection @ camera.view), np.float32).reshape(4, 4),   # mat4 columns
     ]

@@ -7,6 +7,8 @@
  *   clamped_cosine_pole_integrals       <- clamped_cosine._pole_integrals (vec2(upper, lower))
  *   clamped_cosine_langevin_moments     <- clamped_cosine._langevin_moments (vec2(L, V))
  *   clamped_cosine_gaussian_positive_mean <- clamped_cosine._gaussian_positive_mean
+ *   clamped_cosine_sharpness_terms      <- clamped_cosine.sharpness_terms (two vec4)
+ *   clamped_cosine_from_terms           <- clamped_cosine.clamped_cosine_from_terms
  *   clamped_cosine_from_cosine          <- clamped_cosine.clamped_cosine_from_cosine
  *   sg_clamped_cosine_integral          <- clamped_cosine.sg_clamped_cosine_integral
  *
@@ -99,6 +101,41 @@ float clamped_cosine_gaussian_positive_mean(float mean, float variance)
          + sigma * 0.3989422804014327 * exp(-0.5 * ratio * ratio);
 }
 
+/* The parts of I(c, lambda) that depend on lambda alone (clamped_cosine.SHARPNESS_TERMS): poles_moments =
+ * (I_up, I_low, L, V) / as below, shape = (variance scale f, tail blend beta, L / lambda, s's value at
+ * c = -1 before normalising).  lambda > 0 (clamped to [MIN, MAX]_SHARPNESS). */
+void clamped_cosine_sharpness_terms(float sharpness, out vec4 poles_moments, out vec4 shape)
+{
+  float lam = clamp(sharpness, CLAMPED_COSINE_MIN_SHARPNESS, CLAMPED_COSINE_MAX_SHARPNESS);
+  vec2 poles = clamped_cosine_pole_integrals(lam);
+  vec2 moments = clamped_cosine_langevin_moments(lam);
+  float scale = 1.0 + (CLAMPED_COSINE_VARIANCE_F1 * lam + CLAMPED_COSINE_VARIANCE_F0)
+                      / (lam * lam + CLAMPED_COSINE_VARIANCE_F3 * lam + CLAMPED_COSINE_VARIANCE_F2);
+  float lam_power = pow(lam, CLAMPED_COSINE_TAIL_POWER);
+  float beta = lam_power / (lam_power + CLAMPED_COSINE_TAIL_OFFSET);
+  float tangential = moments.x / lam;  /* E[sin^2 theta] / 2 = L / lambda */
+  float at_bottom = clamped_cosine_gaussian_positive_mean(-moments.x, scale * (moments.y + 0.5 * beta * tangential));
+  poles_moments = vec4(poles, moments);
+  shape = vec4(scale, beta, tangential, at_bottom);
+}
+
+/* I(c, lambda) with unit amplitude given lambda's clamped_cosine_sharpness_terms (lambda <= 0: pi). */
+float clamped_cosine_from_terms(float cosine, float sharpness, vec4 poles_moments, vec4 shape)
+{
+  if (!(sharpness > 0.0)) {
+    return SG_PI;  /* lambda -> 0: the cosine's own integral */
+  }
+  float c = clamp(cosine, -1.0, 1.0);
+  float lam = clamp(sharpness, CLAMPED_COSINE_MIN_SHARPNESS, CLAMPED_COSINE_MAX_SHARPNESS);
+  float mean_cos = poles_moments.z;
+  float sin_alpha = sqrt(max(1.0 - c * c, 0.0));
+  float across = (1.0 - shape.y) * (1.0 - c * c) + shape.y * 0.5 * (1.0 + sin_alpha);
+  float positive = clamped_cosine_gaussian_positive_mean(c * mean_cos,
+                                                         shape.x * (c * c * poles_moments.w + across * shape.z));
+  float fraction = mean_cos > 0.0 ? clamp((positive - shape.w) / mean_cos, 0.0, 1.0) : 0.5 * (1.0 + c);
+  return SG_TWO_PI / lam * (poles_moments.y + (poles_moments.x - poles_moments.y) * fraction);
+}
+
 /* I(c, lambda) with unit amplitude, c = n.p: I_low + (I_up - I_low) s(c), s from a
  * Gaussian model of X = n.i with the Langevin moments, a fitted variance scale and
  * a fitted tail blend (clamped_cosine.py's module docstring). */
@@ -107,23 +144,9 @@ float clamped_cosine_from_cosine(float cosine, float sharpness)
   if (!(sharpness > 0.0)) {
     return SG_PI;  /* lambda -> 0: the cosine's own integral */
   }
-  float c = clamp(cosine, -1.0, 1.0);
-  float lam = clamp(sharpness, CLAMPED_COSINE_MIN_SHARPNESS, CLAMPED_COSINE_MAX_SHARPNESS);
-  vec2 poles = clamped_cosine_pole_integrals(lam);
-  vec2 moments = clamped_cosine_langevin_moments(lam);
-  float mean_cos = moments.x;
-  float var_cos = moments.y;
-  float scale = 1.0 + (CLAMPED_COSINE_VARIANCE_F1 * lam + CLAMPED_COSINE_VARIANCE_F0)
-                      / (lam * lam + CLAMPED_COSINE_VARIANCE_F3 * lam + CLAMPED_COSINE_VARIANCE_F2);
-  float lam_power = pow(lam, CLAMPED_COSINE_TAIL_POWER);
-  float beta = lam_power / (lam_power + CLAMPED_COSINE_TAIL_OFFSET);
-  float sin_alpha = sqrt(max(1.0 - c * c, 0.0));
-  float across = (1.0 - beta) * (1.0 - c * c) + beta * 0.5 * (1.0 + sin_alpha);
-  float tangential = mean_cos / lam;  /* E[sin^2 theta] / 2 = L / lambda */
-  float positive = clamped_cosine_gaussian_positive_mean(c * mean_cos, scale * (c * c * var_cos + across * tangential));
-  float at_bottom = clamped_cosine_gaussian_positive_mean(-mean_cos, scale * (var_cos + 0.5 * beta * tangential));
-  float fraction = mean_cos > 0.0 ? clamp((positive - at_bottom) / mean_cos, 0.0, 1.0) : 0.5 * (1.0 + c);
-  return SG_TWO_PI / lam * (poles.y + (poles.x - poles.y) * fraction);
+  vec4 poles_moments, shape;
+  clamped_cosine_sharpness_terms(sharpness, poles_moments, shape);
+  return clamped_cosine_from_terms(cosine, sharpness, poles_moments, shape);
 }
 
 /* Integral over the sphere of G(i; p, lambda, mu) max(0, n.i) (closed form). */

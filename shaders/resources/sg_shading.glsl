@@ -391,7 +391,9 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef HAS_ENVIRONMENT
   for (int e = 0; e < scene.counts.z; e++) {
     irradiance += scene.env_amplitude[e].rgb *
-                  (sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, 1.0, n) *
+                  (clamped_cosine_from_terms(dot(safe_normalize(scene.env_axis_sharpness[e].xyz), n),
+                                             scene.env_axis_sharpness[e].w, scene.env_cosine_terms[2 * e],
+                                             scene.env_cosine_terms[2 * e + 1]) *
                    DIFFUSE_VISIBILITY(e, scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w));   /* eq. 39 */
   }
 #else

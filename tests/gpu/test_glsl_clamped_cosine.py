@@ -50,6 +50,29 @@ def test_clamped_cosine_integral(glsl, fuzz, record_error):
                         error[well_conditioned].max()) <= 3e-5
 
 
+def test_from_terms(glsl, fuzz, record_error):
+    """The lambda-only terms as the renderer computes them (numpy float32, in the scene block) and as
+    the GLSL does, each through clamped_cosine_from_terms: against numpy's I(c, lambda)."""
+    cosine = fuzz.f32(np.concatenate([[-1.0, 1.0, 0.0, 0.5], fuzz.uniform(-1.0, 1.0, N)]))
+    sharpness = fuzz.f32(np.concatenate([[0.0, 1e-4, 0.3, 1e6], fuzz.log_uniform(1e-4, 1e6, N)]))
+    terms = clamped_cosine.sharpness_terms(sharpness, np.float32)
+    body = """
+    vec4 poles_moments, shape;
+    clamped_cosine_sharpness_terms(a.y, poles_moments, shape);
+    result = vec4(clamped_cosine_from_terms(a.x, a.y, t0, t1), clamped_cosine_from_terms(a.x, a.y, poles_moments, shape),
+                  0.0, 0.0);
+    """
+    out = glsl(LIB, body, {"a": np.c_[cosine, sharpness], "t0": terms[:, :4], "t1": terms[:, 4:]}, 4)
+    expected = clamped_cosine.clamped_cosine_from_cosine(cosine, sharpness)
+    np.testing.assert_array_equal(                   # the split is the same arithmetic
+        clamped_cosine.clamped_cosine_from_terms(cosine, sharpness, clamped_cosine.sharpness_terms(sharpness)), expected)
+    scale = clamped_cosine.clamped_cosine_from_cosine(np.ones_like(cosine), sharpness)
+    assert record_error("clamped_cosine from_terms (numpy terms), relative to I(c = 1)",
+                        (np.abs(out[:, 0] - expected) / scale).max()) <= 1e-5
+    assert record_error("clamped_cosine from_terms (GLSL terms), relative to I(c = 1)",
+                        (np.abs(out[:, 1] - expected) / scale).max()) <= 1e-5
+
+
 def test_from_cosine_and_lobe(glsl, fuzz, record_error):
     cosine = fuzz.f32(np.concatenate([[-1.0, 1.0, 0.0], fuzz.uniform(-1.0, 1.0, N)]))
     sharpness = fuzz.log_uniform(1e-4, 1e6, cosine.size)

@@ -334,7 +334,11 @@ def test_clamped_cosine_helpers_stress(glsl):
     vec2 moments = clamped_cosine_langevin_moments(s.x);
     float positive = clamped_cosine_gaussian_positive_mean(s.y * moments.x, s.y * s.y * moments.y);
     float at_zero_variance = clamped_cosine_gaussian_positive_mean(s.y, 0.0);
-    result = vec4(poles.x + poles.y, moments.x + moments.y, positive + at_zero_variance, lobe.x * lobe.y);
+    vec4 poles_moments, shape;
+    clamped_cosine_sharpness_terms(s.x, poles_moments, shape);
+    float from_terms = clamped_cosine_from_terms(s.y, s.x, poles_moments, shape);
+    result = vec4(poles.x + poles.y, moments.x + moments.y, positive + at_zero_variance,
+                  lobe.x * lobe.y + from_terms + dot(poles_moments, shape));
     """
     out = glsl(["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl"], body, inputs, 4)
     _assert_finite(out, "clamped_cosine pole integrals / Langevin moments / Gaussian positive mean")
@@ -706,7 +710,8 @@ COVERED = {
     test_sg_helpers_stress: ["sg_rotate", "sg_support_area", "sg_sharpness_from_area"],
     test_hemisphere_helpers_stress: ["erf_approx", "fh_k", "fh_normalized"],
     test_clamped_cosine_helpers_stress: ["clamped_cosine_lobe", "clamped_cosine_pole_integrals",
-                                         "clamped_cosine_langevin_moments", "clamped_cosine_gaussian_positive_mean"],
+                                         "clamped_cosine_langevin_moments", "clamped_cosine_gaussian_positive_mean",
+                                         "clamped_cosine_sharpness_terms", "clamped_cosine_from_terms"],
     test_brdf_helpers_stress: ["brdf_half_vector", "reflect_about", "brdf_theta", "brdf_log_cosine",
                                "shadowing_cook_torrance", "isotropic_polynomial", "isotropic_mapping_beckmann",
                                "isotropic_mapping_blinn_phong", "isotropic_mapping_ward_iso", "isotropic_mapping_ggx",
