@@ -36,6 +36,10 @@ def test_rows_and_target_check():
     assert check["engine_error"] == pytest.approx(0.04)
     assert check["eevee16_error"] == pytest.approx(math.sqrt(0.1 ** 2 - 0.03 ** 2))
     assert check["error_target_met"]
+    # the fastest shadowed setting below EEVEE 16's error (0.095): the bake (the unshadowed row is faster)
+    assert check["matched_setting"] == "bake R=32" and check["matched_time_ratio"] == pytest.approx(0.08)
+    assert "(target lower: met); fastest shadowed setting below EEVEE 16's error: bake R=32, error 0.040" \
+        in evt.target_lines([check])[0]
     assert evt.target_check(rows, "other") == {"scene": "other", "engine_setting": None}
 
     table = evt.markdown_table(rows).splitlines()

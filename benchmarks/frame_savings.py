@@ -1,0 +1,146 @@
+"""What the per-vertex diffuse visibility, the once-a-frame clamped-cosine terms and the caches kept
+across final renders save, on the example scenes, each against its own baseline in the same run.
+
+Per scene (examples/build_scenes.py at --size, baked by the operator with its defaults):
+- per-vertex diffuse visibility: steady frame (median of render_engine.debug["timed_redraws"]) with the
+  broad diffuse lobes decoded at the vertices vs per pixel (shader_variants.diffuse_visibility_rows
+  forced to 0, the variant's per-pixel path); also the Combined difference between the two, relative
+  RMSE over the surface pixels;
+- clamped-cosine terms: steady frame with the environment lobes' lambda-only terms read from the scene
+  block vs computed per pixel (the surface source patched back to sg_clamped_cosine_integral);
+- caches across renders: bpy.ops.render.render with the shader and environment-texture caches warm vs
+  emptied before each render (what every render paid before).
+Ratios: new / baseline, median over --rounds rounds, the pair rendered back to back each round.
+
+    .venv/bin/python -m benchmarks.frame_savings [--size 512] [--rounds 3] [--scenes NAME ...]
+"""
+import argparse
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+if REPO_ROOT not in sys.path:
+    sys.path.insert(0, REPO_ROOT)
+
+REDRAWS = 5
+# the environment lobes' cosine integral as every pixel computed it before the scene block held the terms
+TERMS_CALL = """(clamped_cosine_from_terms(dot(safe_normalize(scene.env_axis_sharpness[e].xyz), n),
+                                             scene.env_axis_sharpness[e].w, scene.env_cosine_terms[2 * e],
+                                             scene.env_cosine_terms[2 * e + 1]) *"""
+PER_PIXEL_CALL = ("(sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, "
+                  "1.0, n) *")
+
+
+def frame(per_vertex=True, terms=True):
+    """(steady frame seconds, Combined) of one render with the chosen paths."""
+    import bpy
+    from sg_prt_addon.engine import render_engine, shader_variants
+
+    rows, read = shader_variants.diffuse_visibility_rows, shader_variants._read
+
+    def patched_read(path):
+        text = read(path)
+        if path.endswith("sg_shading.glsl"):
+            assert TERMS_CALL in text, "sg_shading.glsl no longer has the call this benchmark replaces"
+            text = text.replace(TERMS_CALL, PER_PIXEL_CALL)
+        return text
+
+    if not per_vertex:
+        shader_variants.diffuse_visibility_rows = lambda environment: 0
+    if not terms:
+        shader_variants._read = patched_read
+    shader_variants.clear_cache()
+    render_engine.debug["timed_redraws"] = REDRAWS
+    try:
+        bpy.ops.render.render()
+    finally:
+        render_engine.debug["timed_redraws"] = 0
+        shader_variants.diffuse_visibility_rows, shader_variants._read = rows, read
+        shader_variants.clear_cache()
+    if "error" in render_engine.last_render:
+        raise RuntimeError(render_engine.last_render["error"])
+    return (statistics.median(render_engine.last_render["timings"]["frames"]),
+            render_engine.last_render["passes"]["Combined"].copy())
+
+
+def render_seconds(warm):
+    import bpy
+    from sg_prt_addon.engine import renderer, shader_variants
+
+    if not warm:
+        shader_variants.clear_cache()
+        renderer._environment_textures.clear()
+    start = time.perf_counter()
+    bpy.ops.render.render()
+    return time.perf_counter() - start
+
+
+def paired(rounds, new, old):
+    """(median new / old, min, max, median new, median old) over rounds, the order alternating."""
+    ratios, news, olds = [], [], []
+    for index in range(rounds):
+        first, second = (new, old) if index % 2 == 0 else (old, new)
+        a, b = first(), second()
+        n, o = (a, b) if index % 2 == 0 else (b, a)
+        news.append(n)
+        olds.append(o)
+        ratios.append(n / o)
+    return statistics.median(ratios), min(ratios), max(ratios), statistics.median(news), statistics.median(olds)
+
+
+def measure_scene(name, size, rounds):
+    import bpy
+    from examples import build_scenes
+
+    build_scenes.SCENES[name](size)
+    if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
+        raise RuntimeError(f"{name}: the visibility bake did not finish")
+    render_seconds(True)                       # compiles, prefilters
+    rows = {}
+    images = {}
+
+    def timed(key, **paths):
+        def run():
+            seconds, images[key] = frame(**paths)
+            return seconds
+        return run
+
+    rows["per-vertex diffuse visibility (frame)"] = paired(rounds, timed("per_vertex"), timed("per_pixel",
+                                                                                              per_vertex=False))
+    surface = np.abs(images["per_pixel"][..., :3]).sum(-1) > 0
+    difference = images["per_vertex"][..., :3][surface] - images["per_pixel"][..., :3][surface]
+    change = float(np.sqrt(np.mean(difference ** 2) / np.mean(images["per_pixel"][..., :3][surface] ** 2)))
+    rows["clamped-cosine terms once a frame (frame)"] = paired(rounds, timed("terms"), timed("no_terms", terms=False))
+    rows["shader + environment caches kept (render())"] = paired(rounds, lambda: render_seconds(True),
+                                                                lambda: render_seconds(False))
+    return rows, change
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--size", type=int, default=512)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--scenes", nargs="*", default=["suzanne_courtyard", "brushed_metal"])
+    args = parser.parse_args(argv)
+
+    import bpy
+    from sg_prt_addon import render
+
+    render.ensure_registered()
+    print(f"{args.size}x{args.size}, Blender {bpy.app.version_string}, {os.cpu_count()} cores, "
+          f"load average {os.getloadavg()[0]:.1f}")
+    print("| scene | saving | new s | baseline s | ratio (min-max) |\n|---|---|---|---|---|")
+    for name in args.scenes:
+        rows, change = measure_scene(name, args.size, args.rounds)
+        for label, (ratio, low, high, new, old) in rows.items():
+            print(f"| {name} | {label} | {new:.3f} | {old:.3f} | {ratio:.3f} ({low:.3f}-{high:.3f}) |", flush=True)
+        print(f"| {name} | per-vertex vs per-pixel Combined, relative RMSE | {change:.4f} | | |", flush=True)
+    print(f"load average {os.getloadavg()[0]:.1f} at the end")
+
+
+if __name__ == "__main__":
+    main()
