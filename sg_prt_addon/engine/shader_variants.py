@@ -480,19 +480,25 @@ def anisotropy_table(lobe_count):
     return np.ascontiguousarray(ndf_fit.anisotropy_table_array(lobe_count), np.float32)
 
 
-def background_create_info(has_environment):
+def _full_screen_create_info(interface_name, extra_defines):
+    """Create info of a full-screen triangle (resources/background.vert.glsl, `ndc` out) with the scene
+    block's typedefs, the limits and `extra_defines`: the caller adds the rest."""
     import gpu
 
     info = gpu.types.GPUShaderCreateInfo()
-    for name, value in LIMITS.items():
+    for name, value in {**LIMITS, **extra_defines}.items():
         info.define(name, str(value))
-    if has_environment:
-        info.define("HAS_ENVIRONMENT", "1")
     info.typedef_source(typedef_source())
     info.vertex_in(0, "VEC2", "position")
-    interface = gpu.types.GPUStageInterfaceInfo("sgprt_background_interface")
+    interface = gpu.types.GPUStageInterfaceInfo(interface_name)
     interface.smooth("VEC2", "ndc")
     info.vertex_out(interface)
+    info.vertex_source(_read(os.path.join(RESOURCE_DIR, "background.vert.glsl")))
+    return info
+
+
+def background_create_info(has_environment):
+    info = _full_screen_create_info("sgprt_background_interface", {"HAS_ENVIRONMENT": 1} if has_environment else {})
     info.push_constant("MAT4", "inverse_view_projection")
     info.push_constant("FLOAT", "background_alpha")
     info.uniform_buf(0, "SceneData", "scene")
@@ -500,7 +506,6 @@ def background_create_info(has_environment):
         info.sampler(0, "FLOAT_2D", "equirect_texture")
     for index, name in enumerate(output_names(False)):
         info.fragment_out(index, "VEC4", "out_" + name)
-    info.vertex_source(_read(os.path.join(RESOURCE_DIR, "background.vert.glsl")))
     info.fragment_source("\n".join([library_source("sg.glsl"),
                                     _read(os.path.join(RESOURCE_DIR, "background.frag.glsl"))]))
     return info
@@ -547,28 +552,16 @@ def get_depth_shader():
 def vertex_visibility_create_info(visibility_layers, rows, has_environment):
     """The per-vertex pass of the broad diffuse lobes (resources/vertex_visibility.frag.glsl), drawn as
     one full-screen triangle over its target (one texel a vertex and vec4)."""
-    import gpu
-
-    info = gpu.types.GPUShaderCreateInfo()
-    for name, value in LIMITS.items():
-        info.define(name, str(value))
-    info.define("HAS_VISIBILITY", "1")
-    info.define("SSDF_MAX_LAYERS", str(visibility_layers))
-    info.define("DIFFUSE_VISIBILITY_ROWS", str(rows))
+    defines = {"HAS_VISIBILITY": 1, "SSDF_MAX_LAYERS": visibility_layers, "DIFFUSE_VISIBILITY_ROWS": rows}
     if has_environment:
-        info.define("HAS_ENVIRONMENT", "1")
-    info.typedef_source(typedef_source())
-    info.vertex_in(0, "VEC2", "position")
-    interface = gpu.types.GPUStageInterfaceInfo("sgprt_vertex_visibility_interface")
-    interface.smooth("VEC2", "ndc")
-    info.vertex_out(interface)
+        defines["HAS_ENVIRONMENT"] = 1
+    info = _full_screen_create_info("sgprt_vertex_visibility_interface", defines)
     info.push_constant("MAT4", "model_matrix")
     info.uniform_buf(0, "SceneData", "scene")
     info.sampler(0, "FLOAT_2D", "visibility_coefficients")
     info.sampler(1, "FLOAT_2D", "vertex_normals")
     info.sampler(2, "FLOAT_2D_ARRAY", "visibility_basis")
     info.fragment_out(0, "VEC4", "out_fractions")
-    info.vertex_source(_read(os.path.join(RESOURCE_DIR, "background.vert.glsl")))
     info.fragment_source("\n".join([library_source(name) for name in
                                     ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "ssdf.glsl")]
                                    + [_read(os.path.join(RESOURCE_DIR, name)) for name in
