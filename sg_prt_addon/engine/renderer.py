@@ -203,6 +203,12 @@ class MeshBuffers:
         self.vertices = vertices
 
 
+def _slot_material(state, entry, slot):
+    """(material name, export.MaterialParams) of an object's material slot; an empty slot: the default."""
+    name = entry.material_names[slot] if slot < len(entry.material_names) else ""
+    return name, state.materials.get(name) or state.materials[""]
+
+
 def environment_textures(environment, equirect):
     """(prefiltered layers, equirect map) GPU textures of an EnvironmentData and the map it was made of,
     shared by every Renderer while the environment cache keeps the EnvironmentData."""
@@ -322,7 +328,7 @@ class Renderer:
         has_lights = state.light_data().count > 0
         has_environment = state.environment.prefiltered is not None
         diffuse_rows = shader_variants.diffuse_visibility_rows(state.environment)
-        self._draw_vertex_visibility(state, diffuse_rows, has_environment)
+        self._draw_vertex_visibility(state, diffuse_rows, has_lights, has_environment)
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
@@ -338,8 +344,7 @@ class Renderer:
                     continue
                 model = _column_major(entry.matrix_world)
                 for slot, first_triangle, batch in buffers.batches:
-                    name = entry.material_names[slot] if slot < len(entry.material_names) else ""
-                    params = state.materials.get(name) or state.materials[""]
+                    name, params = _slot_material(state, entry, slot)
                     if name not in self.material_buffers:
                         name = ""
                     key = shader_variants.variant_key(params, has_lights, has_environment, self.gbuffer,
@@ -379,9 +384,9 @@ class Renderer:
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
 
-    def _draw_vertex_visibility(self, state, rows, has_environment):
-        """The broad diffuse lobes' visibility at the vertices of every object with a bake
-        (resources/vertex_visibility.frag.glsl): one texel a vertex and vec4, for the surface shader."""
+    def _draw_vertex_visibility(self, state, rows, has_lights, has_environment):
+        """The broad diffuse lobes' visibility at the vertices of every object with a bake whose variants
+        read it (a diffuse term; resources/vertex_visibility.frag.glsl): one texel a vertex and vec4."""
         import gpu
         from gpu_extras.batch import batch_for_shader
 
@@ -389,7 +394,10 @@ class Renderer:
             del self.vertex_visibility[object_key]
         for object_key, entry in state.objects.items():
             buffers = self.mesh_buffers.get(entry.mesh_key)
-            if buffers is None or not buffers.visibility_layers or not rows:
+            if buffers is None or not buffers.visibility_layers or not rows or not any(
+                    shader_variants.variant_key(_slot_material(state, entry, slot)[1], has_lights, has_environment,
+                                                self.gbuffer, buffers.visibility_layers, rows).diffuse_visibility_rows
+                    for slot, _first, _batch in buffers.batches):
                 self.vertex_visibility.pop(object_key, None)
                 continue
             per_row = max(1, VISIBILITY_TEXTURE_WIDTH // buffers.visibility_layers)

@@ -150,3 +150,25 @@ def test_per_vertex_diffuse_visibility(engine, bakes, world):
         assert np.abs(gpu - interpolated).max() <= 1e-3 * np.abs(interpolated).max() + 1e-6
     print("per-vertex diffuse visibility, relative RMSE of the Diffuse pass:", errors)
     assert len(errors) == 2 and all(error < 0.005 for error in errors.values()), errors
+
+
+def test_per_vertex_pass_only_where_a_diffuse_term_reads_it(engine, bakes):
+    """The per-vertex pass runs for the baked objects whose variants read it: not for one whose material
+    has no diffuse term (zero colour), nor for one without a bake."""
+    from sg_prt_addon.engine import render_engine
+
+    scene, sphere, floor = _scene("per_vertex_needed")
+    fx.world_colour(scene, (0.3, 0.3, 0.3))
+    sphere.data.materials[0] = fx.material("per_vertex_needed_specular_only", model="GGX", roughness=0.4,
+                                           diffuse_color=(0.0, 0.0, 0.0), specular_color=(0.5, 0.5, 0.5))
+    unbaked = fx.uv_sphere(scene, "per_vertex_needed_unbaked", (1.8, 0.0, 0.6), radius=0.5, segments=16, rings=8)
+    bakes(scene, [sphere, floor], resolution=8)
+    render_engine.debug["after_frame"] = lambda depsgraph, state, renderer, camera: set(renderer.vertex_visibility)
+    try:
+        result = fx.render(scene)
+    finally:
+        render_engine.debug["after_frame"] = None
+    assert "error" not in result, result.get("error")
+    assert len(result["state"].visibility) == 2, "the sphere and the floor baked, the third sphere not"
+    assert result["after_frame"] == {floor.name}, result["after_frame"]
+    assert unbaked.name in result["state"].objects
