@@ -101,9 +101,10 @@ float clamped_cosine_gaussian_positive_mean(float mean, float variance)
          + sigma * 0.3989422804014327 * exp(-0.5 * ratio * ratio);
 }
 
-/* The parts of I(c, lambda) that depend on lambda alone (clamped_cosine.SHARPNESS_TERMS): poles_moments =
- * (I_up, I_low, L, V) / as below, shape = (variance scale f, tail blend beta, L / lambda, s's value at
- * c = -1 before normalising).  lambda > 0 (clamped to [MIN, MAX]_SHARPNESS). */
+/* The parts of I(c, lambda) that depend on lambda alone (clamped_cosine.SHARPNESS_TERMS):
+ * poles_moments = (the pole integrals (I_up, I_low) / (2 pi / lambda), the Langevin moments (L, V)),
+ * shape = (variance scale f, tail blend beta, L / lambda, E[max(0, X)] at c = -1).
+ * lambda > 0 (clamped to [MIN, MAX]_SHARPNESS). */
 void clamped_cosine_sharpness_terms(float sharpness, out vec4 poles_moments, out vec4 shape)
 {
   float lam = clamp(sharpness, CLAMPED_COSINE_MIN_SHARPNESS, CLAMPED_COSINE_MAX_SHARPNESS);
