@@ -124,9 +124,15 @@ VISIBILITY_TEXTURE_WIDTH = 4096     # texels a row of the coefficient texture (a
 MAX_TEXTURE_SIZE = 16384              # GPUTexture side limit measured here (DESIGN.md)
 
 
+def vertices_per_row(layers):
+    """Vertices a row of the per-vertex textures of a bake with `layers` coefficient vec4 a vertex (the
+    coefficient texture, and the normal and per-vertex visibility textures in the same rows)."""
+    return max(1, VISIBILITY_TEXTURE_WIDTH // layers)
+
+
 def visibility_texture_shape(vertex_count, layers):
     """(rows, texels a row) of the coefficient texture of vertex_count vertices."""
-    per_row = max(1, VISIBILITY_TEXTURE_WIDTH // layers)
+    per_row = vertices_per_row(layers)
     return max(1, -(-vertex_count // per_row)), per_row * layers
 
 
@@ -142,9 +148,9 @@ def per_vertex_texture(values, texels_per_vertex, per_row):
 
 def visibility_texture_rows(packed, layers):
     """(H, W, 4) float32 texture of per-vertex coefficient rows (V, 4 layers): vertex v's vec4 k at texel
-    (column (v % per_row) * layers + k, row v // per_row), per_row = VISIBILITY_TEXTURE_WIDTH // layers
+    (column (v % per_row) * layers + k, row v // per_row), per_row = vertices_per_row(layers)
     (mesh.vert.glsl reads it back with texelFetch)."""
-    return per_vertex_texture(packed, layers, max(1, VISIBILITY_TEXTURE_WIDTH // layers))
+    return per_vertex_texture(packed, layers, vertices_per_row(layers))
 
 
 class MeshBuffers:
@@ -161,7 +167,6 @@ class MeshBuffers:
         self.coefficient_texture = None
         self.normal_texture = None
         self.basis_texture = None
-        self.vertex_count = 0
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
         if visibility is not None:
@@ -191,11 +196,9 @@ class MeshBuffers:
                 mesh.vertex_normals[mesh.corner_vertex.astype(np.int64)], np.float32))
             self.visibility_layers = visibility.layers
             self.coefficient_texture = _texture_2d(visibility_texture_rows(visibility.packed, visibility.layers))
-            self.vertex_count = visibility.packed.shape[0]
-            normals = np.zeros((self.vertex_count, 4), np.float32)
+            normals = np.zeros((visibility.packed.shape[0], 4), np.float32)
             normals[:, :3] = mesh.vertex_normals
-            self.normal_texture = _texture_2d(per_vertex_texture(
-                normals, 1, max(1, VISIBILITY_TEXTURE_WIDTH // visibility.layers)))
+            self.normal_texture = _texture_2d(per_vertex_texture(normals, 1, vertices_per_row(visibility.layers)))
             self.basis_texture = _texture_2d_array(visibility.basis_texture)
         for material_index, first, count in mesh.material_ranges:
             indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])
@@ -400,8 +403,8 @@ class Renderer:
                     for slot, _first, _batch in buffers.batches):
                 self.vertex_visibility.pop(object_key, None)
                 continue
-            per_row = max(1, VISIBILITY_TEXTURE_WIDTH // buffers.visibility_layers)
-            size = (per_row * rows, max(1, -(-buffers.vertex_count // per_row)))
+            # one texel a vertex and vec4, in the coefficient texture's rows
+            size = (vertices_per_row(buffers.visibility_layers) * rows, buffers.coefficient_texture.height)
             target = self.vertex_visibility.get(object_key)
             if target is None or (target[0].width, target[0].height) != size:
                 texture = gpu.types.GPUTexture(size, format="RGBA32F")
