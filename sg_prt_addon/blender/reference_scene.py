@@ -79,9 +79,7 @@ def anisotropy_tangents(mesh, entry, materials):
         n = normals[corners]
         tangent = np.broadcast_to(linear @ np.asarray(params.tangent_axis, np.float64), n.shape) if object_axis \
             else tangents[corners]
-        tangent = tangent - n * np.sum(n * tangent, axis=1, keepdims=True)
-        tangent = tangent / np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-30)
-        tangents[corners] = tangent * np.cos(angle) + np.cross(n, tangent) * np.sin(angle)
+        tangents[corners] = shading.rotate_tangent(n, tangent, angle)
     return tangents
 
 
