@@ -18,7 +18,6 @@ import argparse
 import os
 import statistics
 import sys
-import time
 
 import numpy as np
 
@@ -37,7 +36,7 @@ PER_PIXEL_CALL = ("(sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, 
 
 def frame(per_vertex=True, terms=True):
     """(steady frame seconds, Combined) of one render with the chosen paths."""
-    import bpy
+    from benchmarks.engine_vs_eevee import steady_frame
     from sg_prt_addon.engine import render_engine, shader_variants
 
     rows, read = shader_variants.diffuse_visibility_rows, shader_variants._read
@@ -54,29 +53,23 @@ def frame(per_vertex=True, terms=True):
     if not terms:
         shader_variants._read = patched_read
     shader_variants.clear_cache()
-    render_engine.debug["timed_redraws"] = REDRAWS
     try:
-        bpy.ops.render.render()
+        seconds = steady_frame(REDRAWS)
     finally:
-        render_engine.debug["timed_redraws"] = 0
         shader_variants.diffuse_visibility_rows, shader_variants._read = rows, read
         shader_variants.clear_cache()
-    if "error" in render_engine.last_render:
-        raise RuntimeError(render_engine.last_render["error"])
-    return (statistics.median(render_engine.last_render["timings"]["frames"]),
-            render_engine.last_render["passes"]["Combined"].copy())
+    return seconds, render_engine.last_render["passes"]["Combined"].copy()
 
 
 def render_seconds(warm):
-    import bpy
+    """bpy.ops.render.render's wall time, the shader and environment-texture caches kept or emptied."""
+    from benchmarks.engine_vs_eevee import render_seconds as timed_render
     from sg_prt_addon.engine import renderer, shader_variants
 
     if not warm:
         shader_variants.clear_cache()
         renderer._environment_textures.clear()
-    start = time.perf_counter()
-    bpy.ops.render.render()
-    return time.perf_counter() - start
+    return timed_render()
 
 
 def paired(rounds, new, old):
