@@ -31,6 +31,8 @@ horizon) and a variance scale f(lambda); both are rational in lambda, fitted
 minimax to quadrature over lambda in [1e-3, 1e4] and all c (constants below).
 For broad lobes the weight I_up - I_low = O(lambda) makes the shape of s irrelevant.
 """
+import functools
+
 import numpy as np
 
 from . import sg
@@ -38,16 +40,20 @@ from .hemisphere import erf_approx
 
 # Truncation of the exponential tail e^-t in the ring quadrature: e^-40 = 4e-18.
 _TAIL = 40.0
-_GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(64)
-# Gauss nodes mapped to [0, 1] and clustered at both ends by s = (1 - cos(pi u)) / 2:
-# ring averages have square-root kinks at the ends of each sub-interval, which
-# this substitution makes smooth (converged to ~1e-14 at 48 nodes).
-_U = 0.5 * (_GAUSS_NODES + 1.0)
-_CLUSTERED = 0.5 * (1.0 - np.cos(np.pi * _U))
-_CLUSTERED_WEIGHTS = 0.25 * np.pi * _GAUSS_WEIGHTS * np.sin(np.pi * _U)
+QUADRATURE_NODES = 64
 
 
-def ring_quadrature(ring_average, sharpness, breakpoints):
+@functools.lru_cache(maxsize=None)
+def _clustered_rule(count):
+    """Gauss-Legendre nodes mapped to [0, 1] and clustered at both ends by s = (1 - cos(pi u)) / 2, and
+    their weights: ring averages have square-root kinks at the ends of each sub-interval, which this
+    substitution makes smooth (converged to ~1e-14 at 48 nodes)."""
+    nodes, weights = np.polynomial.legendre.leggauss(count)
+    u = 0.5 * (nodes + 1.0)
+    return 0.5 * (1.0 - np.cos(np.pi * u)), 0.25 * np.pi * weights * np.sin(np.pi * u)
+
+
+def ring_quadrature(ring_average, sharpness, breakpoints, nodes=QUADRATURE_NODES):
     """(lambda / 2 pi) * integral over the sphere of exp(lambda (i.p - 1)) f(i), as a 1D
     integral over the polar angle theta around p.
 
@@ -58,6 +64,7 @@ def ring_quadrature(ring_average, sharpness, breakpoints):
     the ring average has a kink), each truncated after e^-40, so lambda up to 1e6
     is as accurate as lambda = 1.  Vectorized: broadcasts over sharpness and breakpoints.
     """
+    clustered, clustered_weights = _clustered_rule(nodes)
     sharpness = np.asarray(sharpness, np.float64)
     edges = np.sort(np.stack(np.broadcast_arrays(0.0 * sharpness, *breakpoints, 2.0 * sharpness)), axis=0)
     lam = sharpness[..., None]
@@ -65,12 +72,12 @@ def ring_quadrature(ring_average, sharpness, breakpoints):
     total = 0.0
     for start, stop in zip(edges[:-1], edges[1:]):
         length = np.minimum(stop - start, _TAIL)
-        offset = length[..., None] * _CLUSTERED
+        offset = length[..., None] * clustered
         t = start[..., None] + offset
         cos_theta = np.clip(1.0 - t / safe, -1.0, 1.0)
         sin_theta = np.sqrt(np.clip(t * (2.0 * lam - t), 0.0, None)) / safe  # no cancellation near the pole
         values = np.exp(-offset) * ring_average(cos_theta, sin_theta)
-        total = total + np.exp(-start) * length * np.sum(values * _CLUSTERED_WEIGHTS, axis=-1)
+        total = total + np.exp(-start) * length * np.sum(values * clustered_weights, axis=-1)
     return total
 
 # wang2009 eq. 40: single SG fit of max(0, n.i).
@@ -228,8 +235,9 @@ def sg_clamped_cosine_integral_exact(axis, sharpness, amplitude, normal):
     return np.asarray(amplitude, np.float64) * clamped_cosine_exact_from_cosine(cosine, sharpness)
 
 
-def clamped_cosine_exact_from_cosine(cosine, sharpness):
-    """I(c, lambda) with unit amplitude by quadrature, c = n.p (float64, broadcasts)."""
+def clamped_cosine_exact_from_cosine(cosine, sharpness, nodes=QUADRATURE_NODES):
+    """I(c, lambda) with unit amplitude by quadrature, c = n.p (float64, broadcasts); ``nodes`` Gauss
+    nodes a sub-interval (ring_quadrature)."""
     cosine, sharpness = np.broadcast_arrays(np.asarray(cosine, np.float64), np.asarray(sharpness, np.float64))
     c = cosine[..., None]
     sin_alpha = np.sqrt(np.maximum(1 - c * c, 0))
@@ -244,7 +252,8 @@ def clamped_cosine_exact_from_cosine(cosine, sharpness):
     # the ring of polar angle theta meets the horizon of n from theta = |pi/2 - alpha| to
     # pi - |pi/2 - alpha|, and cos(pi/2 - alpha) = sin(alpha): kinks at lambda (1 -+ sin(alpha))
     edge = sin_alpha[..., 0]
-    integral = ring_quadrature(ring_positive_mean, sharpness, [sharpness * (1 - edge), sharpness, sharpness * (1 + edge)])
+    kinks = [sharpness * (1 - edge), sharpness, sharpness * (1 + edge)]
+    integral = ring_quadrature(ring_positive_mean, sharpness, kinks, nodes)
     return np.where(sharpness > 0, sg.TWO_PI * integral / np.where(sharpness > 0, sharpness, 1), np.pi)
 
 

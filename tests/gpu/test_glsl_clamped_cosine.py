@@ -1,4 +1,7 @@
-"""shaders/lib/clamped_cosine.glsl (float32) against sg_prt_addon/core/clamped_cosine.py (float64)."""
+"""shaders/lib/clamped_cosine.glsl and clamped_cosine_table.glsl (float32) against sg_prt_addon/core/clamped_cosine.py
+and clamped_cosine_table.py (float64)."""
+import re
+
 import numpy as np
 import pytest
 
@@ -88,3 +91,36 @@ def test_from_cosine_and_lobe(glsl, fuzz, record_error):
     lobe = clamped_cosine.clamped_cosine_lobe_evaluate(direction, normal)
     assert fuzz.relative_error(out[:, 1], lobe, 1e-30).max() <= 2e-6
     assert np.allclose(out[:, 2:], clamped_cosine.clamped_cosine_lobe(), rtol=1e-7)
+
+
+def test_tabulated(glsl, fuzz, record_error):
+    """shaders/lib/clamped_cosine_table.glsl reading the uploaded table through the hardware's bilinear
+    filter, against the numpy mirror of that filter (whose own error against quadrature
+    tests/core/test_clamped_cosine_table.py bounds); and its constants against the module's."""
+    from sg_prt_addon.core import clamped_cosine_table
+    from sg_prt_addon.engine import shader_variants
+
+    source = shader_variants.library_source("clamped_cosine_table.glsl")
+    constants = dict(re.findall(r"const float CLAMPED_COSINE_TABLE_(\w+) = ([-0-9.e]+);", source))
+    assert {name: float(value) for name, value in constants.items()} == pytest.approx({
+        "LOG_MIN": np.log(clamped_cosine_table.SHARPNESS_RANGE[0]),
+        "LOG_MAX": np.log(clamped_cosine_table.SHARPNESS_RANGE[1]),
+        "KNEE_WEIGHT": clamped_cosine_table.KNEE_WEIGHT, "KNEE_SCALE": clamped_cosine_table.KNEE_SCALE,
+        "MIN_SHARPNESS": clamped_cosine_table.MIN_SHARPNESS}, rel=1e-12)
+
+    axis = fuzz.unit_vectors(N)
+    normal = fuzz.f32(fuzz.near(axis, 2.0) * fuzz.log_uniform(1e-2, 1e2, N)[:, None])
+    normal[:100] = -axis[:100]
+    normal[100:200] = axis[100:200]
+    sharpness = fuzz.f32(np.concatenate([[0.0, 1e-7, -1.0, 1e9], fuzz.log_uniform(1e-6, 1e8, N - 4)]))
+    amplitude = fuzz.uniform(0.0, 3.0, N)
+    table = clamped_cosine_table.clamped_cosine_table()
+    out = glsl(["sg.glsl", "clamped_cosine_table.glsl"],
+               "vec4(sg_clamped_cosine_integral_tabulated(clamped_cosine_table, p.xyz, p.w, n.w, n.xyz))",
+               {"p": np.c_[axis, sharpness], "n": np.c_[normal, amplitude]}, 1,
+               textures={"clamped_cosine_table": table})
+    expected = clamped_cosine_table.sg_clamped_cosine_integral_tabulated(axis, sharpness, amplitude, normal)
+    scale = amplitude * clamped_cosine_table.clamped_cosine_from_table(np.ones(N), sharpness) + 1e-30
+    assert np.all(np.isfinite(out))
+    assert record_error("clamped_cosine_table sg_clamped_cosine_integral_tabulated, relative to I(c = 1)",
+                        (np.abs(out - expected) / scale).max()) <= 2e-5

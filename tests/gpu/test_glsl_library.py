@@ -14,14 +14,15 @@ DEPENDENCIES = {
     "sg.glsl": [],
     "hemisphere.glsl": ["sg.glsl"],
     "clamped_cosine.glsl": ["sg.glsl", "hemisphere.glsl"],
+    "clamped_cosine_table.glsl": ["sg.glsl"],
     "brdf.glsl": ["sg.glsl"],
     "warp.glsl": ["sg.glsl"],
     "lights.glsl": ["sg.glsl"],
     "env_prefilter.glsl": ["sg.glsl"],
     "ssdf.glsl": ["sg.glsl", "hemisphere.glsl"],
 }
-ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl", "warp.glsl", "lights.glsl",
-         "env_prefilter.glsl", "ssdf.glsl"]
+ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
+         "lights.glsl", "env_prefilter.glsl", "ssdf.glsl"]
 
 
 def test_every_file_is_listed():

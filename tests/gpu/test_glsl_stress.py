@@ -164,6 +164,28 @@ def test_clamped_cosine_stress(glsl, fuzz):
     assert np.all(out[:, 0] <= np.pi * amplitude * (1 + 1e-5) + 1e-30)
 
 
+def test_clamped_cosine_table_stress(glsl, fuzz):
+    """The tabulated integral over the same hostile lobes (NaN-free, lambda from 1e-38 to the cap, zero
+    axes and normals, cosines outside [-1, 1]): finite, non-negative, at most pi times the amplitude."""
+    from sg_prt_addon.core import clamped_cosine_table
+
+    axis, normal = _axis_pairs(fuzz, ROWS)
+    sharpness = fuzz.stress_sharpness(ROWS)
+    tiny = fuzz.rng.integers(0, 8, ROWS) == 0
+    sharpness[tiny] = fuzz.log_uniform(1e-38, 1e-4, int(tiny.sum()))
+    amplitude = fuzz.stress_amplitude(ROWS)
+    cosine = fuzz.uniform(-1.5, 1.5, ROWS)
+    inputs = {"p": np.c_[axis, sharpness], "n": np.c_[normal, amplitude], "c": cosine}
+    call = ("vec4(sg_clamped_cosine_integral_tabulated(clamped_cosine_table, p.xyz, p.w, n.w, n.xyz),"
+            " clamped_cosine_tabulated(clamped_cosine_table, c.x, p.w), 0.0, 0.0)")
+    out = glsl(["sg.glsl", "clamped_cosine_table.glsl"], call, inputs, 2,
+               textures={"clamped_cosine_table": clamped_cosine_table.clamped_cosine_table()})
+    _assert_finite(out, "clamped_cosine_table.glsl")
+    assert out.min() >= 0
+    assert np.all(out[:, 0] <= np.pi * amplitude * (1 + 1e-5) + 1e-30)
+    assert np.all(out[:, 1] <= np.pi * (1 + 1e-5))
+
+
 def test_warp_stress(glsl, fuzz):
     axis, wo = _axis_pairs(fuzz, ROWS)  # includes wo = axis, wo = -axis, zero axes
     grazing = fuzz.rng.integers(0, 4, ROWS) == 0
@@ -705,6 +727,7 @@ COVERED = {
     test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "spot_light_sg", "directional_light_sg"],
     test_clamped_cosine_stress: ["sg_clamped_cosine_integral", "sg_clamped_cosine_integral_paper",
                                  "clamped_cosine_from_cosine", "clamped_cosine_lobe_evaluate"],
+    test_clamped_cosine_table_stress: ["sg_clamped_cosine_integral_tabulated", "clamped_cosine_tabulated"],
     test_warp_stress: ["warp_lobes_split2", "warp_lobes_split3", "warp_lobes_paper", "brdf_slice_amplitude"],
     test_env_prefilter_stress: ["env_prefilter_lookup", "env_prefilter_lookup_integral"],
     test_sg_helpers_stress: ["sg_rotate", "sg_support_area", "sg_sharpness_from_area"],
