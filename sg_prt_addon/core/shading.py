@@ -8,8 +8,10 @@ lights and environment data).  wang2009 eq. 36-43 without visibility:
     Rs(o) = sum_j [ sum_lights I(light SG (x) rho*_j, n)                  (eq. 43)
                     + Gamma_L(p_j, lambda_j)/integral * mu_j I(p_j, lambda_j, n) ]   (eq. 41, 35)
 
-I(G, n) is the integral of an SG times the clamped cosine (clamped_cosine.py's
-closed form, more accurate than the paper's single-lobe C*); rho*_j are the
+I(G, n) is the integral of an SG times the clamped cosine (more accurate than the paper's
+single-lobe C*): read from clamped_cosine_table for the lights, the slice lobes and their
+products, whose sharpness varies per pixel, and clamped_cosine.py's closed form for the
+environment's lobes, whose lambda-only terms the shader gets once a frame; rho*_j are the
 model's NDF lobes warped to the view slice (warp.brdf_slice_lobes in
 warp.DEFAULT_MODE: one to three lobes per NDF lobe) with the smooth factor M_o at each lobe
 centre.  For the environment, the cosine is folded in as the ratio
@@ -38,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import brdf, env_prefilter, lights, sg, warp
+from . import brdf, clamped_cosine, env_prefilter, lights, sg, warp
 
 FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
@@ -52,8 +54,10 @@ SHADING_FRAME_MIN_SINE = 1e-3
 
 
 def _clamped_cosine_integral(axis, sharpness, amplitude, normal):
-    from . import clamped_cosine
-    return clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, amplitude, normal)
+    """I(G, n) of a lobe whose sharpness varies per pixel (lights, slices, their products): from the
+    table, as the shader reads it (clamped_cosine_table)."""
+    from . import clamped_cosine_table
+    return clamped_cosine_table.sg_clamped_cosine_integral_tabulated(axis, sharpness, amplitude, normal).astype(FLOAT)
 
 
 @dataclass
@@ -127,7 +131,7 @@ def lobe_visibility(axis, sharpness, n, visibility):
     """Visible fraction (N, K) of I(G, n) for lobes G with axis (N, K, 3), sharpness (N, K); n (N, 3)
     (sg_shading.glsl's lobe_visibility)."""
     from ..bake import hemisphere_map
-    from . import clamped_cosine, hemisphere
+    from . import hemisphere
 
     cosine_sharpness, _ = clamped_cosine.clamped_cosine_lobe()
     product_axis, product_sharpness, _ = sg.product(
@@ -373,7 +377,8 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             env_sharpness = np.broadcast_to(environment.lobe_sharpness[None], (len(n), lobe_count_env))
             env_visible = visible(env_axis, env_sharpness) if visibility is None or visibility.diffuse is None \
                 else np.asarray(visibility.diffuse, FLOAT)[:, :lobe_count_env]
-            irradiance += np.sum(environment.lobe_amplitude[None] * (_clamped_cosine_integral(
+            # the closed form, as the shader evaluates it from the lobes' sharpness terms (scene block)
+            irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
                 env_visible)[..., None], axis=1)
         radiance = env_prefilter.lookup(environment.prefiltered, slice_axis, slice_sharpness)        # (N, J, 3)

@@ -10,7 +10,7 @@ import collections
 
 import numpy as np
 
-from ..core import clamped_cosine
+from ..core import clamped_cosine, clamped_cosine_table
 from . import shader_variants
 from .shader_variants import GBUFFER_OUTPUTS, MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 
@@ -250,6 +250,7 @@ class Renderer:
         self.environment_source = None
         self.anisotropy_tables = {}     # lobe count -> GPUTexture
         self.ggx_texture = None
+        self.clamped_cosine_texture = None
         self.framebuffer = None
         self.targets = []
         self.size = None
@@ -369,6 +370,10 @@ class Renderer:
                         shader.uniform_sampler("environment_texture", self.environment_texture)
                     if key.model in shader_variants.ANISOTROPIC_MODELS:
                         shader.uniform_sampler("anisotropy_table", self._anisotropy_texture(key.ndf_lobes))
+                    if shader_variants.uses_clamped_cosine_table(key):
+                        if self.clamped_cosine_texture is None:
+                            self.clamped_cosine_texture = _texture_2d(clamped_cosine_table.clamped_cosine_table())
+                        shader.uniform_sampler("clamped_cosine_table", self.clamped_cosine_texture)
                     if shader_variants.uses_ggx_table(key):
                         if self.ggx_texture is None:
                             self.ggx_texture = _texture_2d(shader_variants.ggx_table())

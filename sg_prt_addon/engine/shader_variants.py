@@ -59,7 +59,8 @@ ANISOTROPIC_MODELS = ("WARD_ANISO", "ASHIKHMIN_SHIRLEY")
 FITTED_MODEL = "FITTED"
 GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
 # Library files in dependency order; env_prefilter only with an environment texture.
-LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
+LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "lights.glsl",
+                 "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
 # Our own pieces (shaders/resources/), after the library.
 RESOURCE_FILES = ("anisotropic_lobes.glsl", "ggx_two_lobes.glsl", "lobe_visibility.glsl", "sg_shading.glsl")
 
@@ -239,6 +240,8 @@ def library_files(key):
             continue
         if file_name == "lights.glsl" and not key.has_lights:
             continue
+        if file_name == "clamped_cosine_table.glsl" and not uses_clamped_cosine_table(key):
+            continue
         if file_name == "env_prefilter.glsl" and not (key.has_environment and key.has_specular):
             continue
         files.append(file_name)
@@ -377,6 +380,8 @@ def create_info_calls(key):
         samplers.append(("FLOAT_2D", "anisotropy_table"))
     if uses_ggx_table(key):
         samplers.append(("FLOAT_2D", "ggx_table"))
+    if uses_clamped_cosine_table(key):
+        samplers.append(("FLOAT_2D", "clamped_cosine_table"))
     if key.model == FITTED_MODEL:
         samplers.append(("FLOAT_2D_ARRAY", "fitted_layers"))     # texelFetch: the nearest texel
         samplers.append(("FLOAT_2D", "fitted_shadowing"))
@@ -457,6 +462,12 @@ def _remember(key, shader):
 def clear_cache():
     _cache.clear()
     _content_hashes.clear()
+
+
+def uses_clamped_cosine_table(key):
+    """Whether a variant integrates lobes of per-pixel sharpness against the clamped cosine (lights,
+    slice lobes, their products): those read core.clamped_cosine_table."""
+    return key.has_lights or key.has_specular
 
 
 def uses_ggx_table(key):

@@ -1,6 +1,7 @@
 /* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43);
  * mirrored line by line by sg_prt_addon/core/shading.py.  Needs sg.glsl, hemisphere.glsl,
- * clamped_cosine.glsl, (HAS_LIGHTS) lights.glsl, (HAS_SPECULAR) brdf.glsl + warp.glsl,
+ * clamped_cosine.glsl, (lights or specular) clamped_cosine_table.glsl and the `clamped_cosine_table`
+ * sampler (the clamped cosine of the lobes whose sharpness varies per pixel), (HAS_LIGHTS) lights.glsl, (HAS_SPECULAR) brdf.glsl + warp.glsl,
  * (HAS_ENVIRONMENT and HAS_SPECULAR) env_prefilter.glsl and (HAS_VISIBILITY) ssdf.glsl +
  * lobe_visibility.glsl, plus the `scene` uniform block.  HAS_DIFFUSE / HAS_SPECULAR
  * (shader_variants.material_terms): without one, its term is left out (its colour is zero, so the full
@@ -327,7 +328,8 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
 #if defined(HAS_DIFFUSE) || (defined(HAS_SPECULAR) && defined(HAS_VISIBILITY))
-    float light_cosine = sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n);
+    float light_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, light_axis, light_sharpness,
+                                                              1.0, n);
 #endif
 #ifdef HAS_DIFFUSE
     irradiance += light_amplitude * (light_cosine * LOBE_VISIBILITY(light_axis, light_sharpness));   /* eq. 42 */
@@ -347,7 +349,8 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
         float product_sharpness, product_amplitude;
         sg_product(light_axis, light_sharpness, 1.0, slice_axis[j], slice_sharpness[j], slice_amplitude[j],
                    product_axis, product_sharpness, product_amplitude);
-        float product_cosine = sg_clamped_cosine_integral(product_axis, product_sharpness, product_amplitude, n);
+        float product_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, product_axis,
+                                                                    product_sharpness, product_amplitude, n);
         lobe_weight += product_cosine * slice_colour[j];
 #ifdef HAS_VISIBILITY
         /* products negligible next to the light's irradiance (away from the highlight) need no decode:
@@ -377,7 +380,8 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float visibility = LOBE_VISIBILITY(slice_axis[centre], slice_sharpness[centre]);      /* eq. 41 */
     for (int node = 0; node < WARP_NODES; node++) {
       int j = WARP_NODES * k + node;
-      float slice_cosine = sg_clamped_cosine_integral(slice_axis[j], slice_sharpness[j], slice_amplitude[j], n) *
+      float slice_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, slice_axis[j], slice_sharpness[j],
+                                                                slice_amplitude[j], n) *
                            visibility;
 #ifdef HAS_ENVIRONMENT
       radiance += slice_cosine * slice_colour[j] * environment_radiance(slice_axis[j], slice_sharpness[j]);
