@@ -10,7 +10,7 @@ import collections
 
 import numpy as np
 
-from ..core import clamped_cosine, clamped_cosine_table
+from ..core import clamped_cosine, clamped_cosine_table, shading
 from . import shader_variants
 from .shader_variants import GBUFFER_OUTPUTS, MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 
@@ -167,8 +167,10 @@ class MeshBuffers:
         self.coefficient_texture = None
         self.normal_texture = None
         self.basis_texture = None
+        self.bounds = None              # (2, 3) local box, for core.shading.shares_light_visibility
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
+        self.bounds = np.stack([mesh.positions.min(axis=0), mesh.positions.max(axis=0)])
         if visibility is not None:
             # scene_state.VisibilityData.from_bake checked this; check again right before the upload:
             # texelFetch must never read past the rows uploaded
@@ -329,7 +331,8 @@ class Renderer:
         first).  background_alpha: alpha of the world pixels (0 for a transparent film)."""
         import gpu
 
-        has_lights = state.light_data().count > 0
+        light_data = state.light_data()
+        has_lights = light_data.count > 0
         has_environment = state.environment.prefiltered is not None
         diffuse_rows = shader_variants.diffuse_visibility_rows(state.environment)
         self._draw_vertex_visibility(state, diffuse_rows, has_lights, has_environment)
@@ -347,12 +350,14 @@ class Renderer:
                 if buffers is None:
                     continue
                 model = _column_major(entry.matrix_world)
+                shared_light_visibility = bool(buffers.visibility_layers and has_lights) and shading.shares_light_visibility(
+                    light_data, shading.world_bounds(buffers.bounds, entry.matrix_world))
                 for slot, first_triangle, batch in buffers.batches:
                     name, params = _slot_material(state, entry, slot)
                     if name not in self.material_buffers:
                         name = ""
                     key = shader_variants.variant_key(params, has_lights, has_environment, self.gbuffer,
-                                                      buffers.visibility_layers, diffuse_rows)
+                                                      buffers.visibility_layers, diffuse_rows, shared_light_visibility)
                     shader = shader_variants.get_shader(key)
                     shader.bind()
                     shader.uniform_float("model_matrix", model)

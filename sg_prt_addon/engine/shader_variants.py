@@ -89,6 +89,9 @@ class VariantKey:
     has_specular: bool = True       # False: zero specular colour, no texture: no BRDF slice code
     # vec4 of broad diffuse lobe visibility a vertex, from the per-vertex pass (0: none, or decoded per pixel)
     diffuse_visibility_rows: int = 0
+    # light x slice products take the light's visibility (core.shading.shares_light_visibility; with a bake,
+    # lights and a specular term)
+    shared_light_visibility: bool = False
 
     @property
     def has_visibility(self):
@@ -107,6 +110,8 @@ class VariantKey:
             parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
         if self.diffuse_visibility_rows:
             parts.append(f"per-vertex diffuse visibility ({self.diffuse_visibility_rows} vec4)")
+        if self.shared_light_visibility:
+            parts.append("light visibility shared by its products")
         if not self.has_diffuse:
             parts.append("no diffuse")
         if not self.has_specular:
@@ -141,9 +146,11 @@ def diffuse_visibility_rows(environment):
 
 
 def variant_key(material_params, has_lights, has_environment, gbuffer=False, visibility_layers=0,
-                diffuse_rows=0):
+                diffuse_rows=0, shared_light_visibility=False):
     """VariantKey of an export.MaterialParams in a scene (visibility_layers: of the object's bake, 0 without;
-    diffuse_rows: diffuse_visibility_rows of the scene, used with a bake and a diffuse term)."""
+    diffuse_rows: diffuse_visibility_rows of the scene, used with a bake and a diffuse term;
+    shared_light_visibility: core.shading.shares_light_visibility of the object, used with a bake, lights
+    and a specular term)."""
     from ..core.shading import GGX_NDF_LOBES
 
     fitted = getattr(material_params, "fitted", None)
@@ -151,7 +158,8 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False, vis
         textures = ("normal_map",) if "normal_map" in material_params.textures else ()
         return VariantKey(FITTED_MODEL, int(fitted.lobe_count), bool(has_lights), bool(has_environment), textures,
                           bool(gbuffer), int(visibility_layers), int(fitted.components),
-                          diffuse_visibility_rows=int(diffuse_rows) if visibility_layers else 0)
+                          diffuse_visibility_rows=int(diffuse_rows) if visibility_layers else 0,
+                          shared_light_visibility=bool(shared_light_visibility and visibility_layers and has_lights))
     model = material_params.model
     lobes = int(material_params.lobe_count) if model in ANISOTROPIC_MODELS else 1
     if model == "GGX":
@@ -161,7 +169,9 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False, vis
                             and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
     return VariantKey(model, lobes, bool(has_lights), bool(has_environment), textures, bool(gbuffer),
                       int(visibility_layers), has_diffuse=has_diffuse, has_specular=has_specular,
-                      diffuse_visibility_rows=int(diffuse_rows) if visibility_layers and has_diffuse else 0)
+                      diffuse_visibility_rows=int(diffuse_rows) if visibility_layers and has_diffuse else 0,
+                      shared_light_visibility=bool(shared_light_visibility and visibility_layers and has_lights
+                                                   and has_specular))
 
 
 def _read(path):
@@ -221,6 +231,8 @@ def defines(key):
         out["SSDF_MAX_LAYERS"] = key.visibility_layers
     if key.diffuse_visibility_rows:
         out["DIFFUSE_VISIBILITY_ROWS"] = key.diffuse_visibility_rows
+    if key.shared_light_visibility:
+        out["SHARED_LIGHT_VISIBILITY"] = 1
     return out
 
 

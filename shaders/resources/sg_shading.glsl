@@ -7,10 +7,15 @@
  * (shader_variants.material_terms): without one, its term is left out (its colour is zero, so the full
  * variant's term is exactly zero).  DIFFUSE_VISIBILITY_ROWS (with HAS_VISIBILITY and HAS_DIFFUSE): the
  * broad diffuse lobes' visible fractions come interpolated from the vertices (diffuse_fractions, filled
- * by surface.frag.glsl from the pass of resources/vertex_visibility.frag.glsl). */
+ * by surface.frag.glsl from the pass of resources/vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with
+ * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; core.shading.shares_light_visibility): every light is narrow on
+ * the object, and its products with the slice lobes take its own visibility instead of a decode each. */
 
 #ifdef HAS_VISIBILITY
 #define LOBE_VISIBILITY(axis, sharpness) lobe_visibility(axis, sharpness, n)
+#if defined(HAS_SPECULAR) && !defined(SHARED_LIGHT_VISIBILITY)
+#define PRODUCT_VISIBILITY      /* a decode for each NDF lobe's light x slice products */
+#endif
 #else
 #define LOBE_VISIBILITY(axis, sharpness) 1.0
 #endif
@@ -327,18 +332,21 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_sharpness;
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
-#if defined(HAS_DIFFUSE) || (defined(HAS_SPECULAR) && defined(HAS_VISIBILITY))
+#if defined(HAS_DIFFUSE) || defined(PRODUCT_VISIBILITY)
     float light_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, light_axis, light_sharpness,
                                                               1.0, n);
 #endif
+#if defined(HAS_DIFFUSE) || defined(SHARED_LIGHT_VISIBILITY)
+    float light_visibility = LOBE_VISIBILITY(light_axis, light_sharpness);
+#endif
 #ifdef HAS_DIFFUSE
-    irradiance += light_amplitude * (light_cosine * LOBE_VISIBILITY(light_axis, light_sharpness));   /* eq. 42 */
+    irradiance += light_amplitude * (light_cosine * light_visibility);   /* eq. 42 */
 #endif
 #ifdef HAS_SPECULAR
     vec3 weight = vec3(0.0);
     for (int k = 0; k < NDF_LOBES; k++) {
       vec3 lobe_weight = vec3(0.0);
-#ifdef HAS_VISIBILITY
+#ifdef PRODUCT_VISIBILITY
       bool decode = false;
       vec3 centre_axis = vec3(0.0, 0.0, 1.0);
       float centre_sharpness = 0.0;
@@ -352,7 +360,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
         float product_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, product_axis,
                                                                     product_sharpness, product_amplitude, n);
         lobe_weight += product_cosine * slice_colour[j];
-#ifdef HAS_VISIBILITY
+#ifdef PRODUCT_VISIBILITY
         /* products negligible next to the light's irradiance (away from the highlight) need no decode:
          * left unshadowed, at most VISIBILITY_SKIP_FRACTION of the light's cosine integral each */
         decode = decode || product_cosine > VISIBILITY_SKIP_FRACTION * light_cosine;
@@ -362,13 +370,16 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
         }
 #endif
       }
-#ifdef HAS_VISIBILITY
+#ifdef PRODUCT_VISIBILITY
       if (decode) {               /* eq. 43, one decode an NDF lobe: at its centre node's product */
         lobe_weight *= lobe_visibility(centre_axis, centre_sharpness, n);
       }
 #endif
       weight += lobe_weight;
     }
+#ifdef SHARED_LIGHT_VISIBILITY
+    weight *= light_visibility;   /* eq. 43 for a narrow light: its products lie inside it */
+#endif
     radiance += light_amplitude * weight;
 #endif
   }

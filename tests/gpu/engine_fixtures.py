@@ -289,5 +289,9 @@ def pixel_visibility(result, mask):
     at_vertices = shading.vertex_diffuse_visibility(state.environment, shading.Visibility(
         rows=data.packed, normal=mesh.vertex_normals, basis_texture=data.basis_texture))
     diffuse = np.einsum("nk,nke->ne", weights, at_vertices[vertex].astype(np.float64))
+    # the renderer's choice for the object: its local box, to world
+    shared_light = shading.shares_light_visibility(state.light_data(), shading.world_bounds(
+        state.meshes[entry.mesh_key].positions, entry.matrix_world))
     return shading.Visibility(rows=rows.astype(np.float32), normal=normal.astype(np.float32),
-                              basis_texture=data.basis_texture, diffuse=diffuse.astype(np.float32))
+                              basis_texture=data.basis_texture, diffuse=diffuse.astype(np.float32),
+                              shared_light=shared_light)
