@@ -1,5 +1,6 @@
-"""What the per-vertex diffuse visibility, the once-a-frame clamped-cosine terms and the caches kept
-across final renders save, on the example scenes, each against its own baseline in the same run.
+"""What the per-vertex diffuse visibility, the once-a-frame clamped-cosine terms, the clamped-cosine table,
+the shared light visibility and the caches kept across final renders save, on the example scenes, each
+against its own baseline in the same run.
 
 Per scene (examples/build_scenes.py at --size, baked by the operator with its defaults):
 - per-vertex diffuse visibility: steady frame (median of render_engine.debug["timed_redraws"]) with the
@@ -8,6 +9,10 @@ Per scene (examples/build_scenes.py at --size, baked by the operator with its de
   RMSE over the surface pixels;
 - clamped-cosine terms: steady frame with the environment lobes' lambda-only terms read from the scene
   block vs computed per pixel (the surface source patched back to sg_clamped_cosine_integral);
+- clamped cosine from the table: steady frame with the lights', slice lobes' and products' integrals read
+  from core.clamped_cosine_table vs the closed form (the surface source patched back); image change;
+- light visibility shared by its products: steady frame with the narrow lights' products taking the
+  light's visibility (SHARED_LIGHT_VISIBILITY) vs a decode each NDF lobe; image change;
 - caches across renders: bpy.ops.render.render with the shader and environment-texture caches warm vs
   emptied before each render (what every render paid before).
 Ratios: new / baseline, median over --rounds rounds, the pair rendered back to back each round.
@@ -32,31 +37,40 @@ TERMS_CALL = """(clamped_cosine_from_terms(dot(safe_normalize(scene.env_axis_sha
                                              scene.env_cosine_terms[2 * e + 1]) *"""
 PER_PIXEL_CALL = ("(sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, "
                   "1.0, n) *")
+# the lights', slice lobes' and products' cosine integrals: the table, and the closed form they used before
+TABLE_CALL = "sg_clamped_cosine_integral_tabulated(clamped_cosine_table, "
+CLOSED_FORM_CALL = "sg_clamped_cosine_integral("
 
 
-def frame(per_vertex=True, terms=True):
+def frame(per_vertex=True, terms=True, table=True, shared_light=True):
     """(steady frame seconds, Combined) of one render with the chosen paths."""
     from benchmarks.engine_vs_eevee import steady_frame
+    from sg_prt_addon.core import shading
     from sg_prt_addon.engine import render_engine, shader_variants
 
-    rows, read = shader_variants.diffuse_visibility_rows, shader_variants._read
+    rows, read, shares = (shader_variants.diffuse_visibility_rows, shader_variants._read,
+                          shading.shares_light_visibility)
+    substitutions = ([] if terms else [(TERMS_CALL, PER_PIXEL_CALL)]) + ([] if table else [(TABLE_CALL, CLOSED_FORM_CALL)])
 
     def patched_read(path):
         text = read(path)
         if path.endswith("sg_shading.glsl"):
-            assert TERMS_CALL in text, "sg_shading.glsl no longer has the call this benchmark replaces"
-            text = text.replace(TERMS_CALL, PER_PIXEL_CALL)
+            for old, new in substitutions:
+                assert old in text, "sg_shading.glsl no longer has the call this benchmark replaces"
+                text = text.replace(old, new)
         return text
 
     if not per_vertex:
         shader_variants.diffuse_visibility_rows = lambda environment: 0
-    if not terms:
-        shader_variants._read = patched_read
+    if not shared_light:
+        shading.shares_light_visibility = lambda light_data, bounds: False
+    shader_variants._read = patched_read
     shader_variants.clear_cache()
     try:
         seconds = steady_frame(REDRAWS)
     finally:
         shader_variants.diffuse_visibility_rows, shader_variants._read = rows, read
+        shading.shares_light_visibility = shares
         shader_variants.clear_cache()
     return seconds, render_engine.last_render["passes"]["Combined"].copy()
 
@@ -102,15 +116,23 @@ def measure_scene(name, size, rounds):
             return seconds
         return run
 
-    rows["per-vertex diffuse visibility (frame)"] = paired(rounds, timed("per_vertex"), timed("per_pixel",
-                                                                                              per_vertex=False))
-    surface = np.abs(images["per_pixel"][..., :3]).sum(-1) > 0
-    difference = images["per_vertex"][..., :3][surface] - images["per_pixel"][..., :3][surface]
-    change = float(np.sqrt(np.mean(difference ** 2) / np.mean(images["per_pixel"][..., :3][surface] ** 2)))
-    rows["clamped-cosine terms once a frame (frame)"] = paired(rounds, timed("terms"), timed("no_terms", terms=False))
+    rows["per-vertex diffuse visibility (frame)"] = paired(rounds, timed("new"), timed("per_pixel", per_vertex=False))
+    rows["clamped-cosine terms once a frame (frame)"] = paired(rounds, timed("new"), timed("no_terms", terms=False))
+    rows["clamped cosine from the table (frame)"] = paired(rounds, timed("new"), timed("closed_form", table=False))
+    rows["light visibility shared by its products (frame)"] = paired(rounds, timed("new"),
+                                                                    timed("decoded", shared_light=False))
     rows["shader + environment caches kept (render())"] = paired(rounds, lambda: render_seconds(True),
                                                                 lambda: render_seconds(False))
-    return rows, change
+    surface = np.abs(images["new"][..., :3]).sum(-1) > 0
+
+    def change(baseline):
+        difference = images["new"][..., :3][surface] - images[baseline][..., :3][surface]
+        return float(np.sqrt(np.mean(difference ** 2) / np.mean(images[baseline][..., :3][surface] ** 2)))
+
+    changes = {"per-vertex vs per-pixel diffuse visibility": change("per_pixel"),
+               "table vs closed-form clamped cosine": change("closed_form"),
+               "shared vs decoded light visibility": change("decoded")}
+    return rows, changes
 
 
 def main(argv=None):
@@ -128,10 +150,11 @@ def main(argv=None):
           f"load average {os.getloadavg()[0]:.1f}")
     print("| scene | saving | new s | baseline s | ratio (min-max) |\n|---|---|---|---|---|")
     for name in args.scenes:
-        rows, change = measure_scene(name, args.size, args.rounds)
+        rows, changes = measure_scene(name, args.size, args.rounds)
         for label, (ratio, low, high, new, old) in rows.items():
             print(f"| {name} | {label} | {new:.3f} | {old:.3f} | {ratio:.3f} ({low:.3f}-{high:.3f}) |", flush=True)
-        print(f"| {name} | per-vertex vs per-pixel Combined, relative RMSE | {change:.4f} | | |", flush=True)
+        for label, change in changes.items():
+            print(f"| {name} | {label}: Combined, relative RMSE | {change:.4f} | | |", flush=True)
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
 
 
