@@ -3,6 +3,7 @@ import numpy as np
 from scipy import integrate
 
 from sg_prt_addon.core import clamped_cosine as cc
+from sg_prt_addon.core import clamped_cosine_table
 
 EXACT = "ring quadrature (Gauss-Legendre, ~1e-14)"
 
@@ -64,6 +65,14 @@ def measure():
         rows.append(_row(f"sg_clamped_cosine_integral where I > {threshold:g} I(n = p)", relative, EXACT,
                          "relative error", paper=paper_relative,
                          note="below the horizon the value decays like exp(-lambda (1 - sin alpha))"))
+
+    tabulated = clamped_cosine_table.clamped_cosine_from_table(cosine, sharpness)
+    rows.append(_row("clamped_cosine_table (384 x 192 bilinear, what the shader reads for lights and slices)",
+                     np.abs(tabulated - exact) / upper, EXACT, "abs error / I(n = p)",
+                     note="same grid; tests/core/test_clamped_cosine_table.py bounds it up to lambda 1e8"))
+    lit = exact > 0.1 * upper
+    rows.append(_row("clamped_cosine_table where I > 0.1 I(n = p)", (np.abs(tabulated - exact) / safe_exact)[lit],
+                     EXACT, "relative error", note="the closed form's row above: 0.0078"))
 
     sharp = sharpness[:, 0] >= 30  # the light's lobe is narrower than about 0.2 rad
     facing = (cosine >= 0.2)[0]
