@@ -32,14 +32,14 @@ const vec3 SSDF_FRAME_FALLBACK_AXIS = vec3(0.8017837257372732, -0.26726124191242
 /* Inverse concentric map (Shirley & Chiu 1997): disc point -> square point. */
 vec2 ssdf_disc_to_square(vec2 disc)
 {
+  /* one atan for both octant cases: selects, not branches (a shader pays for both sides of a branch) */
   float radius = length(disc);
-  if (abs(disc.x) >= abs(disc.y)) {
-    float a = disc.x < 0.0 ? -radius : radius;
-    float b = disc.x == 0.0 ? 0.0 : a * atan(disc.y / disc.x) / SSDF_QUARTER_PI;
-    return vec2(a, b);
-  }
-  float b = disc.y < 0.0 ? -radius : radius;
-  return vec2(b * atan(disc.x / disc.y) / SSDF_QUARTER_PI, b);
+  bool x_major = abs(disc.x) >= abs(disc.y);
+  float major = x_major ? disc.x : disc.y;
+  float minor = x_major ? disc.y : disc.x;
+  float signed_radius = major < 0.0 ? -radius : radius;
+  float other = major == 0.0 ? 0.0 : signed_radius * atan(minor / major) / SSDF_QUARTER_PI;
+  return x_major ? vec2(signed_radius, other) : vec2(other, signed_radius);
 }
 
 /* Unit direction with z >= 0 -> square point; the disc point (x, y) / sqrt(1 + z) has no cancellation. */
@@ -53,12 +53,12 @@ vec2 ssdf_hemisphere_to_square(vec3 direction)
  * horizon point of the same azimuth (straight down: azimuth 0). */
 vec3 ssdf_horizon_lookup(vec3 direction)
 {
-  if (direction.z >= 0.0) {
-    return vec3(ssdf_hemisphere_to_square(direction), 0.0);
-  }
+  /* one square lookup for both cases (selects, not branches) */
+  bool below = direction.z < 0.0;
   float horizontal = length(direction.xy);
   vec3 on_horizon = horizontal > 0.0 ? vec3(direction.xy / horizontal, 0.0) : vec3(1.0, 0.0, 0.0);
-  return vec3(ssdf_hemisphere_to_square(on_horizon), atan(-direction.z, horizontal));
+  return vec3(ssdf_hemisphere_to_square(below ? on_horizon : direction),
+              below ? atan(-direction.z, horizontal) : 0.0);
 }
 
 /* The bake's local frame of a normal: tangent = reference axis projected on the tangent plane. */
