@@ -16,7 +16,8 @@ on one machine:
    bake (unshadowed); visibility bake resolution 8 / 16 / 32 (the bake operator's default error
    target for the PCA terms); fixed PCA terms 4 / 8 / 16 / all 47 at resolution 32; prefilter
    layer size 64 / 256 (128 is the default); NDF lobe count 2 / 4 / 8 of the anisotropic
-   material (6 is the scene's).  Bake time is reported apart (a precomputation);
+   material (6 is the scene's); the view warp with one or two lobes per NDF lobe (core.warp's paper
+   and split2 modes; split3, three, is the default).  Bake time is reported apart (a precomputation);
 3. baselines: the reference renderer at 1 / 4 / 16 samples per pixel (independent seeds), EEVEE
    at 1 / 16 / 64 samples and Cycles (CPU, direct light only) at 1 / 4 / 16 / 64 samples, both
    with node materials matched to ``material.sgprt`` (benchmarks/matched_materials.py says how
@@ -59,12 +60,12 @@ SCENES = ("suzanne_courtyard", "brushed_metal")
 
 FULL = dict(size=512, noise=0.015, max_reference_spp=256, reference_seconds=240, reference_curve=(1, 4, 16),
             bake_resolutions=(8, 16, 32),
-            fixed_terms=(4, 8, 16, 47), layer_sizes=(64, 256), lobe_counts=(2, 4, 8), eevee_samples=(1, 16, 64),
-            cycles_samples=(1, 4, 16, 64), redraws=3)
+            fixed_terms=(4, 8, 16, 47), layer_sizes=(64, 256), lobe_counts=(2, 4, 8), warp_modes=("paper", "split2"),
+            eevee_samples=(1, 16, 64), cycles_samples=(1, 4, 16, 64), redraws=3)
 QUICK = dict(size=64, noise=0.06, max_reference_spp=32, reference_seconds=20, reference_curve=(1, 4),
              bake_resolutions=(8,),
-             fixed_terms=(4, 47), layer_sizes=(64,), lobe_counts=(2,), eevee_samples=(1, 16), cycles_samples=(1, 4),
-             redraws=2)
+             fixed_terms=(4, 47), layer_sizes=(64,), lobe_counts=(2,), warp_modes=("split2",), eevee_samples=(1, 16),
+             cycles_samples=(1, 4), redraws=2)
 
 
 # ----------------------------------------------------------------------------- pure logic (tested)
@@ -477,6 +478,7 @@ class SceneRun:
                 for name, bake in bakes.items()}
 
     def engine_stage(self):
+        from sg_prt_addon.core import warp
         from sg_prt_addon.engine import render_engine, scene_state
 
         config = self.config
@@ -524,6 +526,14 @@ class SceneRun:
                                             "material": material.name})
                 finally:
                     material.sgprt.lobe_count = default
+            default_mode = warp.DEFAULT_MODE
+            try:
+                for mode in config["warp_modes"]:
+                    warp.DEFAULT_MODE = mode        # the shader variants' WARP_FUNCTION and WARP_NODES
+                    self.engine_render(f"R={resolution}, warp {mode} ({default_mode} default)", "SG-PRT warp",
+                                       {"bake_resolution": resolution, "warp_mode": mode})
+            finally:
+                warp.DEFAULT_MODE = default_mode
         finally:
             scene_state.visibility_provider = None
             render_engine.debug["timed_redraws"] = 0
@@ -574,6 +584,7 @@ def plot(data, path):
 
     styles = {"SG-PRT unshadowed": ("#9467bd", "v"), "SG-PRT bake R": ("#d62728", "o"),
               "SG-PRT terms": ("#ff7f0e", "s"), "SG-PRT layers": ("#e377c2", "D"), "SG-PRT lobes": ("#8c564b", "^"),
+              "SG-PRT warp": ("#7f7f7f", "<"),
               "reference": ("#2ca02c", "P"), "EEVEE": ("#1f77b4", "X"), "Cycles": ("#17becf", "h")}
     scenes = list(data["scenes"])
     figure, axes = plt.subplots(1, len(scenes), figsize=(6.0 * len(scenes), 4.6), squeeze=False)
