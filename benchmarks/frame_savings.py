@@ -50,7 +50,8 @@ def frame(per_vertex=True, terms=True, table=True, shared_light=True):
 
     rows, read, shares = (shader_variants.diffuse_visibility_rows, shader_variants._read,
                           shading.shares_light_visibility)
-    substitutions = ([] if terms else [(TERMS_CALL, PER_PIXEL_CALL)]) + ([] if table else [(TABLE_CALL, CLOSED_FORM_CALL)])
+    substitutions = (([] if terms else [(TERMS_CALL, PER_PIXEL_CALL)])
+                     + ([] if table else [(TABLE_CALL, CLOSED_FORM_CALL)]))
 
     def patched_read(path):
         text = read(path)

@@ -29,10 +29,10 @@ visibility keeps of P relative to what the horizon alone keeps, since I(G, n) cl
 the horizon already).  G is the environment lobe (eq. 39), the light (eq. 42), the
 light (x) slice lobe (eq. 43) and the slice lobe (eq. 41); a constant world colour
 uses the cosine lobe alone.  When every light is narrow on the object (shares_light_visibility), the
-light (x) slice products take the light's own visibility.  Otherwise products below VISIBILITY_SKIP_FRACTION of the
-light's own I(G, n) stay unshadowed (the shader skips their decode).  The warped lobes of one NDF
-lobe (warp.DEFAULT_MODE's nodes, close together) share one visibility: the centre node's
-(``visibility_node_indices``), a third of the decodes of split3 for the slice terms.
+light (x) slice products take the light's own visibility.  Otherwise products below
+VISIBILITY_SKIP_FRACTION of the light's own I(G, n) stay unshadowed (the shader skips their decode).
+The warped lobes of one NDF lobe (warp.DEFAULT_MODE's nodes, close together) share one visibility:
+the centre node's (``visibility_node_indices``), a third of the decodes of split3 for the slice terms.
 
 Everything is computed in float32 like the GPU.  Directions: world space, all
 pointing away from the surface.
@@ -207,8 +207,9 @@ def shares_light_visibility(light_data, bounds):
     nearest = np.clip(position, bounds[0], bounds[1])             # the box's point nearest each light
     distance2 = np.sum((position - nearest) ** 2, axis=-1)
     radius2 = np.asarray(light_data.point_radius, np.float64) ** 2
-    sin2 = radius2 / np.maximum(np.maximum(distance2, radius2), 1e-12 * np.maximum(radius2, 1.0))  # lights.sphere_light_sg
-    suns_narrow = np.asarray(light_data.sun_sharpness, np.float64) >= np.log(10.0) / limit       # lights' cap sharpness
+    # lights.sphere_light_sg's cap, and the suns' cap sharpness ln(10) / sin^2
+    sin2 = radius2 / np.maximum(np.maximum(distance2, radius2), 1e-12 * np.maximum(radius2, 1.0))
+    suns_narrow = np.asarray(light_data.sun_sharpness, np.float64) >= np.log(10.0) / limit
     return bool(np.all(sin2 <= limit) and np.all(suns_narrow))
 
 

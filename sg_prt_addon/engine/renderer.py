@@ -350,8 +350,8 @@ class Renderer:
                 if buffers is None:
                     continue
                 model = _column_major(entry.matrix_world)
-                shared_light_visibility = bool(buffers.visibility_layers and has_lights) and shading.shares_light_visibility(
-                    light_data, shading.world_bounds(buffers.bounds, entry.matrix_world))
+                shared_light_visibility = bool(buffers.visibility_layers and has_lights) and \
+                    shading.shares_light_visibility(light_data, shading.world_bounds(buffers.bounds, entry.matrix_world))
                 for slot, first_triangle, batch in buffers.batches:
                     name, params = _slot_material(state, entry, slot)
                     if name not in self.material_buffers:

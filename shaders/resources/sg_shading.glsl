@@ -1,7 +1,8 @@
 /* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43);
  * mirrored line by line by sg_prt_addon/core/shading.py.  Needs sg.glsl, hemisphere.glsl,
  * clamped_cosine.glsl, (lights or specular) clamped_cosine_table.glsl and the `clamped_cosine_table`
- * sampler (the clamped cosine of the lobes whose sharpness varies per pixel), (HAS_LIGHTS) lights.glsl, (HAS_SPECULAR) brdf.glsl + warp.glsl,
+ * sampler (the clamped cosine of the lobes whose sharpness varies per pixel), (HAS_LIGHTS) lights.glsl,
+ * (HAS_SPECULAR) brdf.glsl + warp.glsl,
  * (HAS_ENVIRONMENT and HAS_SPECULAR) env_prefilter.glsl and (HAS_VISIBILITY) ssdf.glsl +
  * lobe_visibility.glsl, plus the `scene` uniform block.  HAS_DIFFUSE / HAS_SPECULAR
  * (shader_variants.material_terms): without one, its term is left out (its colour is zero, so the full
