@@ -479,7 +479,7 @@ class SceneRun:
 
     def engine_stage(self):
         from sg_prt_addon.core import warp
-        from sg_prt_addon.engine import render_engine, scene_state
+        from sg_prt_addon.engine import render_engine, scene_state, shader_variants
 
         config = self.config
         try:
@@ -529,11 +529,14 @@ class SceneRun:
             default_mode = warp.DEFAULT_MODE
             try:
                 for mode in config["warp_modes"]:
-                    warp.DEFAULT_MODE = mode        # the shader variants' WARP_FUNCTION and WARP_NODES
+                    # the variants' WARP_FUNCTION and WARP_NODES; not in VariantKey, so the cached shaders go
+                    warp.DEFAULT_MODE = mode
+                    shader_variants.clear_cache()
                     self.engine_render(f"R={resolution}, warp {mode} ({default_mode} default)", "SG-PRT warp",
                                        {"bake_resolution": resolution, "warp_mode": mode})
             finally:
                 warp.DEFAULT_MODE = default_mode
+                shader_variants.clear_cache()
         finally:
             scene_state.visibility_provider = None
             render_engine.debug["timed_redraws"] = 0
