@@ -16,8 +16,8 @@ on one machine:
    bake (unshadowed); visibility bake resolution 8 / 16 / 32 (the bake operator's default error
    target for the PCA terms); fixed PCA terms 4 / 8 / 16 / all 47 at resolution 32; prefilter
    layer size 64 / 256 (128 is the default); NDF lobe count 2 / 4 / 8 of the anisotropic
-   material (6 is the scene's); the view warp with one or two lobes per NDF lobe (core.warp's paper
-   and split2 modes; split3, three, is the default).  Bake time is reported apart (a precomputation);
+   material (6 is the scene's); every material's view warp with one or two lobes per NDF lobe
+   (material.sgprt.view_warp PAPER and SPLIT2; SPLIT3, three, is the default).  Bake time is reported apart (a precomputation);
 3. baselines: the reference renderer at 1 / 4 / 16 samples per pixel (independent seeds), EEVEE
    at 1 / 16 / 64 samples and Cycles (CPU, direct light only) at 1 / 4 / 16 / 64 samples, both
    with node materials matched to ``material.sgprt`` (benchmarks/matched_materials.py says how
@@ -60,11 +60,11 @@ SCENES = ("suzanne_courtyard", "brushed_metal")
 
 FULL = dict(size=512, noise=0.015, max_reference_spp=256, reference_seconds=240, reference_curve=(1, 4, 16),
             bake_resolutions=(8, 16, 32),
-            fixed_terms=(4, 8, 16, 47), layer_sizes=(64, 256), lobe_counts=(2, 4, 8), warp_modes=("paper", "split2"),
+            fixed_terms=(4, 8, 16, 47), layer_sizes=(64, 256), lobe_counts=(2, 4, 8), warp_modes=("PAPER", "SPLIT2"),
             eevee_samples=(1, 16, 64), cycles_samples=(1, 4, 16, 64), redraws=3)
 QUICK = dict(size=64, noise=0.06, max_reference_spp=32, reference_seconds=20, reference_curve=(1, 4),
              bake_resolutions=(8,),
-             fixed_terms=(4, 47), layer_sizes=(64,), lobe_counts=(2,), warp_modes=("split2",), eevee_samples=(1, 16),
+             fixed_terms=(4, 47), layer_sizes=(64,), lobe_counts=(2,), warp_modes=("SPLIT2",), eevee_samples=(1, 16),
              cycles_samples=(1, 4), redraws=2)
 
 
@@ -479,7 +479,7 @@ class SceneRun:
 
     def engine_stage(self):
         from sg_prt_addon.core import warp
-        from sg_prt_addon.engine import render_engine, scene_state, shader_variants
+        from sg_prt_addon.engine import render_engine, scene_state
 
         config = self.config
         try:
@@ -526,17 +526,17 @@ class SceneRun:
                                             "material": material.name})
                 finally:
                     material.sgprt.lobe_count = default
-            default_mode = warp.DEFAULT_MODE
+            materials = self._materials()
+            defaults = {material.name: material.sgprt.view_warp for material in materials}
             try:
                 for mode in config["warp_modes"]:
-                    # the variants' WARP_FUNCTION and WARP_NODES; not in VariantKey, so the cached shaders go
-                    warp.DEFAULT_MODE = mode
-                    shader_variants.clear_cache()
-                    self.engine_render(f"R={resolution}, warp {mode} ({default_mode} default)", "SG-PRT warp",
-                                       {"bake_resolution": resolution, "warp_mode": mode})
+                    for material in materials:
+                        material.sgprt.view_warp = mode
+                    self.engine_render(f"R={resolution}, view warp {mode.lower()} ({warp.DEFAULT_MODE} default)",
+                                       "SG-PRT warp", {"bake_resolution": resolution, "warp_mode": mode})
             finally:
-                warp.DEFAULT_MODE = default_mode
-                shader_variants.clear_cache()
+                for material in materials:
+                    material.sgprt.view_warp = defaults[material.name]
         finally:
             scene_state.visibility_provider = None
             render_engine.debug["timed_redraws"] = 0

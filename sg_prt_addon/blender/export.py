@@ -109,6 +109,7 @@ class MaterialParams:
     nu: float = 100.0
     nv: float = 1000.0
     lobe_count: int = 4
+    warp_mode: str = "split3"      # core.warp mode of the view slice (material.sgprt.view_warp)
     normal_strength: float = 1.0
     tangent_source: str = "UV_MAP"
     tangent_axis: tuple = (1.0, 0.0, 0.0)
@@ -421,6 +422,7 @@ def export_material(material):
     for name in SCALAR_PARAMETERS:
         setattr(params, name, float(getattr(settings, name)))
     params.lobe_count = int(settings.lobe_count)
+    params.warp_mode = settings.view_warp.lower()       # properties.VIEW_WARPS: core.warp's mode names
     params.normal_strength = float(settings.normal_strength)
     params.tangent_source = settings.tangent_source
     params.tangent_axis = tuple(settings.tangent_axis)

@@ -32,6 +32,7 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
             row.prop(settings, name)
             if textured and hasattr(settings, f"{name}_texture"):
                 row.template_ID(settings, f"{name}_texture", open="image.open")
+        layout.prop(settings, "view_warp")
         layout.prop(settings, "show_textures")
 
 

@@ -286,7 +286,7 @@ def fitted_shadowing(params, direction):
     return interpolate_shadowing(params["shadowing"], params["shadowing_theta"], theta)
 
 
-def fitted_slice(params, view_local):
+def fitted_slice(params, view_local, warp_mode=None):
     """Slice lobes of the stored fit: its NDF lobes (amplitude 1) warped to the view, times
     M_o(i) = F_eta(|i.h|) S(o) S(i) / (pi (i.n)(o.n)); the RGB lobe amplitudes come separately."""
     axis, sharpness = params["axis"], params["sharpness"]
@@ -306,7 +306,7 @@ def fitted_slice(params, view_local):
         return np.where(above, value, 0.0)
 
     return warp.brdf_slice_lobes(axis, sharpness, np.ones_like(sharpness), view_local, m_factor,
-                                 mode=warp.DEFAULT_MODE)
+                                 mode=warp_mode or warp.DEFAULT_MODE)
 
 
 def slice_colours(model, params, slice_count):
@@ -318,31 +318,35 @@ def slice_colours(model, params, slice_count):
     return np.repeat(colour, slice_count // colour.shape[1], axis=1)
 
 
-def specular_slice(model, params, lobe_count, view_local):
-    """BRDF slice lobes (local frame) for the view: warped NDF lobes times M_o at their centres."""
+def specular_slice(model, params, lobe_count, view_local, warp_mode=None):
+    """BRDF slice lobes (local frame) for the view: NDF lobes warped by ``warp_mode`` (core.warp's; None:
+    its default) times M_o at their centres."""
     if model == FITTED_MODEL:
-        return fitted_slice(params, view_local)
+        return fitted_slice(params, view_local, warp_mode)
     axis, sharpness, amplitude = ndf_lobes(model, params, lobe_count)
     # brdf_slice_lobes calls m_factor with the lobe index leading, so per-pixel parameters broadcast
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
-    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, instance.m_factor, mode=warp.DEFAULT_MODE)
+    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, instance.m_factor,
+                                 mode=warp_mode or warp.DEFAULT_MODE)
 
 
 def visibility_node_indices(slice_count, mode=None):
     """Indices of the slice lobes whose visibility the NDF lobe's warped nodes share: the centre node
-    of each group (warp nodes per NDF lobe // 2; node 0 of the paper's one-node warp)."""
+    of each group ((nodes - 1) // 2: split3's middle one, node 0 of the paper's one-node warp, and split2's
+    node 0, the one towards the viewer, which stays a valid half vector at grazing views)."""
     nodes = warp.nodes_per_lobe(mode or warp.DEFAULT_MODE)
-    return np.arange(slice_count // nodes) * nodes + nodes // 2
+    return np.arange(slice_count // nodes) * nodes + (nodes - 1) // 2
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
-          light_data, environment, lobe_count=1, visibility=None):
+          light_data, environment, lobe_count=1, visibility=None, warp_mode=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
     ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
     applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
 
     view_origin: camera position (perspective) or the camera's forward direction (orthographic).
     visibility: a Visibility (the SSDF shadows of the HAS_VISIBILITY variant) or None (unshadowed).
+    warp_mode: core.warp's mode of the view slice (the material's view warp; None: the default).
     """
     position = np.asarray(position, FLOAT)
     n, t, b = shading_frame(normal, tangent)
@@ -353,7 +357,7 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     frame = np.stack([t, b, n], axis=-1)                          # local -> world: columns t, b, n
     view_local = np.einsum("nji,nj->ni", frame, view).astype(FLOAT)
 
-    slice_axis, slice_sharpness, slice_amplitude = specular_slice(model, params, lobe_count, view_local)
+    slice_axis, slice_sharpness, slice_amplitude = specular_slice(model, params, lobe_count, view_local, warp_mode)
     slice_axis = np.einsum("nij,nkj->nki", frame, slice_axis).astype(FLOAT)    # to world
     slice_sharpness = slice_sharpness.astype(FLOAT)
     slice_amplitude = slice_amplitude.astype(FLOAT)
@@ -373,8 +377,8 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
         flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
         return lobe_visibility(flat_axis, flat_sharpness, n, visibility).reshape(shape)
 
-    nodes = warp.nodes_per_lobe()
-    centre = visibility_node_indices(slice_sharpness.shape[1])
+    nodes = warp.nodes_per_lobe(warp_mode)
+    centre = visibility_node_indices(slice_sharpness.shape[1], warp_mode)
 
     def per_node(group_values):         # (..., K) -> (..., K * nodes): each NDF lobe's to its warped nodes
         return np.repeat(group_values, nodes, axis=-1)
@@ -481,7 +485,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
         shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
         return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
                      model_params, diffuse_color, np.ones((count, 3), FLOAT), light_data, environment,
-                     visibility=visibility)
+                     visibility=visibility, warp_mode=getattr(material, "warp_mode", None))
     diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
     specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
     if "diffuse_color" in textures:
@@ -505,7 +509,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
                  diffuse_color, specular_color, light_data, environment,
                  lobe_count=material.lobe_count if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY") else 1,
-                 visibility=visibility)
+                 visibility=visibility, warp_mode=getattr(material, "warp_mode", None))
 
 
 # The material fields each model reads (names as brdf.model_from_name takes them).

@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core import warp
+
 def _shader_dir():
     """shaders/ inside the package (installed extension) or next to it (the repository)."""
     package_dir = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -92,6 +94,7 @@ class VariantKey:
     # light x slice products take the light's visibility (core.shading.shares_light_visibility; with a bake,
     # lights and a specular term)
     shared_light_visibility: bool = False
+    warp_mode: str = warp.DEFAULT_MODE      # of the view slice (MaterialParams.warp_mode); with a specular term
 
     @property
     def has_visibility(self):
@@ -112,6 +115,8 @@ class VariantKey:
             parts.append(f"per-vertex diffuse visibility ({self.diffuse_visibility_rows} vec4)")
         if self.shared_light_visibility:
             parts.append("light visibility shared by its products")
+        if self.has_specular and self.warp_mode != warp.DEFAULT_MODE:
+            parts.append(f"warp {self.warp_mode}")
         if not self.has_diffuse:
             parts.append("no diffuse")
         if not self.has_specular:
@@ -159,7 +164,8 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False, vis
         return VariantKey(FITTED_MODEL, int(fitted.lobe_count), bool(has_lights), bool(has_environment), textures,
                           bool(gbuffer), int(visibility_layers), int(fitted.components),
                           diffuse_visibility_rows=int(diffuse_rows) if visibility_layers else 0,
-                          shared_light_visibility=bool(shared_light_visibility and visibility_layers and has_lights))
+                          shared_light_visibility=bool(shared_light_visibility and visibility_layers and has_lights),
+                          warp_mode=_warp_mode_of(material_params))
     model = material_params.model
     lobes = int(material_params.lobe_count) if model in ANISOTROPIC_MODELS else 1
     if model == "GGX":
@@ -171,7 +177,16 @@ def variant_key(material_params, has_lights, has_environment, gbuffer=False, vis
                       int(visibility_layers), has_diffuse=has_diffuse, has_specular=has_specular,
                       diffuse_visibility_rows=int(diffuse_rows) if visibility_layers and has_diffuse else 0,
                       shared_light_visibility=bool(shared_light_visibility and visibility_layers and has_lights
-                                                   and has_specular))
+                                                   and has_specular),
+                      warp_mode=_warp_mode_of(material_params) if has_specular else warp.DEFAULT_MODE)
+
+
+def _warp_mode_of(material_params):
+    """The material's core.warp mode (MaterialParams.warp_mode; objects without it: the default)."""
+    mode = getattr(material_params, "warp_mode", warp.DEFAULT_MODE)
+    if mode not in warp.MODES:
+        raise ValueError(f"unknown view warp {mode!r} (core.warp.MODES: {', '.join(warp.MODES)})")
+    return mode
 
 
 def _read(path):
@@ -198,17 +213,16 @@ def _constants_source(key):
             f"const float VISIBILITY_SKIP_FRACTION = {_float_literal(shading.VISIBILITY_SKIP_FRACTION)};\n")
 
 
-def warp_mode():
-    """(GLSL function, lobes per NDF lobe) of core.warp's default mode, which the mirror uses."""
-    from ..core import warp
-    return f"warp_lobes_{warp.DEFAULT_MODE}", warp.nodes_per_lobe()
+def warp_mode(mode):
+    """(GLSL function, lobes per NDF lobe) of a core.warp mode (the mirror warps with the same)."""
+    return f"warp_lobes_{mode}", warp.nodes_per_lobe(mode)
 
 
 def defines(key):
     out = dict(LIMITS)
     if key.has_specular:        # the model only shapes the BRDF slice
         out["HAS_SPECULAR"] = 1
-        out["WARP_FUNCTION"], out["WARP_NODES"] = warp_mode()
+        out["WARP_FUNCTION"], out["WARP_NODES"] = warp_mode(key.warp_mode)
         out["MODEL_" + key.model] = 1
         out["NDF_LOBES"] = key.ndf_lobes
     if key.has_diffuse:

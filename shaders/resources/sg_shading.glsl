@@ -265,8 +265,10 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
 
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
 /* The warped lobes of one NDF lobe lie close together: they share the visibility of the centre one
- * (core.shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3. */
-#define VISIBILITY_NODE (WARP_NODES / 2)
+ * (core.shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3; split2 has
+ * no centre node and takes node 0, the one towards the viewer (a valid half vector whenever the lobe's
+ * centre is; the other can fall below the view's horizon at grazing views). */
+#define VISIBILITY_NODE ((WARP_NODES - 1) / 2)
 
 /* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer.  Without HAS_DIFFUSE
  * the irradiance stays 0, without HAS_SPECULAR the radiance (the variant's colour is zero). */

@@ -214,6 +214,34 @@ def test_visibility_lights_and_world_colour(engine, bakes):
     _assert_shadows(result)
 
 
+@pytest.mark.parametrize("view_warp", ["PAPER", "SPLIT2"])
+def test_view_warps_with_visibility(engine, bakes, view_warp):
+    """A material's view warp (material.sgprt.view_warp: one or two lobes per NDF lobe instead of three)
+    reaches the shader (WARP_FUNCTION / WARP_NODES of its variant) and the mirror alike, shadows included."""
+    from sg_prt_addon.core import warp
+    from sg_prt_addon.engine import shader_variants
+
+    scene, sphere, floor = _shadow_scene("mirror_warp_" + view_warp.lower(), 96)
+    fx.world_colour(scene, (0.1, 0.12, 0.15))
+    fx.point_light(scene, "warp_point_" + view_warp, (1.5, -1.0, 3.5), 1500.0, radius=0.1)
+    sphere.data.materials[0] = fx.material("mirror_warp_as_" + view_warp, model="ASHIKHMIN_SHIRLEY", nu=40.0,
+                                           nv=400.0, lobe_count=3, tangent_source="OBJECT_AXIS",
+                                           tangent_axis=(0.0, 0.0, 1.0), view_warp=view_warp)
+    floor.data.materials[0].sgprt.view_warp = view_warp
+    bakes(scene, [sphere, floor], resolution=12)
+    keys, get_shader = [], shader_variants.get_shader
+    shader_variants.get_shader = lambda key: keys.append(key) or get_shader(key)
+    try:
+        result = fx.render(scene, gbuffer=True)
+    finally:
+        shader_variants.get_shader = get_shader
+    assert {key.warp_mode for key in keys} == {view_warp.lower()}
+    assert {shader_variants.defines(key)["WARP_NODES"] for key in keys} == {warp.nodes_per_lobe(view_warp.lower())}
+    assert all(material.warp_mode == view_warp.lower() for material in result["state"].materials.values()
+               if material.name)
+    _check(result)
+
+
 def _assert_shadows(result):
     """The visibility variant really shadows: many pixels lose over 20% of their diffuse light."""
     shadowed, covered = _mirror(result)
