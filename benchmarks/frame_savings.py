@@ -155,7 +155,7 @@ def main(argv=None):
         for label, (ratio, low, high, new, old) in rows.items():
             print(f"| {name} | {label} | {new:.3f} | {old:.3f} | {ratio:.3f} ({low:.3f}-{high:.3f}) |", flush=True)
         for label, change in changes.items():
-            print(f"| {name} | {label}: Combined, relative RMSE | {change:.4f} | | |", flush=True)
+            print(f"| {name} | {label}: Combined, relative RMSE | {change:.1e} | | |", flush=True)
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
 
 
