@@ -17,7 +17,8 @@ on one machine:
    target for the PCA terms); fixed PCA terms 4 / 8 / 16 / all 47 at resolution 32; prefilter
    layer size 64 / 256 (128 is the default); NDF lobe count 2 / 4 / 8 of the anisotropic
    material (6 is the scene's); every material's view warp with one or two lobes per NDF lobe
-   (material.sgprt.view_warp PAPER and SPLIT2; SPLIT3, three, is the default).  Bake time is reported apart (a precomputation);
+   (material.sgprt.view_warp PAPER and SPLIT2; SPLIT3, three, is the default).  Bake time is
+   reported apart (a precomputation);
 3. baselines: the reference renderer at 1 / 4 / 16 samples per pixel (independent seeds), EEVEE
    at 1 / 16 / 64 samples and Cycles (CPU, direct light only) at 1 / 4 / 16 / 64 samples, both
    with node materials matched to ``material.sgprt`` (benchmarks/matched_materials.py says how

@@ -109,7 +109,7 @@ class MaterialParams:
     nu: float = 100.0
     nv: float = 1000.0
     lobe_count: int = 4
-    warp_mode: str = "split3"      # core.warp mode of the view slice (material.sgprt.view_warp)
+    warp_mode: str = "split3"      # core.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.view_warp)
     normal_strength: float = 1.0
     tangent_source: str = "UV_MAP"
     tangent_axis: tuple = (1.0, 0.0, 0.0)

@@ -86,8 +86,8 @@ FULL_SPLIT_SHARPNESS = 8.0      # below this lambda the cap shrinks linearly to 
 
 
 def nodes_per_lobe(mode=None):
-    """Warped lobes a mode makes of each NDF lobe (1 for the paper's warp); None: DEFAULT_MODE as it is now
-    (benchmarks switch it at run time)."""
+    """Warped lobes a mode makes of each NDF lobe (1 for the paper's warp); None: DEFAULT_MODE, read when
+    called."""
     mode = mode or DEFAULT_MODE
     return 1 if mode == "paper" else len(SPLIT_RULES[mode][0])
 
