@@ -32,14 +32,8 @@ SHARPNESS_RANGE = (1.0e-4, 1.0e8)
 MIN_SHARPNESS = 1.0e-6
 # Gauss nodes a sub-interval of the building quadrature: 3e-6 of I(1, lambda), far below the interpolation
 BUILD_NODES = 16
-
-
+# share of the rows' map given to the knee at the horizon (the module docstring's 0.2)
 KNEE_WEIGHT = 0.2
-KNEE_SCALE = 1.0
-
-
-def _knee_scale(sharpness):
-    return KNEE_SCALE * np.sqrt(sharpness)
 
 
 def _g(t):
@@ -48,14 +42,14 @@ def _g(t):
 
 def row_coordinate(cosine, sharpness):
     """y(c, lambda) in [-1, 1] (the module docstring)."""
-    s = _knee_scale(sharpness)
+    s = np.sqrt(sharpness)
     return (cosine + KNEE_WEIGHT * _g(cosine * s)) / (1.0 + KNEE_WEIGHT * _g(s))
 
 
 def cosine_of_row(y, sharpness):
-    """The inverse of row_coordinate: for y >= 0, s c^2 + (1 + s - Y s) c - Y = 0 with Y = y (1 + g(s)),
-    its non-negative root in the form that does not cancel; odd in y."""
-    s = _knee_scale(sharpness)
+    """The inverse of row_coordinate: for y >= 0, s c^2 + (1 + w s - Y s) c - Y = 0 with s = sqrt(lambda),
+    w = KNEE_WEIGHT and Y = y (1 + w g(s)), its non-negative root in the form that does not cancel; odd in y."""
+    s = np.sqrt(sharpness)
     big_y = np.abs(y) * (1.0 + KNEE_WEIGHT * _g(s))
     linear = 1.0 + KNEE_WEIGHT * s - big_y * s
     c = 2.0 * big_y / (linear + np.sqrt(linear * linear + 4.0 * s * big_y))
@@ -85,20 +79,18 @@ def clamped_cosine_table(columns=COLUMNS, rows=ROWS):
 
 def clamped_cosine_from_table(cosine, sharpness, table=None):
     """I(c, lambda) with unit amplitude read from the table as the GPU's bilinear filter reads it
-    (GLSL: clamped_cosine_tabulated); lambda <= 0 (or NaN) is pi, like clamped_cosine_from_cosine."""
+    (GLSL: clamped_cosine_tabulated, step for step); lambda <= 0 (or NaN) is pi, like clamped_cosine_from_cosine."""
+    from .shading import sample_bilinear       # the GPU's bilinear fetch; shading imports this module
+
     table = clamped_cosine_table() if table is None else table
     rows, columns = table.shape[:2]
     cosine, sharpness = np.broadcast_arrays(np.asarray(cosine, np.float64), np.asarray(sharpness, np.float64))
     broad = ~(sharpness > 0.0)
     lam = np.maximum(np.where(broad, 1.0, sharpness), MIN_SHARPNESS)
     c = np.clip(cosine, -1.0, 1.0)
-    fx = column_coordinate(lam) * (columns - 1)
-    fy = 0.5 * (row_coordinate(c, lam) + 1.0) * (rows - 1)
-    ix = np.clip(np.floor(fx).astype(int), 0, columns - 2)
-    iy = np.clip(np.floor(fy).astype(int), 0, rows - 2)
-    tx, ty = (fx - ix)[..., None], (fy - iy)[..., None]
-    texel = ((1 - tx) * (1 - ty) * table[iy, ix] + tx * (1 - ty) * table[iy, ix + 1]
-             + (1 - tx) * ty * table[iy + 1, ix] + tx * ty * table[iy + 1, ix + 1])
+    size = np.array([columns, rows], np.float64)
+    position = np.stack([column_coordinate(lam), 0.5 + 0.5 * row_coordinate(c, lam)], axis=-1)
+    texel = sample_bilinear(table, (position * (size - 1.0) + 0.5) / size)     # texel centres at the ends
     value = np.pi / (1.0 + lam / 3.0) * texel[..., 0] * texel[..., 1]
     return np.where(broad, np.pi, value)
 

@@ -11,7 +11,6 @@
 const float CLAMPED_COSINE_TABLE_LOG_MIN = -9.210340371976182;      /* log(SHARPNESS_RANGE[0]) */
 const float CLAMPED_COSINE_TABLE_LOG_MAX = 18.420680743952367;      /* log(SHARPNESS_RANGE[1]) */
 const float CLAMPED_COSINE_TABLE_KNEE_WEIGHT = 0.2;
-const float CLAMPED_COSINE_TABLE_KNEE_SCALE = 1.0;
 const float CLAMPED_COSINE_TABLE_MIN_SHARPNESS = 1.0e-6;
 
 /* I(c, lambda) with unit amplitude (lambda <= 0 or NaN: pi, the cosine's own integral). */
@@ -22,7 +21,7 @@ float clamped_cosine_tabulated(sampler2D table, float cosine, float sharpness)
   }
   float lam = max(sharpness, CLAMPED_COSINE_TABLE_MIN_SHARPNESS);
   float c = clamp(cosine, -1.0, 1.0);
-  float s = CLAMPED_COSINE_TABLE_KNEE_SCALE * sqrt(lam);
+  float s = sqrt(lam);
   float t = c * s;
   float y = (c + CLAMPED_COSINE_TABLE_KNEE_WEIGHT * t / (1.0 + abs(t)))
             / (1.0 + CLAMPED_COSINE_TABLE_KNEE_WEIGHT * s / (1.0 + s));
