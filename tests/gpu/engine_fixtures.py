@@ -139,6 +139,20 @@ def world_texture(scene, path, strength=1.0):
     return world
 
 
+@contextlib.contextmanager
+def recorded_variant_keys():
+    """A list that collects the VariantKey of every surface shader asked for (shader_variants.get_shader)
+    inside the block: what a render really drew with."""
+    from sg_prt_addon.engine import shader_variants
+
+    keys, get_shader = [], shader_variants.get_shader
+    shader_variants.get_shader = lambda key: keys.append(key) or get_shader(key)
+    try:
+        yield keys
+    finally:
+        shader_variants.get_shader = get_shader
+
+
 def render(scene, gbuffer=False, environment_layer_size=None):
     """Final render of `scene` with the engine; returns render_engine.last_render.
     environment_layer_size: the prefilter's layer size for this render (small: fast), else the

@@ -229,12 +229,8 @@ def test_view_warps_with_visibility(engine, bakes, view_warp):
                                            tangent_axis=(0.0, 0.0, 1.0), view_warp=view_warp)
     floor.data.materials[0].sgprt.view_warp = view_warp
     bakes(scene, [sphere, floor], resolution=12)
-    keys, get_shader = [], shader_variants.get_shader
-    shader_variants.get_shader = lambda key: keys.append(key) or get_shader(key)
-    try:
+    with fx.recorded_variant_keys() as keys:
         result = fx.render(scene, gbuffer=True)
-    finally:
-        shader_variants.get_shader = get_shader
     assert {key.warp_mode for key in keys} == {view_warp.lower()}
     assert {shader_variants.defines(key)["WARP_NODES"] for key in keys} == {warp.nodes_per_lobe(view_warp.lower())}
     assert all(material.warp_mode == view_warp.lower() for material in result["state"].materials.values()

@@ -182,7 +182,6 @@ def test_narrow_lights_share_their_visibility(engine, bakes):
     sphere's box): 2e-4.  A broad light (radius 1.5) keeps the decodes."""
     import bpy
     from sg_prt_addon.core import shading
-    from sg_prt_addon.engine import shader_variants
 
     scene, sphere, floor = _scene("shared_light")
     fx.world_colour(scene, (0.02, 0.02, 0.02))
@@ -192,14 +191,14 @@ def test_narrow_lights_share_their_visibility(engine, bakes):
     bakes(scene, [sphere, floor], resolution=BAKE_RESOLUTION)
 
     def render(shared=None):
-        keys, get_shader, shares = [], shader_variants.get_shader, shading.shares_light_visibility
-        shader_variants.get_shader = lambda key: keys.append(key) or get_shader(key)
+        shares = shading.shares_light_visibility
         if shared is not None:
             shading.shares_light_visibility = lambda light_data, bounds: shared
         try:
-            image, surface, _ = _engine_image(scene)
+            with fx.recorded_variant_keys() as keys:
+                image, surface, _ = _engine_image(scene)
         finally:
-            shader_variants.get_shader, shading.shares_light_visibility = get_shader, shares
+            shading.shares_light_visibility = shares
         return image.copy(), surface, {key.shared_light_visibility for key in keys if key.visibility_layers}
 
     shared_image, surface, flags = render()
