@@ -107,7 +107,7 @@ class Scene:
 
 
 def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optional[Callable] = None,
-                     batch_rays=1 << 16, tracer=None, threads=2, environment_samples=16):
+                     batch_rays=1 << 16, tracer=None, threads=2, environment_samples=16, pixel_centres=False):
     """Render ``scene`` through ``camera`` (core.camera.Camera).
 
     Returns (image, standard_error), both (H, W, 3) float64.  ``progress`` is
@@ -133,7 +133,7 @@ def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optiona
         tracer = RayTracer(scene.vertices, scene.triangles, threads=threads)
     try:
         return _render(scene, camera, samples_per_pixel, seed, progress, batch_rays, threads,
-                       _Renderer(scene, tracer, environment_samples))
+                       _Renderer(scene, tracer, environment_samples), pixel_centres)
     finally:
         if own_tracer:
             tracer.close()
@@ -179,7 +179,7 @@ def render_to_noise(scene, camera, relative_error=0.01, pilot_samples=8, max_sam
             tracer.close()
 
 
-def _render(scene, camera, samples_per_pixel, seed, progress, batch_rays, threads, renderer):
+def _render(scene, camera, samples_per_pixel, seed, progress, batch_rays, threads, renderer, pixel_centres=False):
     environment_samples = renderer.environment_samples
     height, width = camera.height, camera.width
     pixel_count = height * width
@@ -200,7 +200,7 @@ def _render(scene, camera, samples_per_pixel, seed, progress, batch_rays, thread
         pixels = np.arange(first_pixel, end_pixel)
         pixel_ids = np.tile(pixels, batch_repeats)
         pixel_xy = np.stack([pixel_ids % width, pixel_ids // width], axis=-1).astype(np.float64)
-        pixel_xy += rng.random(pixel_xy.shape)
+        pixel_xy += 0.5 if pixel_centres else rng.random(pixel_xy.shape)
         origins, directions = camera.rays_through(pixel_xy)
         values = renderer.radiance(origins, directions, rng).reshape(batch_repeats, len(pixels), 3)
         return pixels, values
