@@ -41,12 +41,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import brdf, clamped_cosine, env_prefilter, lights, sg, warp
+from . import brdf, clamped_cosine, env_prefilter, equirect, ggx_albedo, lights, sg, warp
 
 FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
 # GGX's projected area at roughness 0.3-0.5 (its long tail), two lobes 0.93-0.97.
 GGX_NDF_LOBES = 2
+# GGX's tail lobe of environment light (environment_tail) has this fraction of the broader NDF lobe's sharpness.
+TAIL_SHARPNESS_RATIO = 0.25
 # Light (x) slice products (eq. 43) whose clamped-cosine integral is below this fraction of the light's own
 # (away from the highlight) skip the SSDF decode and stay unshadowed (the GLSL branches: it saves decodes).
 VISIBILITY_SKIP_FRACTION = 1e-4
@@ -97,6 +99,7 @@ class EnvironmentData:
     lobe_sharpness: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
     lobe_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
     prefiltered: object = None          # env_prefilter.PrefilteredEnvironment or None
+    radiance: np.ndarray = None         # the equirect map it was made of (H, W, 3), row 0 at the top
 
     @property
     def has_texture(self):
@@ -168,6 +171,45 @@ def vertex_diffuse_visibility(environment, vertices):
     else:
         axis, sharpness = n[:, None, :], np.zeros((len(n), 1), FLOAT)
     return lobe_visibility(axis, sharpness, n, vertices)
+
+
+def environment_tail(model, params, view_local, slice_axis, slice_sharpness, slice_cosine, warp_mode=None):
+    """GGX's energy beyond its slice lobes, as a broad lobe of environment light (sg_shading.glsl's
+    ENVIRONMENT_TAIL): (albedo (N,), axis (N, 3), sharpness (N,)), or None for other models.  The albedo
+    is max(0, E(o) - sum_j I(S_j, n)), E(o) the model's exact directional albedo (core.ggx_albedo's
+    table, one bilinear fetch), the sum the slice lobes' own clamped-cosine integrals (unshadowed); the
+    lobe lies on the broader NDF lobe's centre node with TAIL_SHARPNESS_RATIO of its sharpness (GGX's
+    tail is wider than either lobe) and takes that node's visibility."""
+    if model != "GGX":
+        return None
+    table = ggx_albedo.albedo_table()[..., None]
+    s, t = ggx_albedo.table_coordinates(np.asarray(view_local, FLOAT)[:, 2], np.asarray(params["roughness"], FLOAT))
+    albedo = sample_bilinear(table, np.stack([s, t], axis=-1))[:, 0]
+    node = visibility_node_indices(slice_sharpness.shape[1], warp_mode)[0]
+    missing = np.maximum(albedo - np.sum(slice_cosine, axis=1), FLOAT(0))
+    return missing.astype(FLOAT), slice_axis[:, node], (slice_sharpness[:, node] * FLOAT(TAIL_SHARPNESS_RATIO))
+
+
+def environment_radiance(environment, axis, sharpness):
+    """Gamma_L / integral G of slice lobes (sg_shading.glsl's environment_radiance): the prefiltered
+    lookup, and for lobes sharper than its top layer a blend in log2(lambda) towards the map's own radiance
+    (bilinear, as the GPU samples the equirect texture), reached where the lobe's width 1 / sqrt(lambda) is
+    one map row (lambda = (rows / pi)^2).  The top layer alone blurs such lobes by its own width: a GGX
+    roughness 0.1 slice (lambda about 5000) read a layer of lambda 660 at the default layer size."""
+    prefiltered = environment.prefiltered
+    value = env_prefilter.lookup(prefiltered, axis, sharpness)
+    if environment.radiance is None:
+        return value
+    log2_top = FLOAT(prefiltered.log2_min_sharpness + (len(prefiltered.sharpness) - 1) / prefiltered.levels_per_octave)
+    rows = FLOAT(environment.radiance.shape[0])
+    log2_raw = np.maximum(FLOAT(2) * np.log2(rows / FLOAT(np.pi)), log2_top + FLOAT(1))
+    beyond = np.clip((np.log2(np.maximum(np.asarray(sharpness, FLOAT), FLOAT(1e-30))) - log2_top)
+                     / (log2_raw - log2_top), 0, 1)[..., None]
+    u, v = equirect.direction_to_uv(sg.normalize(np.asarray(axis, FLOAT)))
+    uv = np.stack([u, v], axis=-1).astype(FLOAT)
+    image = np.asarray(environment.radiance, FLOAT)[::-1, :, :3]          # the texture's rows: t = 0 at the bottom
+    raw = sample_bilinear(image, uv.reshape(-1, 2)).reshape(uv.shape[:-1] + (3,))
+    return (value + (raw - value) * beyond).astype(FLOAT)
 
 
 def point_light_sgs(position, light_data):
@@ -338,6 +380,34 @@ def visibility_node_indices(slice_count, mode=None):
     return np.arange(slice_count // nodes) * nodes + (nodes - 1) // 2
 
 
+def light_tail(model, params, view_local, frame, light_axis, light_sharpness, light_cosine,
+               slice_axis, slice_sharpness, slice_amplitude):
+    """What the slice lobes miss of the model's own BRDF at each light's centre, (N, P): the long tail of
+    GGX (an SG falls off as exp(-lambda theta^2 / 2), GGX as theta^-4) and the lobes' error at the
+    peak.  The residual rho_s(o, i_c) - sum_j S_j(i_c) times the light's clamped-cosine integral (what
+    the light delivers at its centre, horizon included) is exact for a point light and stands for the
+    light's average of the residual where the residual is smooth across the light; so it is weighted by
+    how narrow the light is against the BRDF's local scale at its centre,
+
+        w = lambda_L s^2 / (1 + lambda_L s^2),   s^2 = min_j (1 / lambda_j + 2 (1 - p_j . i_c)),
+
+    s^2 the squared angular scale of the nearest slice lobe around its axis (its own width, or the
+    distance to it: the tail varies on the scale of its distance from the peak), 1 / lambda_L the
+    light's: a point light keeps all of it (w -> 1); a broad light on the peak of a sharp lobe, where the
+    SG products integrate the lobes exactly and the peak residual would be multiplied by the light's whole
+    solid angle, none of it.  Light (N, P, 3) / (N, P), slices world (N, J, 3) / (N, J)."""
+    light_axis = np.asarray(light_axis, FLOAT)
+    cosine = np.einsum("npc,njc->npj", light_axis, slice_axis)                             # (N, P, J)
+    slice_value = np.sum(slice_amplitude[:, None] * np.exp(slice_sharpness[:, None] * (cosine - FLOAT(1))), axis=-1)
+    scale2 = np.min(FLOAT(1) / np.maximum(slice_sharpness[:, None], FLOAT(1e-6)) + FLOAT(2) * (FLOAT(1) - cosine),
+                    axis=-1)
+    light_local = np.einsum("nji,npj->npi", frame, light_axis).astype(FLOAT)
+    instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[:, None] for k, v in params.items()})
+    exact = instance.specular(np.broadcast_to(view_local[:, None, :], light_local.shape), light_local)
+    narrow = scale2 * light_sharpness / (FLOAT(1) + scale2 * light_sharpness)
+    return (narrow * light_cosine * (exact - slice_value)).astype(FLOAT)
+
+
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
           light_data, environment, lobe_count=1, visibility=None, warp_mode=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
@@ -407,11 +477,20 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             decoded = per_node(above.reshape(above.shape[:2] + (-1, nodes)).any(axis=-1))
             weight = np.where(decoded, weight * per_node(visible(axis_m[:, :, centre], sharpness_m[:, :, centre])),
                               weight)
-        specular += np.sum(light_amplitude * np.sum(weight[..., None] * slice_colour[:, None], axis=2), axis=1)
+        weight = np.sum(weight[..., None] * slice_colour[:, None], axis=2)                         # (N, P, 3)
+        if model != FITTED_MODEL:
+            tail = light_tail(model, params, view_local, frame, light_axis, light_sharpness, light_cosine,
+                              slice_axis, slice_sharpness, slice_amplitude)
+            weight = np.maximum(weight + (tail * light_visible)[..., None], FLOAT(0))
+        specular += np.sum(light_amplitude * weight, axis=1)
 
     slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)    # (N, J)
+    tail = environment_tail(model, params, view_local, slice_axis, slice_sharpness, slice_cosine, warp_mode)
     if visibility is not None:
-        slice_cosine = slice_cosine * per_node(visible(slice_axis[:, centre], slice_sharpness[:, centre]))
+        slice_visible = visible(slice_axis[:, centre], slice_sharpness[:, centre])                 # (N, K)
+        slice_cosine = slice_cosine * per_node(slice_visible)
+        if tail is not None:
+            tail = (tail[0] * slice_visible[:, 0],) + tail[1:]
     if environment.has_texture:
         if len(environment.lobe_sharpness):
             lobe_count_env = len(environment.lobe_sharpness)
@@ -423,8 +502,10 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
                 env_visible)[..., None], axis=1)
-        radiance = env_prefilter.lookup(environment.prefiltered, slice_axis, slice_sharpness)        # (N, J, 3)
+        radiance = environment_radiance(environment, slice_axis, slice_sharpness)                   # (N, J, 3)
         specular += np.sum(radiance * (slice_cosine[..., None] * slice_colour), axis=1)
+        if tail is not None:
+            specular += tail[0][:, None] * environment_radiance(environment, tail[1], tail[2])
     else:
         colour = np.asarray(environment.colour, FLOAT)
         if visibility is None:
@@ -434,6 +515,8 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
         else:       # the cosine lobe alone: a zero-sharpness G at the normal
             irradiance += np.pi * colour * visible(n_lobe, np.zeros((len(n), 1), FLOAT))
         specular += np.sum(slice_cosine[..., None] * slice_colour, axis=1) * colour
+        if tail is not None:
+            specular += tail[0][:, None] * colour
 
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
     return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * specular).astype(FLOAT)

@@ -10,7 +10,7 @@ import collections
 
 import numpy as np
 
-from ..core import clamped_cosine, clamped_cosine_table, shading
+from ..core import clamped_cosine, clamped_cosine_table, ggx_albedo, shading
 from . import shader_variants
 from .shader_variants import GBUFFER_OUTPUTS, MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 
@@ -252,6 +252,7 @@ class Renderer:
         self.environment_source = None
         self.anisotropy_tables = {}     # lobe count -> GPUTexture
         self.ggx_texture = None
+        self.ggx_albedo_texture = None
         self.clamped_cosine_texture = None
         self.framebuffer = None
         self.targets = []
@@ -373,6 +374,8 @@ class Renderer:
                     shader.uniform_block("material", self.material_buffers[name])
                     if has_environment:
                         shader.uniform_sampler("environment_texture", self.environment_texture)
+                        if key.has_specular:
+                            shader.uniform_sampler("equirect_texture", self.equirect_texture)
                     if key.model in shader_variants.ANISOTROPIC_MODELS:
                         shader.uniform_sampler("anisotropy_table", self._anisotropy_texture(key.ndf_lobes))
                     if shader_variants.uses_clamped_cosine_table(key):
@@ -383,6 +386,10 @@ class Renderer:
                         if self.ggx_texture is None:
                             self.ggx_texture = _texture_2d(shader_variants.ggx_table())
                         shader.uniform_sampler("ggx_table", self.ggx_texture)
+                        if self.ggx_albedo_texture is None:
+                            albedo = np.repeat(ggx_albedo.albedo_table()[..., None], 4, axis=-1)
+                            self.ggx_albedo_texture = _texture_2d(albedo)
+                        shader.uniform_sampler("ggx_albedo_table", self.ggx_albedo_texture)
                     if key.model == shader_variants.FITTED_MODEL:
                         layers, table = self.fitted_textures[params.name if params.name in self.fitted_textures
                                                              else name]

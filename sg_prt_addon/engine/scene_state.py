@@ -352,7 +352,7 @@ def environment_data(world, layer_size=None):
         prefiltered = env_prefilter.prefilter_environment(image, size=layer_size)
         lobes = _fit_environment(image)
         cached = shading.EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
-                                         lobe_sharpness=lobes[1], lobe_amplitude=lobes[2])
+                                         lobe_sharpness=lobes[1], lobe_amplitude=lobes[2], radiance=image)
     _environment_cache[key] = cached                 # (re)inserted last: the most recent
     while len(_environment_cache) > ENVIRONMENT_CACHE_SIZE:
         del _environment_cache[next(iter(_environment_cache))]

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import warp
+from ..core import ggx_albedo, shading, warp
 
 def _shader_dir():
     """shaders/ inside the package (installed extension) or next to it (the repository)."""
@@ -247,6 +247,10 @@ def defines(key):
         out["DIFFUSE_VISIBILITY_ROWS"] = key.diffuse_visibility_rows
     if key.shared_light_visibility:
         out["SHARED_LIGHT_VISIBILITY"] = 1
+    if uses_ggx_table(key):     # GGX's energy beyond its two lobes, from its albedo table (core.ggx_albedo)
+        out["ENVIRONMENT_TAIL"] = 1
+        out["GGX_ALBEDO_SIZE"] = ggx_albedo.TABLE_SIZE
+        out["TAIL_SHARPNESS_RATIO"] = f"{shading.TAIL_SHARPNESS_RATIO!r}"
     return out
 
 
@@ -402,10 +406,13 @@ def create_info_calls(key):
     samplers = []
     if key.has_environment:
         samplers.append(("FLOAT_2D_ARRAY", "environment_texture"))
+        if key.has_specular:        # the map itself, for slice lobes sharper than the top prefiltered layer
+            samplers.append(("FLOAT_2D", "equirect_texture"))
     if key.model in ANISOTROPIC_MODELS:
         samplers.append(("FLOAT_2D", "anisotropy_table"))
     if uses_ggx_table(key):
         samplers.append(("FLOAT_2D", "ggx_table"))
+        samplers.append(("FLOAT_2D", "ggx_albedo_table"))      # ENVIRONMENT_TAIL
     if uses_clamped_cosine_table(key):
         samplers.append(("FLOAT_2D", "clamped_cosine_table"))
     if key.model == FITTED_MODEL:

@@ -208,6 +208,32 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
   return 0.0;
 #endif
 }
+
+#if defined(HAS_LIGHTS) && !defined(MODEL_FITTED)
+/* What the slice lobes miss of the model's own BRDF at a light's centre (core.shading.light_tail) */
+#define LIGHT_TAIL
+
+/* rho_s(o, i) = M_o(i) D(h) of the model itself (brdf.glsl), local frame */
+float model_specular(vec3 wo, vec3 wi, vec4 p, vec4 q)
+{
+  vec3 h = safe_normalize(safe_normalize(wo) + safe_normalize(wi));
+  float ndf = 0.0;
+#if defined(MODEL_GGX)
+  ndf = ggx_ndf(h, p.x);
+#elif defined(MODEL_COOK_TORRANCE)
+  ndf = cook_torrance_ndf(h, p.x);
+#elif defined(MODEL_BLINN_PHONG)
+  ndf = blinn_phong_ndf(h, p.z);
+#elif defined(MODEL_WARD_ISO)
+  ndf = ward_isotropic_ndf(h, p.w);
+#elif defined(MODEL_WARD_ANISO)
+  ndf = ward_anisotropic_ndf(h, p.w, q.x);
+#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
+  ndf = ashikhmin_shirley_ndf(h, q.y, q.z);
+#endif
+  return model_m_factor(wo, wi, p, q) * ndf;
+}
+#endif
 #endif
 
 #if defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
@@ -229,6 +255,17 @@ vec3 environment_radiance(vec3 axis, float sharpness)
   vec4 lower_value = texture(environment_texture, vec3(coords * lower_transform.x + lower_transform.y, float(lower)));
   vec4 upper_value = texture(environment_texture, vec3(coords * upper_transform.x + upper_transform.y, float(upper)));
   vec3 value = (lower_value + (upper_value - lower_value) * fraction).rgb;
+  /* sharper than the top layer: towards the map's own radiance, reached where a lobe's width is one map row
+   * (env_prefilter.lookup's beyond_top_layer) */
+  float log2_top = scene.prefilter_info.x + float(last) / scene.prefilter_info.y;
+  float rows = float(textureSize(equirect_texture, 0).y);
+  float log2_raw = max(2.0 * log2(rows / SG_PI), log2_top + 1.0);
+  float beyond = clamp((log2(max(sharpness, 1.0e-30)) - log2_top) / (log2_raw - log2_top), 0.0, 1.0);
+  if (beyond > 0.0) {
+    vec3 d = safe_normalize(axis);
+    vec2 uv = vec2(0.5 - atan(d.y, d.x) / (2.0 * SG_PI), 0.5 + atan(d.z, length(d.xy)) / SG_PI);
+    value += (texture(equirect_texture, uv).rgb - value) * beyond;
+  }
   /* below the broadest level: affine in lambda towards the mean radiance (world_colour.rgb when
    * world_colour.w is 1) at lambda = 0 */
   float below = clamp((isnan(sharpness) ? 0.0 : sharpness) / exp2(scene.prefilter_info.x), 0.0, 1.0);
@@ -335,11 +372,11 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_sharpness;
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
-#if defined(HAS_DIFFUSE) || defined(PRODUCT_VISIBILITY)
+#if defined(HAS_DIFFUSE) || defined(PRODUCT_VISIBILITY) || defined(LIGHT_TAIL)
     float light_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, light_axis, light_sharpness,
                                                               1.0, n);
 #endif
-#if defined(HAS_DIFFUSE) || defined(SHARED_LIGHT_VISIBILITY)
+#if defined(HAS_DIFFUSE) || defined(SHARED_LIGHT_VISIBILITY) || defined(LIGHT_TAIL)
     float light_visibility = LOBE_VISIBILITY(light_axis, light_sharpness);
 #endif
 #ifdef HAS_DIFFUSE
@@ -383,20 +420,40 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef SHARED_LIGHT_VISIBILITY
     weight *= light_visibility;   /* eq. 43 for a narrow light: its products lie inside it */
 #endif
+#ifdef LIGHT_TAIL
+    /* the model's BRDF minus the slice lobes at the light's centre, times what the light delivers there,
+     * weighted by how narrow the light is against the BRDF's local scale s^2 (core.shading.light_tail) */
+    float slice_value = 0.0;
+    float scale2 = 1.0e30;
+    for (int j = 0; j < SLICE_LOBES; j++) {
+      float c = dot(light_axis, slice_axis[j]);
+      slice_value += slice_amplitude[j] * exp(slice_sharpness[j] * (c - 1.0));
+      scale2 = min(scale2, 1.0 / max(slice_sharpness[j], 1.0e-6) + 2.0 * (1.0 - c));
+    }
+    float narrow = scale2 * light_sharpness / (1.0 + scale2 * light_sharpness);
+    float tail = narrow * light_cosine * (model_specular(view_local, light_axis * frame, p, q) - slice_value);
+    weight = max(weight + tail * light_visibility, vec3(0.0));
+#endif
     radiance += light_amplitude * weight;
 #endif
   }
 #endif
 
 #ifdef HAS_SPECULAR
+  float slice_albedo = 0.0;                    /* the slice lobes' own albedo, unshadowed (ENVIRONMENT_TAIL) */
+  float tail_visibility = 1.0;
   for (int k = 0; k < NDF_LOBES; k++) {
     int centre = WARP_NODES * k + VISIBILITY_NODE;
     float visibility = LOBE_VISIBILITY(slice_axis[centre], slice_sharpness[centre]);      /* eq. 41 */
+    if (k == 0) {
+      tail_visibility = visibility;
+    }
     for (int node = 0; node < WARP_NODES; node++) {
       int j = WARP_NODES * k + node;
       float slice_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, slice_axis[j], slice_sharpness[j],
-                                                                slice_amplitude[j], n) *
-                           visibility;
+                                                                slice_amplitude[j], n);
+      slice_albedo += slice_cosine;
+      slice_cosine *= visibility;
 #ifdef HAS_ENVIRONMENT
       radiance += slice_cosine * slice_colour[j] * environment_radiance(slice_axis[j], slice_sharpness[j]);
 #else
@@ -404,6 +461,19 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
     }
   }
+#ifdef ENVIRONMENT_TAIL
+  /* GGX's energy beyond its slice lobes: its exact albedo minus theirs, as a broad lobe on the broader NDF
+   * lobe's centre node (core.shading.environment_tail) */
+  vec2 albedo_coords = (clamp(vec2(view_local.z, p.x), 0.0, 1.0) * float(GGX_ALBEDO_SIZE - 1) + 0.5) /
+                       float(GGX_ALBEDO_SIZE);
+  float tail_albedo = max(texture(ggx_albedo_table, albedo_coords).r - slice_albedo, 0.0) * tail_visibility;
+#ifdef HAS_ENVIRONMENT
+  radiance += tail_albedo * environment_radiance(slice_axis[VISIBILITY_NODE],
+                                                 slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO);
+#else
+  radiance += tail_albedo * scene.world_colour.rgb;
+#endif
+#endif
 #endif
 
 #ifdef HAS_DIFFUSE

@@ -146,11 +146,12 @@ def test_skipped_variants_lack_the_code():
     assert (specular_only.has_diffuse, specular_only.has_specular) == (False, True)
     _assert_lacks(specular_only, DIFFUSE_CODE, "HAS_DIFFUSE")
     assert "environment_radiance(" in variant_code(specular_only)
-    # the light loop's SSDF decodes go with the term: specular-only decodes light x slice products only
+    # the light loop's SSDF decodes go with the term: specular-only decodes light x slice products and the
+    # light's own visibility (for the light tail, sg_shading.glsl's LIGHT_TAIL), not the diffuse lobes'
     def decodes(key):       # visibility call sites, macro definitions aside
         code = "\n".join(line for line in variant_code(key).split("\n") if not line.lstrip().startswith("#define"))
         return sum(code.count(name) for name in ("lobe_visibility(", "LOBE_VISIBILITY(", "DIFFUSE_VISIBILITY("))
-    assert decodes(specular_only) == decodes(shader_variants.variant_key(MaterialParams(), **full)) - 2
+    assert decodes(specular_only) == decodes(shader_variants.variant_key(MaterialParams(), **full)) - 1
     # with the per-vertex pass the environment's diffuse lobes read the interpolated fractions
     per_vertex_key = shader_variants.variant_key(MaterialParams(), **full, diffuse_rows=2)
     assert shader_variants.defines(per_vertex_key)["DIFFUSE_VISIBILITY_ROWS"] == 2
