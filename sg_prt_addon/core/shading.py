@@ -173,6 +173,36 @@ def vertex_diffuse_visibility(environment, vertices):
     return lobe_visibility(axis, sharpness, n, vertices)
 
 
+def visible_part_offset(visible):
+    """Angle, in lobe widths 1 / sqrt(lambda), from the axis of a Gaussian lobe cut by a straight boundary
+    that keeps the fraction ``visible`` of it to the mean of the kept part: phi(z) / v, z = Phi^-1(v) by
+    the logistic Phi(z) = 1 / (1 + e^(-1.702 z)) (within 2% for v in [0.1, 0.9], below it in the tails)."""
+    v = np.clip(np.asarray(visible, FLOAT), FLOAT(1e-4), FLOAT(1 - 1e-6))
+    z = np.log(v / (FLOAT(1) - v)) / FLOAT(1.702)
+    return (np.exp(FLOAT(-0.5) * z * z) * FLOAT(1 / np.sqrt(2 * np.pi)) / v).astype(FLOAT)
+
+
+def visible_part_axes(slice_axis, slice_sharpness, slice_visible, view, centre, nodes):
+    """Where each slice lobe reads the environment when the SSDF occludes part of it (sg_shading.glsl's
+    VISIBLE_PART_LOOKUP): its NDF lobe's nodes turned together towards the viewer (a direction the point
+    sees) by visible_part_offset of the centre node's visible fraction, in its widths, at most onto the
+    view.  The visible and the occluded part of a lobe see different light (the glossy sphere over a
+    floor: its lower half's lobes point into the floor, their visible part at the horizon), which the
+    product of the visible fraction and the radiance at the lobe's axis ignores."""
+    axis = slice_axis[:, centre]                                                             # (N, K, 3)
+    view = np.asarray(view, FLOAT)[:, None, :]
+    pivot = np.cross(axis, view)
+    length = np.linalg.norm(pivot, axis=-1, keepdims=True)
+    pivot = np.where(length > FLOAT(1e-6), pivot / np.maximum(length, FLOAT(1e-30)), FLOAT(0)).astype(FLOAT)
+    turn = np.minimum(visible_part_offset(slice_visible) / np.sqrt(np.maximum(slice_sharpness[:, centre], FLOAT(1e-6))),
+                      np.arccos(np.clip(np.sum(axis * view, axis=-1), -1, 1)))
+    pivot, turn = np.repeat(pivot, nodes, axis=1), np.repeat(turn, nodes, axis=1)[..., None]
+    c, s = np.cos(turn), np.sin(turn)
+    rotated = slice_axis * c + np.cross(pivot, slice_axis) * s + pivot * (np.sum(pivot * slice_axis, -1, keepdims=True)
+                                                                          * (FLOAT(1) - c))
+    return rotated.astype(FLOAT)
+
+
 def environment_tail(model, params, view_local, slice_axis, slice_sharpness, slice_cosine, warp_mode=None):
     """GGX's energy beyond its slice lobes, as a broad lobe of environment light (sg_shading.glsl's
     ENVIRONMENT_TAIL): (albedo (N,), axis (N, 3), sharpness (N,)), or None for other models.  The albedo
@@ -486,11 +516,14 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
 
     slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)    # (N, J)
     tail = environment_tail(model, params, view_local, slice_axis, slice_sharpness, slice_cosine, warp_mode)
+    lookup_axis = slice_axis
     if visibility is not None:
         slice_visible = visible(slice_axis[:, centre], slice_sharpness[:, centre])                 # (N, K)
         slice_cosine = slice_cosine * per_node(slice_visible)
+        if environment.has_texture:
+            lookup_axis = visible_part_axes(slice_axis, slice_sharpness, slice_visible, view, centre, nodes)
         if tail is not None:
-            tail = (tail[0] * slice_visible[:, 0],) + tail[1:]
+            tail = (tail[0] * slice_visible[:, 0], lookup_axis[:, centre[0]], tail[2])
     if environment.has_texture:
         if len(environment.lobe_sharpness):
             lobe_count_env = len(environment.lobe_sharpness)
@@ -502,7 +535,7 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
                 env_visible)[..., None], axis=1)
-        radiance = environment_radiance(environment, slice_axis, slice_sharpness)                   # (N, J, 3)
+        radiance = environment_radiance(environment, lookup_axis, slice_sharpness)                  # (N, J, 3)
         specular += np.sum(radiance * (slice_cosine[..., None] * slice_colour), axis=1)
         if tail is not None:
             specular += tail[0][:, None] * environment_radiance(environment, tail[1], tail[2])

@@ -301,6 +301,23 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
 
 
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
+
+#if defined(HAS_VISIBILITY) && defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
+/* A partly occluded slice lobe reads the environment at the mean of its visible part (core.shading.
+ * visible_part_offset): its visible and occluded parts see different light, which the product of the
+ * visible fraction and the radiance at the lobe's axis ignores. */
+#define VISIBLE_PART_LOOKUP
+
+/* Angle, in lobe widths 1/sqrt(lambda), from the axis of a Gaussian lobe cut by a straight boundary that
+ * keeps the fraction v of it to the mean of the kept part: phi(z) / v, z = Phi^-1(v) by the logistic
+ * Phi(z) = 1 / (1 + e^(-1.702 z)) (within 2% for v in [0.1, 0.9], below it in the tails). */
+float visible_part_offset(float v)
+{
+  v = clamp(v, 1.0e-4, 1.0 - 1.0e-6);
+  float z = log(v / (1.0 - v)) / 1.702;
+  return exp(-0.5 * z * z) * 0.3989422804014327 / v;
+}
+#endif
 /* The warped lobes of one NDF lobe lie close together: they share the visibility of the centre one
  * (core.shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3; split2 has
  * no centre node and takes node 0, the one towards the viewer (a valid half vector whenever the lobe's
@@ -442,20 +459,37 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef HAS_SPECULAR
   float slice_albedo = 0.0;                    /* the slice lobes' own albedo, unshadowed (ENVIRONMENT_TAIL) */
   float tail_visibility = 1.0;
+  vec3 tail_axis = slice_axis[VISIBILITY_NODE];
   for (int k = 0; k < NDF_LOBES; k++) {
     int centre = WARP_NODES * k + VISIBILITY_NODE;
     float visibility = LOBE_VISIBILITY(slice_axis[centre], slice_sharpness[centre]);      /* eq. 41 */
-    if (k == 0) {
-      tail_visibility = visibility;
-    }
+#ifdef VISIBLE_PART_LOOKUP
+    /* the environment is read where the visible part of the lobe lies: turned towards the viewer */
+    vec3 pivot = cross(slice_axis[centre], view);
+    float pivot_length = length(pivot);
+    pivot = pivot_length > 1.0e-6 ? pivot / pivot_length : vec3(0.0);
+    float turn = min(visible_part_offset(visibility) * inversesqrt(max(slice_sharpness[centre], 1.0e-6)),
+                     acos(clamp(dot(slice_axis[centre], view), -1.0, 1.0)));
+    float turn_cos = cos(turn);
+    float turn_sin = sin(turn);
+#endif
     for (int node = 0; node < WARP_NODES; node++) {
       int j = WARP_NODES * k + node;
       float slice_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, slice_axis[j], slice_sharpness[j],
                                                                 slice_amplitude[j], n);
       slice_albedo += slice_cosine;
       slice_cosine *= visibility;
+      vec3 lookup_axis = slice_axis[j];
+#ifdef VISIBLE_PART_LOOKUP
+      lookup_axis = lookup_axis * turn_cos + cross(pivot, lookup_axis) * turn_sin +
+                    pivot * (dot(pivot, lookup_axis) * (1.0 - turn_cos));
+#endif
+      if (j == VISIBILITY_NODE) {
+        tail_visibility = visibility;
+        tail_axis = lookup_axis;
+      }
 #ifdef HAS_ENVIRONMENT
-      radiance += slice_cosine * slice_colour[j] * environment_radiance(slice_axis[j], slice_sharpness[j]);
+      radiance += slice_cosine * slice_colour[j] * environment_radiance(lookup_axis, slice_sharpness[j]);
 #else
       radiance += slice_cosine * slice_colour[j] * scene.world_colour.rgb;
 #endif
@@ -468,8 +502,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
                        float(GGX_ALBEDO_SIZE);
   float tail_albedo = max(texture(ggx_albedo_table, albedo_coords).r - slice_albedo, 0.0) * tail_visibility;
 #ifdef HAS_ENVIRONMENT
-  radiance += tail_albedo * environment_radiance(slice_axis[VISIBILITY_NODE],
-                                                 slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO);
+  radiance += tail_albedo * environment_radiance(tail_axis, slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO);
 #else
   radiance += tail_albedo * scene.world_colour.rgb;
 #endif
