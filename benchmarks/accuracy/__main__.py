@@ -64,7 +64,9 @@ def main(selected):
     header = ("# Accuracy\n\nEvery approximation's measured error against an exact or high-precision\n"
               f"reference. Regenerate with `{COMMAND}` (machine: {platform.machine()},\n"
               f"Python {platform.python_version()}).\n\n")
-    OUTPUT.write_text(header + "".join(sections[t] for t in topics if t in sections))
+    # sections of other generators (benchmarks/truth_suite.py's) are kept, after the topics
+    others = [text for name, text in sections.items() if name not in topics]
+    OUTPUT.write_text(header + "".join(sections[t] for t in topics if t in sections) + "".join(others))
 
 
 if __name__ == "__main__":
