@@ -54,7 +54,24 @@ class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
             layout.prop(settings, "tangent_rotation")
 
 
-classes = (SGPRT_PT_material, SGPRT_PT_material_geometry)
+class SGPRT_PT_sampling(bpy.types.Panel):
+    bl_label = "Sampling"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE_ID}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(context.scene.sgprt, "render_samples")
+
+
+classes = (SGPRT_PT_material, SGPRT_PT_material_geometry, SGPRT_PT_sampling)
 
 # Built-in panels that work unchanged with this engine.
 COMPATIBLE_BUILTIN_PANELS = (

@@ -143,7 +143,16 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                               description="SG lobes fitted to a measured BRDF (sgprt.fit_lobes)")
 
 
-classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_material)
+class SGPRT_PG_scene(bpy.types.PropertyGroup):
+    """Render settings of the SG-PRT engine: `scene.sgprt`."""
+    render_samples: IntProperty(name="Render Samples", default=1, min=1, max=64, soft_max=16,
+                                description="Final renders average this many frames, each moved by a sub-pixel "
+                                            "offset: anti-aliasing with a 1-pixel box filter, as Cycles' Box "
+                                            "filter (4 = a 2x2 grid per pixel); each sample costs one frame. The "
+                                            "viewport draws one")
+
+
+classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_material, SGPRT_PG_scene)
 
 
 def register():
@@ -151,9 +160,11 @@ def register():
         bpy.utils.register_class(cls)
     bpy.types.Material.sgprt = PointerProperty(type=SGPRT_PG_material, name="SG-PRT",
                                                description="SG-PRT material settings")
+    bpy.types.Scene.sgprt = PointerProperty(type=SGPRT_PG_scene, name="SG-PRT", description="SG-PRT render settings")
 
 
 def unregister():
+    del bpy.types.Scene.sgprt
     del bpy.types.Material.sgprt
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

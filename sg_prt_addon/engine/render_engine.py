@@ -1,4 +1,5 @@
 """The SG-PRT RenderEngine: final renders and the viewport share scene_state + renderer."""
+import dataclasses
 import time
 import traceback
 
@@ -6,6 +7,7 @@ import bpy
 import numpy as np
 
 from ..blender import export
+from ..core import camera as camera_module
 from . import renderer as renderer_module
 from . import scene_state
 from . import shader_variants
@@ -53,7 +55,9 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             return
         self.update_stats("", "SG-PRT: exporting the scene, drawing")
         try:
-            passes, state, timings = render_frame(depsgraph, width, height, gbuffer=debug["capture_gbuffer"])
+            samples = 1 if debug["capture_gbuffer"] else getattr(getattr(scene, "sgprt", None), "render_samples", 1)
+            passes, state, timings = render_frame(depsgraph, width, height, gbuffer=debug["capture_gbuffer"],
+                                                  samples=samples)
         except ShaderCompileError as error:
             print(error)
             # the UI gets the variant and the first located error; the console has every line quoted
@@ -195,8 +199,9 @@ def draw_texture_2d(texture, width, height):
     preset(texture, (0, 0), width, height)
 
 
-def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None):
-    """Export, upload, draw and read back one frame.
+def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1):
+    """Export, upload, draw and read back one frame; with ``samples`` > 1 the average of that many draws,
+    each with the projection moved by core.camera.pixel_jitter's sub-pixel offset (anti-aliasing).
 
     Returns (passes: name -> (H, W, 4) float32 with row 0 at the bottom, the SceneState, timings).
     """
@@ -216,8 +221,23 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     renderer.ensure_targets(width, height)
     timings["upload"] = time.perf_counter() - start
     start = time.perf_counter()
-    renderer.draw(state, camera, background_alpha=0.0 if scene.render.film_transparent else 1.0)
-    passes = {name: renderer.read_output(name.lower()) for name in renderer_module.PASS_NAMES}
+    background_alpha = 0.0 if scene.render.film_transparent else 1.0
+    offsets = camera_module.pixel_jitter(samples) if samples > 1 else np.zeros((1, 2))
+    passes = {}
+    for offset in offsets:
+        if samples > 1:        # the view-projection is in the scene block: upload it moved (nothing else is dirty)
+            frame_camera = dataclasses.replace(
+                camera, projection=camera_module.jittered_projection(camera.projection, offset, width, height))
+            renderer.upload(state, state.consume_dirty(), frame_camera)
+        else:
+            frame_camera = camera
+        renderer.draw(state, frame_camera, background_alpha=background_alpha)
+        for name in renderer_module.PASS_NAMES:
+            image = renderer.read_output(name.lower())
+            passes[name] = image if name not in passes else passes[name] + image
+    if samples > 1:
+        passes = {name: image / np.float32(len(offsets)) for name, image in passes.items()}
+    timings["samples"] = len(offsets)
     if gbuffer:
         for name in renderer_module.GBUFFER_OUTPUTS:
             passes["gbuffer_" + name] = renderer.read_output(name)
