@@ -203,18 +203,23 @@ def visible_part_axes(slice_axis, slice_sharpness, slice_visible, view, centre, 
     return rotated.astype(FLOAT)
 
 
-def environment_tail(model, params, view_local, slice_axis, slice_sharpness, slice_cosine, warp_mode=None):
-    """GGX's energy beyond its slice lobes, as a broad lobe of environment light (sg_shading.glsl's
-    ENVIRONMENT_TAIL): (albedo (N,), axis (N, 3), sharpness (N,)), or None for other models.  The albedo
-    is max(0, E(o) - sum_j I(S_j, n)), E(o) the model's exact directional albedo (core.ggx_albedo's
-    table, one bilinear fetch), the sum the slice lobes' own clamped-cosine integrals (unshadowed); the
-    lobe lies on the broader NDF lobe's centre node with TAIL_SHARPNESS_RATIO of its sharpness (GGX's
-    tail is wider than either lobe) and takes that node's visibility."""
+def model_albedo(model, params, view_local):
+    """The model's exact directional albedo E(o) per pixel (N,) where the engine tabulates it (GGX:
+    core.ggx_albedo's table, one bilinear fetch, as sg_shading.glsl's ENVIRONMENT_TAIL), else None."""
     if model != "GGX":
         return None
     table = ggx_albedo.albedo_table()[..., None]
     s, t = ggx_albedo.table_coordinates(np.asarray(view_local, FLOAT)[:, 2], np.asarray(params["roughness"], FLOAT))
-    albedo = sample_bilinear(table, np.stack([s, t], axis=-1))[:, 0]
+    return sample_bilinear(table, np.stack([s, t], axis=-1))[:, 0]
+
+
+def environment_tail(albedo, slice_axis, slice_sharpness, slice_cosine, warp_mode=None):
+    """GGX's energy beyond its slice lobes, as a broad lobe of environment light (sg_shading.glsl's
+    ENVIRONMENT_TAIL): (albedo (N,), axis (N, 3), sharpness (N,)).  The albedo is max(0, E(o) - sum_j
+    I(S_j, n)), E(o) the model's exact directional albedo (model_albedo), the sum the slice lobes' own
+    clamped-cosine integrals (unshadowed); the lobe lies on the broader NDF lobe's centre node with
+    TAIL_SHARPNESS_RATIO of its sharpness (GGX's tail is wider than either lobe) and takes that node's
+    visibility."""
     node = visibility_node_indices(slice_sharpness.shape[1], warp_mode)[0]
     missing = np.maximum(albedo - np.sum(slice_cosine, axis=1), FLOAT(0))
     return missing.astype(FLOAT), slice_axis[:, node], (slice_sharpness[:, node] * FLOAT(TAIL_SHARPNESS_RATIO))
@@ -483,6 +488,15 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     def per_node(group_values):         # (..., K) -> (..., K * nodes): each NDF lobe's to its warped nodes
         return np.repeat(group_values, nodes, axis=-1)
 
+    # I(S_j, n) unshadowed: the lobes' albedo, capped at the model's own where it is known (GGX: the lobes
+    # overshoot it several times over at grazing views), and the environment's weights below
+    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)    # (N, J)
+    albedo = model_albedo(model, params, view_local)
+    if albedo is not None:
+        scale = np.minimum(FLOAT(1), albedo / np.maximum(np.sum(slice_cosine, axis=1), FLOAT(1e-30)))[:, None]
+        slice_amplitude = (slice_amplitude * scale).astype(FLOAT)
+        slice_cosine = (slice_cosine * scale).astype(FLOAT)
+
     light_sets = []
     if len(light_data.point_radius):
         light_sets.append(point_light_sgs(position, light_data))
@@ -514,8 +528,7 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             weight = np.maximum(weight + (tail * light_visible)[..., None], FLOAT(0))
         specular += np.sum(light_amplitude * weight, axis=1)
 
-    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)    # (N, J)
-    tail = environment_tail(model, params, view_local, slice_axis, slice_sharpness, slice_cosine, warp_mode)
+    tail = None if albedo is None else environment_tail(albedo, slice_axis, slice_sharpness, slice_cosine, warp_mode)
     lookup_axis = slice_axis
     if visibility is not None:
         slice_visible = visible(slice_axis[:, centre], slice_sharpness[:, centre])                 # (N, K)

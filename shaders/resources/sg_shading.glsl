@@ -381,6 +381,27 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
       slice_sharpness[j] = warped_sharpness[node];
     }
   }
+  /* I(S_j, n) of the slice lobes, unshadowed: their albedo, and the environment's weights below */
+  float slice_cosines[SLICE_LOBES];
+  float slice_albedo = 0.0;
+  for (int j = 0; j < SLICE_LOBES; j++) {
+    slice_cosines[j] = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, slice_axis[j], slice_sharpness[j],
+                                                            slice_amplitude[j], n);
+    slice_albedo += slice_cosines[j];
+  }
+#ifdef ENVIRONMENT_TAIL
+  /* GGX's exact albedo (core.ggx_albedo): the lobes keep at most it (at grazing views they overshoot it
+   * several times over), and the environment tail returns what they miss of it (core.shading.model_albedo) */
+  vec2 albedo_coords = (clamp(vec2(view_local.z, p.x), 0.0, 1.0) * float(GGX_ALBEDO_SIZE - 1) + 0.5) /
+                       float(GGX_ALBEDO_SIZE);
+  float model_albedo = texture(ggx_albedo_table, albedo_coords).r;
+  float energy_scale = min(1.0, model_albedo / max(slice_albedo, 1.0e-30));
+  for (int j = 0; j < SLICE_LOBES; j++) {
+    slice_amplitude[j] *= energy_scale;
+    slice_cosines[j] *= energy_scale;
+  }
+  slice_albedo *= energy_scale;
+#endif
 #endif
 
 #ifdef HAS_LIGHTS
@@ -457,7 +478,6 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
 
 #ifdef HAS_SPECULAR
-  float slice_albedo = 0.0;                    /* the slice lobes' own albedo, unshadowed (ENVIRONMENT_TAIL) */
   float tail_visibility = 1.0;
   vec3 tail_axis = slice_axis[VISIBILITY_NODE];
   for (int k = 0; k < NDF_LOBES; k++) {
@@ -475,10 +495,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
     for (int node = 0; node < WARP_NODES; node++) {
       int j = WARP_NODES * k + node;
-      float slice_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, slice_axis[j], slice_sharpness[j],
-                                                                slice_amplitude[j], n);
-      slice_albedo += slice_cosine;
-      slice_cosine *= visibility;
+      float slice_cosine = slice_cosines[j] * visibility;
       vec3 lookup_axis = slice_axis[j];
 #ifdef VISIBLE_PART_LOOKUP
       lookup_axis = lookup_axis * turn_cos + cross(pivot, lookup_axis) * turn_sin +
@@ -498,9 +515,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef ENVIRONMENT_TAIL
   /* GGX's energy beyond its slice lobes: its exact albedo minus theirs, as a broad lobe on the broader NDF
    * lobe's centre node (core.shading.environment_tail) */
-  vec2 albedo_coords = (clamp(vec2(view_local.z, p.x), 0.0, 1.0) * float(GGX_ALBEDO_SIZE - 1) + 0.5) /
-                       float(GGX_ALBEDO_SIZE);
-  float tail_albedo = max(texture(ggx_albedo_table, albedo_coords).r - slice_albedo, 0.0) * tail_visibility;
+  float tail_albedo = max(model_albedo - slice_albedo, 0.0) * tail_visibility;
 #ifdef HAS_ENVIRONMENT
   radiance += tail_albedo * environment_radiance(tail_axis, slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO);
 #else
