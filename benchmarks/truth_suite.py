@@ -79,6 +79,7 @@ from benchmarks.error_vs_time import _number, _signed  # noqa: E402  (the same c
 
 JSON_PATH = ROOT / "docs" / "truth_suite.json"
 QUICK_JSON_PATH = ROOT / "out" / "truth_suite_quick.json"
+BEFORE_JSON_PATH = ROOT / "docs" / "truth_suite_before.json"     # {"description": ..., "rows": [...]}
 DOC_PATH = ROOT / "docs" / "ACCURACY.md"
 PNG_DIR = ROOT / "out" / "truth"
 SECTION_TITLE = "## Truth suite (against Cycles)"
@@ -93,7 +94,9 @@ GLOSSY_MIN_ROUGHNESS = 0.1
 FULL = dict(size=256, cycles_samples=512, eevee_samples=(1, 16, 64))
 QUICK = dict(size=64, cycles_samples=32, eevee_samples=(1, 16))
 
-METHODS = ("SG-PRT", "SG-PRT unshadowed", "SG-PRT 2x2", "Cycles", "Cycles 1 sample", "Cycles equal time", "EEVEE")
+METHODS = ("SG-PRT", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Cycles", "Cycles 1 sample",
+           "Cycles equal time", "EEVEE")
+ANTI_ALIASING_SAMPLES = 16  # "SG-PRT 16 samples": the engine's Render Samples (scene.sgprt.render_samples), 4 x 4
 SUPERSAMPLING = 2          # "SG-PRT 2x2": the engine at twice the size, box-filtered down (Cycles' pixel filter)
 
 
@@ -200,8 +203,8 @@ def markdown_table(rows, scenes):
     """One line per scene (``scenes``: ordered names) of the figures the summary shows."""
     lines = ["| scene | kind | SG-PRT rel. RMSE | SG-PRT bias | SG-PRT HDR-FLIP | SG-PRT unshadowed RMSE "
              "| EEVEE 16 HDR-FLIP | EEVEE 16 RMSE | Cycles equal-time HDR-FLIP (spp) | noise floor "
-             "| SG-PRT s | Cycles s | SG-PRT 2x2 RMSE / HDR-FLIP |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| SG-PRT s | Cycles s | SG-PRT 2x2 RMSE / HDR-FLIP | SG-PRT 16 samples RMSE / HDR-FLIP / s |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, info in scenes.items():
         engine = find_row(rows, name, "SG-PRT") or {}
         unshadowed = find_row(rows, name, "SG-PRT unshadowed") or {}
@@ -209,6 +212,7 @@ def markdown_table(rows, scenes):
         equal = find_row(rows, name, "Cycles equal time") or {}
         truth = find_row(rows, name, "Cycles") or {}
         supersampled = find_row(rows, name, "SG-PRT 2x2") or {}
+        sampled = find_row(rows, name, "SG-PRT 16 samples") or {}
         kind = info.get("kind", "-")
         if kind == "glossy" and info.get("roughness") is not None:
             kind = f"glossy {info['roughness']:g}"
@@ -221,7 +225,8 @@ def markdown_table(rows, scenes):
             f"{_number(eevee16.get('hdr_flip'))} | {_number(eevee16.get('relative_rmse'))} | {equal_cell} | "
             f"{_number(truth.get('noise_floor', engine.get('noise_floor')))} | {_number(engine.get('seconds'))} | "
             f"{_number(truth.get('seconds'))} | {_number(supersampled.get('relative_rmse'))} / "
-            f"{_number(supersampled.get('hdr_flip'))} |")
+            f"{_number(supersampled.get('hdr_flip'))} | {_number(sampled.get('relative_rmse'))} / "
+            f"{_number(sampled.get('hdr_flip'))} / {_number(sampled.get('seconds'))} |")
     return "\n".join(lines)
 
 
@@ -247,8 +252,26 @@ def goal_summary(checks):
             f"relative RMSE goal: {sum(rmses)}/{len(rmses)} scenes")
 
 
-def markdown_section(data):
-    """The "Truth suite (against Cycles)" section of docs/ACCURACY.md, from the JSON this module writes."""
+def before_after_table(before_rows, after_rows, scenes):
+    """Markdown table of SG-PRT's scores on the same scenes by two versions of the engine (rows as this
+    module makes them; ``before_rows`` may hold only SG-PRT, SG-PRT 2x2 and Cycles rows)."""
+    lines = ["| scene | RMSE before | RMSE after | bias before | bias after | HDR-FLIP before | HDR-FLIP after "
+             "| 2x2 RMSE before | 2x2 RMSE after |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for scene in scenes:
+        cells = [scene]
+        pairs = [(find_row(before_rows, scene, "SG-PRT"), find_row(after_rows, scene, "SG-PRT"))]
+        for key, formatter in (("relative_rmse", _number), ("relative_bias", _signed), ("hdr_flip", _number)):
+            cells += [formatter(row and row.get(key)) for row in pairs[0]]
+        cells += [_number(row and row.get("relative_rmse")) for row in
+                  (find_row(before_rows, scene, "SG-PRT 2x2"), find_row(after_rows, scene, "SG-PRT 2x2"))]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def markdown_section(data, before=None):
+    """The "Truth suite (against Cycles)" section of docs/ACCURACY.md, from the JSON this module writes;
+    ``before``: (description, rows) of an earlier engine on the same scenes, shown beside."""
     machine = data["machine"]
     checks = [goal_check(data["rows"], name, info.get("kind"), info.get("roughness"))
               for name, info in data["scenes"].items()]
@@ -273,12 +296,18 @@ def markdown_section(data):
         "Cycles equal time: as many samples as fit in SG-PRT's render() time (spp in brackets). "
         "Cycles s: one seed's render at the truth's samples. SG-PRT 2x2: the same bake rendered at twice the "
         "size and box-filtered down: SG-PRT shades each pixel's centre, Cycles (and the truth) average over the "
-        "pixel, which on sub-pixel highlights and edges is most of SG-PRT's RMSE; this column shows how much.",
+        "pixel, which on sub-pixel highlights and edges is most of SG-PRT's RMSE; this column shows how much "
+        "(it equals Render Samples 4). SG-PRT 16 samples: the engine's own anti-aliasing, Render Samples 16 (a "
+        "4 x 4 grid per pixel, the same box filter as the truth's), render() seconds beside.",
         "",
         markdown_table(data["rows"], data["scenes"]), "",
         f"Goals (relative RMSE < {GLOSSY_RMSE_GOAL:.2f} glossy of roughness >= {GLOSSY_MIN_ROUGHNESS:g}, "
         f"< {DIFFUSE_RMSE_GOAL:.2f} diffuse): {goal_summary(checks)}.", ""]
     lines += [f"- {line}" for line in goal_lines(checks)]
+    if before is not None:
+        description, before_rows = before
+        lines += ["", f"SG-PRT before and after ({description}; the same scenes, size and truth samples):", "",
+                  before_after_table(before_rows, data["rows"], list(data["scenes"]))]
     return "\n".join(lines) + "\n"
 
 
@@ -794,6 +823,15 @@ class SceneRun:
                 render.resolution_x = render.resolution_y = size
             self.add("SG-PRT 2x2", f"bake R={resolution}, {SUPERSAMPLING}x size, box-filtered down", seconds,
                      box_downsample(image, SUPERSAMPLING), warm_up_seconds=warm)
+        settings = getattr(self.scene, "sgprt", None)
+        if "SG-PRT 16 samples" in self.methods and hasattr(settings, "render_samples"):    # the engine's own AA
+            settings.render_samples = ANTI_ALIASING_SAMPLES
+            try:
+                seconds, image, warm = self.engine_render()
+            finally:
+                settings.render_samples = 1
+            self.add("SG-PRT 16 samples", f"bake R={resolution}, Render Samples {ANTI_ALIASING_SAMPLES}", seconds,
+                     image, warm_up_seconds=warm)
 
     def _cycles(self, samples, seed, folder):
         import bpy
@@ -920,11 +958,19 @@ def main(argv=None):
     parser.add_argument("--update-doc", action="store_true",
                         help="write that section from the JSON into docs/ACCURACY.md (no run)")
     parser.add_argument("--png-dir", default=str(PNG_DIR), help="where the side-by-side PNGs go (out/truth)")
+    parser.add_argument("--before", default=None, metavar="JSON",
+                        help="with --markdown / --update-doc: rows of an earlier engine on the same scenes "
+                             f"(default {BEFORE_JSON_PATH.relative_to(ROOT)} if present), shown beside")
     args = parser.parse_args(argv)
     json_path = Path(args.json) if args.json else (QUICK_JSON_PATH if args.quick else JSON_PATH)
     if args.markdown or args.update_doc:
         data = json.loads(json_path.read_text())
-        section = markdown_section(data)
+        before_path = Path(args.before) if args.before else BEFORE_JSON_PATH
+        before = None
+        if before_path.exists():
+            recorded = json.loads(before_path.read_text())
+            before = (recorded["description"], recorded["rows"])
+        section = markdown_section(data, before)
         if args.update_doc:
             from benchmarks import markdown_sections
             markdown_sections.update_file(str(DOC_PATH), SECTION_TITLE, section)

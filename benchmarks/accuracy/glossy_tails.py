@@ -73,8 +73,9 @@ def _albedo_rows():
         dict(name="GGX 2-lobe slice albedo without the environment tail", reference="exact E(o), as above",
              metric="(E - slice albedo) / E, the energy the tail restores",
              max_error=float(np.max(missing)), mean_error=float(np.mean(missing)),
-             note="negative where the lobes overshoot, which the tail does not take back: at grazing views "
-                  "(cos theta_o 0.05) 1.76 against 0.999 at roughness 0.05 and 5.0 against 0.85 at 1.0"),
+             note="negative where the lobes overshoot (grazing views, cos theta_o 0.05: 1.76 against 0.999 at "
+                  "roughness 0.05, 5.0 against 0.85 at 1.0); the shader scales them down to E there "
+                  "(core.shading.model_albedo; white furnace within 0.0017 of E, tests/gpu/test_ggx_energy.py)"),
     ]
 
 

@@ -189,3 +189,13 @@ def test_hdr_flip_without_the_package_returns_none(monkeypatch, capsys):
     assert ts.hdr_flip(image, image) is None
     out = capsys.readouterr().out
     assert out.count("HDR-FLIP skipped") == 1 and "flip-evaluator" in out
+
+
+def test_before_after_table_lists_both_versions():
+    from benchmarks import truth_suite
+
+    before = [truth_suite.make_row("s", "SG-PRT", "bake", 0.1, relative_rmse=0.5, relative_bias=-0.08, hdr_flip=0.2)]
+    after = [truth_suite.make_row("s", "SG-PRT", "bake", 0.1, relative_rmse=0.25, relative_bias=0.01, hdr_flip=0.1),
+             truth_suite.make_row("s", "SG-PRT 2x2", "2x", 0.4, relative_rmse=0.1)]
+    table = truth_suite.before_after_table(before, after, ["s"]).splitlines()
+    assert table[2] == "| s | 0.500 | 0.250 | -0.080 | +0.010 | 0.200 | 0.100 | - | 0.100 |"
