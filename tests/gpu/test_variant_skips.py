@@ -309,7 +309,10 @@ def test_no_lights_skips_the_light_loop(engine, record_error):
     full = _render(_scene("full_no_lights", {}, light_power=0.0))
     assert {key.has_lights for key in _keys(skipped)} == {False}
     assert {key.has_lights for key in _keys(full)} == {True}
-    _compare(skipped, full, record_error, "no lights")
+    # float rounding only, at one or two pixels: the light loop (with its light tail since) changes how the
+    # compiler contracts the slice code both variants share; measured 1.2e-5 to 3.7e-5 of the maximum
+    # depending on what compiled before in the process
+    _compare(skipped, full, record_error, "no lights", rtol=5e-5)
 
 
 def test_no_bake_skips_the_ssdf_decode(engine, record_error):
