@@ -54,8 +54,8 @@ class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
             layout.prop(settings, "tangent_rotation")
 
 
-class SGPRT_PT_sampling(bpy.types.Panel):
-    bl_label = "Sampling"
+class RenderPanel:
+    """Placement and poll shared by the render-properties panels: shown while SG-PRT renders."""
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "render"
@@ -64,6 +64,10 @@ class SGPRT_PT_sampling(bpy.types.Panel):
     @classmethod
     def poll(cls, context):
         return context.engine in cls.COMPAT_ENGINES
+
+
+class SGPRT_PT_sampling(RenderPanel, bpy.types.Panel):
+    bl_label = "Sampling"
 
     def draw(self, context):
         layout = self.layout

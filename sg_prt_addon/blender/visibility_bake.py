@@ -64,6 +64,7 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 from ..bake import decode
 from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility, topology_hash
 from .background_job import BackgroundJob, ModalJobOperator
+from .panels import RenderPanel
 
 FORMAT_VERSION = 1
 PROPERTY = "sgprt_ssdf"
@@ -554,16 +555,8 @@ class SGPRT_OT_clear_visibility(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class SGPRT_PT_visibility_bake(bpy.types.Panel):
+class SGPRT_PT_visibility_bake(RenderPanel, bpy.types.Panel):
     bl_label = "SG-PRT Visibility Bake"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
-    bl_context = "render"
-    COMPAT_ENGINES = {"SG_PRT"}
-
-    @classmethod
-    def poll(cls, context):
-        return context.engine in cls.COMPAT_ENGINES
 
     def draw(self, context):
         layout = self.layout
