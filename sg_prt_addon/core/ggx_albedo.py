@@ -64,5 +64,6 @@ def albedo_table():
 def table_coordinates(cos_o, roughness, size=TABLE_SIZE):
     """Texture coordinates (s, t) of the GPU's bilinear fetch that lands on the texel-centre grid."""
     def coordinate(value):
-        return (np.clip(np.asarray(value, np.float32), 0, 1) * np.float32(size - 1) + np.float32(0.5)) / np.float32(size)
+        clipped = np.clip(np.asarray(value, np.float32), 0, 1)
+        return (clipped * np.float32(size - 1) + np.float32(0.5)) / np.float32(size)
     return coordinate(cos_o), coordinate(roughness)

@@ -34,6 +34,13 @@ VISIBILITY_SKIP_FRACTION of the light's own I(G, n) stay unshadowed (the shader 
 The warped lobes of one NDF lobe (warp.DEFAULT_MODE's nodes, close together) share one visibility:
 the centre node's (``visibility_node_indices``), a third of the decodes of split3 for the slice terms.
 
+What the slice lobes miss is added back (each measured in docs/ACCURACY.md, glossy_tails): at each
+light's centre the model's own BRDF minus the lobes (light_tail: GGX's theta^-4 glow, the lobes' peak
+error); for GGX the lobes capped at and topped up to the model's directional albedo (model_albedo,
+environment_tail); lobes sharper than the top prefiltered layer read towards the map itself
+(environment_radiance); partly occluded lobes read the environment where their visible part lies
+(visible_part_axes).
+
 Everything is computed in float32 like the GPU.  Directions: world space, all
 pointing away from the surface.
 """
