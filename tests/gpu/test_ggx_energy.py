@@ -39,3 +39,25 @@ def test_white_furnace_returns_the_albedo(engine, roughness):
           f"mean {error.mean():.5f}")
     assert specular.max() <= 1.0 + 1e-3          # the energy bound: nothing above the light
     assert error.max() < 0.02                    # E(o) itself, to the table's bilinear error
+
+
+@pytest.mark.parametrize("roughness", [0.0, 0.01, 0.03, 0.1, 0.3])
+def test_a_sphere_light_in_a_near_mirror_stays_within_its_radiance(engine, roughness):
+    """Nothing reflects more than the light's own radiance times ks; the SG light's peak is 1.15 L_e for a
+    mirror lobe (core.lights, the energy model), so the bound is 1.2 ks L_e.  Measured max 1.06 ks L_e at
+    roughness 0-0.03; before the albedo cap (commit e7304ad) 575,000 ks L_e at roughness 0 and 57.5 at 0.01."""
+    import math
+
+    name = f"mirror_light_{roughness}"
+    scene = fx.new_scene(name, 96, 96)
+    fx.world_colour(scene, (0.0, 0.0, 0.0))
+    sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 1.0), radius=1.0, segments=64, rings=32)
+    sphere.data.materials.append(fx.material(name + "_m", model="GGX", roughness=roughness,
+                                             diffuse_color=(0.0, 0.0, 0.0), specular_color=(0.25, 0.25, 0.25)))
+    power, radius = 1000.0, 0.5
+    fx.point_light(scene, name + "_light", (2.0, -3.0, 3.0), power, radius=radius)
+    specular = fx.render(scene)["passes"]["Specular"][..., :3]
+    radiance = power / (math.pi * 4 * math.pi * radius ** 2)        # Blender's sphere light (core.lights)
+    print(f"roughness {roughness}: max Specular {specular.max():.2f} = {specular.max() / (0.25 * radiance):.3f} ks L_e")
+    assert np.all(np.isfinite(specular))
+    assert specular.max() <= 1.2 * 0.25 * radiance
