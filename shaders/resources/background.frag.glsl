@@ -13,7 +13,7 @@ void main()
 #else
   vec3 colour = scene.world_colour.rgb;
 #endif
-  out_combined = vec4(colour, background_alpha);
+  out_combined = vec4(colour, 1.0) * background_alpha;     /* premultiplied: a transparent film is (0, 0, 0, 0) */
   out_diffuse = vec4(0.0);
   out_specular = vec4(0.0);
 }

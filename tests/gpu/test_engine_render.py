@@ -42,6 +42,8 @@ def test_passes_and_world_background(engine):
     scene.render.film_transparent = True
     transparent = fx.render(scene)["passes"]["Combined"]
     assert np.all(transparent[~surface][:, 3] == 0)
+    assert np.all(transparent[~surface][:, :3] == 0)      # premultiplied, as Cycles writes it: (0, 0, 0, 0)
+    np.testing.assert_allclose(transparent[surface], combined[surface], rtol=1e-6)
 
 
 def test_compile_error_names_variant_and_line(engine, monkeypatch):
