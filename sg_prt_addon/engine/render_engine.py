@@ -79,8 +79,11 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, f"SG-PRT: {len(dropped)} dimmest light(s) left out (at most "
                                      f"{shader_variants.MAX_POINT_LIGHTS} point/spot/area and "
                                      f"{shader_variants.MAX_SUNS} sun lights): {', '.join(dropped[:5])}")
-        # one render() per view layer: write into the one being rendered
-        result = self.begin_result(0, 0, width, height, layer=depsgraph.view_layer.name)
+        # one render() per view layer: write into the one being rendered; with a render border Blender's result
+        # holds the border's pixels only (cropped or not; begin_result counts from the border's corner), so the
+        # frame is cut to it
+        x0, y0, x1, y1 = border_rect(scene.render, width, height)
+        result = self.begin_result(0, 0, x1 - x0, y1 - y0, layer=depsgraph.view_layer.name)
         layer = result.layers[0]
         written = []
         for name in renderer_module.PASS_NAMES:
@@ -88,7 +91,15 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             if render_pass is None:
                 continue
             channels = render_pass.channels
-            render_pass.rect.foreach_set(np.ascontiguousarray(passes[name][..., :channels]).ravel())
+            pixels = np.ascontiguousarray(passes[name][y0:y1, x0:x1, :channels]).ravel()
+            if len(render_pass.rect) * channels != pixels.size:
+                self.end_result(result, cancel=True)
+                self.report({"ERROR"}, f"SG-PRT: the render result holds {len(render_pass.rect)} pixels, the "
+                                       f"border {x1 - x0} x {y1 - y0}: nothing written")
+                last_render.clear()
+                last_render["error"] = "render result size mismatch"
+                return
+            render_pass.rect.foreach_set(pixels)
             written.append(name)
         self.end_result(result)
         last_render.clear()
@@ -197,6 +208,17 @@ def draw_texture_2d(texture, width, height):
     """Draw a texture over the region with the bound display-space shader."""
     from gpu_extras.presets import draw_texture_2d as preset
     preset(texture, (0, 0), width, height)
+
+
+def border_rect(render_settings, width, height):
+    """(x0, y0, x1, y1) pixels of the frame a final render writes, y from the bottom: the render border when
+    it is on (Blender truncates border * size), else the whole frame."""
+    if not render_settings.use_border:
+        return 0, 0, width, height
+    x0, x1 = int(render_settings.border_min_x * width), int(render_settings.border_max_x * width)
+    y0, y1 = int(render_settings.border_min_y * height), int(render_settings.border_max_y * height)
+    x0, y0 = min(max(x0, 0), width), min(max(y0, 0), height)
+    return x0, y0, max(min(x1, width), x0), max(min(y1, height), y0)
 
 
 def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1):

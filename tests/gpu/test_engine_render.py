@@ -329,3 +329,39 @@ def test_environment_textures_outlive_final_renders(engine):
     np.testing.assert_array_equal(first_image, again_image)
     np.testing.assert_array_equal(first_image, back_image)
     assert np.abs(forest_image - first_image).max() > 0.01
+
+
+@pytest.mark.parametrize("crop", [False, True])
+def test_render_border_writes_the_borders_pixels(engine, tmp_path, crop):
+    """A render border (cropped or not) gets the frame's own pixels inside it, in a file as well (an OPEN_EXR
+    write with the crop used to end the process)."""
+    import bpy
+    from sg_prt_addon import render as batch
+
+    scene = fx.new_scene(f"border_{crop}", 64, 48)
+    fx.world_colour(scene, (0.2, 0.3, 0.4))
+    sphere = fx.uv_sphere(scene, f"border_sphere_{crop}", (0.0, 0.0, 1.0))
+    sphere.data.materials.append(fx.material(f"border_m_{crop}", diffuse_color=(0.8, 0.5, 0.2)))
+    fx.point_light(scene, f"border_light_{crop}", (2.0, -3.0, 3.0), 300.0)
+    full = dict(fx.render(scene))["passes"]["Combined"]
+    render = scene.render
+    render.use_border, render.use_crop_to_border = True, crop
+    render.border_min_x, render.border_max_x, render.border_min_y, render.border_max_y = 0.25, 0.75, 0.0, 0.5
+    render.image_settings.file_format, render.image_settings.color_depth = "OPEN_EXR", "32"
+    render.filepath = str(tmp_path / "border_")
+    with bpy.context.temp_override(scene=scene):
+        bpy.ops.render.render(scene=scene.name, write_still=True)
+    from sg_prt_addon.engine import render_engine
+    assert "error" not in render_engine.last_render
+    written = sorted(tmp_path.glob("border_*.exr"))
+    assert written, "no file written"
+    image = batch.read_float_image(str(written[0]))           # row 0 at the top
+    expected = full[0:24, 16:48] if crop else None
+    if crop:
+        assert image.shape[:2] == (24, 32)
+        np.testing.assert_allclose(image[::-1, :, :3], expected[..., :3], rtol=1e-5, atol=1e-6)
+    else:
+        assert image.shape[:2] == (48, 64)
+        inside = image[::-1][0:24, 16:48, :3]
+        np.testing.assert_allclose(inside, full[0:24, 16:48, :3], rtol=1e-5, atol=1e-6)
+        assert np.all(image[::-1][24:, :, :3] == 0)     # outside the border: nothing rendered
