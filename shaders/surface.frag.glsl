@@ -4,7 +4,9 @@
  * numpy mirror (framebuffers take 6 attachments: Combined is summed on the CPU). */
 void main()
 {
-  vec3 normal = gl_FrontFacing ? world_normal : -world_normal;
+  /* a mirroring transform (negative determinant) reverses the triangles' winding: its front faces face away */
+  bool front = gl_FrontFacing != (determinant(mat3(model_matrix)) < 0.0);
+  vec3 normal = front ? world_normal : -world_normal;
 #ifdef HAS_VISIBILITY
   set_visibility_frame(world_ssdf_normal);     /* the bake's frame: not flipped for back faces */
   visibility_rows[0] = ssdf_coefficients_0;
