@@ -469,6 +469,20 @@ def image_pixels(image):
 
 
 COLOUR_SLOTS = ("diffuse_color", "specular_color")
+# What a texture whose image has no pixels (a missing or unreadable file) samples: Blender's magenta for colours
+# (what its own engines show), a flat normal for the normal map, and 1 for scalars (the factor alone).
+MISSING_COLOUR_TEXEL = (1.0, 0.0, 1.0, 1.0)
+MISSING_NORMAL_TEXEL = (0.5, 0.5, 1.0, 1.0)
+MISSING_SCALAR_TEXEL = (1.0, 1.0, 1.0, 1.0)
+
+
+def image_has_pixels(image):
+    """False for an image Blender could not load (a missing or unreadable file: size 0 x 0)."""
+    return image.size[0] > 0 and image.size[1] > 0 and image.channels > 0
+
+
+def _no_pixels_reason(image):
+    return f"file '{image.filepath}' missing or unreadable" if image.filepath else "no pixels"
 
 
 def srgb_to_linear(values):
@@ -482,6 +496,12 @@ def texture_pixels(image, slot):
     scene-linear when the image holds sRGB-encoded bytes (float images are linear already;
     data slots such as roughness or the normal map are used as stored, like Non-Color).  NaN/Inf
     texels become 0, with a warning (finite_texels): the upload reads each image once."""
+    if not image_has_pixels(image):
+        texel = MISSING_COLOUR_TEXEL if slot in COLOUR_SLOTS else \
+            MISSING_NORMAL_TEXEL if slot == "normal_map" else MISSING_SCALAR_TEXEL
+        what = "magenta" if slot in COLOUR_SLOTS else "a flat normal" if slot == "normal_map" else "the factor alone"
+        warn(f"image '{image.name}': {_no_pixels_reason(image)}: {what} used for {slot}")
+        return np.array(texel, np.float32).reshape(1, 1, 4)
     pixels = finite_texels(image_pixels(image), f"image '{image.name}'")
     if slot in COLOUR_SLOTS and not image.is_float and image.colorspace_settings.name == "sRGB":
         pixels = pixels.copy()
@@ -583,6 +603,10 @@ def export_world(world):
     if uses_nodes:
         for node in world.node_tree.nodes:
             if node.type == "TEX_ENVIRONMENT" and node.image is not None:
+                if not image_has_pixels(node.image):
+                    warn(f"world '{world.name}': image '{node.image.name}': {_no_pixels_reason(node.image)}: the "
+                         f"world colour {tuple(round(float(c), 4) for c in colour[:3])} used")
+                    break
                 pixels = image_pixels(node.image)[::-1, :, :3]      # numpy orientation, row 0 at the top
                 with np.errstate(over="ignore", invalid="ignore"):      # huge x strength: Inf, repaired below
                     pixels = pixels * np.float32(strength)

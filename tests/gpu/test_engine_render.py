@@ -385,3 +385,46 @@ def test_negative_scale_shades_as_the_same_geometry(engine, scale):
     difference = np.abs(images[1] - images[0]).max() / np.abs(images[0]).max()
     print(f"scale {scale}: max |mirrored - unmirrored| / max = {difference:.2e}")
     assert difference < 2e-4         # measured 2e-5 (float rounding)
+
+
+def _missing_image(name):
+    """An image whose file is gone: Blender keeps the datablock, with no pixels (size 0 x 0)."""
+    import bpy
+
+    image = bpy.data.images.new(name, 4, 4)
+    image.source = "FILE"
+    image.filepath = f"/nonexistent/{name}.png"
+    image.reload()
+    assert tuple(image.size) == (0, 0)
+    return image
+
+
+def test_missing_images_render_with_a_warning(engine):
+    """A texture whose file is missing samples Blender's magenta (colours) or the factor alone (scalars), a
+    missing world HDRI falls back to the world colour; each is named in the render's warnings (both used to
+    abort the render: 'dimension must be greater than or equal to 1', 'float division by zero')."""
+    import bpy
+
+    scene = fx.new_scene("missing_images", 48, 48)
+    world = fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    environment = next(node for node in world.node_tree.nodes if node.type == "TEX_ENVIRONMENT")
+    environment.image = _missing_image("missing_hdri")
+    world.color = (0.2, 0.2, 0.2)
+    sphere = fx.uv_sphere(scene, "missing_sphere", (0.0, 0.0, 1.0))
+    material = fx.material("missing_material", diffuse_color=(1.0, 1.0, 1.0), specular_color=(0.0, 0.0, 0.0))
+    material.sgprt.diffuse_color_texture = _missing_image("missing_colour")
+    material.sgprt.roughness_texture = _missing_image("missing_roughness")
+    sphere.data.materials.append(material)
+    result = dict(fx.render(scene))
+    assert "error" not in result, result.get("error")
+    warnings = " | ".join(result["state"].warnings)
+    assert "image 'missing_colour'" in warnings and "magenta" in warnings
+    assert "image 'missing_roughness'" in warnings and "the factor alone" in warnings
+    assert "image 'missing_hdri'" in warnings and "world colour" in warnings
+    diffuse = result["passes"]["Diffuse"]
+    lit = diffuse[..., 3] > 0.5
+    red, green, blue = (diffuse[lit][:, c].mean() for c in range(3))
+    assert red > 0.05 and blue > 0.05 and green < 1e-6          # magenta, lit by the grey world
+    background = result["passes"]["Combined"][~lit][:, :3]
+    np.testing.assert_allclose(background, 0.2, rtol=1e-5)       # the world colour behind
+    assert bpy.data.images["missing_colour"].size[0] == 0          # nothing was changed in the file
