@@ -53,6 +53,12 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         if scene.camera is None:
             self.report({"ERROR"}, "SG-PRT: the scene has no camera")
             return
+        if getattr(scene.camera.data, "type", None) == "PANO":
+            self.report({"ERROR"}, f"SG-PRT: camera '{scene.camera.name}' is panoramic; SG-PRT renders perspective "
+                                   "and orthographic cameras only (switch its Type, or render it with Cycles)")
+            last_render.clear()
+            last_render["error"] = "panoramic camera"
+            return
         self.update_stats("", "SG-PRT: exporting the scene, drawing")
         try:
             samples = 1 if debug["capture_gbuffer"] else getattr(getattr(scene, "sgprt", None), "render_samples", 1)

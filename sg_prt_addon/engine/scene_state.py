@@ -20,6 +20,9 @@ from ..core import shading
 _environment_cache = {}
 ENVIRONMENT_CACHE_SIZE = 4
 ENVIRONMENT_LAYER_SIZE = 128
+# Visible object types the engine has no shading for: named in the render's warnings, not silently dropped.
+UNRENDERED_GEOMETRY = {"CURVES": "Curves hair", "POINTCLOUD": "a point cloud", "VOLUME": "a volume",
+                       "GPENCIL": "Grease Pencil", "GREASEPENCIL": "Grease Pencil"}
 ENVIRONMENT_FIT_LOBES = 8
 
 # Tests (and scripts) may set this to a callable(object_eval) -> bake or None, standing in for the
@@ -139,6 +142,7 @@ class SceneState:
         self.materials = {"": export.MaterialParams()}
         self.lights = []
         seen_meshes = set()
+        unrendered = set()          # objects named once in the warnings
         for instance in depsgraph.object_instances:
             obj = instance.object
             if obj.type == "LIGHT":
@@ -148,7 +152,16 @@ class SceneState:
                     self.lights.append(light)
                 continue
             if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
+                if obj.type in UNRENDERED_GEOMETRY and obj.name not in unrendered:
+                    unrendered.add(obj.name)
+                    export.warn(f"object '{obj.name}': {UNRENDERED_GEOMETRY[obj.type]} is not rendered by SG-PRT "
+                                "(left out)")
                 continue        # object_instances already lists only what is visible
+            if obj.type == "MESH" and obj.name not in unrendered and any(
+                    system.settings.type == "HAIR" and system.settings.render_type == "PATH"
+                    for system in obj.particle_systems):
+                unrendered.add(obj.name)
+                export.warn(f"object '{obj.name}': particle hair is not rendered by SG-PRT (its mesh is)")
             name = obj.name if not instance.is_instance else f"{obj.name}#{len(self.objects)}"
             mesh_key = self._mesh_key(obj)
             if mesh_key not in seen_meshes:

@@ -428,3 +428,33 @@ def test_missing_images_render_with_a_warning(engine):
     background = result["passes"]["Combined"][~lit][:, :3]
     np.testing.assert_allclose(background, 0.2, rtol=1e-5)       # the world colour behind
     assert bpy.data.images["missing_colour"].size[0] == 0          # nothing was changed in the file
+
+
+def test_panoramic_camera_is_refused_clearly(engine):
+    import bpy
+
+    scene = fx.new_scene("panoramic", 32, 32)
+    fx.uv_sphere(scene, "panoramic_sphere", (0.0, 0.0, 1.0), segments=8, rings=4)
+    scene.camera.data.type = "PANO"
+    with pytest.raises(RuntimeError, match="is panoramic; SG-PRT renders perspective and orthographic cameras"):
+        with bpy.context.temp_override(scene=scene):
+            bpy.ops.render.render(scene=scene.name, write_still=False)
+
+
+def test_hair_is_named_not_dropped_silently(engine):
+    """Curves hair objects and particle hair render as nothing, with one warning each naming them."""
+    import bpy
+
+    scene = fx.new_scene("hair", 32, 32)
+    sphere = fx.uv_sphere(scene, "hair_sphere", (0.0, 0.0, 1.0), segments=8, rings=4)
+    curves = bpy.data.objects.new("hair_curves", bpy.data.hair_curves.new("hair_curves"))
+    scene.collection.objects.link(curves)
+    modifier = sphere.modifiers.new("hair", "PARTICLE_SYSTEM")
+    modifier.particle_system.settings.type = "HAIR"
+    modifier.particle_system.settings.count = 10
+    result = dict(fx.render(scene))
+    assert "error" not in result, result.get("error")
+    warnings = result["state"].warnings
+    assert sum("object 'hair_curves': Curves hair is not rendered" in w for w in warnings) == 1
+    assert sum("object 'hair_sphere': particle hair is not rendered" in w for w in warnings) == 1
+    assert (result["passes"]["Diffuse"][..., 3] > 0.5).any()         # the sphere itself renders
