@@ -99,6 +99,37 @@ def read_source(path):
         raise FitError(f"not a valid {kind}: {error}") from error
 
 
+# A MERL file must hold finite, non-negative samples in at least this fraction of its bins whose directions are
+# both above the horizon (real files mark some bins invalid; half or more invalid leaves too little to fit), and
+# no sample above MAX_MERL_VALUE per steradian (measured BRDFs stay orders of magnitude below it).
+MIN_VALID_FRACTION = 0.75
+MAX_MERL_VALUE = 1e6
+
+
+def _bins_above_horizon():
+    (theta_h, theta_d, phi_d), _ = merl_format.bin_centre_angles()
+    wo, wi = merl_format.directions_from_half_difference(theta_h, theta_d, phi_d)
+    return (wo[..., 2] > 0) & (wi[..., 2] > 0)
+
+
+def check_merl_samples(source, name):
+    """FitError saying what is wrong when the samples of MERL file ``name`` cannot support a fit."""
+    above = _bins_above_horizon()
+    usable = source.valid & above
+    fraction = usable.sum() / max(int(above.sum()), 1)
+    counts = ", ".join(f"{count} {kind}" for kind, count in source.counts.items() if count)
+    if fraction < MIN_VALID_FRACTION:
+        raise FitError(f"{name}: only {int(usable.sum())} of {int(above.sum())} bins above the horizon hold finite, "
+                       f"non-negative samples ({fraction:.0%}; {counts or 'none invalid'} channel samples): too few "
+                       f"to fit (at least {MIN_VALID_FRACTION:.0%})")
+    values = source.rho[usable]
+    if values.max() <= 0:
+        raise FitError(f"{name}: every valid sample is 0: nothing to fit")
+    if values.max() > MAX_MERL_VALUE:
+        raise FitError(f"{name}: samples reach {values.max():.3g} per steradian: not a measured BRDF (they stay below "
+                       f"{MAX_MERL_VALUE:g})")
+
+
 class _TexelReference:
     """The source as relative_rmse's reference callable (wo, wi, texels) -> (b, N, 3)."""
 
@@ -171,6 +202,8 @@ class FitJob(BackgroundJob):
             if self.record_progress(0.0, f"reading {name}"):
                 raise _Cancelled
             kind, source = read_source(self.path)
+            if kind == "MERL":
+                check_merl_samples(source, name)
             if self.record_progress(0.05, f"read {name}"):
                 raise _Cancelled
 
@@ -196,6 +229,12 @@ class FitJob(BackgroundJob):
             self.cancelled = True
             if self.verbose:
                 print("[sg-prt] fit cancelled: nothing written", flush=True)
+            return
+        except np.linalg.LinAlgError as error:      # samples with no microfacet structure: singular systems
+            self.error = (f"{name}: the samples do not behave like a microfacet BRDF (the fit's least squares is "
+                          f"singular: {error})")
+            if self.verbose:
+                print(f"[sg-prt] fit failed: {self.error}", flush=True)
             return
         except Exception as error:      # reported by the operator, nothing written
             self.error = str(error) if isinstance(error, FitError) else f"{type(error).__name__}: {error}"

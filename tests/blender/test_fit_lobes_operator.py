@@ -158,7 +158,34 @@ def _bad_files(data):
         ("trailing.binary", valid + b"\0" * 8, "trailing bytes"),
         ("garbage.binary", os.urandom(4096), "wrong dimensions"),
         ("broken.npz", table[:len(table) // 2], "SVBRDF table"),
+        ("all_nan.binary", _merl_bytes(np.full(merl.DIMENSIONS + (3,), np.nan)), "too few to fit"),
+        ("half_nan.binary", _merl_bytes(_half_nan(valid)), "too few to fit"),
+        ("huge.binary", _merl_bytes(np.full(merl.DIMENSIONS + (3,), 1e300)), "not a measured BRDF"),
+        ("zeros.binary", _merl_bytes(np.zeros(merl.DIMENSIONS + (3,))), "nothing to fit"),
     ]
+
+
+def _merl_bytes(rho):
+    """A MERL file of the samples rho (90, 90, 180, 3), as core.merl.write_merl writes it."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "samples.binary")
+        merl.write_merl(path, rho)
+        return open(path, "rb").read()
+
+
+def _half_nan(valid_bytes):
+    """The valid file's samples with every other theta_h row NaN (half of them)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "valid.binary")
+        open(path, "wb").write(valid_bytes)
+        source = merl.read_merl(path)
+    rho = source.rho.copy()
+    rho[::2] = np.nan
+    return rho
 
 
 def test_bad_files_are_reported_and_nothing_is_written(material, data, tmp_path):
