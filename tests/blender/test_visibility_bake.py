@@ -121,6 +121,43 @@ def test_store_is_bit_exact_against_the_bake_result(scene, tmp_path):
     assert stored.rms_error == pytest.approx(result.rms_error, rel=1e-12)
 
 
+def test_objects_disabled_in_renders_cast_no_shadow_in_bakes(scene):
+    """Disable in Renders, on an object or on a collection holding it, takes it out of the occluders and of
+    an ALL bake's receivers (it cast its shadow into bakes while the render left it out)."""
+    _, floor, suzanne = scene
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    both = len(vb.occluder_arrays(depsgraph)[1])
+    suzanne.hide_render = True
+    try:
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        assert len(vb.occluder_arrays(depsgraph)[1]) == both - len(suzanne.data.loop_triangles)
+        assert [obj.name for obj in vb._mesh_objects(bpy.context, "ALL")] == [floor.name]
+    finally:
+        suzanne.hide_render = False
+    hidden = bpy.data.collections.new("hidden_in_renders")
+    child = bpy.data.collections.new("inside_it")
+    bpy.context.scene.collection.children.link(hidden)
+    hidden.children.link(child)
+    owners = list(suzanne.users_collection)
+    child.objects.link(suzanne)
+    hidden.hide_render = True
+    try:
+        assert suzanne.name not in vb.hidden_from_render(bpy.context.scene)       # still linked where it renders
+        for owner in owners:
+            owner.objects.unlink(suzanne)
+        assert suzanne.name in vb.hidden_from_render(bpy.context.scene)
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        assert len(vb.occluder_arrays(depsgraph)[1]) == both - len(suzanne.data.loop_triangles)
+    finally:
+        for owner in owners:
+            if suzanne.name not in owner.objects:
+                owner.objects.link(suzanne)
+        child.objects.unlink(suzanne)
+        bpy.data.collections.remove(child)
+        bpy.data.collections.remove(hidden)
+    assert suzanne.name not in vb.hidden_from_render(bpy.context.scene)
+
+
 def test_cancelled_rebake_keeps_the_previous_bake(scene, tmp_path):
     _, floor, suzanne = scene
     _select(suzanne)
