@@ -78,7 +78,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             last_render.clear()
             last_render["error"] = traceback.format_exc()
             return
-        for warning in dict.fromkeys(state.warnings):
+        for warning in dict.fromkeys(state.warnings + state.unshadowed_warnings()):
             self.report({"WARNING"}, f"SG-PRT: {warning}")
         dropped = state.dropped_lights(shader_variants.MAX_POINT_LIGHTS, shader_variants.MAX_SUNS)
         if dropped:

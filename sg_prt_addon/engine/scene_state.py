@@ -190,6 +190,25 @@ class SceneState:
         self.visibility_status[mesh_key] = message
         return mesh
 
+    def unshadowed_warnings(self):
+        """The render report's lines for objects that render unshadowed: one per object whose bake cannot
+        shade it (stale, unusable...) naming it and why; the objects with no bake at all in one line, when
+        the scene has bakes (a scene never baked renders unshadowed by design)."""
+        lines, unbaked, seen = [], [], set()
+        for entry in self.objects.values():
+            if entry.mesh_key in seen or entry.mesh_key in self.visibility:
+                continue
+            seen.add(entry.mesh_key)
+            status = self.visibility_status.get(entry.mesh_key, "no visibility bake")
+            if status == "no visibility bake":
+                unbaked.append(entry.name)
+            else:
+                lines.append(f"object '{entry.name}' renders unshadowed: {status}")
+        if unbaked and (self.visibility or lines):
+            names = ", ".join(f"'{name}'" for name in unbaked[:5]) + (" ..." if len(unbaked) > 5 else "")
+            lines.append(f"{len(unbaked)} object(s) without a visibility bake render unshadowed: {names}")
+        return lines
+
     @staticmethod
     def _mesh_key(obj):
         # evaluated data of modified objects is per object; plain meshes can be shared

@@ -59,6 +59,14 @@ def test_stored_bakes_shadow_and_stale_bakes_do_not(engine):
     assert floor_key not in state.visibility
     assert "stale" in state.visibility_status[floor_key]
     assert len(state.visibility) == 1                      # the sphere keeps its shadows
+    # and the render says so, naming the object and why
+    warnings = state.unshadowed_warnings()
+    assert len(warnings) == 1 and warnings[0].startswith(f"object '{floor.name}' renders unshadowed: stale")
+    # without its bake at all it is named in the one line of unbaked objects (the sphere is baked)
+    visibility_bake.clear_visibility_bake(floor.data)
+    floor.data.update()
+    warnings = fx.render(scene)["state"].unshadowed_warnings()
+    assert warnings == [f"1 object(s) without a visibility bake render unshadowed: '{floor.name}'"]
 
 
 def test_a_bake_of_another_vertex_count_is_refused(engine):
