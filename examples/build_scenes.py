@@ -203,6 +203,16 @@ def main(output_dir):
         print(f"wrote {save_scene(Path(output_dir) / f'{name}.blend')}", flush=True)
 
 
+def script_arguments(argv):
+    """The script's own arguments: those after '--' when Blender runs it (`blender -b --python
+    examples/build_scenes.py -- out`, where argv holds Blender's too; without '--' none), else everything
+    after the script (python examples/build_scenes.py out, argv[0] the script)."""
+    if "--" in argv:
+        return argv[argv.index("--") + 1:]
+    return argv[1:] if argv and argv[0].endswith(".py") else []
+
+
 if __name__ == "__main__":
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    main(sys.argv[1] if len(sys.argv) > 1 else "out/scenes")
+    arguments = script_arguments(sys.argv)
+    main(arguments[0] if arguments else "out/scenes")

@@ -46,3 +46,12 @@ def test_batch_render_names_a_missing_file(tmp_path):
     assert completed.returncode != 0
     assert "error: no such .blend file" in completed.stderr and "nothing.blend" in completed.stderr
     assert "Traceback" not in completed.stderr
+
+
+def test_build_scenes_reads_its_own_arguments_under_a_blender_binary():
+    """`blender -b --python examples/build_scenes.py -- out` hands the script Blender's argv: the output folder
+    is what follows '--' (it used to be argv[1], '-b')."""
+    assert build_scenes.script_arguments(["blender", "-b", "--python", "examples/build_scenes.py", "--", "out"]) \
+        == ["out"]
+    assert build_scenes.script_arguments(["examples/build_scenes.py", "out/scenes"]) == ["out/scenes"]
+    assert build_scenes.script_arguments(["blender", "-b", "--python", "examples/build_scenes.py"]) == []
