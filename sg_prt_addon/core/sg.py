@@ -9,6 +9,8 @@ and is safe for sharpness in [0, 1e6], opposite or equal axes, and zero
 amplitudes: the forms below never evaluate exp of a large positive number and
 never subtract two nearly equal large numbers.
 """
+import math
+
 import numpy as np
 
 FOUR_PI = 4.0 * np.pi
@@ -115,12 +117,13 @@ def support_area(sharpness, epsilon=0.1):
     The region is the cap cos(theta) >= 1 + ln(epsilon) / lambda, so this is exact for
     lambda >= -ln(epsilon) / 2 (below, the cap would exceed the sphere); for
     lambda > -ln(epsilon) the cap lies within a hemisphere.  The paper uses epsilon = 0.1."""
-    return -TWO_PI * np.log(epsilon) / np.asarray(sharpness)
+    # math.log: a Python float keeps float32 input float32 under NumPy 2's promotion (a NumPy float64 would not)
+    return -TWO_PI * math.log(epsilon) / np.asarray(sharpness)
 
 
 def sharpness_from_area(area, epsilon=0.1):
     """Inverse of support_area."""
-    return -TWO_PI * np.log(epsilon) / np.asarray(area)
+    return -TWO_PI * math.log(epsilon) / np.asarray(area)
 
 
 def mixture_evaluate(direction, axes, sharpnesses, amplitudes):
