@@ -165,10 +165,11 @@ def _draw(shader, batch, rows_by_name, texture_objects):
     count = next(iter(rows_by_name.values())).shape[0]
     width = min(count, GRID_WIDTH)
     height = -(-count // width)
-    uploaded = {}
+    uploaded, grids = {}, []
     for name, rows in rows_by_name.items():
         grid = np.zeros((height * width, 4), np.float32)
         grid[:count] = rows
+        grids.append(grid)      # alive until the draw: Blender 5.3 may read a texture's data only when it draws
         uploaded[name] = _upload_texture(grid.reshape(height, width, 4))
     offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA32F")
     try:
@@ -177,9 +178,9 @@ def _draw(shader, batch, rows_by_name, texture_objects):
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")
             shader.bind()
-            for name, texture in uploaded.items():
-                shader.uniform_sampler(f"harness_input_{name}", texture)
-            for name, texture in texture_objects.items():
+            samplers = [(f"harness_input_{name}", texture) for name, texture in uploaded.items()]
+            samplers += list(texture_objects.items())
+            for name, texture in reversed(samplers):
                 shader.uniform_sampler(name, texture)
             batch.draw(shader)
             out = np.empty((height, width, 4), np.float32)
