@@ -128,6 +128,7 @@ class SceneState:
         self.dirty = Dirty()
         # bad input met while exporting (NaN texels, degenerate normals...): said once a render/redraw
         self.warnings = []
+        self._edited_meshes = None  # names of the meshes the update being applied edited (update())
 
     # ----------------------------------------------------------------- full sync
 
@@ -235,6 +236,10 @@ class SceneState:
         export.collect_warnings(self.warnings)
         dirty = self.dirty
         membership_changed = False
+        # meshes whose own data changed (an edit): Blender 5.3 also flags an object's geometry when only its
+        # material changed, so a plain mesh object re-exports only when its mesh is among these
+        self._edited_meshes = {update.id.name for update in depsgraph.updates
+                               if isinstance(update.id, bpy.types.Mesh) and update.is_updated_geometry}
         for update in depsgraph.updates:
             datablock = update.id
             if isinstance(datablock, bpy.types.Material):
@@ -296,7 +301,8 @@ class SceneState:
                 dirty.objects = True
             return
         mesh_key = self._mesh_key(obj)
-        if entry is None or update.is_updated_geometry or mesh_key not in self.meshes:
+        if entry is None or mesh_key not in self.meshes or (update.is_updated_geometry and _geometry_may_differ(
+                obj, self._edited_meshes)):
             self._export_mesh(obj, mesh_key)
             dirty.meshes.add(mesh_key)
         self.objects[obj.name] = ObjectEntry(obj.name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
@@ -366,6 +372,18 @@ def light_data(light_exports):
         data.sun_axis, data.sun_sharpness, data.sun_amplitude = (
             np.asarray(axis, f), np.asarray(sharpness, f), np.asarray(amplitude, f))
     return data
+
+
+def _geometry_may_differ(obj, edited_meshes):
+    """Whether an object whose update flags its geometry can shade differently: anything but a plain mesh
+    object (modifiers, shape keys and other types evaluate from more than the mesh) does; a plain mesh only
+    when its mesh itself was edited (edited_meshes; None: not known, so it may)."""
+    original = obj.original
+    if edited_meshes is None or original.type != "MESH" or len(original.modifiers) or original.data is None:
+        return True
+    if getattr(original.data, "shape_keys", None) is not None:
+        return True
+    return original.data.name in edited_meshes
 
 
 def environment_data(world, layer_size=None):
