@@ -1,13 +1,24 @@
 #!/usr/bin/env bash
-# Set up and run the whole test suite: every tier on the newest supported
-# Blender (pip bpy 5.0), then the Blender and GPU tiers on the oldest (4.2 LTS).
+# Set up and run the whole test suite: every tier on pip bpy 5.0 (the last for Python 3.11) and on the newest,
+# 5.3 (Python 3.13, through pyenv), then the Blender and GPU tiers on 5.2 LTS and on the oldest, 4.2 LTS.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup_venv.sh .venv requirements.txt
 bash scripts/setup_venv.sh .venv-bpy42 requirements-oldest-blender.txt
+python313=$(command -v python3.13 || echo "$HOME/.pyenv/versions/3.13.0/bin/python3.13")
+PYENV_VERSION=3.13.0 PYTHON=$python313 bash scripts/setup_venv.sh .venv-bpy53 requirements-newest-blender.txt
+PYENV_VERSION=3.13.0 PYTHON=$python313 bash scripts/setup_venv.sh .venv-bpy52 requirements-lts-blender.txt
 
-echo "== all tiers, bpy $(.venv/bin/python -c 'import bpy; print(bpy.app.version_string)')"
+version() { "$1/bin/python" -c 'import bpy; print(bpy.app.version_string)'; }
+
+echo "== all tiers, bpy $(version .venv)"
 .venv/bin/python -m pytest tests -q -p no:cacheprovider "$@"
 
-echo "== blender and gpu tiers, bpy $(.venv-bpy42/bin/python -c 'import bpy; print(bpy.app.version_string)')"
+echo "== all tiers, bpy $(version .venv-bpy53)"
+.venv-bpy53/bin/python -m pytest tests -q -p no:cacheprovider "$@"
+
+echo "== blender and gpu tiers, bpy $(version .venv-bpy52)"
+.venv-bpy52/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider "$@"
+
+echo "== blender and gpu tiers, bpy $(version .venv-bpy42)"
 .venv-bpy42/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider "$@"
