@@ -15,14 +15,19 @@ def engine(blender):
     return blender
 
 
-@pytest.mark.parametrize("roughness", [0.0, 0.005, 0.02, 0.1, 0.3, 0.6, 1.0])
-def test_white_furnace_returns_the_albedo(engine, roughness):
-    name = f"furnace_{roughness}"
-    scene = fx.new_scene(name, 64, 64)
-    fx.world_colour(scene, (1.0, 1.0, 1.0))
+def _specular_sphere(name, size, roughness, world, ks):
+    """A GGX sphere of specular colour ks (no diffuse) in a world of constant colour."""
+    scene = fx.new_scene(name, size, size)
+    fx.world_colour(scene, (world,) * 3)
     sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 1.0), radius=1.0, segments=64, rings=32)
     sphere.data.materials.append(fx.material(name + "_m", model="GGX", roughness=roughness,
-                                             diffuse_color=(0.0, 0.0, 0.0), specular_color=(1.0, 1.0, 1.0)))
+                                             diffuse_color=(0.0, 0.0, 0.0), specular_color=(ks,) * 3))
+    return scene
+
+
+@pytest.mark.parametrize("roughness", [0.0, 0.005, 0.02, 0.1, 0.3, 0.6, 1.0])
+def test_white_furnace_returns_the_albedo(engine, roughness):
+    scene = _specular_sphere(f"furnace_{roughness}", 64, roughness, 1.0, 1.0)
     result = fx.render(scene, gbuffer=True)
     passes = result["passes"]
     covered = passes["Diffuse"][..., 3] > 0.5
@@ -49,11 +54,7 @@ def test_a_sphere_light_in_a_near_mirror_stays_within_its_radiance(engine, rough
     import math
 
     name = f"mirror_light_{roughness}"
-    scene = fx.new_scene(name, 96, 96)
-    fx.world_colour(scene, (0.0, 0.0, 0.0))
-    sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 1.0), radius=1.0, segments=64, rings=32)
-    sphere.data.materials.append(fx.material(name + "_m", model="GGX", roughness=roughness,
-                                             diffuse_color=(0.0, 0.0, 0.0), specular_color=(0.25, 0.25, 0.25)))
+    scene = _specular_sphere(name, 96, roughness, 0.0, 0.25)
     power, radius = 1000.0, 0.5
     fx.point_light(scene, name + "_light", (2.0, -3.0, 3.0), power, radius=radius)
     specular = fx.render(scene)["passes"]["Specular"][..., :3]
