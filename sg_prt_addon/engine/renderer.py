@@ -346,9 +346,11 @@ class Renderer:
             if self.depth_prepass:
                 self._draw_depth(state)
                 gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
+            else:       # holdouts shade nothing but occlude: their depth alone, first
+                self._draw_depth(state, holdouts_only=True)
             for object_index, (object_key, entry) in enumerate(state.objects.items()):
                 buffers = self.mesh_buffers.get(entry.mesh_key)
-                if buffers is None:
+                if buffers is None or entry.holdout:       # a holdout's pixels keep the clear: (0, 0, 0, 0)
                     continue
                 model = _column_major(entry.matrix_world)
                 shared_light_visibility = bool(buffers.visibility_layers and has_lights) and \
@@ -441,9 +443,10 @@ class Renderer:
                 shader.uniform_sampler("visibility_basis", buffers.basis_texture)
                 self.vertex_visibility_batch.draw(shader)
 
-    def _draw_depth(self, state):
+    def _draw_depth(self, state, holdouts_only=False):
         """Depth of every surface, no colour: the surface shaders then shade each pixel once instead of
-        every surface drawn over it (they are the frame's whole cost; the pre-pass is vertex work)."""
+        every surface drawn over it (they are the frame's whole cost; the pre-pass is vertex work).
+        holdouts_only: the holdouts' depth alone (without the pre-pass the shading pass writes the rest)."""
         import gpu
 
         shader = shader_variants.get_depth_shader()
@@ -452,7 +455,7 @@ class Renderer:
         gpu.state.color_mask_set(False, False, False, False)
         for entry in state.objects.values():
             buffers = self.mesh_buffers.get(entry.mesh_key)
-            if buffers is None:
+            if buffers is None or (holdouts_only and not entry.holdout):
                 continue
             shader.uniform_float("model_matrix", _column_major(entry.matrix_world))
             for _slot, _first_triangle, batch in buffers.batches:

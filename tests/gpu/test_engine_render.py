@@ -458,3 +458,43 @@ def test_hair_is_named_not_dropped_silently(engine):
     assert sum("object 'hair_curves': Curves hair is not rendered" in w for w in warnings) == 1
     assert sum("object 'hair_sphere': particle hair is not rendered" in w for w in warnings) == 1
     assert (result["passes"]["Diffuse"][..., 3] > 0.5).any()         # the sphere itself renders
+
+
+def _in_collection(scene, obj, name):
+    import bpy
+
+    collection = bpy.data.collections.new(name)
+    scene.collection.children.link(collection)
+    collection.objects.link(obj)
+    scene.collection.objects.unlink(obj)
+    return scene.view_layers[0].layer_collection.children[collection.name]
+
+
+def test_holdout_and_indirect_only_collections(engine):
+    """A holdout occludes what is behind it and leaves (0, 0, 0, 0), as Cycles writes it; an object of an
+    Indirect Only collection is not seen by the camera (they rendered as ordinary objects)."""
+    scene = fx.new_scene("roles", 64, 64)
+    fx.world_colour(scene, (0.2, 0.3, 0.4))
+    material = fx.material("roles_m", diffuse_color=(0.8, 0.8, 0.8))
+    back = fx.uv_sphere(scene, "roles_back", (0.0, 2.0, 1.0), radius=1.5)
+    front = fx.uv_sphere(scene, "roles_front", (0.0, -2.0, 1.0), radius=0.5)
+    for sphere in (back, front):
+        sphere.data.materials.append(material)
+    fx.point_light(scene, "roles_light", (2.0, -3.0, 3.0), 300.0)
+    back.hide_render = True
+    front_pixels = dict(fx.render(scene))["passes"]["Diffuse"][..., 3] > 0.5       # the front sphere alone
+    back.hide_render = False
+    assert front_pixels.sum() > 20
+    front_layer = _in_collection(scene, front, "roles_holdout")
+    front_layer.holdout = True
+    held = dict(fx.render(scene))
+    assert held["state"].objects["roles_front"].holdout
+    for name in ("Combined", "Diffuse", "Specular"):
+        assert np.all(held["passes"][name][front_pixels] == 0), name      # (0, 0, 0, 0), over the back sphere too
+    assert np.all(held["passes"]["Combined"][~front_pixels][:, 3] == 1)
+    front_layer.holdout = False
+    front_layer.indirect_only = True
+    unseen = dict(fx.render(scene))
+    assert "roles_front" not in unseen["state"].objects
+    behind = unseen["passes"]["Combined"][front_pixels]
+    assert np.all(behind[:, 3] == 1) and (unseen["passes"]["Diffuse"][front_pixels][:, 3] > 0.5).any()  # the back sphere
