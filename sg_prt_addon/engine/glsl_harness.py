@@ -165,11 +165,10 @@ def _draw(shader, batch, rows_by_name, texture_objects):
     count = next(iter(rows_by_name.values())).shape[0]
     width = min(count, GRID_WIDTH)
     height = -(-count // width)
-    uploaded, grids = {}, []
+    uploaded = {}
     for name, rows in rows_by_name.items():
         grid = np.zeros((height * width, 4), np.float32)
         grid[:count] = rows
-        grids.append(grid)      # alive until the draw: Blender 5.3 may read a texture's data only when it draws
         uploaded[name] = _upload_texture(grid.reshape(height, width, 4))
     offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA32F")
     try:
@@ -180,6 +179,7 @@ def _draw(shader, batch, rows_by_name, texture_objects):
             shader.bind()
             samplers = [(f"harness_input_{name}", texture) for name, texture in uploaded.items()]
             samplers += list(texture_objects.items())
+            # slot 0 last: on Blender 5.3 it reads whichever texture was bound last
             for name, texture in reversed(samplers):
                 shader.uniform_sampler(name, texture)
             batch.draw(shader)
