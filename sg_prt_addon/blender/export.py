@@ -469,11 +469,10 @@ def image_pixels(image):
 
 
 COLOUR_SLOTS = ("diffuse_color", "specular_color")
-# What a texture whose image has no pixels (a missing or unreadable file) samples: Blender's magenta for colours
-# (what its own engines show), a flat normal for the normal map, and 1 for scalars (the factor alone).
-MISSING_COLOUR_TEXEL = (1.0, 0.0, 1.0, 1.0)
-MISSING_NORMAL_TEXEL = (0.5, 0.5, 1.0, 1.0)
-MISSING_SCALAR_TEXEL = (1.0, 1.0, 1.0, 1.0)
+# What a texture whose image has no pixels (a missing or unreadable file) samples, and what the warning calls it:
+# Blender's magenta for colours (what its own engines show), a flat normal for the normal map, 1 for scalars.
+MISSING_TEXEL = {"colour": ((1.0, 0.0, 1.0, 1.0), "magenta"), "normal_map": ((0.5, 0.5, 1.0, 1.0), "a flat normal"),
+                 "scalar": ((1.0, 1.0, 1.0, 1.0), "the factor alone")}
 
 
 def image_has_pixels(image):
@@ -497,9 +496,8 @@ def texture_pixels(image, slot):
     data slots such as roughness or the normal map are used as stored, like Non-Color).  NaN/Inf
     texels become 0, with a warning (finite_texels): the upload reads each image once."""
     if not image_has_pixels(image):
-        texel = MISSING_COLOUR_TEXEL if slot in COLOUR_SLOTS else \
-            MISSING_NORMAL_TEXEL if slot == "normal_map" else MISSING_SCALAR_TEXEL
-        what = "magenta" if slot in COLOUR_SLOTS else "a flat normal" if slot == "normal_map" else "the factor alone"
+        texel, what = MISSING_TEXEL["colour" if slot in COLOUR_SLOTS else "normal_map" if slot == "normal_map"
+                                    else "scalar"]
         warn(f"image '{image.name}': {_no_pixels_reason(image)}: {what} used for {slot}")
         return np.array(texel, np.float32).reshape(1, 1, 4)
     pixels = finite_texels(image_pixels(image), f"image '{image.name}'")
@@ -616,6 +614,44 @@ def export_world(world):
                                    equirect=np.ascontiguousarray(pixels, np.float32),
                                    strength=strength)
     return WorldExport(colour=tuple(float(c) * strength for c in colour[:3]), strength=strength)
+
+
+# --------------------------------------------------------------------------- what renders
+
+@dataclass
+class RenderRoles:
+    """What a render does with a view layer's objects, by (original) name (render_roles)."""
+    hidden: set         # disabled in renders: on the object, or on every collection path that holds it
+    holdout: set        # in a Holdout collection (through any path), or the object's own Holdout
+    indirect: set       # in an Indirect Only collection (through any path): not seen by the camera
+
+
+def render_roles(view_layer):
+    """RenderRoles of a view layer's collections and objects.  A holdout occludes and cuts the film's alpha; an
+    indirect-only object is not seen by the camera (this engine renders direct light only: it only shadows,
+    through bakes); a hidden one is left out of renders and of bakes (the viewport's depsgraph still lists
+    it)."""
+    shown, holdout, indirect = set(), set(), set()
+
+    def walk(layer_collection, in_holdout, in_indirect):
+        if layer_collection.collection.hide_render:
+            return
+        in_holdout = in_holdout or layer_collection.holdout
+        in_indirect = in_indirect or layer_collection.indirect_only
+        names = [obj.name for obj in layer_collection.collection.objects]
+        shown.update(names)
+        if in_holdout:
+            holdout.update(names)
+        if in_indirect:
+            indirect.update(names)
+        for child in layer_collection.children:
+            walk(child, in_holdout, in_indirect)
+
+    walk(view_layer.layer_collection, False, False)
+    objects = list(view_layer.objects)
+    hidden = {obj.name for obj in objects if obj.hide_render or obj.name not in shown}
+    holdout.update(obj.name for obj in objects if getattr(obj, "is_holdout", False))
+    return RenderRoles(hidden, holdout - hidden, indirect - hidden)
 
 
 # --------------------------------------------------------------------------- camera

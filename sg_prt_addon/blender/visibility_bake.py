@@ -63,6 +63,7 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 from ..bake import decode
 from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility, topology_hash
+from . import export
 from .background_job import BackgroundJob, ModalJobOperator
 from .panels import RenderPanel
 
@@ -133,29 +134,12 @@ def receiver_arrays(obj, depsgraph):
     return vertices, normals, mesh_triangles(mesh)
 
 
-def hidden_from_render(scene):
-    """Names of the scene's objects a render leaves out: Disable in Renders on the object, or on every
-    collection path that holds it (an object linked also elsewhere still renders there).  The viewport's
-    depsgraph still lists them; bakes must take only what renders."""
-    shown = set()
-
-    def walk(collection):
-        if collection.hide_render:
-            return
-        shown.update(obj.name for obj in collection.objects)
-        for child in collection.children:
-            walk(child)
-
-    walk(scene.collection)
-    return {obj.name for obj in scene.objects if obj.hide_render or obj.name not in shown}
-
-
 def occluder_arrays(depsgraph):
     """(vertices (P, 3) float32, triangles (T, 3) int32) of every object with geometry a render shows (visible
-    and not disabled in renders, hidden_from_render), world space."""
+    and not disabled in renders: export.render_roles), world space."""
     by_object = {}
     vertices, triangles, offset = [], [], 0
-    hidden = hidden_from_render(depsgraph.scene_eval)
+    hidden = export.render_roles(depsgraph.view_layer).hidden
     for instance in depsgraph.object_instances:
         obj = instance.object
         if obj.type not in GEOMETRY_TYPES or obj.name in hidden:
@@ -456,7 +440,7 @@ def _bake_options(settings):
 
 def _mesh_objects(context, target):
     if target == "ALL":
-        hidden = hidden_from_render(context.scene)
+        hidden = export.render_roles(context.view_layer).hidden
         return [obj for obj in context.scene.objects if obj.type == "MESH" and obj.visible_get()
                 and obj.name not in hidden]
     return [obj for obj in context.selected_objects if obj.type == "MESH"]

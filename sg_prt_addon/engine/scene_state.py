@@ -20,10 +20,10 @@ from ..core import shading
 _environment_cache = {}
 ENVIRONMENT_CACHE_SIZE = 4
 ENVIRONMENT_LAYER_SIZE = 128
+ENVIRONMENT_FIT_LOBES = 8
 # Visible object types the engine has no shading for: named in the render's warnings, not silently dropped.
 UNRENDERED_GEOMETRY = {"CURVES": "Curves hair", "POINTCLOUD": "a point cloud", "VOLUME": "a volume",
                        "GPENCIL": "Grease Pencil", "GREASEPENCIL": "Grease Pencil"}
-ENVIRONMENT_FIT_LOBES = 8
 
 # Tests (and scripts) may set this to a callable(object_eval) -> bake or None, standing in for the
 # stored bakes: see visibility_for.
@@ -99,7 +99,7 @@ class ObjectEntry:
     mesh_key: str                   # name of the mesh datablock (objects sharing a mesh share the export)
     matrix_world: np.ndarray
     material_names: list            # material name (or "") per slot
-    holdout: bool = False           # a holdout: occludes, shades nothing, alpha 0 (render_roles)
+    holdout: bool = False           # a holdout: occludes, shades nothing, alpha 0 (export.render_roles)
 
 
 @dataclass
@@ -130,7 +130,7 @@ class SceneState:
         # bad input met while exporting (NaN texels, degenerate normals...): said once a render/redraw
         self.warnings = []
         self._edited_meshes = None  # names of the meshes the update being applied edited (update())
-        self._roles = (set(), set())  # render_roles of the view layer, as of the last update()
+        self._roles = export.RenderRoles(set(), set(), set())  # the view layer's, as of the last update()
 
     # ----------------------------------------------------------------- full sync
 
@@ -146,7 +146,7 @@ class SceneState:
         self.lights = []
         seen_meshes = set()
         unrendered = set()          # objects named once in the warnings
-        holdout, indirect = render_roles(depsgraph.view_layer)
+        roles = export.render_roles(depsgraph.view_layer)
         for instance in depsgraph.object_instances:
             obj = instance.object
             if obj.type == "LIGHT":
@@ -166,7 +166,7 @@ class SceneState:
                     for system in obj.particle_systems):
                 unrendered.add(obj.name)
                 export.warn(f"object '{obj.name}': particle hair is not rendered by SG-PRT (its mesh is)")
-            if obj.original.name in indirect:
+            if obj.original.name in roles.indirect:
                 continue        # not seen by the camera
             name = obj.name if not instance.is_instance else f"{obj.name}#{len(self.objects)}"
             mesh_key = self._mesh_key(obj)
@@ -174,7 +174,7 @@ class SceneState:
                 self._export_mesh(obj, mesh_key)
                 seen_meshes.add(mesh_key)
             self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(instance.matrix_world),
-                                             self._read_materials(obj), _is_holdout(obj, holdout))
+                                             self._read_materials(obj), obj.original.name in roles.holdout)
         self.world = export.export_world(depsgraph.scene.world)
         self.environment = environment_data(self.world, self.environment_layer_size)
         self.mark_all_dirty()
@@ -245,7 +245,7 @@ class SceneState:
         # material changed, so a plain mesh object re-exports only when its mesh is among these
         self._edited_meshes = {update.id.name for update in depsgraph.updates
                                if isinstance(update.id, bpy.types.Mesh) and update.is_updated_geometry}
-        self._roles = render_roles(depsgraph.view_layer)
+        self._roles = export.render_roles(depsgraph.view_layer)
         for update in depsgraph.updates:
             datablock = update.id
             if isinstance(datablock, bpy.types.Material):
@@ -277,11 +277,11 @@ class SceneState:
     def _sync_membership(self, depsgraph, dirty):
         """Drop objects no longer in the evaluated scene (or now indirect only), export the ones that appeared,
         and follow the holdout collections."""
-        holdout, indirect = self._roles
-        present = {obj.name: obj for obj in depsgraph.objects if obj.original.name not in indirect}
+        roles = self._roles
+        present = {obj.name: obj for obj in depsgraph.objects if obj.original.name not in roles.indirect}
         for name, entry in self.objects.items():
             obj = present.get(name.split("#")[0])
-            if obj is not None and entry.holdout != _is_holdout(obj, holdout):
+            if obj is not None and entry.holdout != (obj.original.name in roles.holdout):
                 entry.holdout = not entry.holdout
                 dirty.objects = True
         for name in [name for name in self.objects if name.split("#")[0] not in present]:
@@ -296,7 +296,7 @@ class SceneState:
                 self._export_mesh(obj, mesh_key)
                 dirty.meshes.add(mesh_key)
                 self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
-                                                 self._read_materials(obj), _is_holdout(obj, holdout))
+                                                 self._read_materials(obj), obj.original.name in roles.holdout)
                 dirty.objects = True
         if len([obj for obj in present.values() if obj.type == "LIGHT"]) != len(self.lights):
             dirty.lights = True
@@ -308,8 +308,7 @@ class SceneState:
         if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
             return
         entry = self.objects.get(obj.name)
-        holdout, indirect = self._roles
-        if not _visible(obj) or obj.original.name in indirect:
+        if not _visible(obj) or obj.original.name in self._roles.indirect:
             if entry is not None:
                 del self.objects[obj.name]
                 dirty.objects = True
@@ -320,7 +319,7 @@ class SceneState:
             self._export_mesh(obj, mesh_key)
             dirty.meshes.add(mesh_key)
         self.objects[obj.name] = ObjectEntry(obj.name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
-                                             self._read_materials(obj), _is_holdout(obj, holdout))
+                                             self._read_materials(obj), obj.original.name in self._roles.holdout)
         dirty.objects = True
 
     def mark_all_dirty(self):
@@ -341,34 +340,6 @@ class SceneState:
         """Names of the lights beyond the shader's limits (the dimmest are dropped)."""
         kept = set(light.name for light in _strongest(self.lights, max_points, max_suns))
         return [light.name for light in self.lights if light.name not in kept]
-
-
-def render_roles(view_layer):
-    """(holdout, indirect only): names of the objects in the view layer's Holdout and Indirect Only
-    collections (at any depth, through any path), holdouts also by the object's own Holdout setting.  A
-    holdout occludes and cuts the film's alpha; an indirect-only object is not seen by the camera (this engine
-    renders direct light only: it only shadows, through bakes)."""
-    holdout, indirect = set(), set()
-
-    def walk(layer_collection, in_holdout, in_indirect):
-        in_holdout = in_holdout or layer_collection.holdout
-        in_indirect = in_indirect or layer_collection.indirect_only
-        names = [obj.name for obj in layer_collection.collection.objects]
-        if in_holdout:
-            holdout.update(names)
-        if in_indirect:
-            indirect.update(names)
-        for child in layer_collection.children:
-            walk(child, in_holdout, in_indirect)
-
-    if view_layer is not None:
-        walk(view_layer.layer_collection, False, False)
-    return holdout, indirect
-
-
-def _is_holdout(obj, holdout):
-    original = getattr(obj, "original", obj)
-    return original.name in holdout or bool(getattr(original, "is_holdout", False))
 
 
 def _visible(obj):

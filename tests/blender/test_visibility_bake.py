@@ -9,6 +9,7 @@ import pytest
 
 from sg_prt_addon.bake import decode, hemisphere_map
 from sg_prt_addon.bake.pipeline import BakeOptions, bake_visibility
+from sg_prt_addon.blender import export
 from sg_prt_addon.blender import visibility_bake as vb
 
 SMALL = dict(resolution=12, refinement=3, term_mode="FIXED", terms=6, max_terms=47)
@@ -142,10 +143,11 @@ def test_objects_disabled_in_renders_cast_no_shadow_in_bakes(scene):
     child.objects.link(suzanne)
     hidden.hide_render = True
     try:
-        assert suzanne.name not in vb.hidden_from_render(bpy.context.scene)       # still linked where it renders
+        # still linked where it renders
+        assert suzanne.name not in export.render_roles(bpy.context.view_layer).hidden
         for owner in owners:
             owner.objects.unlink(suzanne)
-        assert suzanne.name in vb.hidden_from_render(bpy.context.scene)
+        assert suzanne.name in export.render_roles(bpy.context.view_layer).hidden
         depsgraph = bpy.context.evaluated_depsgraph_get()
         assert len(vb.occluder_arrays(depsgraph)[1]) == both - len(suzanne.data.loop_triangles)
     finally:
@@ -155,7 +157,7 @@ def test_objects_disabled_in_renders_cast_no_shadow_in_bakes(scene):
         child.objects.unlink(suzanne)
         bpy.data.collections.remove(child)
         bpy.data.collections.remove(hidden)
-    assert suzanne.name not in vb.hidden_from_render(bpy.context.scene)
+    assert suzanne.name not in export.render_roles(bpy.context.view_layer).hidden
 
 
 def test_cancelled_rebake_keeps_the_previous_bake(scene, tmp_path):
