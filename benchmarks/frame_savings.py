@@ -4,7 +4,7 @@ against its own baseline in the same run.
 
 Per scene (examples/build_scenes.py at --size, baked by the operator with its defaults):
 - per-vertex diffuse visibility: steady frame (median of render_engine.debug["timed_redraws"]) with the
-  broad diffuse lobes decoded at the vertices vs per pixel (shader_variants.diffuse_visibility_rows
+  broad diffuse lobes decoded at the vertices vs per pixel (techniques/sg_lobes.py diffuse_visibility_rows
   forced to 0, the variant's per-pixel path); also the Combined difference between the two, relative
   RMSE over the surface pixels;
 - clamped-cosine terms: steady frame with the environment lobes' lambda-only terms read from the scene
@@ -46,10 +46,10 @@ def frame(per_vertex=True, terms=True, table=True, shared_light=True):
     """(steady frame seconds, Combined) of one render with the chosen paths."""
     from benchmarks.engine_vs_eevee import steady_frame
     from sg_prt_addon.core import shading
-    from sg_prt_addon.engine import render_engine, shader_variants
+    from sg_prt_addon.engine import render_engine, shader_cache
+    from sg_prt_addon.techniques import sg_lobes, shader_sources
 
-    rows, read, shares = (shader_variants.diffuse_visibility_rows, shader_variants._read,
-                          shading.shares_light_visibility)
+    rows, read, shares = (sg_lobes.diffuse_visibility_rows, shader_sources.read, shading.shares_light_visibility)
     substitutions = (([] if terms else [(TERMS_CALL, PER_PIXEL_CALL)])
                      + ([] if table else [(TABLE_CALL, CLOSED_FORM_CALL)]))
 
@@ -62,27 +62,27 @@ def frame(per_vertex=True, terms=True, table=True, shared_light=True):
         return text
 
     if not per_vertex:
-        shader_variants.diffuse_visibility_rows = lambda environment: 0
+        sg_lobes.diffuse_visibility_rows = lambda environment: 0
     if not shared_light:
         shading.shares_light_visibility = lambda light_data, bounds: False
-    shader_variants._read = patched_read
-    shader_variants.clear_cache()
+    shader_sources.read = patched_read
+    shader_cache.clear_cache()
     try:
         seconds = steady_frame(REDRAWS)
     finally:
-        shader_variants.diffuse_visibility_rows, shader_variants._read = rows, read
+        sg_lobes.diffuse_visibility_rows, shader_sources.read = rows, read
         shading.shares_light_visibility = shares
-        shader_variants.clear_cache()
+        shader_cache.clear_cache()
     return seconds, render_engine.last_render["passes"]["Combined"].copy()
 
 
 def render_seconds(warm):
     """bpy.ops.render.render's wall time, the shader and environment-texture caches kept or emptied."""
     from benchmarks.engine_vs_eevee import render_seconds as timed_render
-    from sg_prt_addon.engine import renderer, shader_variants
+    from sg_prt_addon.engine import renderer, shader_cache
 
     if not warm:
-        shader_variants.clear_cache()
+        shader_cache.clear_cache()
         renderer._environment_textures.clear()
     return timed_render()
 

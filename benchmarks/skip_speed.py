@@ -14,7 +14,7 @@ passes); the ratio is the median over rounds of skipped / with, each pair render
   image, through the prefiltered map and the SG mixture)
 - SSDF decode: no bake; with it: an all-visible bake (19 PCA terms, 5 vec4 a vertex, every ratio 1)
 
-Forcing monkeypatches shader_variants.variant_key (a benchmark may; the tests do not): the key of
+Forcing monkeypatches the techniques' variant_key (a benchmark may; the tests do not): the key of
 each draw goes through dataclasses.replace(key, **fields).
 
 Update rows, timed inside one render (the GPU context): a viewport-style update where nothing
@@ -89,24 +89,27 @@ def build_scene(size):
 
 @contextlib.contextmanager
 def variants(force=None, seen=None):
-    """shader_variants.variant_key with `force` fields replaced; every key drawn is added to `seen`."""
-    from sg_prt_addon.engine import shader_variants
+    """Every technique's variant_key with `force` fields replaced; every key drawn is added to `seen`."""
+    from sg_prt_addon import techniques
 
-    original = shader_variants.variant_key
+    def patched(original):
+        def variant_key(*args, **kwargs):
+            key = original(*args, **kwargs)
+            if force:
+                key = dataclasses.replace(key, **force)
+            if seen is not None:
+                seen.add(key)
+            return key
+        return variant_key
 
-    def patched(*args, **kwargs):
-        key = original(*args, **kwargs)
-        if force:
-            key = dataclasses.replace(key, **force)
-        if seen is not None:
-            seen.add(key)
-        return key
-
-    shader_variants.variant_key = patched
+    registered = [techniques.get(name) for name in techniques.names()]
+    for technique in registered:
+        technique.variant_key = patched(technique.variant_key)
     try:
         yield
     finally:
-        shader_variants.variant_key = original
+        for technique in registered:
+            del technique.variant_key          # the class's method again
 
 
 def all_visible_provider():

@@ -23,6 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import techniques
+from ..techniques import sg_fitted
+
 # Mesh exports since import; tests read it to check what an update re-exported.
 export_counter = {"meshes": 0}
 
@@ -115,7 +118,8 @@ class MaterialParams:
     tangent_axis: tuple = (1.0, 0.0, 0.0)
     tangent_rotation: float = 0.0
     textures: dict = field(default_factory=dict)     # parameter name or "normal_map" -> image name
-    fitted: object = None          # FittedLobes when use_fitted_lobes and the stored fit is VALID
+    technique: str = techniques.DEFAULT    # the registered technique that renders it (techniques/)
+    fitted: object = None          # FittedLobes with the fitted-lobes technique and a VALID stored fit
 
     def values_key(self):
         """Everything but textures, hashable: the material UBO is rebuilt when this changes."""
@@ -143,13 +147,12 @@ class FittedLobes:
 
 
 def export_fitted_lobes(material):
-    """FittedLobes of a material with use_fitted_lobes and a VALID fit, else None."""
+    """FittedLobes of a material's VALID stored fit, else None."""
     from . import lobe_fit
 
-    settings = getattr(material, "sgprt", None)
-    if settings is None or not settings.use_fitted_lobes or lobe_fit.fit_status(material)[0] != "VALID":
+    if getattr(material, "sgprt", None) is None or lobe_fit.fit_status(material)[0] != "VALID":
         return None
-    fit = settings.lobe_fit
+    fit = material.sgprt.lobe_fit
     arrays = lobe_fit.lobe_fit_images(material)
     count, components = int(fit.lobe_count), int(fit.shadowing_components)
     roles = ["base"] + [f"lobe_{k}_{part}" for k in range(count) for part in ("axis", "amplitude")]
@@ -407,6 +410,26 @@ def matrix_to_numpy(matrix):
 
 # --------------------------------------------------------------------------- materials
 
+def _usable_technique(material, params):
+    """The technique the material picks, when it can render it (the fitted lobes need a VALID stored fit,
+    which goes to params.fitted); else the default, with a warning that says why."""
+    from . import lobe_fit
+
+    name = techniques.of_settings(material.sgprt)
+    if name not in techniques.names():
+        warn(f"material '{material.name}': technique {name!r} is not available in this version "
+             f"(registered: {', '.join(techniques.names())}): rendered with {techniques.DEFAULT}")
+        return techniques.DEFAULT
+    if name == sg_fitted.NAME:
+        params.fitted = export_fitted_lobes(material)
+        if params.fitted is None:
+            state, message = lobe_fit.fit_status(material)
+            warn(f"material '{material.name}': no usable lobe fit ({message or state.lower()}): rendered with "
+                 "its model")
+            return techniques.DEFAULT
+    return name
+
+
 def export_material(material):
     """MaterialParams of a bpy Material (None, or without `sgprt`: the defaults)."""
     params = MaterialParams()
@@ -433,7 +456,7 @@ def export_material(material):
             params.textures[name] = image.name
     if settings.normal_map is not None:
         params.textures["normal_map"] = settings.normal_map.name
-    params.fitted = export_fitted_lobes(material)
+    params.technique = _usable_technique(material, params)
     _finite_settings(params)
     return params
 

@@ -26,8 +26,9 @@ Storage (format version 1), the engine's input
 cosine-weighted fitted BRDF against the source over an independent direction grid:
 microfacet_fit.relative_rmse, mean / max over texels), ``ndf_error`` (mean relative L2
 of the SG fit of D), ``date`` (ISO 8601 UTC), ``seconds``, and ``images``: a collection of
-(``role``, ``image``).  ``material.sgprt.use_fitted_lobes`` is set True by a fit: the
-engine should then render the fit instead of ``model``.
+(``role``, ``image``).  A fit sets ``material.sgprt.technique`` to the fitted-lobes technique
+(techniques/sg_fitted.py): the engine then renders the fit instead of ``model``; clearing the fit sets
+the default technique back.
 
 Every image is a FLOAT RGBA image (32-bit float), packed into the .blend (OpenEXR,
 float32-exact through save and reopen on 4.2 and 5.0), colour space Non-Color,
@@ -64,8 +65,10 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, IntProperty, StringProperty
 
+from .. import techniques
 from ..core import merl as merl_format
 from ..core import microfacet_fit, svbrdf_table
+from ..techniques import sg_fitted
 from .background_job import BackgroundJob, ModalJobOperator
 from .panels import MaterialPanel
 
@@ -283,7 +286,10 @@ def clear_lobe_fit(material):
                  "shadowing_components", "shadowing_samples", "width", "height", "fit_error", "fit_error_max",
                  "ndf_error", "date", "seconds"):
         settings.property_unset(name)
-    material.sgprt.use_fitted_lobes = False
+    if techniques.of_settings(material.sgprt) == sg_fitted.NAME:
+        material.sgprt.technique = techniques.DEFAULT
+    if "use_fitted_lobes" in material.sgprt.keys():        # the setting of files before techniques
+        del material.sgprt["use_fitted_lobes"]
     for image in images:
         if image.users == 0:
             bpy.data.images.remove(image)
@@ -329,7 +335,7 @@ def store_lobe_fit(material, result, path, free_axes=None):
     settings.date = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     settings.seconds = float(result["seconds"])
     settings.format_version = FORMAT_VERSION
-    material.sgprt.use_fitted_lobes = True
+    material.sgprt.technique = sg_fitted.NAME
     material.update_tag()
 
 
@@ -549,7 +555,8 @@ class SGPRT_PT_material_lobe_fit(MaterialPanel, bpy.types.Panel):
         if state == "NONE":
             column.label(text="No fitted lobes: renders the model above", icon="INFO")
             return
-        layout.prop(material.sgprt, "use_fitted_lobes")
+        if techniques.of_settings(material.sgprt) != sg_fitted.NAME:
+            column.label(text="Renders the model: pick the fitted technique above to render the fit", icon="INFO")
         if state == "INVALID":
             column.alert = True
             column.label(text=message, icon="ERROR")

@@ -25,6 +25,7 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
         settings = context.material.sgprt
         layout = self.layout
         layout.use_property_split = True
+        layout.prop(settings, "technique")
         layout.prop(settings, "model")
         textured = settings.show_textures
         for name in ("diffuse_color", "specular_color") + MODEL_PARAMETERS[settings.model]:

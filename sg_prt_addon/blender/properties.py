@@ -8,6 +8,8 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from .. import techniques
+
 MODELS = (
     ("GGX", "GGX", "Microfacet GGX matching Blender's Glossy BSDF (alpha = roughness^2, "
                    "height-correlated Smith shadowing, no Fresnel)"),
@@ -43,6 +45,16 @@ VIEW_WARPS = (
 # Parameters that may be driven by an image texture: `<name>_texture`.
 TEXTURED_PARAMETERS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
                        "alpha_x", "alpha_y", "nu", "nv")
+
+
+# The registered techniques as enum items; Blender keeps no copy of the strings of a dynamic enum, so the
+# list a callback returns must outlive the call
+_technique_items = []
+
+
+def technique_items(self, context):
+    _technique_items[:] = techniques.enum_items()
+    return _technique_items
 
 
 def _tag_material_changed(self, context):
@@ -86,6 +98,10 @@ class SGPRT_PG_lobe_fit(bpy.types.PropertyGroup):
 
 
 class SGPRT_PG_material(bpy.types.PropertyGroup):
+    # default 0: the number of techniques.DEFAULT; a file without the setting: techniques.of_settings
+    technique: EnumProperty(update=_tag_material_changed, name="Technique", items=technique_items, default=0,
+                            description="The rendering method of this material (techniques/: the reference each "
+                                        "implements is in its description)")
     model: EnumProperty(update=_tag_material_changed, name="Model", items=MODELS, default="GGX",
                         description="Specular reflectance model, rendered with spherical Gaussian NDF lobes")
     diffuse_color: FloatVectorProperty(update=_tag_material_changed, name="Diffuse", subtype="COLOR", size=3, default=(0.5, 0.5, 0.5),
@@ -137,8 +153,6 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                                     description="Rotation of the tangent about the normal")
     show_textures: BoolProperty(update=_tag_material_changed, name="Show Textures", default=True,
                                 description="Show the texture slot next to each parameter")
-    use_fitted_lobes: BoolProperty(update=_tag_material_changed, name="Use Fitted Lobes", default=False,
-                                   description="Render the stored lobe fit (lobe_fit) instead of the model")
     lobe_fit: PointerProperty(type=SGPRT_PG_lobe_fit, name="Lobe Fit",
                               description="SG lobes fitted to a measured BRDF (sgprt.fit_lobes)")
 

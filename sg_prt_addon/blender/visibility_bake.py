@@ -27,14 +27,18 @@ so a stale bake is never read out of bounds.
 
 Storage, per mesh datablock (format version 1)
 ----------------------------------------------
+The per-vertex record of kind ``ssdf`` (blender/per_vertex_store.py, the one storage path of every
+per-vertex kind):
+
 - ``sgprt_ssdf_00`` .. ``sgprt_ssdf_{L-1}``: POINT-domain FLOAT_COLOR attributes
   (4 float32 a vertex; saved, reloaded and propagated through modifiers by 4.2
-  and 5.0 alike), together the rows of ``decode.pack_coefficients``:
-  [1, w_0, w_1, ...] zero-padded to 4 L floats, L = ceil((terms + 1) / 4) <= 12;
-- ``mesh["sgprt_ssdf"]``, an ID property group: ``format_version``,
-  ``resolution`` R, ``terms`` N, ``layers`` L, ``rms_error`` (radians),
-  ``vertex_count``, ``topology_hash`` (``bake.pipeline.topology_hash`` of the
-  vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``),
+  and 5.x alike), together the rows of ``decode.pack_coefficients``:
+  [1, w_0, w_1, ...] zero-padded to 4 L floats, L = ceil((terms + 1) / 4) <= 12
+  (bake.per_vertex.MAX_ROWS);
+- ``mesh["sgprt_ssdf"]``, an ID property group: the store's ``format_version``,
+  ``layers`` L, ``vertex_count``, ``topology_hash`` (``bake.pipeline.topology_hash`` of the
+  vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``), and the bake's
+  ``resolution`` R, ``terms`` N, ``rms_error`` (radians),
   ``frame_reference_axis`` (3), ``date`` (ISO 8601 UTC), ``seconds``,
   ``refinement``, ``error_target`` (-1 for fixed terms), ``rays_traced``, and the
   basis ``basis`` (N R R) and ``mean`` (R R) as float arrays (stored as double:
@@ -62,15 +66,18 @@ import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 from ..bake import decode
-from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility, topology_hash
-from . import export
+from ..bake.per_vertex import MAX_ROWS
+from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility
+from . import export, per_vertex_store
+from .per_vertex_store import mesh_topology_hash, mesh_triangles
 from .background_job import BackgroundJob, ModalJobOperator
 from .panels import RenderPanel
 
 FORMAT_VERSION = 1
-PROPERTY = "sgprt_ssdf"
-ATTRIBUTE_PREFIX = "sgprt_ssdf_"
-MAX_LAYERS = 12
+KIND = "ssdf"           # the bake's per-vertex kind (bake.per_vertex; stored by per_vertex_store)
+PROPERTY = per_vertex_store.property_name(KIND)
+ATTRIBUTE_PREFIX = per_vertex_store.attribute_name(KIND, 0)[:-2]
+MAX_LAYERS = MAX_ROWS
 GEOMETRY_TYPES = ("MESH", "CURVE", "SURFACE", "META", "FONT")
 
 # Tests (and scripts) may set this to a callable(fraction, message) -> bool: True cancels the bake.
@@ -78,26 +85,10 @@ progress_hook = None
 
 
 def attribute_name(layer):
-    return f"{ATTRIBUTE_PREFIX}{layer:02d}"
+    return per_vertex_store.attribute_name(KIND, layer)
 
 
 # --------------------------------------------------------------------------- mesh arrays (main thread)
-
-def mesh_triangles(mesh):
-    """(T, 3) int64 vertex indices of the loop triangles of a bpy Mesh."""
-    triangles = mesh.loop_triangles
-    if len(triangles) == 0 and len(mesh.polygons):
-        mesh.calc_loop_triangles()
-        triangles = mesh.loop_triangles
-    flat = np.empty(len(triangles) * 3, np.int64)
-    triangles.foreach_get("vertices", flat)
-    return flat.reshape(-1, 3)
-
-
-def mesh_topology_hash(mesh):
-    """``bake.pipeline.topology_hash`` of a bpy Mesh: its vertex count and loop triangles' vertices."""
-    return topology_hash(len(mesh.vertices), mesh_triangles(mesh))
-
 
 def _vertex_array(mesh, name):
     out = np.empty(len(mesh.vertices) * 3, np.float32)
@@ -208,19 +199,12 @@ class StoredBake:
 
 
 def has_visibility_bake(mesh):
-    return PROPERTY in mesh.keys()
+    return per_vertex_store.has_record(mesh, KIND)
 
 
 def clear_visibility_bake(mesh):
     """Remove a stored bake (metadata first, then the attributes). True if there was anything."""
-    found = False
-    if PROPERTY in mesh.keys():
-        del mesh[PROPERTY]
-        found = True
-    for name in [a.name for a in mesh.attributes if a.name.startswith(ATTRIBUTE_PREFIX)]:
-        mesh.attributes.remove(mesh.attributes[name])
-        found = True
-    return found
+    return per_vertex_store.clear_record(mesh, KIND)
 
 
 def store_visibility_bake(mesh, result, options=None):
@@ -232,19 +216,11 @@ def store_visibility_bake(mesh, result, options=None):
     layers = packed.shape[1] // 4
     if layers > MAX_LAYERS:
         raise ValueError(f"{result.terms} terms need {layers} attributes, more than {MAX_LAYERS}")
-    clear_visibility_bake(mesh)
-    for layer in range(layers):
-        attribute = mesh.attributes.new(attribute_name(layer), "FLOAT_COLOR", "POINT")
-        attribute.data.foreach_set("color", np.ascontiguousarray(packed[:, 4 * layer:4 * layer + 4]).ravel())
     options = options or BakeOptions(resolution=result.resolution)
-    mesh[PROPERTY] = {
-        "format_version": FORMAT_VERSION,
+    per_vertex_store.store_record(mesh, KIND, packed, FORMAT_VERSION, result.topology_hash, {
         "resolution": int(result.resolution),
         "terms": int(result.terms),
-        "layers": int(layers),
         "rms_error": float(result.rms_error),
-        "vertex_count": int(result.vertex_count),
-        "topology_hash": str(result.topology_hash),
         "frame_reference_axis": [float(x) for x in np.asarray(result.frame_reference_axis).ravel()],
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "seconds": float(result.seconds),
@@ -253,7 +229,7 @@ def store_visibility_bake(mesh, result, options=None):
         "rays_traced": int(result.rays_traced),
         "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
         "mean": np.asarray(result.mean, np.float32).ravel().astype(np.float64).tolist(),
-    }
+    })
 
 
 def _float_array(value):
@@ -263,47 +239,38 @@ def _float_array(value):
         return np.asarray(value.to_list() if hasattr(value, "to_list") else list(value), np.float64).ravel()
 
 
+def _terms_fill_layers(group, layers):
+    """per_vertex_store's check of the SSDF's own fields: the mean and the terms fill the layers."""
+    if layers != -(-(int(group["terms"]) + 1) // 4):
+        return "bake metadata inconsistent (terms vs layers): re-bake"
+    return None
+
+
 def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
     """The bake stored on a mesh datablock, or None if it has none.
 
     evaluated_mesh: the mesh the engine draws (an object's evaluated data), checked for staleness
     instead of ``mesh`` itself.  read_arrays=False skips the arrays (cheap status for panels).
     """
-    group = mesh.get(PROPERTY)
-    if group is None:
+    try:
+        record = per_vertex_store.load_record(mesh, KIND, FORMAT_VERSION, evaluated_mesh, read_arrays,
+                                              check_layers=_terms_fill_layers)
+    except (KeyError, TypeError, ValueError) as error:
+        return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
+    if record is None:
         return None
-    current = evaluated_mesh if evaluated_mesh is not None else mesh
+    group = record.metadata
     try:
         stored = StoredBake(
-            status="VALID", message="", format_version=int(group.get("format_version", 0)),
-            resolution=int(group["resolution"]), terms=int(group["terms"]), layers=int(group["layers"]),
-            rms_error=float(group["rms_error"]), vertex_count=int(group["vertex_count"]),
-            topology_hash=str(group["topology_hash"]),
-            frame_reference_axis=_float_array(group["frame_reference_axis"]),
+            status=record.status, message=record.message, format_version=record.format_version,
+            resolution=int(group["resolution"]), terms=int(group["terms"]), layers=record.layers,
+            rms_error=float(group["rms_error"]), vertex_count=record.vertex_count,
+            topology_hash=record.topology_hash, frame_reference_axis=_float_array(group["frame_reference_axis"]),
             date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)))
     except (KeyError, TypeError, ValueError) as error:
         return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
-    if stored.format_version != FORMAT_VERSION:
-        stored.status, stored.message = "INVALID", (f"bake format {stored.format_version}, this add-on reads "
-                                                    f"{FORMAT_VERSION}: re-bake")
+    if not stored.usable:
         return stored
-    if stored.layers != -(-(stored.terms + 1) // 4) or not 0 < stored.layers <= MAX_LAYERS:
-        stored.status, stored.message = "INVALID", "bake metadata inconsistent (terms vs layers): re-bake"
-        return stored
-    if len(current.vertices) != stored.vertex_count:
-        stored.status = "STALE"
-        stored.message = (f"stale: the mesh has {len(current.vertices)} vertices, the bake "
-                          f"{stored.vertex_count}: re-bake")
-        return stored
-    if mesh_topology_hash(current) != stored.topology_hash:
-        stored.status, stored.message = "STALE", "stale: the mesh topology changed since the bake: re-bake"
-        return stored
-    for layer in range(stored.layers):
-        attribute = mesh.attributes.get(attribute_name(layer))
-        if (attribute is None or attribute.data_type != "FLOAT_COLOR" or attribute.domain != "POINT"
-                or len(attribute.data) != stored.vertex_count):
-            stored.status, stored.message = "INVALID", f"attribute {attribute_name(layer)} missing or damaged: re-bake"
-            return stored
     stored.message = (f"{stored.terms} terms, RMS error {np.degrees(stored.rms_error):.2f} deg, "
                       f"{stored.vertex_count} vertices, baked {stored.date}")
     if not read_arrays:
@@ -316,12 +283,7 @@ def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
         return stored
     stored.basis = basis.astype(np.float32).reshape(stored.terms, resolution, resolution)
     stored.mean = mean.astype(np.float32).reshape(resolution, resolution)
-    packed = np.empty((stored.vertex_count, 4 * stored.layers), np.float32)
-    column = np.empty(stored.vertex_count * 4, np.float32)
-    for layer in range(stored.layers):
-        mesh.attributes[attribute_name(layer)].data.foreach_get("color", column)
-        packed[:, 4 * layer:4 * layer + 4] = column.reshape(-1, 4)
-    stored.packed_coefficients = packed
+    stored.packed_coefficients = record.rows
     return stored
 
 

@@ -24,7 +24,7 @@ import re
 
 import numpy as np
 
-from .shader_variants import create_capturing_log
+from .shader_cache import create_capturing_log
 
 ENGINE_IDNAME = "SG_PRT_GLSL_HARNESS"
 SCENE_NAME = "SG_PRT_GLSL_HARNESS"

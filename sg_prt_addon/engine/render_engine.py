@@ -10,8 +10,8 @@ from ..blender import export
 from ..core import camera as camera_module
 from . import renderer as renderer_module
 from . import scene_state
-from . import shader_variants
-from .shader_variants import ShaderCompileError
+from ..techniques.shader_sources import GBUFFER_OUTPUTS, MAX_POINT_LIGHTS, MAX_SUNS
+from .shader_cache import ShaderCompileError
 
 # Debug hooks for tests and benchmarks (no UI): when `capture_gbuffer` is True the next
 # final render also writes the shading inputs; every final render leaves its float
@@ -80,11 +80,11 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             return
         for warning in dict.fromkeys(state.warnings + state.unshadowed_warnings()):
             self.report({"WARNING"}, f"SG-PRT: {warning}")
-        dropped = state.dropped_lights(shader_variants.MAX_POINT_LIGHTS, shader_variants.MAX_SUNS)
+        dropped = state.dropped_lights(MAX_POINT_LIGHTS, MAX_SUNS)
         if dropped:
             self.report({"WARNING"}, f"SG-PRT: {len(dropped)} dimmest light(s) left out (at most "
-                                     f"{shader_variants.MAX_POINT_LIGHTS} point/spot/area and "
-                                     f"{shader_variants.MAX_SUNS} sun lights): {', '.join(dropped[:5])}")
+                                     f"{MAX_POINT_LIGHTS} point/spot/area and "
+                                     f"{MAX_SUNS} sun lights): {', '.join(dropped[:5])}")
         # one render() per view layer: write into the one being rendered; with a render border Blender's result
         # holds the border's pixels only (cropped or not; begin_result counts from the border's corner), so the
         # frame is cut to it
@@ -267,7 +267,7 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
         passes = {name: image / np.float32(len(offsets)) for name, image in passes.items()}
     timings["samples"] = len(offsets)
     if gbuffer:
-        for name in renderer_module.GBUFFER_OUTPUTS:
+        for name in GBUFFER_OUTPUTS:
             passes["gbuffer_" + name] = renderer.read_output(name)
     timings["draw_and_read"] = time.perf_counter() - start
     # steady-state frame cost (shaders compiled and JIT-ed, data uploaded): draw + read the passes

@@ -1,4 +1,4 @@
-"""GPU side: uploads a SceneState and draws it with the SG surface shaders.
+"""GPU side: uploads a SceneState and draws it with each material's technique (techniques/).
 
 Used by both the final render (into our float offscreen framebuffer) and the
 viewport (view_draw draws the same framebuffer's Combined texture).  Only
@@ -10,9 +10,12 @@ import collections
 
 import numpy as np
 
-from ..core import clamped_cosine, clamped_cosine_table, ggx_albedo, shading
-from . import shader_variants
-from .shader_variants import GBUFFER_OUTPUTS, MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
+from .. import techniques
+from ..blender.export import COLOUR_SLOTS, texture_pixels
+from ..core import clamped_cosine
+from ..techniques import shader_sources
+from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
+from . import shader_cache
 
 PASS_NAMES = ("Combined", "Diffuse", "Specular")
 
@@ -42,7 +45,6 @@ def _texture_2d_array(layers):
 
 
 def _texture_key(image_name, slot):
-    from ..blender.export import COLOUR_SLOTS
     return image_name, slot in COLOUR_SLOTS
 
 
@@ -118,27 +120,26 @@ def material_block(params, material_id=0):
     ], np.float32)
 
 
-VISIBILITY_TEXTURE_WIDTH = 4096     # texels a row of the coefficient texture (a multiple of the layers is used)
-
-
-MAX_TEXTURE_SIZE = 16384              # GPUTexture side limit measured here (DESIGN.md)
+PER_VERTEX_TEXTURE_WIDTH = 4096     # texels a row of a per-vertex texture (a multiple of its rows is used)
+MAX_TEXTURE_SIZE = 16384            # GPUTexture side limit measured here (DESIGN.md)
 
 
 def vertices_per_row(layers):
-    """Vertices a row of the per-vertex textures of a bake with `layers` coefficient vec4 a vertex (the
-    coefficient texture, and the normal and per-vertex visibility textures in the same rows)."""
-    return max(1, VISIBILITY_TEXTURE_WIDTH // layers)
+    """Vertices a row of the per-vertex textures of data with `layers` vec4 a vertex (its rows texture,
+    and the normal and pass textures laid out in the same rows)."""
+    return max(1, PER_VERTEX_TEXTURE_WIDTH // layers)
 
 
-def visibility_texture_shape(vertex_count, layers):
-    """(rows, texels a row) of the coefficient texture of vertex_count vertices."""
+def per_vertex_texture_shape(vertex_count, layers):
+    """(rows, texels a row) of the rows texture of vertex_count vertices."""
     per_row = vertices_per_row(layers)
     return max(1, -(-vertex_count // per_row)), per_row * layers
 
 
 def per_vertex_texture(values, texels_per_vertex, per_row):
     """(rows, per_row * texels_per_vertex, 4) float32 texture of per-vertex values (V, 4 * texels_per_vertex):
-    vertex v's texel k at (column (v % per_row) * texels_per_vertex + k, row v // per_row)."""
+    vertex v's texel k at (column (v % per_row) * texels_per_vertex + k, row v // per_row)
+    (shader_sources.per_vertex_fetch_source reads it back with texelFetch)."""
     count = values.shape[0]
     rows = max(1, -(-count // per_row))
     out = np.zeros((rows * per_row, texels_per_vertex, 4), np.float32)
@@ -146,66 +147,70 @@ def per_vertex_texture(values, texels_per_vertex, per_row):
     return out.reshape(rows, per_row * texels_per_vertex, 4)
 
 
-def visibility_texture_rows(packed, layers):
-    """(H, W, 4) float32 texture of per-vertex coefficient rows (V, 4 layers): vertex v's vec4 k at texel
-    (column (v % per_row) * layers + k, row v // per_row), per_row = vertices_per_row(layers)
-    (mesh.vert.glsl reads it back with texelFetch)."""
-    return per_vertex_texture(packed, layers, vertices_per_row(layers))
+def per_vertex_fits(mesh, data):
+    """Whether bake.per_vertex data can be uploaded for a MeshExport: scene_state checked it when it was
+    read; checked again right before the upload, since texelFetch must never read past the rows uploaded."""
+    return not (mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions)
+                or data.rows.shape[0] != mesh.vertex_count
+                or (len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= data.rows.shape[0])
+                or per_vertex_texture_shape(data.rows.shape[0], data.layers)[0] > MAX_TEXTURE_SIZE)
+
+
+class PerVertexBuffers:
+    """GPU copy of one kind of per-vertex data (bake.per_vertex.PerVertexData): its rows texture, the
+    vertex normal texture in the same rows (one texel a vertex) and the basis texture."""
+
+    def __init__(self, mesh, data):
+        self.layers = data.layers
+        self.vertices_per_row = vertices_per_row(data.layers)
+        self.rows_texture = _texture_2d(per_vertex_texture(data.rows, data.layers, self.vertices_per_row))
+        normals = np.zeros((data.rows.shape[0], 4), np.float32)
+        normals[:, :3] = mesh.vertex_normals
+        self.normal_texture = _texture_2d(per_vertex_texture(normals, 1, self.vertices_per_row))
+        self.basis_texture = _texture_2d_array(data.basis_texture)
 
 
 class MeshBuffers:
-    """Vertex buffer + one index buffer per material range of a MeshExport; with a usable visibility
-    bake (scene_state.VisibilityData) also the corners' mesh vertex index and SSDF normal attributes,
-    the per-vertex coefficient texture, the vertex normal texture (one texel a vertex, in the same rows)
-    and the basis texture."""
+    """Vertex buffer + one index buffer per material range of a MeshExport; with per-vertex data
+    (scene_state.per_vertex) also the corners' mesh vertex index and vertex normal attributes, and a
+    PerVertexBuffers of each kind."""
 
-    def __init__(self, mesh, visibility=None):
+    def __init__(self, mesh, per_vertex=None):
         import gpu
 
         self.batches = []               # (material slot index, first triangle, GPUBatch)
-        self.visibility_layers = 0
-        self.coefficient_texture = None
-        self.normal_texture = None
-        self.basis_texture = None
-        self.bounds = None              # (2, 3) local box, for core.shading.shares_light_visibility
+        self.per_vertex = {}            # kind -> PerVertexBuffers
+        self.bounds = None              # (2, 3) local box
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
         self.bounds = np.stack([mesh.positions.min(axis=0), mesh.positions.max(axis=0)])
-        if visibility is not None:
-            # scene_state.VisibilityData.from_bake checked this; check again right before the upload:
-            # texelFetch must never read past the rows uploaded
-            if (mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions)
-                    or visibility.packed.shape[0] != mesh.vertex_count
-                    or (len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= visibility.packed.shape[0])
-                    or visibility_texture_shape(visibility.packed.shape[0], visibility.layers)[0] > MAX_TEXTURE_SIZE):
-                visibility = None
+        usable = {kind: data for kind, data in (per_vertex or {}).items() if per_vertex_fits(mesh, data)}
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="normal", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="tangent", comp_type="F32", len=4, fetch_mode="FLOAT")
         fmt.attr_add(id="uv", comp_type="F32", len=2, fetch_mode="FLOAT")
-        if visibility is not None:
+        if usable:
             fmt.attr_add(id="vertex_index", comp_type="I32", len=1, fetch_mode="INT")
-            fmt.attr_add(id="ssdf_normal", comp_type="F32", len=3, fetch_mode="FLOAT")
+            fmt.attr_add(id="vertex_normal", comp_type="F32", len=3, fetch_mode="FLOAT")
         vertices = gpu.types.GPUVertBuf(fmt, len(mesh.positions))
         vertices.attr_fill("position", mesh.positions)
         vertices.attr_fill("normal", mesh.normals)
         vertices.attr_fill("tangent", mesh.tangents)
         vertices.attr_fill("uv", mesh.uvs)
-        if visibility is not None:
+        if usable:
             vertices.attr_fill("vertex_index", np.ascontiguousarray(mesh.corner_vertex, np.int32))
-            vertices.attr_fill("ssdf_normal", np.ascontiguousarray(
+            vertices.attr_fill("vertex_normal", np.ascontiguousarray(
                 mesh.vertex_normals[mesh.corner_vertex.astype(np.int64)], np.float32))
-            self.visibility_layers = visibility.layers
-            self.coefficient_texture = _texture_2d(visibility_texture_rows(visibility.packed, visibility.layers))
-            normals = np.zeros((visibility.packed.shape[0], 4), np.float32)
-            normals[:, :3] = mesh.vertex_normals
-            self.normal_texture = _texture_2d(per_vertex_texture(normals, 1, vertices_per_row(visibility.layers)))
-            self.basis_texture = _texture_2d_array(visibility.basis_texture)
+            self.per_vertex = {kind: PerVertexBuffers(mesh, data) for kind, data in usable.items()}
         for material_index, first, count in mesh.material_ranges:
             indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])
             self.batches.append((material_index, first, gpu.types.GPUBatch(type="TRIS", buf=vertices, elem=indices)))
         self.vertices = vertices
+
+    def per_vertex_layers(self):
+        """kind -> vec4 rows a vertex of the uploaded per-vertex data (base.ObjectInputs.per_vertex)."""
+        return {kind: buffers.layers for kind, buffers in self.per_vertex.items()}
 
 
 def _slot_material(state, entry, slot):
@@ -234,6 +239,71 @@ def environment_textures(environment, equirect):
     return entry[1], entry[2]
 
 
+class _DrawContext(techniques.DrawContext):
+    """The renderer's side of the technique seam for one object (and, in bind, one material slot)."""
+
+    def __init__(self, renderer, object_key, entry, buffers):
+        self.renderer = renderer
+        self.object_key = object_key
+        self.buffers = buffers
+        self.model_matrix = _column_major(entry.matrix_world)
+        self.scene_buffer = renderer.scene_buffer
+        self.material_buffer = None
+        self.material_name = ""
+        self.params = None
+
+    def for_material(self, name, params):
+        self.material_name, self.params = name, params
+        self.material_buffer = self.renderer.material_buffers[name]
+        return self
+
+    def per_vertex(self, kind):
+        return self.buffers.per_vertex[kind]
+
+    def environment_textures(self):
+        return self.renderer.environment_texture, self.renderer.equirect_texture
+
+    def table(self, name, build):
+        tables = self.renderer.tables
+        if name not in tables:
+            tables[name] = _texture(build())
+        return tables[name]
+
+    def material_table(self, name, build):
+        tables = self.renderer.material_tables.setdefault(self.params.name or self.material_name, {})
+        if name not in tables:
+            tables[name] = _texture(build())
+        return tables[name]
+
+    def image(self, slot):
+        return self.renderer.textures[_texture_key(self.params.textures[slot], slot)]
+
+    def object_target(self, name, size):
+        import gpu
+
+        targets = self.renderer.object_targets.setdefault(self.object_key, {})
+        target = targets.get(name)
+        if target is None or (target[0].width, target[0].height) != tuple(size):
+            texture = gpu.types.GPUTexture(tuple(size), format="RGBA32F")
+            target = targets[name] = (texture, gpu.types.GPUFrameBuffer(color_slots=texture))
+        return target
+
+    def object_texture(self, name):
+        target = self.renderer.object_targets.get(self.object_key, {}).get(name)
+        return None if target is None else target[0]
+
+    def fixed_shader(self, cache_key, calls_of):
+        return shader_cache.get_fixed_shader(cache_key, calls_of, f"technique {cache_key[0]}")
+
+    def full_screen_batch(self, shader, name):
+        return self.renderer.full_screen_batch(shader, name)
+
+
+def _texture(array):
+    """A float RGBA GPU texture of an (H, W, 4) or (L, H, W, 4) array."""
+    return _texture_2d_array(array) if np.ndim(array) == 4 else _texture_2d(array)
+
+
 class Renderer:
     """Owns the GPU resources of one SceneState and draws it."""
 
@@ -245,22 +315,18 @@ class Renderer:
         self.material_buffers = {}      # material name -> GPUUniformBuf
         self.material_ids = {}          # material name -> id written to the G-buffer (uv.z)
         self.textures = {}              # (image name, slot is a colour) -> GPUTexture
-        self.fitted_textures = {}       # material name -> (layers, shadowing table) of its lobe fit
+        self.tables = {}                # a technique's tables (DrawContext.table): name -> GPUTexture
+        self.material_tables = {}       # material name -> {name: GPUTexture} (DrawContext.material_table)
+        self.object_targets = {}        # object key -> {name: (GPUTexture, GPUFrameBuffer)} of techniques' passes
         self.scene_buffer = None
         self.environment_texture = None
         self.equirect_texture = None
         self.environment_source = None
-        self.anisotropy_tables = {}     # lobe count -> GPUTexture
-        self.ggx_texture = None
-        self.ggx_albedo_texture = None
-        self.clamped_cosine_texture = None
         self.framebuffer = None
         self.targets = []
         self.size = None
         self.uploads = {"meshes": 0, "materials": 0}
-        self.background_batch = None
-        self.vertex_visibility = {}     # object key -> (GPUTexture, GPUFrameBuffer) of the per-vertex pass
-        self.vertex_visibility_batch = None
+        self._full_screen_batches = {}  # pass name -> GPUBatch of a full-screen triangle
 
     # ----------------------------------------------------------------- uploads
 
@@ -269,7 +335,7 @@ class Renderer:
 
         for key in dirty.meshes:
             if key in state.meshes:
-                self.mesh_buffers[key] = MeshBuffers(state.meshes[key], state.visibility.get(key))
+                self.mesh_buffers[key] = MeshBuffers(state.meshes[key], state.per_vertex.get(key))
                 self.uploads["meshes"] += 1
         for key in list(self.mesh_buffers):
             if key not in state.meshes:
@@ -286,15 +352,11 @@ class Renderer:
             material_id = self.material_ids.setdefault(name, len(self.material_ids))
             self.material_buffers[name] = _uniform_buffer(material_block(params, material_id))
             self.uploads["materials"] += 1
-            self.fitted_textures.pop(name, None)
-            if params.fitted is not None:
-                self.fitted_textures[name] = (_texture_2d_array(params.fitted.layers),
-                                              _texture_2d(params.fitted.table))
+            self.material_tables.pop(params.name or name, None)
             for slot, image_name in params.textures.items():
                 key = _texture_key(image_name, slot)
                 if key not in self.textures and image_name in bpy.data.images:
-                    from ..blender import export
-                    self.textures[key] = _texture_2d(export.texture_pixels(bpy.data.images[image_name], slot))
+                    self.textures[key] = _texture_2d(texture_pixels(bpy.data.images[image_name], slot))
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)
@@ -305,13 +367,6 @@ class Renderer:
         else:
             self.scene_buffer.update(gpu_buffer(block))
 
-    def _anisotropy_texture(self, lobe_count):
-        texture = self.anisotropy_tables.get(lobe_count)
-        if texture is None:
-            texture = _texture_2d(shader_variants.anisotropy_table(lobe_count))
-            self.anisotropy_tables[lobe_count] = texture
-        return texture
-
     # ----------------------------------------------------------------- targets
 
     def ensure_targets(self, width, height):
@@ -319,24 +374,54 @@ class Renderer:
 
         if self.size == (width, height):
             return
-        count = len(shader_variants.output_names(self.gbuffer))
+        count = len(shader_sources.output_names(self.gbuffer))
         self.targets = [gpu.types.GPUTexture((width, height), format="RGBA32F") for _ in range(count)]
         self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         self.framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.targets)
         self.size = (width, height)
 
+    def full_screen_batch(self, shader, name):
+        """One triangle covering any target, for the full-screen pass `name` (position in NDC): a batch
+        for each pass, made with its shader."""
+        from gpu_extras.batch import batch_for_shader
+
+        batch = self._full_screen_batches.get(name)
+        if batch is None:
+            batch = self._full_screen_batches[name] = batch_for_shader(
+                shader, "TRIS", {"position": [(-1, -1), (3, -1), (-1, 3)]})
+        return batch
+
     # ----------------------------------------------------------------- drawing
+
+    def object_draws(self, state):
+        """[(object index, object key, ObjectEntry, DrawContext, [(first triangle, GPUBatch, material name,
+        params, technique, variant key)])] of every drawable object, in draw order (the index counts every
+        object of the state: the G-buffer's object id)."""
+        light_data = state.light_data()
+        draws = []
+        for object_index, (object_key, entry) in enumerate(state.objects.items()):
+            buffers = self.mesh_buffers.get(entry.mesh_key)
+            if buffers is None:
+                continue
+            inputs = techniques.ObjectInputs(light_data, state.environment, self.gbuffer,
+                                             buffers.per_vertex_layers(), buffers.bounds, entry.matrix_world)
+            slots = []
+            for slot, first_triangle, batch in buffers.batches:
+                name, params = _slot_material(state, entry, slot)
+                if name not in self.material_buffers:
+                    name = ""
+                technique = techniques.for_material(params)
+                slots.append((first_triangle, batch, name, params, technique, technique.variant_key(params, inputs)))
+            draws.append((object_index, object_key, entry, _DrawContext(self, object_key, entry, buffers), slots))
+        return draws
 
     def draw(self, state, camera, background_alpha=1.0):
         """Draw every object, then the world behind them, into our framebuffer (call ensure_targets
         first).  background_alpha: alpha of the world pixels (0 for a transparent film)."""
         import gpu
 
-        light_data = state.light_data()
-        has_lights = light_data.count > 0
-        has_environment = state.environment.prefiltered is not None
-        diffuse_rows = shader_variants.diffuse_visibility_rows(state.environment)
-        self._draw_vertex_visibility(state, diffuse_rows, has_lights, has_environment)
+        draws = self.object_draws(state)
+        self._prepare_objects(draws)
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
@@ -348,100 +433,37 @@ class Renderer:
                 gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
             else:       # holdouts shade nothing but occlude: their depth alone, first
                 self._draw_depth(state, holdouts_only=True)
-            for object_index, (object_key, entry) in enumerate(state.objects.items()):
-                buffers = self.mesh_buffers.get(entry.mesh_key)
-                if buffers is None or entry.holdout:       # a holdout's pixels keep the clear: (0, 0, 0, 0)
+            for object_index, _object_key, entry, context, slots in draws:
+                if entry.holdout:       # a holdout's pixels keep the clear: (0, 0, 0, 0)
                     continue
-                model = _column_major(entry.matrix_world)
-                shared_light_visibility = bool(buffers.visibility_layers and has_lights) and \
-                    shading.shares_light_visibility(light_data, shading.world_bounds(buffers.bounds, entry.matrix_world))
-                for slot, first_triangle, batch in buffers.batches:
-                    name, params = _slot_material(state, entry, slot)
-                    if name not in self.material_buffers:
-                        name = ""
-                    key = shader_variants.variant_key(params, has_lights, has_environment, self.gbuffer,
-                                                      buffers.visibility_layers, diffuse_rows, shared_light_visibility)
-                    shader = shader_variants.get_shader(key)
+                for first_triangle, batch, name, params, technique, key in slots:
+                    shader = shader_cache.get_shader(technique, key)
                     shader.bind()
-                    shader.uniform_float("model_matrix", model)
+                    shader.uniform_float("model_matrix", context.model_matrix)
                     if self.gbuffer:
                         shader.uniform_int("gbuffer_object_index", object_index)
                         shader.uniform_int("gbuffer_triangle_offset", first_triangle)
-                    if key.visibility_layers:
-                        shader.uniform_sampler("visibility_coefficients", buffers.coefficient_texture)
-                        shader.uniform_sampler("visibility_basis", buffers.basis_texture)
-                    if key.diffuse_visibility_rows:
-                        shader.uniform_sampler("diffuse_visibility", self.vertex_visibility[object_key][0])
-                    shader.uniform_block("scene", self.scene_buffer)
-                    shader.uniform_block("material", self.material_buffers[name])
-                    if has_environment:
-                        shader.uniform_sampler("environment_texture", self.environment_texture)
-                        if key.has_specular:
-                            shader.uniform_sampler("equirect_texture", self.equirect_texture)
-                    if key.model in shader_variants.ANISOTROPIC_MODELS:
-                        shader.uniform_sampler("anisotropy_table", self._anisotropy_texture(key.ndf_lobes))
-                    if shader_variants.uses_clamped_cosine_table(key):
-                        if self.clamped_cosine_texture is None:
-                            self.clamped_cosine_texture = _texture_2d(clamped_cosine_table.clamped_cosine_table())
-                        shader.uniform_sampler("clamped_cosine_table", self.clamped_cosine_texture)
-                    if shader_variants.uses_ggx_table(key):
-                        if self.ggx_texture is None:
-                            self.ggx_texture = _texture_2d(shader_variants.ggx_table())
-                        shader.uniform_sampler("ggx_table", self.ggx_texture)
-                        if self.ggx_albedo_texture is None:
-                            albedo = np.repeat(ggx_albedo.albedo_table()[..., None], 4, axis=-1)
-                            self.ggx_albedo_texture = _texture_2d(albedo)
-                        shader.uniform_sampler("ggx_albedo_table", self.ggx_albedo_texture)
-                    if key.model == shader_variants.FITTED_MODEL:
-                        layers, table = self.fitted_textures[params.name if params.name in self.fitted_textures
-                                                             else name]
-                        shader.uniform_sampler("fitted_layers", layers)
-                        shader.uniform_sampler("fitted_shadowing", table)
-                    for texture_name in key.textures:
-                        shader.uniform_sampler("texture_" + texture_name, self.textures[
-                            _texture_key(params.textures[texture_name], texture_name)])
+                    technique.bind(shader, key, context.for_material(name, params))
                     batch.draw(shader)
             if not self.gbuffer:
-                self._draw_background(camera, has_environment, background_alpha)
+                self._draw_background(camera, state.environment.prefiltered is not None, background_alpha)
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
 
-    def _draw_vertex_visibility(self, state, rows, has_lights, has_environment):
-        """The broad diffuse lobes' visibility at the vertices of every object with a bake whose variants
-        read it (a diffuse term; resources/vertex_visibility.frag.glsl): one texel a vertex and vec4."""
-        import gpu
-        from gpu_extras.batch import batch_for_shader
-
-        for object_key in [key for key in self.vertex_visibility if key not in state.objects]:
-            del self.vertex_visibility[object_key]
-        for object_key, entry in state.objects.items():
-            buffers = self.mesh_buffers.get(entry.mesh_key)
-            if buffers is None or not buffers.visibility_layers or not rows or not any(
-                    shader_variants.variant_key(_slot_material(state, entry, slot)[1], has_lights, has_environment,
-                                                self.gbuffer, buffers.visibility_layers, rows).diffuse_visibility_rows
-                    for slot, _first, _batch in buffers.batches):
-                self.vertex_visibility.pop(object_key, None)
+    def _prepare_objects(self, draws):
+        """Each technique's own passes for the objects that use it (Technique.prepare_object), before the
+        surfaces; the targets of objects gone are dropped."""
+        live = {object_key for _index, object_key, *_ in draws}
+        for object_key in [key for key in self.object_targets if key not in live]:
+            del self.object_targets[object_key]
+        for _index, _object_key, entry, context, slots in draws:
+            if entry.holdout:
                 continue
-            # one texel a vertex and vec4, in the coefficient texture's rows
-            size = (vertices_per_row(buffers.visibility_layers) * rows, buffers.coefficient_texture.height)
-            target = self.vertex_visibility.get(object_key)
-            if target is None or (target[0].width, target[0].height) != size:
-                texture = gpu.types.GPUTexture(size, format="RGBA32F")
-                target = self.vertex_visibility[object_key] = (texture, gpu.types.GPUFrameBuffer(color_slots=texture))
-            shader = shader_variants.get_vertex_visibility_shader(buffers.visibility_layers, rows, has_environment)
-            if self.vertex_visibility_batch is None:
-                self.vertex_visibility_batch = batch_for_shader(
-                    shader, "TRIS", {"position": [(-1, -1), (3, -1), (-1, 3)]})
-            with target[1].bind():
-                gpu.state.depth_test_set("NONE")
-                gpu.state.blend_set("NONE")
-                shader.bind()
-                shader.uniform_float("model_matrix", _column_major(entry.matrix_world))
-                shader.uniform_block("scene", self.scene_buffer)
-                shader.uniform_sampler("visibility_coefficients", buffers.coefficient_texture)
-                shader.uniform_sampler("vertex_normals", buffers.normal_texture)
-                shader.uniform_sampler("visibility_basis", buffers.basis_texture)
-                self.vertex_visibility_batch.draw(shader)
+            by_technique = {}
+            for *_, technique, key in slots:
+                by_technique.setdefault(technique.name, (technique, []))[1].append(key)
+            for technique, keys in by_technique.values():
+                technique.prepare_object(keys, context)
 
     def _draw_depth(self, state, holdouts_only=False):
         """Depth of every surface, no colour: the surface shaders then shade each pixel once instead of
@@ -449,7 +471,7 @@ class Renderer:
         holdouts_only: the holdouts' depth alone (without the pre-pass the shading pass writes the rest)."""
         import gpu
 
-        shader = shader_variants.get_depth_shader()
+        shader = shader_cache.get_depth_shader()
         shader.bind()
         shader.uniform_block("scene", self.scene_buffer)
         gpu.state.color_mask_set(False, False, False, False)
@@ -465,11 +487,8 @@ class Renderer:
     def _draw_background(self, camera, has_environment, alpha):
         """Full-screen triangle at the far plane: only where no surface was drawn (depth test)."""
         import gpu
-        from gpu_extras.batch import batch_for_shader
 
-        shader = shader_variants.get_background_shader(has_environment)
-        if self.background_batch is None:
-            self.background_batch = batch_for_shader(shader, "TRIS", {"position": [(-1, -1), (3, -1), (-1, 3)]})
+        shader = shader_cache.get_background_shader(has_environment)
         gpu.state.depth_mask_set(False)
         shader.bind()
         shader.uniform_float("background_alpha", float(alpha))
@@ -478,12 +497,12 @@ class Renderer:
             shader.uniform_float("inverse_view_projection",
                                  _column_major(np.linalg.inv(camera.projection @ camera.view)))
             shader.uniform_sampler("equirect_texture", self.equirect_texture)
-        self.background_batch.draw(shader)
+        self.full_screen_batch(shader, "background").draw(shader)
         gpu.state.depth_mask_set(True)
 
     def read_output(self, name):
         """(H, W, 4) float32 of output `name` ("combined", "diffuse", "position"...), row 0 at the bottom."""
-        names = shader_variants.output_names(self.gbuffer)
+        names = shader_sources.output_names(self.gbuffer)
         if name == "combined" and name not in names:
             combined = self.read(names.index("diffuse")) + self.read(names.index("specular"))
             combined[..., 3] = np.minimum(combined[..., 3], 1.0)
@@ -506,8 +525,9 @@ class Renderer:
         self.mesh_buffers.clear()
         self.material_buffers.clear()
         self.textures.clear()
-        self.fitted_textures.clear()
-        self.vertex_visibility.clear()
+        self.tables.clear()
+        self.material_tables.clear()
+        self.object_targets.clear()
         self.targets = []
         self.framebuffer = None
         self.size = None

@@ -12,8 +12,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..bake import decode, per_vertex
 from ..blender import export
 from ..core import shading
+from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SUNS
 
 # Prefiltered environments and SG fits by pixel content (prefiltering takes seconds); the most
 # recently used few only, since an artist editing the world makes a new one each edit.
@@ -33,9 +35,9 @@ visibility_provider = None
 def visibility_for(object_eval):
     """The visibility bake of an evaluated object: blender.visibility_bake.visibility_for_object
     (a StoredBake, or None without one), or what ``visibility_provider`` returns when set (a
-    StoredBake, a bake.pipeline.BakeResult or None).  Whatever comes back goes through
-    VisibilityData.from_bake, which refuses unusable (stale, damaged) bakes and any whose vertex
-    count does not match the exported mesh."""
+    StoredBake, a bake.pipeline.BakeResult or None).  Whatever comes back goes through ssdf_data,
+    which refuses unusable (stale, damaged) bakes and any whose vertex count does not match the
+    exported mesh."""
     if visibility_provider is not None:
         return visibility_provider(object_eval)
     try:
@@ -45,52 +47,29 @@ def visibility_for(object_eval):
     return visibility_bake.visibility_for_object(object_eval)
 
 
-@dataclass
-class VisibilityData:
-    """A usable SSDF bake of one exported mesh, as the GPU takes it.
-
-    packed: (vertex_count, 4 layers) float32 rows [1, w_0, ..., w_{N-1}, 0...] per Blender mesh vertex
-    (bake.decode.pack_coefficients); basis_texture: (layers, R, R, 4) float32 (decode.pack_basis_texture).
-    The engine reads row corner_vertex[corner] for each corner (export.MeshExport).
-    """
-    packed: np.ndarray
-    basis_texture: np.ndarray
-    layers: int
-    terms: int
-    resolution: int
-
-    @classmethod
-    def from_bake(cls, bake, mesh):
-        """(VisibilityData or None, message) for a bake and the export.MeshExport it should shade."""
-        if bake is None:
-            return None, "no visibility bake"
-        if getattr(bake, "usable", True) is False:
-            return None, getattr(bake, "message", "unusable bake")
-        from ..bake import decode
-        packed = getattr(bake, "packed_coefficients", None)
-        if packed is None:
-            packed = decode.pack_coefficients(bake.coefficients)
-        packed = np.ascontiguousarray(packed, np.float32)
-        if hasattr(bake, "basis_texture") and callable(bake.basis_texture):
-            basis_texture = bake.basis_texture()
-        else:
-            basis_texture = decode.pack_basis_texture(bake.mean, bake.basis)
-        basis_texture = np.ascontiguousarray(basis_texture, np.float32)
-        layers = packed.shape[1] // 4
-        if packed.ndim != 2 or packed.shape[1] != 4 * layers or basis_texture.shape[0] != layers \
-                or not 0 < layers <= MAX_VISIBILITY_LAYERS:
-            return None, f"bake layout inconsistent ({packed.shape}, basis {basis_texture.shape})"
-        if mesh.corner_vertex is None or packed.shape[0] != mesh.vertex_count:
-            return None, f"stale bake: {packed.shape[0]} vertices baked, the mesh has {mesh.vertex_count}"
-        if len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= packed.shape[0]:
-            return None, "stale bake: corner vertex index beyond the baked vertices"
-        if not np.all(np.isfinite(packed)) or not np.all(np.isfinite(basis_texture)):
-            return None, "bake holds non-finite values"
-        return cls(packed, basis_texture, layers, int(getattr(bake, "terms", 4 * layers - 1)),
-                   int(basis_texture.shape[1])), "ok"
+def ssdf_data(bake, mesh):
+    """(bake.per_vertex.PerVertexData of kind "ssdf", or None, message) of a visibility bake (a StoredBake or
+    a bake.pipeline.BakeResult) and the export.MeshExport it should shade."""
+    if bake is None:
+        return None, "no visibility bake"
+    if getattr(bake, "usable", True) is False:
+        return None, getattr(bake, "message", "unusable bake")
+    packed = getattr(bake, "packed_coefficients", None)
+    if packed is None:
+        packed = decode.pack_coefficients(bake.coefficients)
+    if hasattr(bake, "basis_texture") and callable(bake.basis_texture):
+        basis_texture = bake.basis_texture()
+    else:
+        basis_texture = decode.pack_basis_texture(bake.mean, bake.basis)
+    layers = np.shape(packed)[1] // 4 if np.ndim(packed) == 2 else 0
+    return per_vertex.check(SSDF, packed, basis_texture, getattr(bake, "terms", 4 * layers - 1),
+                            mesh.vertex_count, mesh.corner_vertex)
 
 
-MAX_VISIBILITY_LAYERS = 12
+# Per-vertex kinds the scene state looks up for each mesh: kind -> (source(object_eval), to data(record, mesh))
+SSDF = "ssdf"
+PER_VERTEX_KINDS = {SSDF: (visibility_for, ssdf_data)}
+
 
 
 @dataclass
@@ -120,8 +99,8 @@ class SceneState:
         self.environment_layer_size = environment_layer_size or ENVIRONMENT_LAYER_SIZE
         self.objects = {}           # object name -> ObjectEntry
         self.meshes = {}            # mesh key -> export.MeshExport
-        self.visibility = {}        # mesh key -> VisibilityData (usable bakes only)
-        self.visibility_status = {}  # mesh key -> why there is (or is no) visibility
+        self.per_vertex = {}        # mesh key -> {kind: bake.per_vertex.PerVertexData} (usable ones only)
+        self.per_vertex_status = {}  # mesh key -> {kind: why there is (or is no) data of that kind}
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
         self.world = export.WorldExport()
@@ -140,8 +119,8 @@ class SceneState:
         self.warnings = export.collect_warnings([])
         self.objects.clear()
         self.meshes.clear()
-        self.visibility.clear()
-        self.visibility_status.clear()
+        self.per_vertex.clear()
+        self.per_vertex_status.clear()
         self.materials = {"": export.MaterialParams()}
         self.lights = []
         seen_meshes = set()
@@ -180,21 +159,33 @@ class SceneState:
         self.mark_all_dirty()
 
     def _export_mesh(self, obj, mesh_key):
-        """Export an evaluated object's mesh and look up its visibility bake (see visibility_for)."""
+        """Export an evaluated object's mesh and look up its per-vertex data of every kind."""
         mesh = export.export_object_mesh(obj)
         self.meshes[mesh_key] = mesh
-        try:
-            bake = visibility_for(obj)
-        except Exception as error:          # a damaged bake must not stop the render: unshadowed
-            bake, data, message = None, None, f"bake unreadable: {error}"
-        else:
-            data, message = VisibilityData.from_bake(bake, mesh)
-        if data is None:
-            self.visibility.pop(mesh_key, None)
-        else:
-            self.visibility[mesh_key] = data
-        self.visibility_status[mesh_key] = message
+        found, status = {}, {}
+        for kind, (source, to_data) in PER_VERTEX_KINDS.items():
+            try:
+                record = source(obj)
+            except Exception as error:          # a damaged bake must not stop the render: unshadowed
+                data, message = None, f"bake unreadable: {error}"
+            else:
+                data, message = to_data(record, mesh)
+            if data is not None:
+                found[kind] = data
+            status[kind] = message
+        self.per_vertex[mesh_key] = found
+        self.per_vertex_status[mesh_key] = status
         return mesh
+
+    @property
+    def visibility(self):
+        """mesh key -> the usable SSDF bake (PerVertexData of kind "ssdf") of the meshes that have one."""
+        return {key: kinds[SSDF] for key, kinds in self.per_vertex.items() if SSDF in kinds}
+
+    @property
+    def visibility_status(self):
+        """mesh key -> why its mesh has (or has no) usable SSDF bake."""
+        return {key: kinds.get(SSDF, "no visibility bake") for key, kinds in self.per_vertex_status.items()}
 
     def unshadowed_warnings(self):
         """The render report's lines for objects that render unshadowed: one per object whose bake cannot
@@ -364,7 +355,6 @@ def light_data(light_exports):
     """shading.LightData (float32) from export.LightExport records (the shader's limits applied:
     the dimmest lights beyond them are left out)."""
     from ..core import lights as core_lights
-    from .shader_variants import MAX_POINT_LIGHTS, MAX_SUNS
 
     kept = _strongest(light_exports, MAX_POINT_LIGHTS, MAX_SUNS)
     points = [light for light in kept if light.kind == "POINT"]

@@ -78,7 +78,7 @@ def test_merl_fit_stores_packed_float_images_that_survive_save_and_reopen(materi
     assert "[sg-prt] fit " in printed and "100%" in printed and "%" in printed.splitlines()[0]
 
     settings = material.sgprt.lobe_fit
-    assert material.sgprt.use_fitted_lobes
+    assert material.sgprt.technique == "SG_FITTED"
     assert settings.format_version == lf.FORMAT_VERSION and settings.source_kind == "MERL"
     assert settings.source_file == "analytic.binary" and settings.lobe_count == 2
     assert (settings.width, settings.height) == (1, 1) and settings.shadowing_components == 1
@@ -102,7 +102,7 @@ def test_merl_fit_stores_packed_float_images_that_survive_save_and_reopen(materi
     _reopen(tmp_path / "merl.blend")
     reopened = bpy.data.materials["Measured"]
     _same_snapshot(before, _snapshot(reopened))
-    assert lf.fit_status(reopened)[0] == "VALID" and reopened.sgprt.use_fitted_lobes
+    assert lf.fit_status(reopened)[0] == "VALID" and reopened.sgprt.technique == "SG_FITTED"
     assert all(item.image.packed_file is not None for item in reopened.sgprt.lobe_fit.images)
     # the fitted BRDF from the reopened file matches the direct fit's within float32 rounding
     wo, wi, _ = microfacet_fit.half_difference_samples(8, 4, 4, offset=0.3)
@@ -233,7 +233,7 @@ def test_refit_replaces_images_and_clear_removes_them(material, data):
     assert len(material.sgprt.lobe_fit.images) == len(lf.expected_roles(1, 5))
     assert all(item.image.name == lf.image_name(material, item.role) for item in material.sgprt.lobe_fit.images)
     assert bpy.ops.sgprt.clear_lobe_fit() == {"FINISHED"}
-    assert lf.fit_status(material)[0] == "NONE" and not material.sgprt.use_fitted_lobes
+    assert lf.fit_status(material)[0] == "NONE" and material.sgprt.technique == "SG_PARAMETRIC"
     assert not second & {image.name for image in bpy.data.images}
     # an 8-bit image in place of a float one, or a removed image, makes a stored fit invalid, not a crash
     assert bpy.ops.sgprt.fit_lobes(filepath=data["table"], lobe_count=1) == {"FINISHED"}

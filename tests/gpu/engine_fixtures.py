@@ -141,16 +141,54 @@ def world_texture(scene, path, strength=1.0):
 
 @contextlib.contextmanager
 def recorded_variant_keys():
-    """A list that collects the VariantKey of every surface shader asked for (shader_variants.get_shader)
+    """A list that collects the variant key of every surface shader asked for (shader_cache.get_shader)
     inside the block: what a render really drew with."""
-    from sg_prt_addon.engine import shader_variants
+    from sg_prt_addon.engine import shader_cache
 
-    keys, get_shader = [], shader_variants.get_shader
-    shader_variants.get_shader = lambda key: keys.append(key) or get_shader(key)
+    keys, get_shader = [], shader_cache.get_shader
+    shader_cache.get_shader = lambda technique, key: keys.append(key) or get_shader(technique, key)
     try:
         yield keys
     finally:
-        shader_variants.get_shader = get_shader
+        shader_cache.get_shader = get_shader
+
+
+def variant_key(params, has_lights=False, has_environment=False, gbuffer=False, visibility_layers=0,
+                diffuse_rows=0, shared_light_visibility=False):
+    """The variant key of an export.MaterialParams's technique for a scene described by its facts (not by
+    lights and an environment): diffuse_rows and shared_light_visibility stand in for what the SG
+    technique derives from the environment, the lights and the object's bounds."""
+    from sg_prt_addon import techniques
+    from sg_prt_addon.core.shading import EnvironmentData, LightData
+
+    inputs = techniques.ObjectInputs(LightData(), EnvironmentData(), gbuffer,
+                                     {"ssdf": visibility_layers} if visibility_layers else {})
+    inputs.has_lights, inputs.has_environment = bool(has_lights), bool(has_environment)
+    inputs.memo.update(diffuse_rows=diffuse_rows, shared_light_visibility=bool(shared_light_visibility))
+    return techniques.for_material(params).variant_key(params, inputs)
+
+
+def technique_of(key):
+    """The registered technique a variant key belongs to."""
+    from sg_prt_addon import techniques
+    return techniques.get(key.technique)
+
+
+def variant_defines(key):
+    """name -> value of every define of a variant's shader (the scene limits included)."""
+    return {arguments[0]: arguments[1] for method, arguments in technique_of(key).create_info_calls(key)
+            if method == "define"}
+
+
+def variant_fragment(key):
+    """The assembled fragment source of a variant's shader."""
+    return next(arguments[0] for method, arguments in technique_of(key).create_info_calls(key)
+                if method == "fragment_source")
+
+
+def content_hash(key):
+    from sg_prt_addon.engine import shader_cache
+    return shader_cache.content_hash(technique_of(key).create_info_calls(key))
 
 
 def render(scene, gbuffer=False, environment_layer_size=None):

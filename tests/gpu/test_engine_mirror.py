@@ -219,7 +219,6 @@ def test_view_warps_with_visibility(engine, bakes, view_warp):
     """A material's view warp (material.sgprt.view_warp: one or two lobes per NDF lobe instead of three)
     reaches the shader (WARP_FUNCTION / WARP_NODES of its variant) and the mirror alike, shadows included."""
     from sg_prt_addon.core import warp
-    from sg_prt_addon.engine import shader_variants
 
     scene, sphere, floor = _shadow_scene("mirror_warp_" + view_warp.lower(), 96)
     fx.world_colour(scene, (0.1, 0.12, 0.15))
@@ -232,7 +231,7 @@ def test_view_warps_with_visibility(engine, bakes, view_warp):
     with fx.recorded_variant_keys() as keys:
         result = fx.render(scene, gbuffer=True)
     assert {key.warp_mode for key in keys} == {view_warp.lower()}
-    assert {shader_variants.defines(key)["WARP_NODES"] for key in keys} == {warp.nodes_per_lobe(view_warp.lower())}
+    assert {int(fx.variant_defines(key)["WARP_NODES"]) for key in keys} == {warp.nodes_per_lobe(view_warp.lower())}
     assert all(material.warp_mode == view_warp.lower() for material in result["state"].materials.values()
                if material.name)
     _check(result)

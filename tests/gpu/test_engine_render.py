@@ -48,25 +48,28 @@ def test_passes_and_world_background(engine):
 
 def test_compile_error_names_variant_and_line(engine, monkeypatch):
     import bpy
-    from sg_prt_addon.engine import render_engine, shader_variants
+    from sg_prt_addon.engine import render_engine, shader_cache
+    from sg_prt_addon.techniques import sg_lobes
 
-    original = shader_variants.fragment_source
+    original = sg_lobes.SGLobes.fragment_source
     broken_line = "  vec3 view_local = view * frame_that_does_not_exist;"
 
-    def broken(key):
-        return original(key).replace("  vec3 view_local = view * frame;", broken_line)
+    def broken(technique, key):
+        return original(technique, key).replace("  vec3 view_local = view * frame;", broken_line)
 
-    monkeypatch.setattr(shader_variants, "fragment_source", broken)
-    shader_variants.clear_cache()
+    monkeypatch.setattr(sg_lobes.SGLobes, "fragment_source", broken)
+    shader_cache.clear_cache()
     scene = fx.new_scene("render_broken", 16, 16)
     fx.uv_sphere(scene, "broken_sphere", (0.0, 0.0, 1.0), segments=8, rings=4)
-    with pytest.raises(RuntimeError, match=r"SG-PRT shader variant \[GGX, \d lobe\(s\), no lights") as raised:
+    with pytest.raises(RuntimeError, match=r"SG-PRT shader variant SG Lobes \(Wang 2009\) \[GGX, \d lobe\(s\), no lights") as raised:
         with bpy.context.temp_override(scene=scene):
             bpy.ops.render.render(scene=scene.name, write_still=False)
     assert "frame_that_does_not_exist' undeclared" in str(raised.value)      # what the UI reports
     message = render_engine.last_render["error"]
     from sg_prt_addon.core.shading import GGX_NDF_LOBES
-    lines = broken(shader_variants.VariantKey(ndf_lobes=GGX_NDF_LOBES)).split("\n")
+    from sg_prt_addon import techniques
+    technique = techniques.get("SG_PARAMETRIC")
+    lines = broken(technique, sg_lobes.VariantKey(ndf_lobes=GGX_NDF_LOBES)).split("\n")
     number = next(n for n, line in enumerate(lines, 1) if broken_line in line)
     assert f"fragment line {number}: `frame_that_does_not_exist' undeclared" in message
     assert f"{number:5d}> {lines[number - 1]}" in message
@@ -267,7 +270,7 @@ def test_furnace(engine, textured_world):
 def test_shaders_outlive_final_renders(engine, monkeypatch):
     """A batch job's later renders reuse the compiled shaders, across scenes (each render has its own
     GPU context); past MAX_CACHED_SHADERS the oldest is dropped and compiled again when needed."""
-    from sg_prt_addon.engine import shader_variants
+    from sg_prt_addon.engine import shader_cache
 
     scenes = []
     for index, model in enumerate(("GGX", "BLINN_PHONG", "WARD_ISO")):
@@ -277,22 +280,22 @@ def test_shaders_outlive_final_renders(engine, monkeypatch):
         sphere.data.materials.append(fx.material(f"cache_material_{index}", model=model))
         fx.point_light(scene, f"cache_light_{index}", (1.0, -3.0, 3.0), 500.0)
         scenes.append(scene)
-    shader_variants.clear_cache()
+    shader_cache.clear_cache()
     first = [fx.render(scene)["passes"]["Combined"] for scene in scenes]
-    compiles = shader_variants.compile_count["surface"]
+    compiles = shader_cache.compile_count["surface"]
     assert compiles >= 3
     again = [fx.render(scene)["passes"]["Combined"] for scene in reversed(scenes)][::-1]
-    assert shader_variants.compile_count["surface"] == compiles, "a later render compiled its shader again"
+    assert shader_cache.compile_count["surface"] == compiles, "a later render compiled its shader again"
     for image, repeated in zip(first, again):
         np.testing.assert_array_equal(image, repeated)
 
     # room for the background and depth shaders and two surface variants: the third evicts the first
-    monkeypatch.setattr(shader_variants, "MAX_CACHED_SHADERS", 4)
-    shader_variants.clear_cache()
+    monkeypatch.setattr(shader_cache, "MAX_CACHED_SHADERS", 4)
+    shader_cache.clear_cache()
     for scene, image in zip(scenes + scenes[:1], first + first[:1]):
         np.testing.assert_array_equal(fx.render(scene)["passes"]["Combined"], image)
-        assert len(shader_variants._cache) <= 4
-    assert shader_variants.compile_count["surface"] == compiles + 4     # three, then the first again
+        assert len(shader_cache._cache) <= 4
+    assert shader_cache.compile_count["surface"] == compiles + 4     # three, then the first again
 
 
 def test_environment_textures_outlive_final_renders(engine):

@@ -116,17 +116,18 @@ def test_world_space_export_matches_blender(tracked_scene):
 
 def test_lights_beyond_the_shader_limit_drop_the_dimmest():
     from sg_prt_addon.blender import export
-    from sg_prt_addon.engine import scene_state, shader_variants
+    from sg_prt_addon.engine import scene_state
+    from sg_prt_addon.techniques import shader_sources
 
     lights = [export.LightExport(f"point{i}", "POINT", (0.0, 0.0, float(i)), (0.0, 0.0, -1.0), (float(i),) * 3)
-              for i in range(shader_variants.MAX_POINT_LIGHTS + 3)]
+              for i in range(shader_sources.MAX_POINT_LIGHTS + 3)]
     lights.append(export.LightExport("sun", "SUN", (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), (2.0, 2.0, 2.0), angle=0.1))
     data = scene_state.light_data(lights)
-    assert len(data.point_radius) == shader_variants.MAX_POINT_LIGHTS and len(data.sun_sharpness) == 1
+    assert len(data.point_radius) == shader_sources.MAX_POINT_LIGHTS and len(data.sun_sharpness) == 1
     assert data.point_intensity[:, 0].min() == 3.0          # points 0, 1, 2 were the dimmest
     state = scene_state.SceneState()
     state.lights = lights
-    assert state.dropped_lights(shader_variants.MAX_POINT_LIGHTS, shader_variants.MAX_SUNS) == \
+    assert state.dropped_lights(shader_sources.MAX_POINT_LIGHTS, shader_sources.MAX_SUNS) == \
         ["point0", "point1", "point2"]
 
 

@@ -28,7 +28,7 @@ def fitted_material(blender, tmp_path_factory):
     material = fx.material("mat_fitted_table", model="GGX", roughness=0.4)
     with bpy.context.temp_override(material=material):
         assert bpy.ops.sgprt.fit_lobes(filepath=path, lobe_count=2, shadowing_components=5) == {"FINISHED"}
-    assert lobe_fit.fit_status(material)[0] == "VALID" and material.sgprt.use_fitted_lobes
+    assert lobe_fit.fit_status(material)[0] == "VALID" and material.sgprt.technique == "SG_FITTED"
     return material
 
 
@@ -68,8 +68,7 @@ def _errors(result, mask=None):
 
 def test_fitted_lobes_engine_matches_mirror(fitted_material):
     import bpy
-    from sg_prt_addon.engine import shader_variants
-
+    
     scene = fx.new_scene("fitted_mirror", 128, 128)
     fx.world_texture(scene, fx.studio_world_path(), strength=0.6)
     sphere = fx.uv_sphere(scene, "fitted_sphere", (0.0, 0.0, 1.0), radius=1.0)
@@ -81,8 +80,8 @@ def test_fitted_lobes_engine_matches_mirror(fitted_material):
     result = fx.render(scene, gbuffer=True)
     params = result["state"].materials[fitted_material.name]
     assert params.fitted is not None and params.fitted.layers.shape[1:3] == (8, 8)
-    key = shader_variants.variant_key(params, True, True, True)
-    assert key.model == shader_variants.FITTED_MODEL and key.ndf_lobes == 2 and key.shadowing_components == 5
+    key = fx.variant_key(params, True, True, True)
+    assert key.model == "FITTED" and key.technique == "SG_FITTED" and key.ndf_lobes == 2 and key.shadowing_components == 5
 
     material_id = result["passes"]["material_ids"][fitted_material.name]
     on_sphere = np.abs(result["passes"]["gbuffer_uv"][..., 2] - material_id) < 0.25
@@ -97,7 +96,7 @@ def test_fitted_lobes_engine_matches_mirror(fitted_material):
 
     fitted_specular = result["passes"]["Specular"][on_sphere].copy()
     # the fit switched off: the material's own model again (the GGX variant), still matching its mirror
-    fitted_material.sgprt.use_fitted_lobes = False
+    fitted_material.sgprt.technique = "SG_PARAMETRIC"
     try:
         plain = fx.render(scene, gbuffer=True)
         assert plain["state"].materials[fitted_material.name].fitted is None
@@ -106,4 +105,4 @@ def test_fitted_lobes_engine_matches_mirror(fitted_material):
         assert max(plain_errors.values()) <= TOLERANCE
         assert not np.allclose(plain["passes"]["Specular"][on_sphere], fitted_specular)
     finally:
-        fitted_material.sgprt.use_fitted_lobes = True
+        fitted_material.sgprt.technique = "SG_FITTED"

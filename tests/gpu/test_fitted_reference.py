@@ -35,7 +35,7 @@ def score_fitted_sphere(merl_path, name="fitted_reference", size=SIZE, seed=7):
     sphere.data.materials.append(material)
     with bpy.context.temp_override(material=material):
         assert bpy.ops.sgprt.fit_lobes(filepath=merl_path, lobe_count=2) == {"FINISHED"}
-    assert lobe_fit.fit_status(material)[0] == "VALID" and material.sgprt.use_fitted_lobes
+    assert lobe_fit.fit_status(material)[0] == "VALID" and material.sgprt.technique == "SG_FITTED"
     result = fx.render(scene)
     assert "error" not in result, result.get("error")
     assert result["state"].materials[material.name].fitted is not None

@@ -98,9 +98,9 @@ def test_tabulated(glsl, fuzz, record_error):
     filter, against the numpy mirror of that filter (whose own error against quadrature
     tests/core/test_clamped_cosine_table.py bounds); and its constants against the module's."""
     from sg_prt_addon.core import clamped_cosine_table
-    from sg_prt_addon.engine import shader_variants
+    from sg_prt_addon.techniques import shader_sources
 
-    source = shader_variants.library_source("clamped_cosine_table.glsl")
+    source = shader_sources.library_source("clamped_cosine_table.glsl")
     constants = dict(re.findall(r"const float CLAMPED_COSINE_TABLE_(\w+) = ([-0-9.e]+);", source))
     assert {name: float(value) for name, value in constants.items()} == pytest.approx({
         "LOG_MIN": np.log(clamped_cosine_table.SHARPNESS_RANGE[0]),

@@ -232,7 +232,7 @@ def test_env_prefilter_stress(glsl, fuzz):
 
 # =========================================================================== every kernel
 # The kernels above are the ones the shaders call per pixel; the tests below fuzz every other
-# function of shaders/lib/*.glsl (helpers included) and the per-pixel pieces of shaders/resources that
+# function of shaders/lib/*.glsl (helpers included) and the per-pixel pieces of shaders/techniques/sg that
 # can be called alone, over the numpy stress suite's own inputs (tests/core/test_stress_*.py: its
 # hostile SG set and BRDF directions, sub-sampled), in float32 on llvmpipe.  test_every_kernel_is_fuzzed
 # parses the function names of shaders/lib and fails when one is missing from COVERED.
@@ -317,7 +317,7 @@ def _glsl_function(source, name):
 
 
 def _resource(file_name):
-    with open(os.path.join(SHADERS, "resources", file_name), encoding="utf-8") as handle:
+    with open(os.path.join(SHADERS, "techniques", "sg", file_name), encoding="utf-8") as handle:
         return handle.read()
 
 
@@ -537,7 +537,7 @@ def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
     assert out[:, :2].min() >= 0
 
 
-# ---- shaders/resources: the per-pixel pieces that can be called alone
+# ---- shaders/techniques/sg: the per-pixel pieces that can be called alone
 
 RESOURCE_KERNELS = {
     "lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility"],
@@ -613,7 +613,7 @@ MODEL_VARIANTS = [("GGX", 1), ("GGX", 2), ("COOK_TORRANCE", 1), ("BLINN_PHONG", 
 def test_model_lobes_stress(glsl, model, lobes):
     """sg_shading.glsl's model_ndf_lobe (through ggx_two_lobes / anisotropic_lobes and their tables)
     and model_m_factor, per model, over the numpy suite's parameters (0 included) and directions."""
-    from sg_prt_addon.engine import shader_variants
+    from sg_prt_addon.techniques import sg_parametric
 
     wo, wi, h, roughness, exponent, rng = _brdf_inputs()
     alpha_y = _f32(np.where(rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, np.exp(rng.uniform(np.log(1e-4), 0.0, SMALL_ROWS))))
@@ -629,10 +629,10 @@ def test_model_lobes_stress(glsl, model, lobes):
     textures = {}
     if model == "GGX" and lobes == 2:
         pieces.append(_resource("ggx_two_lobes.glsl"))
-        textures["ggx_table"] = shader_variants.ggx_table()
+        textures["ggx_table"] = sg_parametric.ggx_table()
     if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY"):
         pieces.append(_resource("anisotropic_lobes.glsl"))
-        textures["anisotropy_table"] = shader_variants.anisotropy_table(lobes)
+        textures["anisotropy_table"] = sg_parametric.anisotropy_table(lobes)
     pieces += [_glsl_function(shading, "model_ndf_lobe"), _glsl_function(shading, "model_m_factor")]
     body = """
     vec3 axis_sum = vec3(0.0);
@@ -651,7 +651,7 @@ def test_model_lobes_stress(glsl, model, lobes):
 
 def test_table_lobes_stress(glsl, fuzz):
     """ggx_two_lobes and anisotropic_lobes called alone: roughness / widths 0..1e3, any peak."""
-    from sg_prt_addon.engine import shader_variants
+    from sg_prt_addon.techniques import sg_parametric
 
     roughness = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 10.0, SMALL_ROWS)))
     width_x = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 1e3, SMALL_ROWS)))
@@ -667,7 +667,7 @@ def test_table_lobes_stress(glsl, fuzz):
     """
     library = ["sg.glsl", "brdf.glsl", _resource("ggx_two_lobes.glsl"), _resource("anisotropic_lobes.glsl")]
     out = glsl(library, body, {"a": np.c_[roughness, width_x, width_y, peak]}, 4,
-               {"ggx_table": shader_variants.ggx_table(), "anisotropy_table": shader_variants.anisotropy_table(2)})
+               {"ggx_table": sg_parametric.ggx_table(), "anisotropy_table": sg_parametric.anisotropy_table(2)})
     _assert_finite(out, "ggx_two_lobes / anisotropic_lobes")
     assert out[:, :3].min() >= 0 and np.abs(out[:, 3] - 1).max() < 1e-5
 
@@ -763,7 +763,7 @@ def _defined_functions(path):
 
 def test_every_kernel_is_fuzzed():
     """Every function defined in shaders/lib/*.glsl (and the listed per-pixel pieces of
-    shaders/resources) is in COVERED, and every name COVERED gives a test is called in that test's
+    shaders/techniques/sg) is in COVERED, and every name COVERED gives a test is called in that test's
     GLSL: a new kernel without a stress test fails here."""
     library_dir = os.path.join(SHADERS, "lib")
     defined = set()
@@ -772,8 +772,8 @@ def test_every_kernel_is_fuzzed():
             defined |= _defined_functions(os.path.join(library_dir, file_name))
     assert len(defined) > 80, sorted(defined)          # the parse found the library
     for file_name, names in RESOURCE_KERNELS.items():
-        missing = set(names) - _defined_functions(os.path.join(SHADERS, "resources", file_name))
-        assert not missing, f"resources/{file_name} no longer defines {sorted(missing)}"
+        missing = set(names) - _defined_functions(os.path.join(SHADERS, "techniques", "sg", file_name))
+        assert not missing, f"techniques/sg/{file_name} no longer defines {sorted(missing)}"
         defined |= set(names)
     covered = set()
     for test, names in COVERED.items():

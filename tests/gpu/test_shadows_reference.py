@@ -163,7 +163,8 @@ def test_per_vertex_pass_only_where_a_diffuse_term_reads_it(engine, bakes):
                                            diffuse_color=(0.0, 0.0, 0.0), specular_color=(0.5, 0.5, 0.5))
     unbaked = fx.uv_sphere(scene, "per_vertex_needed_unbaked", (1.8, 0.0, 0.6), radius=0.5, segments=16, rings=8)
     bakes(scene, [sphere, floor], resolution=8)
-    render_engine.debug["after_frame"] = lambda depsgraph, state, renderer, camera: set(renderer.vertex_visibility)
+    render_engine.debug["after_frame"] = lambda depsgraph, state, renderer, camera: {
+        key for key, targets in renderer.object_targets.items() if "diffuse_visibility" in targets}
     try:
         result = fx.render(scene)
     finally:

@@ -93,19 +93,18 @@ def active_source(source, defines):
 
 
 def variant_code(key):
-    from sg_prt_addon.engine import shader_variants
-    return active_source(shader_variants.fragment_source(key), shader_variants.defines(key))
+    return active_source(fx.variant_fragment(key), fx.variant_defines(key))
 
 
 def test_preprocessor_keeps_the_full_variant_code():
     """The helper itself: the full variant keeps every term, the #if logic picks branches."""
-    from sg_prt_addon.engine import shader_variants
+    from sg_prt_addon.techniques.sg_lobes import VariantKey
 
     assert active_source("#if defined(A) && B > 1\nyes\n#elif !defined(C)\nno\n#else\nelse\n#endif",
                          {"A": 1, "B": 2}) == "yes"
     assert active_source("#if defined(A) && B > 1\nyes\n#elif !defined(C)\nno\n#else\nelse\n#endif",
                          {"A": 1, "B": 1}) == "no"
-    key = shader_variants.VariantKey("GGX", 2, True, True, (), False, 3)
+    key = VariantKey(model="GGX", ndf_lobes=2, has_lights=True, has_environment=True, visibility_layers=3)
     code = variant_code(key)
     for name in ("warp_lobes_", "model_ndf_lobe(", "model_m_factor(", "environment_radiance(", "scene_light_sg(",
                  "ssdf_decode(", "lobe_visibility(", "env_amplitude", "texture(environment_texture"):
@@ -125,24 +124,21 @@ VISIBILITY_CODE = ("ssdf_decode(", "lobe_visibility(", "visibility_rows", "set_v
 
 
 def _assert_lacks(key, names, define):
-    from sg_prt_addon.engine import shader_variants
-
     code = variant_code(key)
     present = [name for name in names if name in code]
     assert not present, f"{key.describe()}: {present} still in the compiled source"
-    assert define not in shader_variants.defines(key)
+    assert define not in fx.variant_defines(key)
 
 
 def test_skipped_variants_lack_the_code():
-    from sg_prt_addon.engine import shader_variants
     from sg_prt_addon.blender.export import MaterialParams
 
     full = dict(has_lights=True, has_environment=True, visibility_layers=3)
-    diffuse_only = shader_variants.variant_key(MaterialParams(specular_color=(0.0, 0.0, 0.0)), **full)
+    diffuse_only = fx.variant_key(MaterialParams(specular_color=(0.0, 0.0, 0.0)), **full)
     assert (diffuse_only.has_diffuse, diffuse_only.has_specular) == (True, False)
     _assert_lacks(diffuse_only, SPECULAR_CODE, "HAS_SPECULAR")
     assert "env_amplitude" in variant_code(diffuse_only) and "ssdf_decode(" in variant_code(diffuse_only)
-    specular_only = shader_variants.variant_key(MaterialParams(diffuse_color=(0.0, 0.0, 0.0)), **full)
+    specular_only = fx.variant_key(MaterialParams(diffuse_color=(0.0, 0.0, 0.0)), **full)
     assert (specular_only.has_diffuse, specular_only.has_specular) == (False, True)
     _assert_lacks(specular_only, DIFFUSE_CODE, "HAS_DIFFUSE")
     assert "environment_radiance(" in variant_code(specular_only)
@@ -151,41 +147,40 @@ def test_skipped_variants_lack_the_code():
     def decodes(key):       # visibility call sites, macro definitions aside
         code = "\n".join(line for line in variant_code(key).split("\n") if not line.lstrip().startswith("#define"))
         return sum(code.count(name) for name in ("lobe_visibility(", "LOBE_VISIBILITY(", "DIFFUSE_VISIBILITY("))
-    assert decodes(specular_only) == decodes(shader_variants.variant_key(MaterialParams(), **full)) - 1
+    assert decodes(specular_only) == decodes(fx.variant_key(MaterialParams(), **full)) - 1
     # with the per-vertex pass the environment's diffuse lobes read the interpolated fractions
-    per_vertex_key = shader_variants.variant_key(MaterialParams(), **full, diffuse_rows=2)
-    assert shader_variants.defines(per_vertex_key)["DIFFUSE_VISIBILITY_ROWS"] == 2
+    per_vertex_key = fx.variant_key(MaterialParams(), **full, diffuse_rows=2)
+    assert fx.variant_defines(per_vertex_key)["DIFFUSE_VISIBILITY_ROWS"] == "2"
     assert "diffuse_fractions[1] = diffuse_fractions_1;" in variant_code(per_vertex_key)
-    assert shader_variants.variant_key(MaterialParams(diffuse_color=(0.0, 0.0, 0.0)), **full,
-                                       diffuse_rows=2).diffuse_visibility_rows == 0
-    _assert_lacks(shader_variants.variant_key(MaterialParams(), False, True, False, 3), LIGHT_CODE, "HAS_LIGHTS")
-    _assert_lacks(shader_variants.variant_key(MaterialParams(), True, False, False, 3), ENVIRONMENT_CODE,
+    assert fx.variant_key(MaterialParams(diffuse_color=(0.0, 0.0, 0.0)), **full,
+                          diffuse_rows=2).diffuse_visibility_rows == 0
+    _assert_lacks(fx.variant_key(MaterialParams(), False, True, False, 3), LIGHT_CODE, "HAS_LIGHTS")
+    _assert_lacks(fx.variant_key(MaterialParams(), True, False, False, 3), ENVIRONMENT_CODE,
                   "HAS_ENVIRONMENT")
-    _assert_lacks(shader_variants.variant_key(MaterialParams(), True, True, False, 0), VISIBILITY_CODE,
+    _assert_lacks(fx.variant_key(MaterialParams(), True, True, False, 0), VISIBILITY_CODE,
                   "HAS_VISIBILITY")
     # a texture keeps the term; textures only the specular term reads leave the diffuse-only variant
     textured = MaterialParams(specular_color=(0.0, 0.0, 0.0), textures={"specular_color": "s", "roughness": "r"})
-    assert shader_variants.variant_key(textured, True, True).has_specular
+    assert fx.variant_key(textured, True, True).has_specular
     rough = MaterialParams(specular_color=(0.0, 0.0, 0.0), textures={"roughness": "r", "normal_map": "n"})
-    assert shader_variants.variant_key(rough, True, True).textures == ("normal_map",)
-    assert shader_variants.variant_key(MaterialParams(diffuse_color=(0.0, 0.0, 0.0),
-                                                      textures={"diffuse_color": "d"}), True, True).has_diffuse
+    assert fx.variant_key(rough, True, True).textures == ("normal_map",)
+    assert fx.variant_key(MaterialParams(diffuse_color=(0.0, 0.0, 0.0),
+                                         textures={"diffuse_color": "d"}), True, True).has_diffuse
     # NaN is not zero: the full variant shows it
-    assert shader_variants.variant_key(MaterialParams(specular_color=(float("nan"), 0.0, 0.0)), True, True).has_specular
+    assert fx.variant_key(MaterialParams(specular_color=(float("nan"), 0.0, 0.0)), True, True).has_specular
 
 
 def test_equal_sources_share_one_shader_key():
     """The model only shapes the BRDF slice: diffuse-only Cook-Torrance, Blinn-Phong and GGX variants
     assemble to one shader (one content hash); with specular they do not."""
-    from sg_prt_addon.engine import shader_variants
     from sg_prt_addon.blender.export import MaterialParams
 
-    keys = [shader_variants.variant_key(MaterialParams(model=model, specular_color=(0.0, 0.0, 0.0)), True, True)
+    keys = [fx.variant_key(MaterialParams(model=model, specular_color=(0.0, 0.0, 0.0)), True, True)
             for model in ("COOK_TORRANCE", "BLINN_PHONG", "GGX")]
     assert len(set(keys)) == 3
-    assert len({shader_variants.content_hash(key) for key in keys}) == 1
-    full = [shader_variants.variant_key(MaterialParams(model=model), True, True) for model in ("COOK_TORRANCE", "GGX")]
-    assert shader_variants.content_hash(full[0]) != shader_variants.content_hash(full[1])
+    assert len({fx.content_hash(key) for key in keys}) == 1
+    full = [fx.variant_key(MaterialParams(model=model), True, True) for model in ("COOK_TORRANCE", "GGX")]
+    assert fx.content_hash(full[0]) != fx.content_hash(full[1])
 
 
 # --------------------------------------------------------------------------- images
@@ -254,8 +249,6 @@ def _render(scene):
 
 def _keys(result):
     """The VariantKeys the render drew with (its SceneState through variant_key)."""
-    from sg_prt_addon.engine import shader_variants
-
     state = result["state"]
     has_lights = state.light_data().count > 0
     has_environment = state.environment.prefiltered is not None
@@ -263,8 +256,8 @@ def _keys(result):
     for entry in state.objects.values():
         layers = state.visibility[entry.mesh_key].layers if entry.mesh_key in state.visibility else 0
         for name in entry.material_names:
-            keys.add(shader_variants.variant_key(state.materials.get(name) or state.materials[""], has_lights,
-                                                 has_environment, False, layers))
+            keys.add(fx.variant_key(state.materials.get(name) or state.materials[""], has_lights,
+                                    has_environment, False, layers))
     return keys
 
 
@@ -340,18 +333,18 @@ def test_world_colour_skips_the_environment_fetch(engine, record_error):
 
 def test_equal_sources_compile_once(engine):
     """Two materials whose variants assemble to the same shader: one surface compile in the render."""
-    from sg_prt_addon.engine import shader_variants
+    from sg_prt_addon.engine import shader_cache
 
     scene = _scene("shared_shader", dict(model="COOK_TORRANCE", specular_color=(0.0, 0.0, 0.0)), world=(0.2,) * 3)
     other = fx.material("shared_shader_other", model="BLINN_PHONG", specular_color=(0.0, 0.0, 0.0))
     floor = next(obj for obj in scene.objects if obj.name.endswith("_floor"))
     floor.data.materials[0] = other
-    shader_variants.clear_cache()
-    before = shader_variants.compile_count["surface"]
+    shader_cache.clear_cache()
+    before = shader_cache.compile_count["surface"]
     result = _render(scene)
     keys = _keys(result)
-    assert len(keys) == 2 and len({shader_variants.content_hash(key) for key in keys}) == 1
-    assert shader_variants.compile_count["surface"] == before + 1
+    assert len(keys) == 2 and len({fx.content_hash(key) for key in keys}) == 1
+    assert shader_cache.compile_count["surface"] == before + 1
 
 
 # --------------------------------------------------------------------------- uploads

@@ -5,7 +5,7 @@
  * (HAS_SPECULAR) brdf.glsl + warp.glsl,
  * (HAS_ENVIRONMENT and HAS_SPECULAR) env_prefilter.glsl and (HAS_VISIBILITY) ssdf.glsl +
  * lobe_visibility.glsl, plus the `scene` uniform block.  HAS_DIFFUSE / HAS_SPECULAR
- * (shader_variants.material_terms): without one, its term is left out (its colour is zero, so the full
+ * (sg_parametric.material_terms): without one, its term is left out (its colour is zero, so the full
  * variant's term is exactly zero).  DIFFUSE_VISIBILITY_ROWS (with HAS_VISIBILITY and HAS_DIFFUSE): the
  * broad diffuse lobes' visible fractions come interpolated from the vertices (diffuse_fractions, filled
  * by surface.frag.glsl from the pass of resources/vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with

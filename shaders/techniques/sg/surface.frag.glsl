@@ -1,5 +1,5 @@
 /* Material parameters (property x texture over the active UV map), normal map, tangent
- * frame, then shade_surface (resources/sg_shading.glsl).  Writes Combined, Diffuse and
+ * frame, then shade_surface (sg_shading.glsl).  Writes Combined, Diffuse and
  * Specular; the GBUFFER variant writes Diffuse, Specular and the shading inputs for the
  * numpy mirror (framebuffers take 6 attachments: Combined is summed on the CPU). */
 void main()
@@ -8,53 +8,8 @@ void main()
   bool front = gl_FrontFacing != (determinant(mat3(model_matrix)) < 0.0);
   vec3 normal = front ? world_normal : -world_normal;
 #ifdef HAS_VISIBILITY
-  set_visibility_frame(world_ssdf_normal);     /* the bake's frame: not flipped for back faces */
-  visibility_rows[0] = ssdf_coefficients_0;
-#if SSDF_MAX_LAYERS > 1
-  visibility_rows[1] = ssdf_coefficients_1;
-#endif
-#if SSDF_MAX_LAYERS > 2
-  visibility_rows[2] = ssdf_coefficients_2;
-#endif
-#if SSDF_MAX_LAYERS > 3
-  visibility_rows[3] = ssdf_coefficients_3;
-#endif
-#if SSDF_MAX_LAYERS > 4
-  visibility_rows[4] = ssdf_coefficients_4;
-#endif
-#if SSDF_MAX_LAYERS > 5
-  visibility_rows[5] = ssdf_coefficients_5;
-#endif
-#if SSDF_MAX_LAYERS > 6
-  visibility_rows[6] = ssdf_coefficients_6;
-#endif
-#if SSDF_MAX_LAYERS > 7
-  visibility_rows[7] = ssdf_coefficients_7;
-#endif
-#if SSDF_MAX_LAYERS > 8
-  visibility_rows[8] = ssdf_coefficients_8;
-#endif
-#if SSDF_MAX_LAYERS > 9
-  visibility_rows[9] = ssdf_coefficients_9;
-#endif
-#if SSDF_MAX_LAYERS > 10
-  visibility_rows[10] = ssdf_coefficients_10;
-#endif
-#if SSDF_MAX_LAYERS > 11
-  visibility_rows[11] = ssdf_coefficients_11;
-#endif
-#endif
-#ifdef DIFFUSE_VISIBILITY_ROWS
-  diffuse_fractions[0] = diffuse_fractions_0;
-#if DIFFUSE_VISIBILITY_ROWS > 1
-  diffuse_fractions[1] = diffuse_fractions_1;
-#endif
-#if DIFFUSE_VISIBILITY_ROWS > 2
-  diffuse_fractions[2] = diffuse_fractions_2;
-#endif
-#if DIFFUSE_VISIBILITY_ROWS > 3
-  diffuse_fractions[3] = diffuse_fractions_3;
-#endif
+  set_visibility_frame(world_vertex_normal);     /* the bake's frame: not flipped for back faces */
+  load_per_vertex_rows();     /* the SSDF coefficients and the diffuse lobes' fractions (sg_lobes.py) */
 #endif
   vec3 diffuse_color = material.diffuse_color.rgb;
   vec3 specular_color = material.specular_color.rgb;

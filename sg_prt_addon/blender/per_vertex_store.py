@@ -1,0 +1,142 @@
+"""Per-vertex precomputations stored on a mesh datablock: one storage path for every kind (bake.per_vertex).
+
+A record of kind K (an SSDF bake is kind "ssdf"; blender/visibility_bake.py documents its fields):
+
+- ``sgprt_K_00`` .. ``sgprt_K_{L-1}``: POINT-domain FLOAT_COLOR attributes (4 float32 a vertex; saved,
+  reloaded and propagated through modifiers by 4.2 and 5.x alike), together the rows, L <= MAX_ROWS;
+- ``mesh["sgprt_K"]``: an ID property group.  ``format_version``, ``layers`` L, ``vertex_count`` and
+  ``topology_hash`` (bake.pipeline.topology_hash of the vertex count and the loop triangles' vertex
+  indices: mesh_topology_hash) are this module's; the kind adds its own fields.
+
+A record whose vertex count or topology hash no longer matches the mesh is STALE; missing or inconsistent
+data is INVALID; both are unusable.  load() reads and checks any kind the same way.
+"""
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from ..bake.per_vertex import MAX_ROWS
+from ..bake.pipeline import topology_hash
+
+
+def property_name(kind):
+    return f"sgprt_{kind}"
+
+
+def attribute_name(kind, layer):
+    return f"sgprt_{kind}_{layer:02d}"
+
+
+def mesh_triangles(mesh):
+    """(T, 3) int64 vertex indices of the loop triangles of a bpy Mesh."""
+    triangles = mesh.loop_triangles
+    if len(triangles) == 0 and len(mesh.polygons):
+        mesh.calc_loop_triangles()
+        triangles = mesh.loop_triangles
+    flat = np.empty(len(triangles) * 3, np.int64)
+    triangles.foreach_get("vertices", flat)
+    return flat.reshape(-1, 3)
+
+
+def mesh_topology_hash(mesh):
+    """``bake.pipeline.topology_hash`` of a bpy Mesh: its vertex count and loop triangles' vertices."""
+    return topology_hash(len(mesh.vertices), mesh_triangles(mesh))
+
+
+@dataclass
+class StoredRecord:
+    """A record read back from a mesh.  rows is None unless ``status`` is VALID (and rows were read)."""
+    status: str                         # 'VALID', 'STALE' or 'INVALID'
+    message: str
+    metadata: object = None             # the ID property group, as read
+    format_version: int = 0
+    layers: int = 0
+    vertex_count: int = 0
+    topology_hash: str = ""
+    rows: Optional[np.ndarray] = None   # (V, 4 L) float32
+
+
+def has_record(mesh, kind):
+    return property_name(kind) in mesh.keys()
+
+
+def clear_record(mesh, kind):
+    """Remove a stored record (metadata first, then the attributes).  True if there was anything."""
+    found = False
+    if property_name(kind) in mesh.keys():
+        del mesh[property_name(kind)]
+        found = True
+    prefix = attribute_name(kind, 0)[:-2]
+    for name in [a.name for a in mesh.attributes if a.name.startswith(prefix)]:
+        mesh.attributes.remove(mesh.attributes[name])
+        found = True
+    return found
+
+
+def store_record(mesh, kind, rows, format_version, vertex_topology_hash, metadata):
+    """Write rows (V, 4 L) and the kind's metadata to a mesh datablock, replacing any record of that kind."""
+    rows = np.asarray(rows, np.float32)
+    layers = rows.shape[1] // 4
+    if rows.shape[0] != len(mesh.vertices):
+        raise ValueError(f"{rows.shape[0]} vertices do not fit '{mesh.name}' ({len(mesh.vertices)} vertices)")
+    if rows.shape[1] != 4 * layers or not 0 < layers <= MAX_ROWS:
+        raise ValueError(f"{rows.shape[1]} values a vertex need {-(-rows.shape[1] // 4)} attributes, at most {MAX_ROWS}")
+    clear_record(mesh, kind)
+    for layer in range(layers):
+        attribute = mesh.attributes.new(attribute_name(kind, layer), "FLOAT_COLOR", "POINT")
+        attribute.data.foreach_set("color", np.ascontiguousarray(rows[:, 4 * layer:4 * layer + 4]).ravel())
+    mesh[property_name(kind)] = {"format_version": int(format_version), "layers": int(layers),
+                                 "vertex_count": int(rows.shape[0]), "topology_hash": str(vertex_topology_hash),
+                                 **metadata}
+
+
+def load_record(mesh, kind, format_version, evaluated_mesh=None, read_rows=True, check_layers=None):
+    """The record of `kind` on a mesh datablock, or None without one.
+
+    evaluated_mesh: the mesh the engine draws (an object's evaluated data), checked for staleness instead
+    of `mesh`; read_rows=False skips the attributes' values (a cheap status for panels); check_layers:
+    callable(metadata, layers) -> None or the message of an inconsistency of the kind's own fields."""
+    group = mesh.get(property_name(kind))
+    if group is None:
+        return None
+    current = evaluated_mesh if evaluated_mesh is not None else mesh
+    try:
+        record = StoredRecord("VALID", "", group, format_version=int(group.get("format_version", 0)),
+                              layers=int(group["layers"]), vertex_count=int(group["vertex_count"]),
+                              topology_hash=str(group["topology_hash"]))
+    except (KeyError, TypeError, ValueError) as error:
+        return StoredRecord("INVALID", f"bake metadata damaged ({error}): re-bake")
+    if record.format_version != format_version:
+        record.status, record.message = "INVALID", (f"bake format {record.format_version}, this add-on reads "
+                                                    f"{format_version}: re-bake")
+        return record
+    problem = check_layers(group, record.layers) if check_layers is not None else None
+    if problem is None and not 0 < record.layers <= MAX_ROWS:
+        problem = f"bake metadata inconsistent ({record.layers} layers): re-bake"
+    if problem is not None:
+        record.status, record.message = "INVALID", problem
+        return record
+    if len(current.vertices) != record.vertex_count:
+        record.status = "STALE"
+        record.message = (f"stale: the mesh has {len(current.vertices)} vertices, the bake "
+                          f"{record.vertex_count}: re-bake")
+        return record
+    if mesh_topology_hash(current) != record.topology_hash:
+        record.status, record.message = "STALE", "stale: the mesh topology changed since the bake: re-bake"
+        return record
+    for layer in range(record.layers):
+        attribute = mesh.attributes.get(attribute_name(kind, layer))
+        if (attribute is None or attribute.data_type != "FLOAT_COLOR" or attribute.domain != "POINT"
+                or len(attribute.data) != record.vertex_count):
+            record.status = "INVALID"
+            record.message = f"attribute {attribute_name(kind, layer)} missing or damaged: re-bake"
+            return record
+    if read_rows:
+        rows = np.empty((record.vertex_count, 4 * record.layers), np.float32)
+        column = np.empty(record.vertex_count * 4, np.float32)
+        for layer in range(record.layers):
+            mesh.attributes[attribute_name(kind, layer)].data.foreach_get("color", column)
+            rows[:, 4 * layer:4 * layer + 4] = column.reshape(-1, 4)
+        record.rows = rows
+    return record

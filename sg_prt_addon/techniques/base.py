@@ -1,0 +1,88 @@
+"""The seam every rendering method plugs into: a Technique and what the engine hands it.
+
+A technique renders the surfaces of the materials that pick it (material.sgprt.technique).  For one
+material on one object it says:
+
+- ``variant_key(params, inputs)``: a hashable key of what changes its shader's code (not the values),
+  with ``describe()`` for messages;
+- ``create_info_calls(key)``: what the GPUShaderCreateInfo of that variant is made of, as (method,
+  arguments) calls in order (``shader_sources.surface_calls`` gives the parts every surface shares);
+  the engine compiles and caches the shader by a hash of these calls;
+- ``bind(shader, key, context)``: binds its textures and blocks through a DrawContext;
+- ``prepare_object(keys, context)`` (optional): GPU passes of its own before the surfaces are drawn;
+- ``mirror``: the numpy function that computes what its shader does, for the tests.
+
+The engine (draw loop, shader cache, scene state) knows no technique by name: it reads the registry
+(techniques/__init__.py).  The DrawContext is the engine's side of the seam (engine/renderer.py); its
+methods are listed in the DrawContext docstring below.
+"""
+import functools
+
+import numpy as np
+
+
+class ObjectInputs:
+    """What a variant may depend on besides its material: the scene and the object drawn.
+
+    light_data: core.shading.LightData; environment: core.shading.EnvironmentData; gbuffer: the draw
+    writes the G-buffer outputs; per_vertex: per-vertex kind ("ssdf", ...) -> vec4 rows a vertex of the
+    object's usable precomputation (absent: none); bounds: (2, 3) local box or None; matrix_world (4, 4).
+    Derived values a technique computes once per object go in ``memo``."""
+
+    def __init__(self, light_data, environment, gbuffer=False, per_vertex=None, bounds=None, matrix_world=None):
+        self.light_data = light_data
+        self.environment = environment
+        self.gbuffer = bool(gbuffer)
+        self.per_vertex = dict(per_vertex or {})
+        self.bounds = bounds
+        self.matrix_world = np.eye(4) if matrix_world is None else np.asarray(matrix_world)
+        self.memo = {}
+
+    @functools.cached_property
+    def has_lights(self):
+        return self.light_data.count > 0
+
+    @functools.cached_property
+    def has_environment(self):
+        return self.environment.prefiltered is not None
+
+
+class DrawContext:
+    """What the engine offers a technique's bind() and prepare_object() (engine/renderer.py implements it).
+
+    scene_buffer, material_buffer: the SceneData and MaterialData uniform buffers of the draw;
+    per_vertex(kind): the object's engine.per_vertex.PerVertexBuffers of that kind;
+    environment_textures(): (prefiltered layers, equirect map) GPU textures of the scene's environment;
+    table(name, build): a GPU texture of build()'s float32 array ((H, W, 4) or (L, H, W, 4)), made once
+      for the renderer; material_table(name, build): the same, remade when the material changes;
+    image(slot): the material's image texture of a texture slot;
+    object_target(name, size): a float RGBA (texture, framebuffer) of the object, kept while it lives;
+    object_texture(name): the texture of object_target(name, ...), or None;
+    fixed_shader(cache_key, create_info_calls): a compiled shader of a pass of the technique's own;
+    full_screen_batch(shader, name): a triangle covering the target for the pass `name`, position in NDC.
+    """
+
+
+class Technique:
+    """A rendering method.  Subclasses set the class attributes and implement the methods."""
+
+    name = ""            # identifier, stored in material.sgprt.technique
+    label = ""           # shown in the material panel
+    description = ""
+    number = 0           # the enum value stored in .blend files: unique and never reused
+    paper = ""           # the reference it implements, e.g. "wang2009"
+    mirror = None        # numpy function of what its shader computes (tests compare the two)
+
+    def variant_key(self, params, inputs):
+        raise NotImplementedError
+
+    def create_info_calls(self, key):
+        raise NotImplementedError
+
+    def bind(self, shader, key, context):
+        raise NotImplementedError
+
+    def prepare_object(self, keys, context):
+        """GPU work of the technique's own for one object before its surfaces are drawn (keys: the
+        variant keys of its material slots that use this technique; what it makes with
+        context.object_target is dropped with the object).  Default: none."""

@@ -1,0 +1,96 @@
+"""wang2009 with an analytic BRDF model: the NDF as SG lobes from the model's parameters (property x
+texture per pixel), GGX's two-lobe table and albedo tail, the anisotropic models' lobe tables."""
+import numpy as np
+
+from ..core import ggx_albedo, ndf_fit, shading, warp
+from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
+
+NAME = "SG_PARAMETRIC"
+ANISOTROPIC_MODELS = ("WARD_ANISO", "ASHIKHMIN_SHIRLEY")
+# Material textures that only the specular term reads (left out of a variant without it)
+SPECULAR_ONLY_TEXTURES = ("specular_color", "roughness", "ior", "exponent", "alpha_x", "alpha_y", "nu", "nv")
+
+
+def material_terms(material_params):
+    """(has_diffuse, has_specular) of an export.MaterialParams: False when that colour is zero and no
+    texture scales it, so the term (colour x irradiance / pi, colour x radiance) is exactly zero and the
+    variant leaves its code out."""
+    def present(colour, slot):      # NaN counts as present: the full variant shows it
+        return slot in material_params.textures or any(not float(c) == 0.0 for c in tuple(colour)[:3])
+
+    return (present(material_params.diffuse_color, "diffuse_color"),
+            present(material_params.specular_color, "specular_color"))
+
+
+def uses_ggx_table(key):
+    return key.model == "GGX" and key.ndf_lobes == 2 and key.has_specular
+
+
+def ggx_table():
+    """ndf_fit's two-lobe GGX table as an (A, 2, 4) float32 texture: texel (k, row) =
+    (log alpha, sharpness * alpha^2, amplitude / D(n), 0)."""
+    alphas, table = ndf_fit.ggx_two_lobe_table()
+    out = np.zeros((len(alphas), 2, 4), np.float32)
+    out[..., 0] = np.log(alphas)[:, None]
+    out[..., 1:3] = table
+    return out
+
+
+def ggx_albedo_texture():
+    """core.ggx_albedo's table in every channel of a float texture."""
+    return np.repeat(ggx_albedo.albedo_table()[..., None], 4, axis=-1)
+
+
+def anisotropy_table(lobe_count):
+    """ndf_fit's table as an (R, K, 4) float32 texture: texel (k, row)."""
+    return np.ascontiguousarray(ndf_fit.anisotropy_table_array(lobe_count), np.float32)
+
+
+class SGParametric(SGLobes):
+    name = NAME
+    label = "SG Lobes (Wang 2009)"
+    description = ("The material's BRDF model as spherical Gaussian lobes, warped to the view; all-frequency "
+                   "light and SSDF shadows (Wang et al. 2009)")
+    number = 0
+
+    def variant_key(self, params, inputs):
+        model = params.model
+        lobes = int(params.lobe_count) if model in ANISOTROPIC_MODELS else 1
+        if model == "GGX":
+            lobes = shading.GGX_NDF_LOBES
+        has_diffuse, has_specular = material_terms(params)
+        textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS
+                                and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
+        return VariantKey(self.name, model, lobes, textures=textures, has_diffuse=has_diffuse,
+                          has_specular=has_specular, warp_mode=warp_mode_of(params) if has_specular else
+                          warp.DEFAULT_MODE, **scene_fields(inputs, has_diffuse, has_specular))
+
+    def model_defines(self, key):
+        if not uses_ggx_table(key):
+            return {}
+        # GGX's energy beyond its two lobes, from its albedo table (core.ggx_albedo)
+        return {"ENVIRONMENT_TAIL": 1, "GGX_ALBEDO_SIZE": ggx_albedo.TABLE_SIZE,
+                "TAIL_SHARPNESS_RATIO": f"{shading.TAIL_SHARPNESS_RATIO!r}"}
+
+    def model_files(self, key):
+        if key.model in ANISOTROPIC_MODELS:
+            return ("anisotropic_lobes.glsl",)
+        return ("ggx_two_lobes.glsl",) if uses_ggx_table(key) else ()
+
+    def model_samplers(self, key):
+        if key.model in ANISOTROPIC_MODELS:
+            return [("FLOAT_2D", "anisotropy_table")]
+        if uses_ggx_table(key):
+            return [("FLOAT_2D", "ggx_table"), ("FLOAT_2D", "ggx_albedo_table")]      # ENVIRONMENT_TAIL
+        return []
+
+    def bind_model(self, shader, key, context):
+        if key.model in ANISOTROPIC_MODELS:
+            shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", key.ndf_lobes),
+                                                                     lambda: anisotropy_table(key.ndf_lobes)))
+        if uses_ggx_table(key):
+            shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", ggx_table))
+            shader.uniform_sampler("ggx_albedo_table", context.table("ggx_albedo", ggx_albedo_texture))
+
+
+TECHNIQUE = SGParametric()
