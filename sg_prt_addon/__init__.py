@@ -1,11 +1,13 @@
-"""SG-PRT: all-frequency SVBRDF rendering with spherical Gaussians and SSDFs."""
+"""SG-PRT: all-frequency SVBRDF rendering with spherical Gaussians and SSDFs.
+
+Importing the package needs no bpy (its maths runs anywhere); register() imports the Blender side."""
 
 
 def register():
-    from .blender import registration
+    from . import registration
     registration.register()
 
 
 def unregister():
-    from .blender import registration
+    from . import registration
     registration.unregister()

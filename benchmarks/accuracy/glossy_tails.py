@@ -56,7 +56,7 @@ def _albedo_rows():
     cos_o, roughness = np.array(grid).T
     table = ggx_albedo.albedo_table()[..., None]
     s, t = ggx_albedo.table_coordinates(cos_o, roughness)
-    fetched = shading.sample_bilinear(table, np.stack([s, t], -1))[:, 0]
+    fetched = shading.sample_texture(table, np.stack([s, t], -1))[:, 0]
     dense = ggx_albedo.directional_albedo(cos_o, roughness, 256, 256)
     slice_albedo = []
     for c, r in grid:

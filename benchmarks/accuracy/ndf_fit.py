@@ -7,6 +7,7 @@ hemisphere (Monte Carlo, 100k pairs, importance + uniform mixture).
 import numpy as np
 
 from sg_prt_addon.core import brdf, ndf_fit
+from validation import ndf_mappings
 
 L2 = "relative L2 of D over the hemisphere"
 RMSE = "relative RMSE of M D (n.i), 4D"
@@ -26,7 +27,7 @@ def _row(name, reference, metric, errors, note="", paper=None):
 def _curvature_mapping_errors(kind, widths):
     """The naive mapping: same peak and same second derivative at the pole (lambda w^2 = 2 - 4 w^2
     for Beckmann, 2 for Blinn-Phong and Ward, 4 for GGX)."""
-    ndf_of_width = ndf_fit.isotropic_ndf_of_width(kind)
+    ndf_of_width = ndf_mappings.isotropic_ndf_of_width(kind)
     errors = []
     for width in widths:
         theta, weights = ndf_fit.polar_quadrature([width])
@@ -46,9 +47,9 @@ def _isotropic_rows():
                      [ndf_fit.brdf_relative_rmse(m, m.ndf_lobes(), 100_000) for m in models], "m in 0.045..0.5"))
     for kind, label in (("BECKMANN", "Beckmann (CT, normalized) m"), ("BLINN_PHONG", "Blinn-Phong sqrt(2/n)"),
                         ("WARD_ISO", "Ward iso alpha"), ("GGX", "GGX alpha = roughness^2")):
-        high = brdf.ISOTROPIC_MAPPINGS[kind]["width_range"][1]
+        high = ndf_fit.ISOTROPIC_MAPPINGS[kind]["width_range"][1]
         widths = np.linspace(0.01, high, 25)
-        mapping, optimal = ndf_fit.isotropic_mapping_errors(kind, widths)
+        mapping, optimal = ndf_mappings.isotropic_mapping_errors(kind, widths)
         curvature = _curvature_mapping_errors(kind, widths)
         rows.append(_row(f"{kind} 1 lobe, frozen L2 mapping", QUADRATURE, L2, mapping,
                          f"{label} in 0.01..{high}; excess over the optimal lobe <= {np.max(mapping - optimal):.2g}; "
@@ -69,7 +70,7 @@ def _anisotropic_rows():
     cases = (("Ashikhmin-Shirley nu=75 nv=1200 (Fig. 2)", brdf.AshikhminShirley(nu=75.0, nv=1200.0)),
              ("Ward aniso ax=0.3 ay=0.05", brdf.WardAnisotropic(alpha_x=0.3, alpha_y=0.05)))
     for label, model in cases:
-        directions, weights = ndf_fit.hemisphere_quadrature(ndf_fit.model_widths(model), 16, 160)
+        directions, weights = ndf_fit.hemisphere_quadrature(model.ndf_widths(), 16, 160)
         exact = model.ndf(directions)
         for lobe_count in range(1, ndf_fit.MAX_LOBES + 1):
             lobes = model.ndf_lobes(lobe_count)

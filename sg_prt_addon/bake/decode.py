@@ -8,40 +8,15 @@ then sum over layers of dot(texture(basis, (s, t, layer)), coefficients[layer]):
 one bilinear fetch per four terms, and bilinear filtering commutes with the
 linear PCA sum, so this equals the bilinear sample of the reconstructed image.
 
-``sample_bilinear`` reproduces a GPU linear sampler with clamp-to-edge: texel
+``core.texture_fetch`` reproduces the GPU linear sampler with clamp-to-edge: texel
 centres at (k + 0.5) / R, weights from the fractional part.  Stored samples sit
 at the texel centres (``hemisphere_map.sample_texcoord``), so the lookup
 interpolates all the way to the horizon.
 """
 import numpy as np
 
-from ..core import hemisphere, sg
+from ..core import hemisphere, sg, texture_fetch
 from . import hemisphere_map
-
-
-def sample_bilinear(images, texcoord):
-    """Bilinear samples of images (..., R, R) at texture coordinates (Q, 2) in [0, 1]^2 -> (..., Q).
-
-    images are indexed [t row, s column]; clamp-to-edge like a GPU sampler.
-    """
-    return _sample(np.asarray(images), np.asarray(texcoord, np.float64))
-
-
-def _sample(images, texcoord):
-    rows, cols = images.shape[-2], images.shape[-1]
-    x = texcoord[..., 0] * cols - 0.5
-    y = texcoord[..., 1] * rows - 0.5
-    x0 = np.floor(x)
-    y0 = np.floor(y)
-    fx = x - x0
-    fy = y - y0
-    c0 = np.clip(x0, 0, cols - 1).astype(np.intp)
-    c1 = np.clip(x0 + 1, 0, cols - 1).astype(np.intp)
-    r0 = np.clip(y0, 0, rows - 1).astype(np.intp)
-    r1 = np.clip(y0 + 1, 0, rows - 1).astype(np.intp)
-    top = images[..., r0, c0] * (1 - fx) + images[..., r0, c1] * fx
-    bottom = images[..., r1, c0] * (1 - fx) + images[..., r1, c1] * fx
-    return top * (1 - fy) + bottom * fy
 
 
 def texcoord_of(local_direction, resolution):
@@ -59,8 +34,8 @@ def decode(coefficients, basis, mean, local_direction):
     texcoord, below = texcoord_of(local_direction, np.shape(mean)[-1])
     flat_coord = texcoord.reshape(-1, 2)
     count = flat_coord.shape[0]
-    mean_value = _sample(np.asarray(mean, np.float64), flat_coord)
-    basis_values = _sample(np.asarray(basis, np.float64), flat_coord)        # (N, Q)
+    mean_value = texture_fetch.bilinear_channels_first(np.asarray(mean, np.float64), flat_coord)
+    basis_values = texture_fetch.bilinear_channels_first(np.asarray(basis, np.float64), flat_coord)        # (N, Q)
     coefficients = np.asarray(coefficients, np.float64)
     weights = np.broadcast_to(coefficients, below.shape + coefficients.shape[-1:]).reshape(count, -1)
     value = mean_value + np.einsum("qn,nq->q", weights, basis_values)
@@ -70,7 +45,7 @@ def decode(coefficients, basis, mean, local_direction):
 def decode_image(image, local_direction):
     """SSDF (...) at local directions from one uncompressed (R, R) image (same lookup as ``decode``)."""
     texcoord, below = texcoord_of(local_direction, np.shape(image)[-1])
-    return _sample(np.asarray(image, np.float64), texcoord) - below
+    return texture_fetch.bilinear_channels_first(np.asarray(image, np.float64), texcoord) - below
 
 
 def visibility_product(axis_local, sharpness, amplitude, theta_d):

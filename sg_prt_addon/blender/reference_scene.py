@@ -22,13 +22,13 @@ def _texture_lookup(params, images):
         for name in ("diffuse_color", "specular_color"):
             colour = np.broadcast_to(np.asarray(getattr(params, name), np.float64), (count, 3))
             if name in images:
-                colour = colour * shading.sample_bilinear(images[name], uv)[:, :3]
+                colour = colour * shading.sample_texture(images[name], uv)[:, :3]
             values[name] = colour
         model_parameters = {}
         for name in _MODEL_PARAMETERS[params.model]:
             value = np.full(count, float(getattr(params, name)))
             if name in images:
-                value = value * shading.sample_bilinear(images[name], uv)[:, 0]
+                value = value * shading.sample_texture(images[name], uv)[:, 0]
             model_parameters[name] = value
         values["specular_model"] = brdf.model_from_name(params.model, **model_parameters)
         return values

@@ -24,12 +24,14 @@ exact formulas stay finite at grazing angles.
 
 Isotropic models map their parameter to one SG lobe analytically (like eq. 12).
 The mappings of CookTorranceBeckmann, BlinnPhong, WardIsotropic and GGX are
-L2-optimal fits (derived by ndf_fit.derive_isotropic_mapping and frozen here as
+L2-optimal fits (derived by ndf_fit.derive_isotropic_mapping and frozen in ndf_fit as
 polynomials in the lobe width); CookTorrance keeps the paper's eq. 12.
 """
 from dataclasses import dataclass
 
 import numpy as np
+
+from . import ndf_fit
 
 COSINE_EPSILON = 1e-7
 INV_PI = 1.0 / np.pi
@@ -166,51 +168,6 @@ def _frame_lobes(parameter, sharpness, amplitude):
     return axis, sharpness[..., None].copy(), amplitude[..., None].copy()
 
 
-def _polynomial(coefficients, x):
-    """sum_k c_k x^k by Horner (coefficients lowest order first)."""
-    result = np.zeros_like(x) + coefficients[-1]
-    for c in coefficients[-2::-1]:
-        result = result * x + c
-    return result
-
-
-# L2-optimal single SG lobe of an isotropic NDF, as a function of the lobe width w
-# (the model's angular width: m, alpha, or sqrt(2/exponent)):
-#   sharpness = SHARPNESS(w) / w^2,  amplitude = AMPLITUDE(w) * D(h = n).
-# Fitted by ndf_fit.derive_isotropic_mapping on 101 widths (degree 7, 7, 6, 6); the
-# tests check the mapping's relative L2 error exceeds the numerically optimal single
-# lobe's by at most 0.002 (GGX: 0.006) anywhere in width_range (measured: <= 1e-5,
-# 2e-4, 3e-6, 0.0055 at alpha = 1).  shaders/lib/brdf.glsl copies these numbers.
-# (derive_isotropic_mapping(..., endpoint_weight=30) gives GGX an excess <= 3e-4;
-# switch brdf.py and brdf.glsl together if adopted.)  Small widths tend to the
-# Gaussian limit (2, 1); GGX's heavy tails give (2.29, 0.87) instead.
-# fmt: off
-ISOTROPIC_MAPPINGS = {
-    "BECKMANN": {"width_range": (0.0, 1.0),
-        "sharpness": (2.0002526198839767, -0.018562042324853516, -0.7087810352685576, -1.780493452401246, 7.795476534850792, -5.224441602950464, -1.8573600001154729, 1.8313186768538343),
-        "amplitude": (1.0000788099487423, -0.00562487537421968, 0.45936658759780197, -0.4782415853046627, 1.8768790206320416, -0.723505986830146, -1.093140907789823, 0.6774600689844926)},
-    "BLINN_PHONG": {"width_range": (0.0, 1.5),
-        "sharpness": (2.001247483300024, -0.0704030099405333, 1.8252868204860242, -3.7366710387171747, 7.990337405162444, -7.976517234021651, 3.6090854215670936, -0.6165165884429983),
-        "amplitude": (1.0001482120242338, -0.009229085969026461, 0.24259176162034488, -0.5769981443748883, 1.304434552867832, -1.4708046288958752, 0.7476278795213421, -0.1413828848427673)},
-    "WARD_ISO": {"width_range": (0.0, 1.0),
-        "sharpness": (2.0000452113496068, -0.002050309015127145, 3.0147624933803696, 0.02079098217477974, -1.5775218851571589, 1.4289044928620722, -0.4515437794950395),
-        "amplitude": (1.0000361029442135, -0.002018784963236324, 0.39782446238486135, -0.08061386777996582, -0.513448758758516, 0.5383190127812337, -0.17224374461564965)},
-    "GGX": {"width_range": (0.0, 1.0),
-        "sharpness": (2.2949071322803056, -1.8169547610727137, 17.634426696713284, -89.52143467300904, 162.11135492098055, -126.49092884708091, 35.775580872045374),
-        "amplitude": (0.868594309075077, -0.47084346810594657, 5.078988403062825, -20.927444128961213, 34.85993749976531, -24.56259538488302, 6.147831356435162)},
-}
-# fmt: on
-
-
-def isotropic_mapping(kind, width):
-    """(sharpness * width^2, amplitude / D(n)) of the frozen L2 mapping for ``kind``."""
-    mapping = ISOTROPIC_MAPPINGS[kind]
-    w = np.clip(width, *mapping["width_range"])
-    # the GGX polynomial dips to -1e-3 at alpha = 1, where the fit is a constant (sharpness 0)
-    zero = np.zeros_like(w)
-    return np.maximum(_polynomial(mapping["sharpness"], w), zero), np.maximum(_polynomial(mapping["amplitude"], w), zero)
-
-
 # ----------------------------------------------------------------------------- sampling helpers
 
 def _uniforms(u, dtype):
@@ -228,6 +185,10 @@ def _from_spherical(cos_theta, phi):
 class _Microfacet:
     """Shared protocol; subclasses define ndf(h), _m_factor(wo, wi, h) on unit vectors,
     ndf_lobes, and either half_vector_pdf + sample_half_vector or their own sample/pdf."""
+
+    def ndf_widths(self):
+        """Angular widths of the NDF (quadrature breaks of the fits and their error measures)."""
+        return [self.roughness]
 
     def specular(self, wo, wi):
         """rho_s(o, i) = M_o(i) D(h) (eq. 9); 0 below the horizon of either direction."""
@@ -339,7 +300,7 @@ class CookTorranceBeckmann(CookTorrance):
 
     def ndf_lobes(self):
         m = self._m(_dtype(self.roughness))
-        scaled_sharpness, relative_amplitude = isotropic_mapping("BECKMANN", m)
+        scaled_sharpness, relative_amplitude = ndf_fit.isotropic_mapping("BECKMANN", m)
         return _frame_lobes(m, scaled_sharpness / (m * m), relative_amplitude / (np.pi * m * m))
 
 
@@ -349,6 +310,9 @@ class BlinnPhong(_Microfacet):
     Torrance-Sparrow V-cavity shadowing and no Fresnel (F = 1, the colour is ks):
     M_o(i) = S_CT / (4 (n.i)(n.o)).
     """
+
+    def ndf_widths(self):
+        return [np.sqrt(2 / np.maximum(self.exponent, 1e-6))]
     exponent: object = 100.0
 
     def _n(self, dtype):
@@ -368,8 +332,8 @@ class BlinnPhong(_Microfacet):
     def ndf_lobes(self):
         n = self._n(_dtype(self.exponent))
         width = np.sqrt(2 / np.maximum(n, np.asarray(1e-6, n.dtype)))
-        scaled_sharpness, relative_amplitude = isotropic_mapping("BLINN_PHONG", width)
-        sharpness = scaled_sharpness / np.square(np.clip(width, *ISOTROPIC_MAPPINGS["BLINN_PHONG"]["width_range"]))
+        scaled_sharpness, relative_amplitude = ndf_fit.isotropic_mapping("BLINN_PHONG", width)
+        sharpness = scaled_sharpness / np.square(np.clip(width, *ndf_fit.ISOTROPIC_MAPPINGS["BLINN_PHONG"]["width_range"]))
         return _frame_lobes(n, sharpness, relative_amplitude * (n + 2) / (2 * np.pi))
 
     def half_vector_pdf(self, h):
@@ -388,6 +352,9 @@ class WardAnisotropic(_Microfacet):
     so M does not depend on h at all.  SG lobes: K free-axis lobes from the
     precomputed anisotropy table of ndf_fit (see ndf_fit.anisotropic_lobes).
     """
+
+    def ndf_widths(self):
+        return [self.alpha_x, self.alpha_y]
     alpha_x: object = 0.2
     alpha_y: object = 0.05
 
@@ -414,7 +381,6 @@ class WardAnisotropic(_Microfacet):
         shaders/resources/anisotropic_lobes.glsl, does not apply it yet).  refine (scalar
         parameters only) fits the exact D on the sphere from there
         (ndf_fit.refined_anisotropic_lobes, cached)."""
-        from . import ndf_fit
         if refine:
             return ndf_fit.refined_anisotropic_lobes(self, lobe_count, "WARD_ISO" if broad_lobe_correction else None)
         ax, ay = self._alphas(_dtype(self.alpha_x, self.alpha_y))
@@ -433,6 +399,9 @@ class WardAnisotropic(_Microfacet):
 @dataclass(frozen=True, eq=False)
 class WardIsotropic(WardAnisotropic):
     """Isotropic Ward (alpha_x = alpha_y = alpha): one SG lobe by the frozen L2 mapping."""
+
+    def ndf_widths(self):
+        return [self.alpha_x]
     alpha_x: object = 0.2
     alpha_y: object = None
 
@@ -442,7 +411,7 @@ class WardIsotropic(WardAnisotropic):
 
     def ndf_lobes(self):
         alpha, _ = self._alphas(_dtype(self.alpha_x))
-        scaled_sharpness, relative_amplitude = isotropic_mapping("WARD_ISO", alpha)
+        scaled_sharpness, relative_amplitude = ndf_fit.isotropic_mapping("WARD_ISO", alpha)
         return _frame_lobes(alpha, scaled_sharpness / (alpha * alpha),
                             relative_amplitude / (np.pi * alpha * alpha))
 
@@ -455,6 +424,9 @@ class AshikhminShirley(_Microfacet):
     Split D = sqrt((nu+1)(nv+1))/(2 pi) (n.h)^e (integral of D dw_h = 1),
     M_o(i) = F(h.k) / (4 (h.k) max(n.i, n.o)).  Sampling is A-S's own (p_h = D exactly).
     """
+
+    def ndf_widths(self):
+        return [np.sqrt(2 / np.maximum(self.nu, 1e-6)), np.sqrt(2 / np.maximum(self.nv, 1e-6))]
     nu: object = 75.0
     nv: object = 1200.0
     rf0: object = 0.05
@@ -483,7 +455,6 @@ class AshikhminShirley(_Microfacet):
         (the small-angle Gaussian of (n.h)^e).  broad_lobe_correction: the Blinn-Phong
         L2 mapping (same (n.h)^n shape) at the geometric-mean width; refine: see
         WardAnisotropic."""
-        from . import ndf_fit
         if refine:
             return ndf_fit.refined_anisotropic_lobes(self, lobe_count, "BLINN_PHONG" if broad_lobe_correction else None)
         nu, nv = self._exponents(_dtype(self.nu, self.nv))
@@ -514,6 +485,9 @@ class GGX(_Microfacet):
     height-correlated Smith G = 1/(1 + Lambda(i) + Lambda(o)), no Fresnel:
     M_o(i) = G / (4 (n.i)(n.o)).  Sampling: visible normals (Heitz 2018).
     """
+
+    def ndf_widths(self):
+        return [self.roughness ** 2]
     roughness: object = 0.3
 
     def _alpha(self, dtype):
@@ -546,11 +520,10 @@ class GGX(_Microfacet):
         alpha = self._alpha(_dtype(self.roughness))
         peak = 1 / (np.pi * alpha * alpha)
         if lobe_count == 1:
-            scaled_sharpness, relative_amplitude = isotropic_mapping("GGX", alpha)
+            scaled_sharpness, relative_amplitude = ndf_fit.isotropic_mapping("GGX", alpha)
             return _frame_lobes(alpha, scaled_sharpness / (alpha * alpha), relative_amplitude * peak)
         if lobe_count != 2:
             raise ValueError("GGX has 1- and 2-lobe fits")
-        from . import ndf_fit
         return ndf_fit.ggx_two_lobes(alpha)
 
     def sample(self, wo, u):

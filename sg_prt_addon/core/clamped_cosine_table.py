@@ -23,6 +23,7 @@ import functools
 
 import numpy as np
 
+from . import texture_fetch
 from .clamped_cosine import _cosine, clamped_cosine_exact_from_cosine
 
 COLUMNS = 384
@@ -80,8 +81,6 @@ def clamped_cosine_table(columns=COLUMNS, rows=ROWS):
 def clamped_cosine_from_table(cosine, sharpness, table=None):
     """I(c, lambda) with unit amplitude read from the table as the GPU's bilinear filter reads it
     (GLSL: clamped_cosine_tabulated, step for step); lambda <= 0 (or NaN) is pi, like clamped_cosine_from_cosine."""
-    from .shading import sample_bilinear       # the GPU's bilinear fetch; shading imports this module
-
     table = clamped_cosine_table() if table is None else table
     rows, columns = table.shape[:2]
     cosine, sharpness = np.broadcast_arrays(np.asarray(cosine, np.float64), np.asarray(sharpness, np.float64))
@@ -90,7 +89,7 @@ def clamped_cosine_from_table(cosine, sharpness, table=None):
     c = np.clip(cosine, -1.0, 1.0)
     size = np.array([columns, rows], np.float64)
     position = np.stack([column_coordinate(lam), 0.5 + 0.5 * row_coordinate(c, lam)], axis=-1)
-    texel = sample_bilinear(table, (position * (size - 1.0) + 0.5) / size)     # texel centres at the ends
+    texel = texture_fetch.bilinear(table, (position * (size - 1.0) + 0.5) / size)     # texel centres at the ends
     value = np.pi / (1.0 + lam / 3.0) * texel[..., 0] * texel[..., 1]
     return np.where(broad, np.pi, value)
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import equirect, sg
+from . import equirect, sg, texture_fetch
 
 DEFAULT_MIN_SHARPNESS = 0.125
 DEFAULT_MAX_SHARPNESS = 2048.0
@@ -346,24 +346,6 @@ def prefilter_environment(equirect_image, levels=None, size=256, levels_per_octa
 
 # -- lookup (numpy mirror of the GLSL) -------------------------------------------------
 
-def _bilinear_clamp(layer_stack, layer_index, s, t):
-    """Hardware bilinear filtering at texel centres with clamp-to-edge: texcoords (s, t) in [0, 1]."""
-    size = layer_stack.shape[1]
-    x = s * size - 0.5
-    y = t * size - 0.5
-    x0 = np.floor(x)
-    y0 = np.floor(y)
-    fx = (x - x0)[..., None]
-    fy = (y - y0)[..., None]
-    x0 = x0.astype(np.int64)
-    y0 = y0.astype(np.int64)
-    xa, xb = np.clip(x0, 0, size - 1), np.clip(x0 + 1, 0, size - 1)
-    ya, yb = np.clip(y0, 0, size - 1), np.clip(y0 + 1, 0, size - 1)
-    top = layer_stack[layer_index, ya, xa] * (1 - fx) + layer_stack[layer_index, ya, xb] * fx
-    bottom = layer_stack[layer_index, yb, xa] * (1 - fx) + layer_stack[layer_index, yb, xb] * fx
-    return top * (1 - fy) + bottom * fy
-
-
 def blend_parameter(prefiltered, sharpness):
     """Continuous layer index: (log2(lambda) - log2(lambda_0)) * levels_per_octave, clamped to the levels."""
     sharpness = np.asarray(sharpness, dtype=np.float32)
@@ -401,7 +383,7 @@ def lookup(prefiltered, axis, sharpness):
     for index in (lower, upper):
         s = coords[..., 0] * prefiltered.texcoord_scale[index] + prefiltered.texcoord_offset[index]
         t = coords[..., 1] * prefiltered.texcoord_scale[index] + prefiltered.texcoord_offset[index]
-        values.append(_bilinear_clamp(prefiltered.layers, index, s, t))
+        values.append(texture_fetch.bilinear(prefiltered.layers, np.stack([s, t], axis=-1), layer=index))
     result = values[0] + (values[1] - values[0]) * fraction
     # below the broadest level: affine in lambda towards the mean radiance at lambda = 0
     below = np.clip(np.nan_to_num(np.asarray(sharpness, dtype=np.float32), nan=0.0)

@@ -32,7 +32,7 @@
   the rest.
 * ``ggx_two_lobe_table``: 2-lobe L2 fits of GGX over log alpha (alpha-normalized).
 * ``derive_isotropic_mapping``: the L2-optimal 1-lobe fit over a width grid and
-  a polynomial through it (the frozen coefficients of brdf.ISOTROPIC_MAPPINGS).
+  a polynomial through it (the frozen coefficients of ISOTROPIC_MAPPINGS).
 * ``ndf_l2_error`` / ``brdf_relative_rmse``: the two error measures the tests
   and benchmarks/accuracy/ndf_fit.py report.
 """
@@ -217,7 +217,7 @@ def derive_isotropic_mapping(ndf_of_width, peak_of_width, widths, degree=5, endp
 
     ndf_of_width(theta, width) -> D; peak_of_width(width) -> D(n).  The fitted
     quantities are sharpness * width^2 and amplitude / D(n), polynomials in width
-    (lowest order first), as stored in brdf.ISOTROPIC_MAPPINGS.
+    (lowest order first), as stored in ISOTROPIC_MAPPINGS.
     Returns (sharpness_coefficients, amplitude_coefficients, table (W, 3) of
     width, scaled sharpness, relative amplitude).
     """
@@ -237,6 +237,51 @@ def derive_isotropic_mapping(ndf_of_width, peak_of_width, widths, degree=5, endp
     sharpness_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 1], degree, w=fit_weights)
     amplitude_coefficients = np.polynomial.polynomial.polyfit(table[:, 0], table[:, 2], degree, w=fit_weights)
     return sharpness_coefficients, amplitude_coefficients, table
+
+
+def _polynomial(coefficients, x):
+    """sum_k c_k x^k by Horner (coefficients lowest order first)."""
+    result = np.zeros_like(x) + coefficients[-1]
+    for c in coefficients[-2::-1]:
+        result = result * x + c
+    return result
+
+
+# L2-optimal single SG lobe of an isotropic NDF, as a function of the lobe width w
+# (the model's angular width: m, alpha, or sqrt(2/exponent)):
+#   sharpness = SHARPNESS(w) / w^2,  amplitude = AMPLITUDE(w) * D(h = n).
+# Fitted by derive_isotropic_mapping on 101 widths (degree 7, 7, 6, 6); the
+# tests check the mapping's relative L2 error exceeds the numerically optimal single
+# lobe's by at most 0.002 (GGX: 0.006) anywhere in width_range (measured: <= 1e-5,
+# 2e-4, 3e-6, 0.0055 at alpha = 1).  shaders/lib/brdf.glsl copies these numbers.
+# (derive_isotropic_mapping(..., endpoint_weight=30) gives GGX an excess <= 3e-4;
+# switch this table and brdf.glsl together if adopted.)  Small widths tend to the
+# Gaussian limit (2, 1); GGX's heavy tails give (2.29, 0.87) instead.
+# fmt: off
+ISOTROPIC_MAPPINGS = {
+    "BECKMANN": {"width_range": (0.0, 1.0),
+        "sharpness": (2.0002526198839767, -0.018562042324853516, -0.7087810352685576, -1.780493452401246, 7.795476534850792, -5.224441602950464, -1.8573600001154729, 1.8313186768538343),
+        "amplitude": (1.0000788099487423, -0.00562487537421968, 0.45936658759780197, -0.4782415853046627, 1.8768790206320416, -0.723505986830146, -1.093140907789823, 0.6774600689844926)},
+    "BLINN_PHONG": {"width_range": (0.0, 1.5),
+        "sharpness": (2.001247483300024, -0.0704030099405333, 1.8252868204860242, -3.7366710387171747, 7.990337405162444, -7.976517234021651, 3.6090854215670936, -0.6165165884429983),
+        "amplitude": (1.0001482120242338, -0.009229085969026461, 0.24259176162034488, -0.5769981443748883, 1.304434552867832, -1.4708046288958752, 0.7476278795213421, -0.1413828848427673)},
+    "WARD_ISO": {"width_range": (0.0, 1.0),
+        "sharpness": (2.0000452113496068, -0.002050309015127145, 3.0147624933803696, 0.02079098217477974, -1.5775218851571589, 1.4289044928620722, -0.4515437794950395),
+        "amplitude": (1.0000361029442135, -0.002018784963236324, 0.39782446238486135, -0.08061386777996582, -0.513448758758516, 0.5383190127812337, -0.17224374461564965)},
+    "GGX": {"width_range": (0.0, 1.0),
+        "sharpness": (2.2949071322803056, -1.8169547610727137, 17.634426696713284, -89.52143467300904, 162.11135492098055, -126.49092884708091, 35.775580872045374),
+        "amplitude": (0.868594309075077, -0.47084346810594657, 5.078988403062825, -20.927444128961213, 34.85993749976531, -24.56259538488302, 6.147831356435162)},
+}
+# fmt: on
+
+
+def isotropic_mapping(kind, width):
+    """(sharpness * width^2, amplitude / D(n)) of the frozen L2 mapping for ``kind``."""
+    mapping = ISOTROPIC_MAPPINGS[kind]
+    w = np.clip(width, *mapping["width_range"])
+    # the GGX polynomial dips to -1e-3 at alpha = 1, where the fit is a constant (sharpness 0)
+    zero = np.zeros_like(w)
+    return np.maximum(_polynomial(mapping["sharpness"], w), zero), np.maximum(_polynomial(mapping["amplitude"], w), zero)
 
 
 def _ggx_normalized(theta, alpha):
@@ -391,7 +436,7 @@ def fit_ndf(ndf, lobe_count, width_hint=0.1, isotropic=None):
 @functools.lru_cache(maxsize=256)
 def _refined_lobes(model_class, parameters, lobe_count, mapping_kind):
     model = model_class(**dict(parameters))
-    widths = model_widths(model)
+    widths = model.ndf_widths()
     width_x, width_y = widths if len(widths) == 2 else widths * 2
     peak = float(model.ndf(np.array([0.0, 0.0, 1.0])))
     start = anisotropic_lobes(np.float64(width_x), np.float64(width_y), peak, lobe_count, mapping_kind)
@@ -522,7 +567,7 @@ def anisotropic_lobes(width_x, width_y, peak, lobe_count, mapping_kind=None):
     """K SG lobes of an anisotropic NDF with small-angle Gaussian widths (width_x, width_y)
     (slopes) and peak value D(n), from the normalized table; arrays broadcast.
 
-    mapping_kind (a key of brdf.ISOTROPIC_MAPPINGS: "WARD_ISO" for Ward, "BLINN_PHONG"
+    mapping_kind (a key of ISOTROPIC_MAPPINGS: "WARD_ISO" for Ward, "BLINN_PHONG"
     for Ashikhmin-Shirley) corrects the small-angle scaling for broad lobes: every
     lobe's sharpness is multiplied by S(w)/2 and amplitude by A(w), the isotropic L2
     mapping at the geometric-mean width w = sqrt(width_x width_y).  Exact for the
@@ -553,77 +598,19 @@ def anisotropic_lobes(width_x, width_y, peak, lobe_count, mapping_kind=None):
     sharpness = entry[..., 1] / (long_width * long_width)[..., None]
     amplitude = entry[..., 2] * peak[..., None]
     if mapping_kind is not None:
-        from . import brdf
-        scaled_sharpness, relative_amplitude = brdf.isotropic_mapping(
+        scaled_sharpness, relative_amplitude = isotropic_mapping(
             mapping_kind, np.sqrt(width_x.astype(np.float64) * width_y.astype(np.float64)))
         sharpness = sharpness * (0.5 * scaled_sharpness)[..., None]
         amplitude = amplitude * relative_amplitude[..., None]
     return axis, sharpness.astype(dtype), amplitude.astype(dtype)
 
 
-def isotropic_model_of_width(kind, width):
-    """The brdf model whose 1-lobe mapping ``kind`` (a key of brdf.ISOTROPIC_MAPPINGS) is
-    parametrized by ``width``, and its peak D(n)."""
-    from . import brdf
-    if kind == "BECKMANN":
-        return brdf.CookTorranceBeckmann(roughness=width), 1 / (np.pi * width * width)
-    if kind == "BLINN_PHONG":
-        exponent = 2 / (width * width)
-        return brdf.BlinnPhong(exponent=exponent), (exponent + 2) / (2 * np.pi)
-    if kind == "WARD_ISO":
-        return brdf.WardIsotropic(alpha_x=width), 1 / (np.pi * width * width)
-    if kind == "GGX":
-        return brdf.GGX(roughness=np.sqrt(width)), 1 / (np.pi * width * width)
-    raise ValueError(kind)
-
-
-def isotropic_ndf_of_width(kind):
-    """ndf_of_width(theta, width) -> D(theta) / D(n) for derive_isotropic_mapping."""
-    def ndf_of_width(theta, width):
-        model, peak = isotropic_model_of_width(kind, width)
-        h = np.stack([np.sin(theta), np.zeros_like(theta), np.cos(theta)], axis=-1)
-        return model.ndf(h) / peak
-    return ndf_of_width
-
-
-def isotropic_mapping_errors(kind, widths):
-    """Relative L2 (hemisphere) of the frozen brdf mapping and of the L2-optimal
-    single lobe, per width: (mapping_error (W,), optimal_error (W,))."""
-    from . import brdf
-    mapping_errors, optimal_errors = [], []
-    ndf_of_width = isotropic_ndf_of_width(kind)
-    for width in np.asarray(widths, np.float64):
-        theta, weights = polar_quadrature([width])
-        target = ndf_of_width(theta, width)
-        scaled_sharpness, relative_amplitude = brdf.isotropic_mapping(kind, np.float64(width))
-        lobe = relative_amplitude * np.exp(-scaled_sharpness / width ** 2 * 2 * np.sin(0.5 * theta) ** 2)
-        mapping_errors.append(relative_l2(target, lobe, weights))
-        optimal_errors.append(fit_isotropic(target, theta, weights, 1)[2])
-    return np.array(mapping_errors), np.array(optimal_errors)
-
-
 # ----------------------------------------------------------------------------- error measures
-
-def model_widths(model):
-    """Angular widths of a model's NDF (for quadrature breaks)."""
-    from . import brdf
-    if isinstance(model, brdf.AshikhminShirley):
-        return [np.sqrt(2 / np.maximum(model.nu, 1e-6)), np.sqrt(2 / np.maximum(model.nv, 1e-6))]
-    if isinstance(model, brdf.WardIsotropic):
-        return [model.alpha_x]
-    if isinstance(model, brdf.WardAnisotropic):
-        return [model.alpha_x, model.alpha_y]
-    if isinstance(model, brdf.GGX):
-        return [model.roughness ** 2]
-    if isinstance(model, brdf.BlinnPhong):
-        return [np.sqrt(2 / np.maximum(model.exponent, 1e-6))]
-    return [model.roughness]
-
 
 def ndf_l2_error(model, lobes, nodes_per_segment=24, phi_count=192):
     """Relative L2 over the hemisphere of the SG mixture ``lobes`` = (axis (K,3), sharpness (K,),
     amplitude (K,)) against the model's exact D (uniform-parameter models)."""
-    directions, weights = hemisphere_quadrature(model_widths(model), nodes_per_segment, phi_count)
+    directions, weights = hemisphere_quadrature(model.ndf_widths(), nodes_per_segment, phi_count)
     axis, sharpness, amplitude = (np.asarray(a, np.float64) for a in lobes)
     cosine = directions @ axis.T
     approximation = np.sum(amplitude * np.exp(sharpness * np.minimum(cosine - 1, 0)), axis=-1)

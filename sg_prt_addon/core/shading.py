@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import brdf, clamped_cosine, env_prefilter, equirect, ggx_albedo, lights, sg, warp
+from . import brdf, clamped_cosine, env_prefilter, equirect, ggx_albedo, lights, sg, texture_fetch, warp
 
 FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
@@ -140,7 +140,7 @@ def ssdf_decode_packed(rows, basis_texture, local_direction):
     texcoord, below = decode.texcoord_of(local_direction, resolution)        # (N, K, 2), (N, K)
     images = np.asarray(basis_texture, np.float64).transpose(0, 3, 1, 2).reshape(4 * layers, resolution,
                                                                                resolution)
-    samples = decode.sample_bilinear(images, texcoord.reshape(-1, 2)).reshape(
+    samples = texture_fetch.bilinear_channels_first(images, texcoord.reshape(-1, 2)).reshape(
         (4 * layers,) + texcoord.shape[:-1])                                    # (4L, N, K)
     value = np.einsum("cnk,nc->nk", samples, np.asarray(rows, np.float64)[:, :4 * layers])
     return (value - below).astype(FLOAT)
@@ -217,7 +217,7 @@ def model_albedo(model, params, view_local):
         return None
     table = ggx_albedo.albedo_table()[..., None]
     s, t = ggx_albedo.table_coordinates(np.asarray(view_local, FLOAT)[:, 2], np.asarray(params["roughness"], FLOAT))
-    return sample_bilinear(table, np.stack([s, t], axis=-1))[:, 0]
+    return sample_texture(table, np.stack([s, t], axis=-1))[:, 0]
 
 
 def environment_tail(albedo, slice_axis, slice_sharpness, slice_cosine, warp_mode=None):
@@ -250,7 +250,7 @@ def environment_radiance(environment, axis, sharpness):
     u, v = equirect.direction_to_uv(sg.normalize(np.asarray(axis, FLOAT)))
     uv = np.stack([u, v], axis=-1).astype(FLOAT)
     image = np.asarray(environment.radiance, FLOAT)[::-1, :, :3]          # the texture's rows: t = 0 at the bottom
-    raw = sample_bilinear(image, uv.reshape(-1, 2)).reshape(uv.shape[:-1] + (3,))
+    raw = sample_texture(image, uv.reshape(-1, 2)).reshape(uv.shape[:-1] + (3,))
     return (value + (raw - value) * beyond).astype(FLOAT)
 
 
@@ -575,22 +575,9 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * specular).astype(FLOAT)
 
 
-# --------------------------------------------------------------------------- texture sampling
-
-def sample_bilinear(image, uv):
-    """GPU-style bilinear fetch with clamp-to-edge: image (H, W, C) with row 0 at t = 0
-    (Blender's pixel order), uv (N, 2) -> (N, C) float32."""
-    height, width = image.shape[:2]
-    x = np.asarray(uv[..., 0], FLOAT) * width - FLOAT(0.5)
-    y = np.asarray(uv[..., 1], FLOAT) * height - FLOAT(0.5)
-    x0, y0 = np.floor(x), np.floor(y)
-    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
-    x0, y0 = x0.astype(np.int64), y0.astype(np.int64)
-    xa, xb = np.clip(x0, 0, width - 1), np.clip(x0 + 1, 0, width - 1)
-    ya, yb = np.clip(y0, 0, height - 1), np.clip(y0 + 1, 0, height - 1)
-    low = image[ya, xa] * (1 - fx) + image[ya, xb] * fx
-    high = image[yb, xa] * (1 - fx) + image[yb, xb] * fx
-    return (low * (1 - fy) + high * fy).astype(FLOAT)
+def sample_texture(image, uv):
+    """A material texture or table (H, W, C) read as the GPU reads it, as float32 (N, C)."""
+    return texture_fetch.bilinear(image, np.asarray(uv, FLOAT)).astype(FLOAT)
 
 
 SCALAR_SLOTS = {"roughness": "roughness", "ior": "ior", "exponent": "exponent", "alpha_x": "alpha_x",
@@ -616,7 +603,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
         tangent = np.asarray(tangent, FLOAT)
         if "normal_map" in textures:
             shading_normal = apply_normal_map(shading_normal, tangent,
-                                              sample_bilinear(textures["normal_map"], uv)[:, :3],
+                                              sample_texture(textures["normal_map"], uv)[:, :3],
                                               FLOAT(material.normal_strength))
         shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
         return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
@@ -625,19 +612,19 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
     specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
     if "diffuse_color" in textures:
-        diffuse_color = diffuse_color * sample_bilinear(textures["diffuse_color"], uv)[:, :3]
+        diffuse_color = diffuse_color * sample_texture(textures["diffuse_color"], uv)[:, :3]
     if "specular_color" in textures:
-        specular_color = specular_color * sample_bilinear(textures["specular_color"], uv)[:, :3]
+        specular_color = specular_color * sample_texture(textures["specular_color"], uv)[:, :3]
     params = {}
     for name in SCALAR_SLOTS:
         value = np.full(count, getattr(material, name), FLOAT)
         if name in textures:
-            value = value * sample_bilinear(textures[name], uv)[:, 0]
+            value = value * sample_texture(textures[name], uv)[:, 0]
         params[name] = value
     shading_normal = np.asarray(normal, FLOAT)
     tangent = np.asarray(tangent, FLOAT)
     if "normal_map" in textures:
-        shading_normal = apply_normal_map(shading_normal, tangent, sample_bilinear(textures["normal_map"], uv)[:, :3],
+        shading_normal = apply_normal_map(shading_normal, tangent, sample_texture(textures["normal_map"], uv)[:, :3],
                                           FLOAT(material.normal_strength))
     shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
     model = material.model

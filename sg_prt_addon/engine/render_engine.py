@@ -7,7 +7,7 @@ import bpy
 import numpy as np
 
 from ..blender import export
-from ..core import camera as camera_module
+from . import anti_aliasing
 from . import renderer as renderer_module
 from . import scene_state
 from ..techniques.shader_sources import GBUFFER_OUTPUTS, MAX_POINT_LIGHTS, MAX_SUNS
@@ -229,7 +229,7 @@ def border_rect(render_settings, width, height):
 
 def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1):
     """Export, upload, draw and read back one frame; with ``samples`` > 1 the average of that many draws,
-    each with the projection moved by core.camera.pixel_jitter's sub-pixel offset (anti-aliasing).
+    each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset (anti-aliasing).
 
     Returns (passes: name -> (H, W, 4) float32 with row 0 at the bottom, the SceneState, timings).
     """
@@ -250,12 +250,12 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     timings["upload"] = time.perf_counter() - start
     start = time.perf_counter()
     background_alpha = 0.0 if scene.render.film_transparent else 1.0
-    offsets = camera_module.pixel_jitter(samples) if samples > 1 else np.zeros((1, 2))
+    offsets = anti_aliasing.pixel_jitter(samples) if samples > 1 else np.zeros((1, 2))
     passes = {}
     for offset in offsets:
         if samples > 1:        # the view-projection is in the scene block: upload it moved (nothing else is dirty)
             frame_camera = dataclasses.replace(
-                camera, projection=camera_module.jittered_projection(camera.projection, offset, width, height))
+                camera, projection=anti_aliasing.jittered_projection(camera.projection, offset, width, height))
             renderer.upload(state, state.consume_dirty(), frame_camera)
         else:
             frame_camera = camera

@@ -3,7 +3,7 @@ and the shadowed lobe integral against ray-traced visibility."""
 import numpy as np
 
 from sg_prt_addon.bake import decode, hemisphere_map, ssdf
-from sg_prt_addon.core import sg
+from sg_prt_addon.core import sg, texture_fetch
 
 
 def test_bilinear_is_exact_at_texel_centres_linear_between_and_clamped():
@@ -11,12 +11,12 @@ def test_bilinear_is_exact_at_texel_centres_linear_between_and_clamped():
     image = rng.normal(size=(8, 8))
     centres = (np.arange(8) + 0.5) / 8
     t, s = np.meshgrid(centres, centres, indexing="ij")
-    assert np.allclose(decode.sample_bilinear(image, np.stack([s, t], -1).reshape(-1, 2)), image.ravel())
+    assert np.allclose(texture_fetch.bilinear_channels_first(image, np.stack([s, t], -1).reshape(-1, 2)), image.ravel())
     # half-way between two texels in s: their mean
-    assert np.isclose(decode.sample_bilinear(image, np.array([[2 / 8, 0.5 / 8]]))[0], 0.5 * (image[0, 1] + image[0, 2]))
+    assert np.isclose(texture_fetch.bilinear_channels_first(image, np.array([[2 / 8, 0.5 / 8]]))[0], 0.5 * (image[0, 1] + image[0, 2]))
     # clamp to edge outside the outer texel centres
-    assert np.isclose(decode.sample_bilinear(image, np.array([[0.0, 0.0]]))[0], image[0, 0])
-    assert np.isclose(decode.sample_bilinear(image, np.array([[1.0, 0.3 / 8]]))[0], image[0, 7])
+    assert np.isclose(texture_fetch.bilinear_channels_first(image, np.array([[0.0, 0.0]]))[0], image[0, 0])
+    assert np.isclose(texture_fetch.bilinear_channels_first(image, np.array([[1.0, 0.3 / 8]]))[0], image[0, 7])
 
 
 def test_packed_layout_decodes_the_same():
@@ -34,7 +34,7 @@ def test_packed_layout_decodes_the_same():
     packed = decode.pack_coefficients(coefficients)
     assert texture.shape == (2, resolution, resolution, 4) and packed.shape == (50, 8)
     texcoord, below = decode.texcoord_of(direction, resolution)
-    fetched = decode.sample_bilinear(np.moveaxis(texture, -1, 1), texcoord)        # (L, 4, Q)
+    fetched = texture_fetch.bilinear_channels_first(np.moveaxis(texture, -1, 1), texcoord)        # (L, 4, Q)
     value = np.einsum("lcq,qlc->q", fetched, packed.reshape(50, 2, 4)) - below
     assert np.abs(value - expected).max() < 1e-5
 

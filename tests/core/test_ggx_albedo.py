@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from sg_prt_addon.core import brdf, ggx_albedo
-from sg_prt_addon.core.shading import sample_bilinear
+from sg_prt_addon.core.shading import sample_texture
 
 
 def _solid_angle_albedo(cos_o, roughness, nodes=700):
@@ -39,7 +39,7 @@ def test_bilinear_fetch_lands_on_the_texel_centres():
     table = ggx_albedo.albedo_table()
     grid = ggx_albedo.texel_centres()
     s, t = ggx_albedo.table_coordinates(grid[[3, 17, 31]], grid[[0, 9, 30]])
-    fetched = sample_bilinear(table[..., None], np.stack([s, t], -1))[:, 0]
+    fetched = sample_texture(table[..., None], np.stack([s, t], -1))[:, 0]
     np.testing.assert_allclose(fetched, table[[0, 9, 30], [3, 17, 31]], rtol=1e-5)
 
 

@@ -5,6 +5,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.optimize import approx_fprime
 
 from sg_prt_addon.core import brdf, ndf_fit, sg
+from validation import ndf_mappings
 
 
 @pytest.mark.parametrize("roughness, bound", [(0.045, 3e-4), (0.2, 5e-3), (0.5, 0.03), (0.8, 0.07)])
@@ -16,11 +17,11 @@ def test_cook_torrance_eq12_single_lobe(roughness, bound):
     assert ndf_fit.ndf_l2_error(model, (axis, sharpness, amplitude)) < bound
 
 
-@pytest.mark.parametrize("kind", sorted(brdf.ISOTROPIC_MAPPINGS))
+@pytest.mark.parametrize("kind", sorted(ndf_fit.ISOTROPIC_MAPPINGS))
 def test_isotropic_mappings_are_near_l2_optimal(kind):
-    low, high = brdf.ISOTROPIC_MAPPINGS[kind]["width_range"]
+    low, high = ndf_fit.ISOTROPIC_MAPPINGS[kind]["width_range"]
     widths = np.r_[np.linspace(0.01, high, 7), 0.99 * high]
-    mapping_error, optimal_error = ndf_fit.isotropic_mapping_errors(kind, widths)
+    mapping_error, optimal_error = ndf_mappings.isotropic_mapping_errors(kind, widths)
     allowed = 0.006 if kind == "GGX" else 0.002  # GGX: 0.0055 at alpha = 1 (a constant NDF)
     assert np.all(mapping_error <= optimal_error + allowed), (mapping_error - optimal_error)
 
@@ -103,7 +104,7 @@ def test_table_is_close_to_a_direct_fit():
     """The normalized table loses little against L-BFGS-B on the exact sphere NDF."""
     model = brdf.AshikhminShirley(nu=75.0, nv=1200.0)
     lobes = model.ndf_lobes(2)
-    directions, weights = ndf_fit.hemisphere_quadrature(ndf_fit.model_widths(model), 16, 128)
+    directions, weights = ndf_fit.hemisphere_quadrature(model.ndf_widths(), 16, 128)
     table_error = ndf_fit.relative_l2(model.ndf(directions), sg.mixture_evaluate(directions, *lobes), weights)
     *_, direct_error = ndf_fit.fit_anisotropic(model.ndf(directions), directions, weights, 2, initial=lobes,
                                                max_iterations=100)

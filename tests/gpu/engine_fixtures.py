@@ -15,11 +15,11 @@ def ensure_registered():
     sg_prt_addon.register() unless another tier's fixture already did it."""
     import bpy
     import sg_prt_addon
-    from sg_prt_addon import engine
+    from sg_prt_addon import registration
 
     if not hasattr(bpy.types.Material, "sgprt"):
         sg_prt_addon.register()
-    for cls in engine.classes:
+    for cls in registration.ENGINE_CLASSES:
         if not getattr(cls, "is_registered", False):
             bpy.utils.register_class(cls)
 

@@ -12,9 +12,9 @@ def engine(blender):
 
 
 def test_engine_class_contract(engine):
-    from sg_prt_addon import engine as engine_package
+    from sg_prt_addon import registration
 
-    (cls,) = engine_package.classes
+    (cls,) = registration.ENGINE_CLASSES
     assert cls.bl_idname == "SG_PRT" and cls.bl_label == "SG-PRT"
     assert cls.bl_use_gpu_context and not cls.bl_use_preview
 
@@ -144,7 +144,7 @@ def test_environment_background_follows_blender_mapping(engine):
     near = np.c_[ndc, -np.ones(len(ndc)), np.ones(len(ndc))] @ inverse.T
     direction = far[:, :3] / far[:, 3:] - near[:, :3] / near[:, 3:]
     u, v = equirect.direction_to_uv(direction / np.linalg.norm(direction, axis=1, keepdims=True))
-    expected = shading.sample_bilinear(pixels, np.stack([u, v], axis=1))[:, :3]
+    expected = shading.sample_texture(pixels, np.stack([u, v], axis=1))[:, :3]
     actual = result["passes"]["Combined"].reshape(-1, 4)
     away_from_seam = (u > 1.5 / 64) & (u < 1 - 1.5 / 64)
     assert away_from_seam.mean() > 0.8

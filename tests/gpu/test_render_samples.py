@@ -1,11 +1,11 @@
 """Render Samples (scene.sgprt.render_samples): final renders average frames moved by sub-pixel offsets
-(core.camera.pixel_jitter).  Four samples sample the same points as a render twice as large, so their
+(engine.anti_aliasing.pixel_jitter).  Four samples sample the same points as a render twice as large, so their
 average must equal that render box-filtered down (Cycles' 1-pixel box filter); the render panel shows it."""
 import numpy as np
 import pytest
 
 import engine_fixtures as fx
-from sg_prt_addon.core import camera
+from sg_prt_addon.engine import anti_aliasing
 
 
 @pytest.fixture(scope="module")
@@ -15,10 +15,10 @@ def engine(blender):
 
 
 def test_pixel_jitter_patterns():
-    grid = camera.pixel_jitter(4)
+    grid = anti_aliasing.pixel_jitter(4)
     np.testing.assert_allclose(sorted(map(tuple, grid)), [(-0.25, -0.25), (-0.25, 0.25), (0.25, -0.25), (0.25, 0.25)])
-    assert np.array_equal(camera.pixel_jitter(1), [[0.0, 0.0]])
-    r2 = camera.pixel_jitter(7)
+    assert np.array_equal(anti_aliasing.pixel_jitter(1), [[0.0, 0.0]])
+    r2 = anti_aliasing.pixel_jitter(7)
     assert r2.shape == (7, 2) and np.all(r2 >= -0.5) and np.all(r2 < 0.5)
     assert np.abs(r2.mean(axis=0)).max() < 1e-12         # centred: every stratum once per axis
     assert len(set(np.round(r2[:, 1], 9))) == 7

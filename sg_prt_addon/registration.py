@@ -1,27 +1,19 @@
 """Register and unregister everything the add-on adds to Blender, in dependency order."""
 import bpy
 
-from . import lobe_fit, panels, properties, visibility_bake
+from .blender import lobe_fit, panels, properties, visibility_bake
+from .engine.render_engine import SGPRT_RenderEngine
 
-
-def _engine_classes():
-    try:
-        from ..engine import classes
-    except ImportError as error:  # a broken install must say what is missing, not register half an add-on
-        raise RuntimeError(f"SG-PRT: the render engine package failed to import: {error}") from error
-    return classes
-
-
+ENGINE_CLASSES = (SGPRT_RenderEngine,)
 _registered_engine_classes = []
 
 
 def register():
-    engine_classes = _engine_classes()
     properties.register()
     panels.register()
     visibility_bake.register()
     lobe_fit.register()           # after panels: its panel's parent is SGPRT_PT_material
-    for cls in engine_classes:
+    for cls in ENGINE_CLASSES:
         bpy.utils.register_class(cls)
         _registered_engine_classes.append(cls)
 

@@ -1,0 +1,40 @@
+"""The GPU's bilinear texture fetch in numpy, for every mirror of a shader's texture read.
+
+GL_LINEAR with clamp-to-edge: texel k of a side of `size` texels has its centre at (k + 0.5) / size,
+and a coordinate between two centres mixes them linearly.  The tables (clamped cosine, GGX albedo),
+the prefiltered environment's layers, the SSDF basis and the material textures are all read this way.
+"""
+import numpy as np
+
+
+def bilinear(image, uv, layer=None):
+    """Samples of `image` at texture coordinates uv (..., 2) in [0, 1]^2 (u along a row, v across rows).
+
+    image: (H, W, ...) indexed [row, column], row 0 at v = 0 (the GPU's and Blender's order); with `layer`,
+    (L, H, W, ...) and layer (...) integer indices, as a texture array.  Returns (...) + image's trailing
+    dimensions.  The arithmetic is in uv's precision (float32 coordinates: the shader's, float64: a
+    reference's)."""
+    uv = np.asarray(uv)
+    dtype = np.result_type(uv.dtype, np.float32).type
+    first = 0 if layer is None else 1
+    height, width = image.shape[first], image.shape[first + 1]
+    x = uv[..., 0].astype(dtype) * dtype(width) - dtype(0.5)
+    y = uv[..., 1].astype(dtype) * dtype(height) - dtype(0.5)
+    x0, y0 = np.floor(x), np.floor(y)
+    trailing = (Ellipsis,) + (None,) * (image.ndim - 2 - first)
+    fx, fy = (x - x0)[trailing], (y - y0)[trailing]
+    x0, y0 = x0.astype(np.int64), y0.astype(np.int64)
+    xa, xb = np.clip(x0, 0, width - 1), np.clip(x0 + 1, 0, width - 1)
+    ya, yb = np.clip(y0, 0, height - 1), np.clip(y0 + 1, 0, height - 1)
+    index = () if layer is None else (layer,)
+    low = image[index + (ya, xa)] * (1 - fx) + image[index + (ya, xb)] * fx
+    high = image[index + (yb, xa)] * (1 - fx) + image[index + (yb, xb)] * fx
+    return low * (1 - fy) + high * fy
+
+
+def bilinear_channels_first(images, uv):
+    """bilinear of images laid out (..., H, W) (a stack of single-channel maps): (..., Q) at uv (Q, 2)."""
+    images = np.asarray(images)
+    moved = np.moveaxis(images.reshape((-1,) + images.shape[-2:]), 0, -1)          # (H, W, C)
+    samples = bilinear(moved, uv)                                                   # (Q, C)
+    return np.moveaxis(samples, -1, 0).reshape(images.shape[:-2] + samples.shape[:1])
