@@ -1,4 +1,4 @@
-"""Visibility bake speed and PCA error vs terms (sg_prt_addon/bake).
+"""Visibility bake speed and PCA error vs terms (sg_prt_addon/visibility).
 
 Procedural scenes (numpy only): a subdivided icosphere resting over a
 subdivided floor grid, about 5k, 20k (and 80k) vertices; every vertex is
@@ -16,8 +16,8 @@ import time
 
 import numpy as np
 
-from sg_prt_addon.bake import BakeOptions, bake_visibility, hemisphere_map
-from sg_prt_addon.core.raytrace import RayTracer
+from sg_prt_addon.visibility import BakeOptions, bake_visibility, hemisphere_map
+from sg_prt_addon.visibility.raytrace import RayTracer
 
 
 def icosphere(subdivisions):

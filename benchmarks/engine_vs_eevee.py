@@ -31,6 +31,7 @@ SECTION_TITLE = "## Engine frame vs EEVEE"
 def render_seconds():
     """Wall time of one render of the context's scene; raises if SG-PRT reported an error."""
     import bpy
+
     from sg_prt_addon.engine import render_engine
 
     render_engine.last_render.clear()
@@ -82,6 +83,7 @@ def viewport_redraws(redraws):
 
 def measure_scene(name, size, renders, redraws, eevee_samples):
     import bpy
+
     from benchmarks import matched_materials
     from examples import build_scenes
     from sg_prt_addon.engine import render_engine

@@ -7,10 +7,10 @@
 For each scene of examples/build_scenes.py (suzanne_courtyard, brushed_metal), in one process
 on one machine:
 
-1. the error reference: the Monte Carlo reference renderer (core.reference, exact direct light)
+1. the error reference: the Monte Carlo reference renderer (validation.reference, exact direct light)
    at enough samples per pixel for about ``--noise`` mean relative standard error, capped by a time
    budget (``--reference-seconds``, predicted from the 16-spp curve point); its noise floor
-   (core.image_error.rmse_noise_floor) is recorded and taken out of the errors;
+   (validation.image_error.rmse_noise_floor) is recorded and taken out of the errors;
 2. SG-PRT (``bpy.ops.render.render`` wall time after a warm-up render of the same setting, and
    the steady-state frame, median of ``render_engine.debug["timed_redraws"]`` redraws) at: no
    bake (unshadowed); visibility bake resolution 8 / 16 / 32 (the bake operator's default error
@@ -226,14 +226,14 @@ def markdown_section(data, image="images/error_vs_time.png"):
 
 
 def _frame_note(data):
-    """Runs made before blender/reference_scene.py gave the reference the engine's anisotropy frame
+    """Runs made before validation/reference_scene.py gave the reference the engine's anisotropy frame
     (commit 189bc1f) set that frame from the benchmark side and say so in their JSON."""
     fixed = sorted({name for info in data["scenes"].values()
                     for name in info.get("reference_object_axis_tangents", ())})
     if not fixed:
         return ""
     return (f"This run gave the reference the engine's object-axis anisotropy frame for {', '.join(fixed)} "
-            "from the benchmark side (the same tangents blender/reference_scene.py computes since commit "
+            "from the benchmark side (the same tangents validation/reference_scene.py computes since commit "
             "189bc1f; before it the reference took UV tangents). ")
 
 
@@ -306,7 +306,7 @@ class SceneRun:
     def score(self, image, against=None):
         """(relative RMSE, relative bias) of an image over the surface pixels; against: (reference, noise
         floor) in place of the error reference."""
-        from sg_prt_addon.core import image_error
+        from validation import image_error
         reference = self.reference if against is None else against[0]
         return (image_error.relative_rmse(image, reference, self.mask),
                 image_error.relative_mean_bias(image, reference, self.mask))
@@ -317,7 +317,7 @@ class SceneRun:
         row = make_row(self.name, method, setting, seconds, rmse, floor, relative_bias=bias,
                        load_average=_load(), **fields)
         if image is not None:       # per material (index into info["material_names"]): where the error is
-            from sg_prt_addon.core import image_error
+            from validation import image_error
             reference = self.reference if against is None else against[0]
             row["material_rmse"] = {
                 str(index): image_error.relative_rmse(image, reference, self.mask & (self.material_map == index))
@@ -335,8 +335,8 @@ class SceneRun:
 
         from examples import build_scenes
         from sg_prt_addon import render
-        from sg_prt_addon.blender.reference_scene import reference_inputs
-        from sg_prt_addon.core.raytrace import RayTracer
+        from sg_prt_addon.visibility.raytrace import RayTracer
+        from validation.reference_scene import reference_inputs
 
         render.ensure_registered()
         size = self.config["size"]
@@ -369,8 +369,8 @@ class SceneRun:
         floor; the 1-sample point (no standard error of its own) against the whole reference."""
         import numpy as np
 
-        from sg_prt_addon.core import image_error
-        from sg_prt_addon.core.reference import mean_relative_error, render_reference
+        from validation import image_error
+        from validation.reference import mean_relative_error, render_reference
 
         runs = []                                 # (spp, seconds, image, standard error)
         for spp in self.config["reference_curve"]:
@@ -479,8 +479,8 @@ class SceneRun:
                 for name, bake in bakes.items()}
 
     def engine_stage(self):
-        from sg_prt_addon.core import warp
         from sg_prt_addon.engine import render_engine, scene_state
+        from sg_prt_addon.spherical import warp
 
         config = self.config
         try:

@@ -4,7 +4,7 @@
 
 1. bpy.ops.sgprt.fit_lobes (synchronous execute(): read, factorize or fit, measure the fit error,
    store packed float images) on a generated MERL file (one texel: 1.46M bins factorized) and on
-   generated SVBRDF tables (core.brdf_generators.generate_svbrdf_table) of a few sizes: seconds
+   generated SVBRDF tables (validation.brdf_generators.generate_svbrdf_table) of a few sizes: seconds
    and texels/s, the stored fit_error.
 2. The 64 x 64 sphere of tests/gpu/test_fitted_reference.py: a GGX-like AnalyticMaterial tabulated
    as MERL, fitted with 2 lobes, rendered by the engine from the fit under courtyard.exr, scored
@@ -42,7 +42,9 @@ def main(argv=None):
 
     import engine_fixtures as fx
     from test_fitted_reference import ANALYTIC, score_fitted_sphere
-    from sg_prt_addon.core import brdf_generators, svbrdf_table
+
+    from sg_prt_addon.measured import svbrdf_table
+    from validation import brdf_generators
 
     fx.ensure_registered()
     with tempfile.TemporaryDirectory() as folder:

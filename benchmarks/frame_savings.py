@@ -10,7 +10,7 @@ Per scene (examples/build_scenes.py at --size, baked by the operator with its de
 - clamped-cosine terms: steady frame with the environment lobes' lambda-only terms read from the scene
   block vs computed per pixel (the surface source patched back to sg_clamped_cosine_integral);
 - clamped cosine from the table: steady frame with the lights', slice lobes' and products' integrals read
-  from core.clamped_cosine_table vs the closed form (the surface source patched back); image change;
+  from spherical.clamped_cosine_table vs the closed form (the surface source patched back); image change;
 - light visibility shared by its products: steady frame with the narrow lights' products taking the
   light's visibility (SHARED_LIGHT_VISIBILITY) vs a decode each NDF lobe; image change;
 - caches across renders: bpy.ops.render.render with the shader and environment-texture caches warm vs
@@ -45,11 +45,10 @@ CLOSED_FORM_CALL = "sg_clamped_cosine_integral("
 def frame(per_vertex=True, terms=True, table=True, shared_light=True):
     """(steady frame seconds, Combined) of one render with the chosen paths."""
     from benchmarks.engine_vs_eevee import steady_frame
-    from sg_prt_addon.core import shading
     from sg_prt_addon.engine import render_engine, shader_cache
-    from sg_prt_addon.techniques import sg_lobes, shader_sources
+    from sg_prt_addon.techniques import sg_lobes, sg_shading, shader_sources
 
-    rows, read, shares = (sg_lobes.diffuse_visibility_rows, shader_sources.read, shading.shares_light_visibility)
+    rows, read, shares = (sg_lobes.diffuse_visibility_rows, shader_sources.read, sg_shading.shares_light_visibility)
     substitutions = (([] if terms else [(TERMS_CALL, PER_PIXEL_CALL)])
                      + ([] if table else [(TABLE_CALL, CLOSED_FORM_CALL)]))
 
@@ -64,14 +63,14 @@ def frame(per_vertex=True, terms=True, table=True, shared_light=True):
     if not per_vertex:
         sg_lobes.diffuse_visibility_rows = lambda environment: 0
     if not shared_light:
-        shading.shares_light_visibility = lambda light_data, bounds: False
+        sg_shading.shares_light_visibility = lambda light_data, bounds: False
     shader_sources.read = patched_read
     shader_cache.clear_cache()
     try:
         seconds = steady_frame(REDRAWS)
     finally:
         sg_lobes.diffuse_visibility_rows, shader_sources.read = rows, read
-        shading.shares_light_visibility = shares
+        sg_shading.shares_light_visibility = shares
         shader_cache.clear_cache()
     return seconds, render_engine.last_render["passes"]["Combined"].copy()
 
@@ -102,6 +101,7 @@ def paired(rounds, new, old):
 
 def measure_scene(name, size, rounds):
     import bpy
+
     from examples import build_scenes
 
     build_scenes.SCENES[name](size)
@@ -144,6 +144,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import bpy
+
     from sg_prt_addon import render
 
     render.ensure_registered()

@@ -11,9 +11,8 @@ Stages, each timed on a size x size material (default 16):
 import sys
 import time
 
-import numpy as np
-
-from sg_prt_addon.core import brdf_generators, microfacet_fit
+from sg_prt_addon.measured import microfacet_fit
+from validation import brdf_generators
 
 FULL = 256 * 256
 

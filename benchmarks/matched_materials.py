@@ -3,7 +3,7 @@
 `match_scene(scene)` rewrites the node tree of every material the scene's meshes use from
 its ``material.sgprt`` settings, so EEVEE and Cycles render (as closely as Blender's nodes
 allow) the BRDF the SG-PRT engine and the Monte Carlo reference render
-(sg_prt_addon/core/brdf.py): Lambert ``kd / pi`` plus ``ks x`` the specular model.
+(sg_prt_addon/reflectance/brdf.py): Lambert ``kd / pi`` plus ``ks x`` the specular model.
 `configure_eevee` / `configure_cycles` set the render engines up for direct light only
 as far as each allows.  Only the node trees and render settings change; ``material.sgprt``
 (what SG-PRT and the reference read) is left alone.
@@ -54,7 +54,7 @@ Mapping per model (ours -> nodes) and the mismatches left:
 """
 import math
 
-RF0_ASHIKHMIN_SHIRLEY = 0.05          # core.brdf.AshikhminShirley's default rf0 (the engine's too)
+RF0_ASHIKHMIN_SHIRLEY = 0.05          # reflectance.brdf.AshikhminShirley's default rf0 (the engine's too)
 DIELECTRIC_IOR_OF_RF0 = (1 + math.sqrt(RF0_ASHIKHMIN_SHIRLEY)) / (1 - math.sqrt(RF0_ASHIKHMIN_SHIRLEY))
 
 

@@ -19,10 +19,9 @@ import time
 
 import numpy as np
 
-from sg_prt_addon.core.camera import Camera
-from sg_prt_addon.core.raytrace import RayTracer
-from sg_prt_addon.core.reference import (DirectionalLight, Material, PointLight, Scene, mean_relative_error,
-                                         render_reference)
+from sg_prt_addon.visibility.raytrace import RayTracer
+from validation.camera import Camera
+from validation.reference import DirectionalLight, Material, PointLight, Scene, mean_relative_error, render_reference
 
 
 def make_icosphere(subdivisions, radius=1.0, center=(0.0, 0.0, 0.0)):
@@ -54,7 +53,7 @@ def make_icosphere(subdivisions, radius=1.0, center=(0.0, 0.0, 0.0)):
 
 def make_sky(height=64, width=128):
     """Procedural equirect sky: blue-white gradient above, dark ground below, a bright sun patch."""
-    from sg_prt_addon.core.equirect import texel_directions
+    from sg_prt_addon.lighting.equirect import texel_directions
     directions = texel_directions(height, width)
     up = directions[..., 2:3]
     sky = np.where(up > 0, np.array([0.5, 0.7, 1.0]) * (0.4 + 0.6 * (1 - up)), np.array([0.15, 0.12, 0.1]))
@@ -87,8 +86,8 @@ def compare_with_cycles(size=64, cycles_samples=1024, reference_samples=64, glos
     import bpy
     import mathutils
 
-    from sg_prt_addon.core.brdf import GGX
-    from sg_prt_addon.core.lights import blender_point_light_intensity
+    from sg_prt_addon.lighting.lights import blender_point_light_intensity
+    from sg_prt_addon.reflectance.brdf import GGX
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene

@@ -4,7 +4,7 @@ resolution, or the PCA terms.
     .venv/bin/python -m benchmarks.shadow_edge [--update-doc]
 
 A diffuse sphere over a floor under a sun of angle 0.05 rad (black world, 96 x 96), baked with
-bake.pipeline at each setting (tests/gpu/engine_fixtures.bake_objects: every mesh occludes), rendered
+visibility.pipeline at each setting (tests/gpu/engine_fixtures.bake_objects: every mesh occludes), rendered
 by the engine and by the Monte Carlo reference at pixel centres (32 samples; the engine samples pixel
 centres too, so no anti-aliasing enters).  Scores over the floor pixels, and over the band of floor
 pixels within 3 pixels of the reference's lit/shadowed boundary; "penumbra pixels": pixels of that band
@@ -30,14 +30,14 @@ SETTINGS = (            # (floor segments, SSDF resolution, PCA terms: None = th
 
 def measure(segments, resolution, terms):
     import bpy  # noqa: F401  (the engine and the fixtures need it loaded)
+    import engine_fixtures as fx
     import numpy as np
     from scipy import ndimage
 
-    import engine_fixtures as fx
-    from sg_prt_addon.blender.reference_scene import reference_inputs
-    from sg_prt_addon.core import image_error
-    from sg_prt_addon.core.raytrace import RayTracer
-    from sg_prt_addon.core.reference import render_reference
+    from sg_prt_addon.visibility.raytrace import RayTracer
+    from validation import image_error
+    from validation.reference import render_reference
+    from validation.reference_scene import reference_inputs
 
     fx.ensure_registered()
     name = f"shadow_edge_{segments}_{resolution}_{terms}"

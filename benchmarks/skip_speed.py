@@ -238,6 +238,7 @@ class Cases:
 def render_frames(scene, redraws, force=None):
     """(steady-state frame times, variant keys drawn) of one final render."""
     import bpy
+
     from sg_prt_addon.engine import render_engine
 
     seen = set()
@@ -256,8 +257,10 @@ def render_frames(scene, redraws, force=None):
 def measure_updates(scene, repeats, environment_repeats):
     """Update rows, timed inside one render (render_engine.debug["after_frame"]): see the module docstring."""
     import bpy
+
     from sg_prt_addon.blender import export
-    from sg_prt_addon.engine import render_engine, renderer as renderer_module, scene_state
+    from sg_prt_addon.engine import render_engine, scene_state
+    from sg_prt_addon.engine import renderer as renderer_module
 
     forest = world_with_image("skip_forest", bpy.data.images.load(
         os.path.join(bpy.utils.system_resource("DATAFILES"), "studiolights", "world", "forest.exr")))
@@ -322,6 +325,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import bpy
+
     import sg_prt_addon
 
     if not hasattr(bpy.types.Material, "sgprt"):

@@ -39,13 +39,13 @@ process, by:
 
 Scores over the surface pixels (camera rays that hit a mesh, as benchmarks/error_vs_time.py finds
 them, eroded by one pixel to drop the silhouettes): relative RMSE and relative mean bias
-(sg_prt_addon.core.image_error) and HDR-FLIP (NVIDIA's ``flip_evaluator`` package, the mean of its
+(validation.image_error) and HDR-FLIP (NVIDIA's ``flip_evaluator`` package, the mean of its
 per-pixel error map over the same pixels; the test image is laid over the truth's background
 first, so a difference in the background does not bleed into the scored pixels through FLIP's
 filters; FLIP's exposure range comes from the truth image, the same for every method of a scene).
 The errors are raw: the truth's noise floor is reported beside them, not taken out.
 
-Lights: Blender's units as core.lights states them (the same for every renderer); point and spot
+Lights: Blender's units as lighting.lights states them (the same for every renderer); point and spot
 lights have Blender's "soft falloff" turned off, so Cycles renders the uniform sphere SG-PRT models
 (with it, a sphere light differs from a sphere closer than a few radii: diffuse_sphere_light's
 light is 4 radii away).
@@ -493,7 +493,7 @@ def _black_world(scene):
 
 def _light(scene, kind, location, energy, radius=0.0, target=(0.0, 0.0, 0.8)):
     """A light aimed at ``target``.  Point and spot lights turn Blender's soft falloff off: with it a
-    sphere light is not a uniform sphere closer than a few radii, and SG-PRT (core.lights) models the
+    sphere light is not a uniform sphere closer than a few radii, and SG-PRT (lighting.lights) models the
     sphere."""
     import bpy
     from mathutils import Vector
@@ -674,8 +674,8 @@ class SceneRun:
         import bpy
         from scipy import ndimage
 
-        from sg_prt_addon.blender.reference_scene import reference_inputs
-        from sg_prt_addon.core.raytrace import RayTracer
+        from sg_prt_addon.visibility.raytrace import RayTracer
+        from validation.reference_scene import reference_inputs
 
         size = self.config["size"]
         self.spec.build(size)
@@ -735,7 +735,7 @@ class SceneRun:
         return row
 
     def score_all(self):
-        from sg_prt_addon.core import image_error
+        from validation import image_error
 
         rows = []
         for row, image in self.pending:
@@ -866,7 +866,7 @@ class SceneRun:
                              noise_floor=self.noise_floor,
                              cycles_seconds_per_sample=(seeds[0][0] - one_seconds) / max(samples - 1, 1))
             seed_flip = hdr_flip(seeds[0][1], seeds[1][1], self.mask, background_mask=~self.surface)
-            from sg_prt_addon.core import image_error
+            from validation import image_error
             self.add("Cycles", f"{samples} spp x 2 seeds (truth)", self.truth_seconds, samples=samples,
                      seeds=list(TRUTH_SEEDS), seed_relative_rmse=image_error.relative_rmse(seeds[0][1], seeds[1][1],
                                                                                            self.mask),

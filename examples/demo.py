@@ -18,11 +18,11 @@ sys.path.insert(0, str(ROOT))
 import bpy  # noqa: E402
 
 from examples import build_scenes  # noqa: E402
-from sg_prt_addon import render  # noqa: E402
-from sg_prt_addon.blender.reference_scene import reference_inputs  # noqa: E402
-from sg_prt_addon.core import image_error  # noqa: E402
-from sg_prt_addon.core.raytrace import RayTracer  # noqa: E402
-from sg_prt_addon.core.reference import mean_relative_error, render_to_noise  # noqa: E402
+from sg_prt_addon import render
+from sg_prt_addon.visibility.raytrace import RayTracer
+from validation import image_error
+from validation.reference import mean_relative_error, render_to_noise
+from validation.reference_scene import reference_inputs
 
 SCENE = "suzanne_courtyard"
 

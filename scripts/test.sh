@@ -11,6 +11,9 @@ PYENV_VERSION=3.13.0 PYTHON=$python313 bash scripts/setup_venv.sh .venv-bpy52 re
 
 version() { "$1/bin/python" -c 'import bpy; print(bpy.app.version_string)'; }
 
+echo "== lint (ruff, pyproject.toml)"
+.venv/bin/ruff check .
+
 echo "== all tiers, bpy $(version .venv)"
 .venv/bin/python -m pytest tests -q -p no:cacheprovider "$@"
 

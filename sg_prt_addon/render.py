@@ -39,6 +39,7 @@ def open_blend(path):
 def ensure_registered():
     """Register the add-on once per process (the pip module has no add-on preferences)."""
     import bpy
+
     import sg_prt_addon
     if not hasattr(bpy.types.Material, "sgprt"):
         sg_prt_addon.register()

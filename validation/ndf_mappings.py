@@ -3,7 +3,7 @@ for: the model of a lobe width, its normalized NDF (what ndf_fit.derive_isotropi
 mapping's error next to the optimal single lobe's."""
 import numpy as np
 
-from sg_prt_addon.core import brdf, ndf_fit
+from sg_prt_addon.reflectance import brdf, ndf_fit
 
 
 def isotropic_model_of_width(kind, width):

@@ -2,8 +2,8 @@
 import numpy as np
 from scipy import integrate
 
-from sg_prt_addon.core import clamped_cosine as cc
-from sg_prt_addon.core import clamped_cosine_table
+from sg_prt_addon.spherical import clamped_cosine as cc
+from sg_prt_addon.spherical import clamped_cosine_table
 
 EXACT = "ring quadrature (Gauss-Legendre, ~1e-14)"
 

@@ -1,4 +1,4 @@
-"""Accuracy of what the SG technique adds to its GGX lobes (core.shading): the light tail (the model's
+"""Accuracy of what the SG technique adds to its GGX lobes (techniques.sg_shading): the light tail (the model's
 own BRDF at a light's centre), GGX's directional albedo table (the environment tail), the visible-part
 offset of partly occluded lobes, and environment lookups sharper than the top prefiltered layer.
 
@@ -8,7 +8,10 @@ the exact mean of a truncated Gaussian; brute-force summation of courtyard.exr.
 import numpy as np
 
 from benchmarks.accuracy.lighting import load_world
-from sg_prt_addon.core import brdf, env_prefilter, ggx_albedo, shading, sg
+from sg_prt_addon.lighting import env_prefilter
+from sg_prt_addon.reflectance import brdf, ggx_albedo
+from sg_prt_addon.spherical import sg
+from sg_prt_addon.techniques import sg_shading
 
 ROUGHNESS = (0.1, 0.3, 0.5)
 
@@ -32,11 +35,11 @@ def _point_light_rows():
         for theta_o in np.radians([0.0, 30.0, 60.0, 75.0]):
             view = np.array([[np.sin(theta_o), 0.0, np.cos(theta_o)]], np.float32)
             params = {"roughness": np.array([roughness], np.float32)}
-            axis, sharpness, amplitude = shading.specular_slice("GGX", params, 1, view)
+            axis, sharpness, amplitude = sg_shading.specular_slice("GGX", params, 1, view)
             cosine = np.einsum("mc,njc->nmj", directions, axis)
             slice_value = np.sum(amplitude[:, None] * np.exp(sharpness[:, None] * (cosine - 1)), -1)[0]
             exact = brdf.GGX(roughness=roughness).specular(np.broadcast_to(view, directions.shape), directions)
-            tail = shading.light_tail("GGX", params, view, np.eye(3, dtype=np.float32)[None], directions[None],
+            tail = sg_shading.light_tail("GGX", params, view, np.eye(3, dtype=np.float32)[None], directions[None],
                                       np.full((1, len(directions)), 1e6, np.float32),
                                       np.ones((1, len(directions)), np.float32), axis, sharpness, amplitude)[0]
             norm = np.sqrt(np.sum(weights * (exact * directions[:, 2]) ** 2))
@@ -56,13 +59,13 @@ def _albedo_rows():
     cos_o, roughness = np.array(grid).T
     table = ggx_albedo.albedo_table()[..., None]
     s, t = ggx_albedo.table_coordinates(cos_o, roughness)
-    fetched = shading.sample_texture(table, np.stack([s, t], -1))[:, 0]
+    fetched = sg_shading.sample_texture(table, np.stack([s, t], -1))[:, 0]
     dense = ggx_albedo.directional_albedo(cos_o, roughness, 256, 256)
     slice_albedo = []
     for c, r in grid:
         view = np.array([[np.sqrt(1 - c * c), 0.0, c]], np.float32)
-        axis, sharpness, amplitude = shading.specular_slice("GGX", {"roughness": np.array([r], np.float32)}, 1, view)
-        integral = shading._clamped_cosine_integral(axis, sharpness, amplitude, np.array([[[0, 0, 1.0]]], np.float32))
+        axis, sharpness, amplitude = sg_shading.specular_slice("GGX", {"roughness": np.array([r], np.float32)}, 1, view)
+        integral = sg_shading._clamped_cosine_integral(axis, sharpness, amplitude, np.array([[[0, 0, 1.0]]], np.float32))
         slice_albedo.append(float(np.sum(integral)))
     missing = (dense - np.array(slice_albedo)) / dense
     return [
@@ -75,7 +78,7 @@ def _albedo_rows():
              max_error=float(np.max(missing)), mean_error=float(np.mean(missing)),
              note="negative where the lobes overshoot (grazing views, cos theta_o 0.05: 1.76 against 0.999 at "
                   "roughness 0.05, 5.0 against 0.85 at 1.0); the shader scales them down to E there "
-                  "(core.shading.model_albedo; white furnace within 0.0017 of E, tests/gpu/test_ggx_energy.py)"),
+                  "(techniques.sg_shading.model_albedo; white furnace within 0.0017 of E, tests/gpu/test_ggx_energy.py)"),
     ]
 
 
@@ -84,9 +87,9 @@ def _visible_part_rows():
 
     v = np.linspace(0.1, 0.9, 161)
     exact = norm.pdf(norm.ppf(v)) / v
-    error = np.abs(shading.visible_part_offset(v) / exact - 1)
+    error = np.abs(sg_shading.visible_part_offset(v) / exact - 1)
     tails = np.array([0.01, 0.05, 0.95, 0.99])
-    tail_ratio = shading.visible_part_offset(tails) / (norm.pdf(norm.ppf(tails)) / tails)
+    tail_ratio = sg_shading.visible_part_offset(tails) / (norm.pdf(norm.ppf(tails)) / tails)
     return [dict(name="visible-part offset phi(Phi^-1(v)) / v, logistic Phi", reference="scipy's normal quantile",
                  metric="relative error, v in [0.1, 0.9]", max_error=float(error.max()), mean_error=float(error.mean()),
                  note="in the tails below the exact (a smaller turn): ratio " +
@@ -104,7 +107,7 @@ def _sharp_lookup_rows():
         exact = env_prefilter.brute_force_convolution(image, axis, sharpness)
         scale = np.maximum(np.abs(exact).max(axis=1), 1e-3 * float(image.mean()))
         top = env_prefilter.lookup(prefiltered, axis.astype(np.float32), sharpness.astype(np.float32))
-        blended = shading.environment_radiance(shading.EnvironmentData(prefiltered=prefiltered, radiance=image),
+        blended = sg_shading.environment_radiance(sg_shading.EnvironmentData(prefiltered=prefiltered, radiance=image),
                                                axis.astype(np.float32), sharpness.astype(np.float32))
         for label, value in (("top layer alone", top), ("blended towards the map", blended)):
             error = np.abs(value - exact).max(axis=1) / scale

@@ -2,7 +2,7 @@
 import numpy as np
 from scipy import special
 
-from sg_prt_addon.core import hemisphere, sg
+from sg_prt_addon.spherical import hemisphere, sg
 
 
 def _grid(lam_low, lam_high, n_lam=40, n_theta=100):

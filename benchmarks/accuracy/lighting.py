@@ -2,7 +2,7 @@
 SG-prefiltered environment (eq. 34-35) and the SG-mixture diffuse fit (eq. 39).
 
 References: exact quadrature of a uniform spherical cap times SG lobes
-(core.lights.cap_sg_inner_product_reference); closed-form SG inner products for an
+(lighting.lights.cap_sg_inner_product_reference); closed-form SG inner products for an
 SG-mixture environment; brute-force summation over every texel of Blender's
 bundled HDRIs; quadrature of the clamped cosine for irradiance.
 """
@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from sg_prt_addon.core import env_fit, env_prefilter, equirect, lights, sg
+from sg_prt_addon.lighting import env_fit, env_prefilter, equirect, lights
+from sg_prt_addon.spherical import sg
 
 WORLD_DIR = Path(__file__).resolve().parents[2] / ".venv/lib/python3.11/site-packages/bpy/5.0/datafiles/studiolights/world"
 WORLDS = ["courtyard", "forest", "city", "interior", "night", "studio", "sunrise", "sunset"]

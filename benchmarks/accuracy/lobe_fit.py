@@ -1,6 +1,6 @@
-"""Measured-BRDF lobe fitting (wang2009 section 4.2, core.microfacet_fit) on generated data.
+"""Measured-BRDF lobe fitting (wang2009 section 4.2, measured.microfacet_fit) on generated data.
 
-Each material is generated analytically (core.brdf_generators), written as a noisy MERL
+Each material is generated analytically (validation.brdf_generators), written as a noisy MERL
 file (2% log-normal noise, 1e-4 corrupt samples) or sampled per texel (SVBRDF), then
 factorized into kd, ks, eta, tabulated D and S (eq. 13), S PCA-compressed, D fitted by
 1, 2 (z+, Levenberg-Marquardt) or 4 (free axes, TNC) SG lobes.  The error is the relative
@@ -12,7 +12,8 @@ import tempfile
 
 import numpy as np
 
-from sg_prt_addon.core import brdf_generators, merl, microfacet_fit
+from sg_prt_addon.measured import merl, microfacet_fit
+from validation import brdf_generators
 
 METRIC = "relative RMSE of rho (i.n), 4D"
 METRIC_IO = "relative RMSE of rho (i.n)(o.n), 4D"

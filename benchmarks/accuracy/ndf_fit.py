@@ -1,4 +1,4 @@
-"""SG fits of microfacet NDFs (wang2009 section 4.1-4.2): core.brdf ndf_lobes and core.ndf_fit.
+"""SG fits of microfacet NDFs (wang2009 section 4.1-4.2): reflectance.brdf ndf_lobes and reflectance.ndf_fit.
 
 Two metrics: the relative L2 of D over the hemisphere (quadrature) and the relative
 RMSE of the cosine-weighted specular BRDF M_o(i) D(h) (n.i) over hemisphere x
@@ -6,7 +6,7 @@ hemisphere (Monte Carlo, 100k pairs, importance + uniform mixture).
 """
 import numpy as np
 
-from sg_prt_addon.core import brdf, ndf_fit
+from sg_prt_addon.reflectance import brdf, ndf_fit
 from validation import ndf_mappings
 
 L2 = "relative L2 of D over the hemisphere"

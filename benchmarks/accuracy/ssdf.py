@@ -1,11 +1,11 @@
-"""Accuracy of the SSDF visibility bake (wang2009 eq. 23-31, section 5.2): sg_prt_addon/bake."""
+"""Accuracy of the SSDF visibility bake (wang2009 eq. 23-31, section 5.2): sg_prt_addon/visibility."""
 import numpy as np
 
 from benchmarks.bake_speed import sphere_over_floor
-from sg_prt_addon.bake import BakeOptions, decode, hemisphere_map, pca, ssdf, visibility
-from sg_prt_addon.bake.pipeline import bake_ssdf
-from sg_prt_addon.core import hemisphere, sg
-from sg_prt_addon.core.raytrace import RayTracer
+from sg_prt_addon.spherical import hemisphere, sg
+from sg_prt_addon.visibility import BakeOptions, binary_visibility, decode, hemisphere_map, pca, ssdf
+from sg_prt_addon.visibility.pipeline import bake_ssdf
+from sg_prt_addon.visibility.raytrace import RayTracer
 
 
 def _row(name, error, reference, metric, paper=None, note=""):
@@ -96,8 +96,8 @@ def measure():
     pick = rng.choice(len(vertices), 48, replace=False)
     frames = hemisphere_map.local_frame(normals[pick])
     origins = vertices[pick] + tracer.offset * normals[pick]
-    adaptive, rays = visibility.adaptive_visibility(tracer, origins, frames, 32, 5)
-    dense = visibility.dense_visibility(tracer, origins, frames, 160)
+    adaptive, rays = binary_visibility.adaptive_visibility(tracer, origins, frames, 32, 5)
+    dense = binary_visibility.dense_visibility(tracer, origins, frames, 160)
     rows.append(_row("adaptive visibility (32^2 coarse, x5 in mixed cells)", np.mean(adaptive != dense, axis=(1, 2)),
                      "dense 160^2 rays", "fraction of mismatched texels per vertex", paper="512^2 rays",
                      note=f"{rays / len(pick):.0f} rays/vertex vs 25600; sphere over floor"))

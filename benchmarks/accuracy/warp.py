@@ -1,7 +1,7 @@
-"""Accuracy of the spherical warp (core/warp.py) against the exact slice D(h(wi)).
+"""Accuracy of the spherical warp (spherical/warp.py) against the exact slice D(h(wi)).
 
 Reference: quadrature in the lighting domain (polar Gauss-Legendre panels
-around the warped centre x 1024 azimuths, core.warp.lighting_quadrature) of
+around the warped centre x 1024 azimuths, spherical.warp.lighting_quadrature) of
 the exact slice D(h(wi)), h = normalize(wo + wi), of one SG NDF lobe around
 the normal.  Sharpness set: GGX-like alpha 0.05, 0.1, 0.3, 0.5 as lambda =
 2 / alpha^2, and lambda = 1, 10, 100, 1e3, 1e4.
@@ -10,7 +10,7 @@ import importlib.util
 
 import numpy as np
 
-from sg_prt_addon.core import sg, warp
+from sg_prt_addon.spherical import sg, warp
 
 VIEW_ANGLES = (0, 30, 60, 75, 85)
 ALPHAS = (0.05, 0.1, 0.3, 0.5)
@@ -45,7 +45,7 @@ def _asg_errors(theta, sharpness):
 
 def _ggx_ratio(roughness, theta, mode):
     """(slice lobes x clamped cosine) / exact integral of Mo(wi) D*(h) cos(theta_i), GGX's SG lobe and Mo."""
-    from sg_prt_addon.core import brdf
+    from sg_prt_addon.reflectance import brdf
 
     model = brdf.GGX(roughness=roughness)
     axis, sharpness, amplitude = model.ndf_lobes()
@@ -101,7 +101,7 @@ def measure():
                          "paper": abs(paper["energy_cosine"] - 1),
                          "note": (f"ratio {ours['energy_cosine']:.3f} vs paper {paper['energy_cosine']:.3f}; "
                                   f"L2 {ours['l2']:.2f} vs {paper['l2']:.2f}")})
-    if importlib.util.find_spec("sg_prt_addon.core.brdf") is not None:
+    if importlib.util.find_spec("sg_prt_addon.reflectance.brdf") is not None:
         for theta in VIEW_ANGLES + (89,):
             ours, three, paper = (np.array([abs(_ggx_ratio(r, theta, mode) - 1) for r in GGX_ROUGHNESSES])
                                   for mode in ("split2", "split3", "paper"))

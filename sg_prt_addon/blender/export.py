@@ -1,7 +1,7 @@
 """Blender scene -> plain numpy arrays and small dataclasses (no `gpu` here).
 
 Everything the engine draws goes through this module, so the GPU side and the
-numpy mirror (core/shading.py) see exactly the same numbers:
+numpy mirror (techniques/sg_shading.py) see exactly the same numbers:
 
 - meshes: one vertex per face corner (loop), so split normals, UV seams and
   tangent sign flips need no vertex splitting logic; triangles index corners;
@@ -12,7 +12,7 @@ numpy mirror (core/shading.py) see exactly the same numbers:
   vertex's corners) and `vertex_normals` are the smooth vertex normals (the bake's frames);
 - materials: `material.sgprt` read into `MaterialParams` (defaults when the
   material has no settings or the slot is empty);
-- lights in Blender units, converted to the quantities core/lights.py takes;
+- lights in Blender units, converted to the quantities lighting/lights.py takes;
 - the world: an Environment Texture's equirect pixels, else the world colour.
 
 `export_counter` counts mesh exports: the viewport's update logic is tested
@@ -112,7 +112,7 @@ class MaterialParams:
     nu: float = 100.0
     nv: float = 1000.0
     lobe_count: int = 4
-    warp_mode: str = "split3"      # core.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.view_warp)
+    warp_mode: str = "split3"      # spherical.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.view_warp)
     normal_strength: float = 1.0
     tangent_source: str = "UV_MAP"
     tangent_axis: tuple = (1.0, 0.0, 0.0)
@@ -445,7 +445,7 @@ def export_material(material):
     for name in SCALAR_PARAMETERS:
         setattr(params, name, float(getattr(settings, name)))
     params.lobe_count = int(settings.lobe_count)
-    params.warp_mode = settings.view_warp.lower()       # properties.VIEW_WARPS: core.warp's mode names
+    params.warp_mode = settings.view_warp.lower()       # properties.VIEW_WARPS: spherical.warp's mode names
     params.normal_strength = float(settings.normal_strength)
     params.tangent_source = settings.tangent_source
     params.tangent_axis = tuple(settings.tangent_axis)
@@ -562,7 +562,7 @@ def export_light(object_eval):
     """LightExport of an evaluated light object in Blender's units; None for unsupported types (and
     for a light whose transform is not finite).  Intensities are finite and at most
     MAX_LIGHT_INTENSITY in magnitude, sizes and angles finite (warned otherwise)."""
-    from ..core import lights as core_lights
+    from ..lighting import lights as core_lights
 
     light = object_eval.data
     matrix = matrix_to_numpy(object_eval.matrix_world)

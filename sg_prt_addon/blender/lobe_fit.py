@@ -3,9 +3,9 @@
 ``bpy.ops.sgprt.fit_lobes(filepath=..., lobe_count=2)`` fits the file to the active
 material (``context.material``, else the active object's active material):
 
-- a MERL ``.binary`` file (core.merl.read_merl): homogeneous, one texel (1 x 1 images),
-  factorized and fitted by core.microfacet_fit.fit_merl (about 1 s);
-- an SVBRDF table ``.npz`` (core.svbrdf_table): H x W texels, fitted by fit_lobes.
+- a MERL ``.binary`` file (measured.merl.read_merl): homogeneous, one texel (1 x 1 images),
+  factorized and fitted by measured.microfacet_fit.fit_merl (about 1 s);
+- an SVBRDF table ``.npz`` (measured.svbrdf_table): H x W texels, fitted by fit_lobes.
 The kind is told by content (a .npz is a zip: it starts with ``PK``), not by the name.
 
 execute(): synchronous, printing ``[sg-prt] fit 30% ...`` lines (``blender -b``, tests).
@@ -55,7 +55,7 @@ The shadowing of a texel is S(theta) = max(0, mean + coefficients @ basis) at th
 interpolated linearly, clamped below theta_0 and falling to 0 at pi/2
 (svbrdf_table.interpolate_shadowing); eta enters the Fresnel factor F(|i.h|) of eq. 14;
 rho(o, i) = kd/pi + F S(o) S(i) D_rgb(h) / (pi (i.n)(o.n)).  ``stored_lobe_fit(material)``
-rebuilds a core.microfacet_fit.LobeFit from the images (what a renderer mirrors).
+rebuilds a measured.microfacet_fit.LobeFit from the images (what a renderer mirrors).
 """
 import datetime
 import os
@@ -66,8 +66,8 @@ import numpy as np
 from bpy.props import EnumProperty, IntProperty, StringProperty
 
 from .. import techniques
-from ..core import merl as merl_format
-from ..core import microfacet_fit, svbrdf_table
+from ..measured import merl as merl_format
+from ..measured import microfacet_fit, svbrdf_table
 from ..techniques import sg_fitted
 from .background_job import BackgroundJob, ModalJobOperator
 from .panels import MaterialPanel
@@ -387,7 +387,7 @@ def lobe_fit_images(material):
 
 
 def stored_lobe_fit(material):
-    """A core.microfacet_fit.LobeFit (B = H W texels, float64) rebuilt from the stored images."""
+    """A measured.microfacet_fit.LobeFit (B = H W texels, float64) rebuilt from the stored images."""
     settings = material.sgprt.lobe_fit
     arrays = lobe_fit_images(material)
     flat = {role: a.reshape(-1, 4).astype(np.float64) for role, a in arrays.items() if role != "shadowing_table"}

@@ -1,11 +1,11 @@
-"""Per-vertex precomputations stored on a mesh datablock: one storage path for every kind (bake.per_vertex).
+"""Per-vertex precomputations stored on a mesh datablock: one storage path for every kind (visibility.per_vertex).
 
 A record of kind K (an SSDF bake is kind "ssdf"; blender/visibility_bake.py documents its fields):
 
 - ``sgprt_K_00`` .. ``sgprt_K_{L-1}``: POINT-domain FLOAT_COLOR attributes (4 float32 a vertex; saved,
   reloaded and propagated through modifiers by 4.2 and 5.x alike), together the rows, L <= MAX_ROWS;
 - ``mesh["sgprt_K"]``: an ID property group.  ``format_version``, ``layers`` L, ``vertex_count`` and
-  ``topology_hash`` (bake.pipeline.topology_hash of the vertex count and the loop triangles' vertex
+  ``topology_hash`` (visibility.pipeline.topology_hash of the vertex count and the loop triangles' vertex
   indices: mesh_topology_hash) are this module's; the kind adds its own fields.
 
 A record whose vertex count or topology hash no longer matches the mesh is STALE; missing or inconsistent
@@ -16,8 +16,8 @@ from typing import Optional
 
 import numpy as np
 
-from ..bake.per_vertex import MAX_ROWS
-from ..bake.pipeline import topology_hash
+from ..visibility.per_vertex import MAX_ROWS
+from ..visibility.pipeline import topology_hash
 
 
 def property_name(kind):
@@ -40,7 +40,7 @@ def mesh_triangles(mesh):
 
 
 def mesh_topology_hash(mesh):
-    """``bake.pipeline.topology_hash`` of a bpy Mesh: its vertex count and loop triangles' vertices."""
+    """``visibility.pipeline.topology_hash`` of a bpy Mesh: its vertex count and loop triangles' vertices."""
     return topology_hash(len(mesh.vertices), mesh_triangles(mesh))
 
 

@@ -5,8 +5,16 @@ shaded value is the property times the texture sample (RGB for colours, the
 red channel for scalars), like a factor next to a texture in Blender's nodes.
 """
 import bpy
-from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
-                       IntProperty, PointerProperty, StringProperty)
+from bpy.props import (
+    BoolProperty,
+    CollectionProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    PointerProperty,
+    StringProperty,
+)
 
 from .. import techniques
 
@@ -32,7 +40,7 @@ MODEL_PARAMETERS = {
 }
 ANISOTROPIC_MODELS = {"WARD_ANISO", "ASHIKHMIN_SHIRLEY"}
 
-# How each NDF lobe is warped to the view slice: core.warp's modes, upper case (figures from its docstring).
+# How each NDF lobe is warped to the view slice: spherical.warp's modes, upper case (figures from its docstring).
 VIEW_WARPS = (
     ("SPLIT3", "3 Lobes", "Three warped lobes per NDF lobe (default): the most accurate at grazing views "
                           "(mean energy error 0.09 at 75 degrees)"),

@@ -1,11 +1,11 @@
-"""Visibility bake operators and its storage in the .blend (wang2009 section 5; numerics in ../bake).
+"""Visibility bake operators and its storage in the .blend (wang2009 section 5; numerics in ../visibility).
 
 Which vertices are baked
 ------------------------
 The Blender mesh vertices (``mesh.vertices``, one SSDF per vertex), in world
 space, with their smooth vertex normals (``MeshVertex.normal``, also on
 flat-shaded meshes) and the default local frame of
-``bake.hemisphere_map.local_frame`` (no tangents).  The geometry is the
+``visibility.hemisphere_map.local_frame`` (no tangents).  The geometry is the
 evaluated object's (deform modifiers apply), but a modifier that changes the
 topology (subdivision, mirror...) is refused: the coefficients live on the
 original mesh datablock, which must index the same vertices.
@@ -34,9 +34,9 @@ per-vertex kind):
   (4 float32 a vertex; saved, reloaded and propagated through modifiers by 4.2
   and 5.x alike), together the rows of ``decode.pack_coefficients``:
   [1, w_0, w_1, ...] zero-padded to 4 L floats, L = ceil((terms + 1) / 4) <= 12
-  (bake.per_vertex.MAX_ROWS);
+  (visibility.per_vertex.MAX_ROWS);
 - ``mesh["sgprt_ssdf"]``, an ID property group: the store's ``format_version``,
-  ``layers`` L, ``vertex_count``, ``topology_hash`` (``bake.pipeline.topology_hash`` of the
+  ``layers`` L, ``vertex_count``, ``topology_hash`` (``visibility.pipeline.topology_hash`` of the
   vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``), and the bake's
   ``resolution`` R, ``terms`` N, ``rms_error`` (radians),
   ``frame_reference_axis`` (3), ``date`` (ISO 8601 UTC), ``seconds``,
@@ -65,16 +65,16 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from ..bake import decode
-from ..bake.per_vertex import MAX_ROWS
-from ..bake.pipeline import BakeCancelled, BakeOptions, bake_visibility
+from ..visibility import decode
+from ..visibility.per_vertex import MAX_ROWS
+from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
 from . import export, per_vertex_store
-from .per_vertex_store import mesh_topology_hash, mesh_triangles
 from .background_job import BackgroundJob, ModalJobOperator
 from .panels import RenderPanel
+from .per_vertex_store import mesh_topology_hash, mesh_triangles
 
 FORMAT_VERSION = 1
-KIND = "ssdf"           # the bake's per-vertex kind (bake.per_vertex; stored by per_vertex_store)
+KIND = "ssdf"           # the bake's per-vertex kind (visibility.per_vertex; stored by per_vertex_store)
 PROPERTY = per_vertex_store.property_name(KIND)
 ATTRIBUTE_PREFIX = per_vertex_store.attribute_name(KIND, 0)[:-2]
 MAX_LAYERS = MAX_ROWS

@@ -7,10 +7,9 @@ import bpy
 import numpy as np
 
 from ..blender import export
-from . import anti_aliasing
-from . import renderer as renderer_module
-from . import scene_state
 from ..techniques.shader_sources import GBUFFER_OUTPUTS, MAX_POINT_LIGHTS, MAX_SUNS
+from . import anti_aliasing, scene_state
+from . import renderer as renderer_module
 from .shader_cache import ShaderCompileError
 
 # Debug hooks for tests and benchmarks (no UI): when `capture_gbuffer` is True the next

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import techniques
 from ..blender.export import COLOUR_SLOTS, texture_pixels
-from ..core import clamped_cosine
+from ..spherical import clamped_cosine
 from ..techniques import shader_sources
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 from . import shader_cache
@@ -148,7 +148,7 @@ def per_vertex_texture(values, texels_per_vertex, per_row):
 
 
 def per_vertex_fits(mesh, data):
-    """Whether bake.per_vertex data can be uploaded for a MeshExport: scene_state checked it when it was
+    """Whether visibility.per_vertex data can be uploaded for a MeshExport: scene_state checked it when it was
     read; checked again right before the upload, since texelFetch must never read past the rows uploaded."""
     return not (mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions)
                 or data.rows.shape[0] != mesh.vertex_count
@@ -157,7 +157,7 @@ def per_vertex_fits(mesh, data):
 
 
 class PerVertexBuffers:
-    """GPU copy of one kind of per-vertex data (bake.per_vertex.PerVertexData): its rows texture, the
+    """GPU copy of one kind of per-vertex data (visibility.per_vertex.PerVertexData): its rows texture, the
     vertex normal texture in the same rows (one texel a vertex) and the basis texture."""
 
     def __init__(self, mesh, data):

@@ -12,10 +12,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bake import decode, per_vertex
 from ..blender import export
-from ..core import shading
+from ..techniques import sg_shading
 from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SUNS
+from ..visibility import decode, per_vertex
 
 # Prefiltered environments and SG fits by pixel content (prefiltering takes seconds); the most
 # recently used few only, since an artist editing the world makes a new one each edit.
@@ -35,7 +35,7 @@ visibility_provider = None
 def visibility_for(object_eval):
     """The visibility bake of an evaluated object: blender.visibility_bake.visibility_for_object
     (a StoredBake, or None without one), or what ``visibility_provider`` returns when set (a
-    StoredBake, a bake.pipeline.BakeResult or None).  Whatever comes back goes through ssdf_data,
+    StoredBake, a visibility.pipeline.BakeResult or None).  Whatever comes back goes through ssdf_data,
     which refuses unusable (stale, damaged) bakes and any whose vertex count does not match the
     exported mesh."""
     if visibility_provider is not None:
@@ -48,8 +48,8 @@ def visibility_for(object_eval):
 
 
 def ssdf_data(bake, mesh):
-    """(bake.per_vertex.PerVertexData of kind "ssdf", or None, message) of a visibility bake (a StoredBake or
-    a bake.pipeline.BakeResult) and the export.MeshExport it should shade."""
+    """(visibility.per_vertex.PerVertexData of kind "ssdf", or None, message) of a visibility bake (a StoredBake or
+    a visibility.pipeline.BakeResult) and the export.MeshExport it should shade."""
     if bake is None:
         return None, "no visibility bake"
     if getattr(bake, "usable", True) is False:
@@ -99,12 +99,12 @@ class SceneState:
         self.environment_layer_size = environment_layer_size or ENVIRONMENT_LAYER_SIZE
         self.objects = {}           # object name -> ObjectEntry
         self.meshes = {}            # mesh key -> export.MeshExport
-        self.per_vertex = {}        # mesh key -> {kind: bake.per_vertex.PerVertexData} (usable ones only)
+        self.per_vertex = {}        # mesh key -> {kind: visibility.per_vertex.PerVertexData} (usable ones only)
         self.per_vertex_status = {}  # mesh key -> {kind: why there is (or is no) data of that kind}
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
         self.world = export.WorldExport()
-        self.environment = shading.EnvironmentData()
+        self.environment = sg_shading.EnvironmentData()
         self.dirty = Dirty()
         # bad input met while exporting (NaN texels, degenerate normals...): said once a render/redraw
         self.warnings = []
@@ -352,14 +352,14 @@ def _strongest(light_exports, max_points, max_suns):
 
 
 def light_data(light_exports):
-    """shading.LightData (float32) from export.LightExport records (the shader's limits applied:
+    """sg_shading.LightData (float32) from export.LightExport records (the shader's limits applied:
     the dimmest lights beyond them are left out)."""
-    from ..core import lights as core_lights
+    from ..lighting import lights as core_lights
 
     kept = _strongest(light_exports, MAX_POINT_LIGHTS, MAX_SUNS)
     points = [light for light in kept if light.kind == "POINT"]
     suns = [light for light in kept if light.kind == "SUN"]
-    data = shading.LightData()
+    data = sg_shading.LightData()
     f = np.float32
     if points:
         data.point_position = np.array([light.position for light in points], f)
@@ -390,10 +390,10 @@ def _geometry_may_differ(obj, edited_meshes):
 
 
 def environment_data(world, layer_size=None):
-    """shading.EnvironmentData of an export.WorldExport (cached per image and pixels)."""
+    """sg_shading.EnvironmentData of an export.WorldExport (cached per image and pixels)."""
     colour = np.asarray(world.colour[:3], np.float32)
     if world.equirect is None:
-        return shading.EnvironmentData(colour=colour)
+        return sg_shading.EnvironmentData(colour=colour)
     layer_size = layer_size or ENVIRONMENT_LAYER_SIZE
     image = world.equirect
     # keyed by the pixels themselves: a renamed or reloaded image with the same content hits the cache
@@ -401,10 +401,10 @@ def environment_data(world, layer_size=None):
            layer_size)
     cached = _environment_cache.pop(key, None)
     if cached is None:
-        from ..core import env_prefilter
+        from ..lighting import env_prefilter
         prefiltered = env_prefilter.prefilter_environment(image, size=layer_size)
         lobes = _fit_environment(image)
-        cached = shading.EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
+        cached = sg_shading.EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
                                          lobe_sharpness=lobes[1], lobe_amplitude=lobes[2], radiance=image)
     _environment_cache[key] = cached                 # (re)inserted last: the most recent
     while len(_environment_cache) > ENVIRONMENT_CACHE_SIZE:
@@ -413,10 +413,10 @@ def environment_data(world, layer_size=None):
 
 
 def _fit_environment(image):
-    """Diffuse SG mixture of the environment (wang2009 eq. 39): core.env_fit when present,
+    """Diffuse SG mixture of the environment (wang2009 eq. 39): lighting.env_fit when present,
     else a fixed-axis least-squares mixture (_fit_environment_fixed_axes)."""
     try:
-        from ..core import env_fit
+        from ..lighting import env_fit
     except ImportError:
         return _fit_environment_fixed_axes(image)
     fit = env_fit.fit_environment_sg(image, lobes=ENVIRONMENT_FIT_LOBES)
@@ -430,7 +430,8 @@ def _fit_environment_fixed_axes(image, lobe_count=12, sharpness=3.0, rows=32):
     """SG mixture with Fibonacci-sphere axes and one sharpness; non-negative amplitudes per
     channel by least squares, weighted by texel solid angle, on a downsampled map."""
     from scipy.optimize import nnls
-    from ..core import equirect
+
+    from ..lighting import equirect
 
     height, width = image.shape[:2]
     row_index = (np.arange(rows) + 0.5) * height / rows

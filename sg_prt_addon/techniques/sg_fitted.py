@@ -3,7 +3,7 @@ lobes, kd and eta, and the PCA-compressed shadowing, fetched at the UV's nearest
 from .sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_FITTED"
-MODEL = "FITTED"        # the variant's model: MODEL_FITTED in the GLSL, core.shading.FITTED_MODEL in the mirror
+MODEL = "FITTED"        # the variant's model: MODEL_FITTED in the GLSL, techniques.sg_shading.FITTED_MODEL in the mirror
 
 
 class SGFitted(SGLobes):

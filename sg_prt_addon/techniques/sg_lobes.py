@@ -1,6 +1,6 @@
 """What wang2009's two techniques share: SG shading of lights and a prefiltered environment, the view warp
 of the NDF lobes, and SSDF visibility from a per-vertex bake (shaders/techniques/sg/, mirrored by
-core.shading).  sg_parametric gives the lobes of an analytic BRDF model, sg_fitted those of a stored
+techniques.sg_shading).  sg_parametric gives the lobes of an analytic BRDF model, sg_fitted those of a stored
 lobe fit; both subclass SGLobes and fill in the model's part through its hooks.
 
 A variant is keyed by what changes the code (not the values): the model, its NDF lobe count, whether
@@ -19,8 +19,9 @@ pieces (anisotropic_lobes, ggx_two_lobes, lobe_visibility, sg_shading) + the per
 """
 from dataclasses import dataclass
 
-from ..core import brdf, clamped_cosine_table, shading, warp
-from . import shader_sources
+from ..reflectance import brdf
+from ..spherical import clamped_cosine_table, warp
+from . import sg_shading, shader_sources
 from .base import Technique
 from .shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
 
@@ -29,7 +30,7 @@ GLSL_DIR = "sg"
 LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "lights.glsl",
                  "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
 TECHNIQUE_FILES = ("anisotropic_lobes.glsl", "ggx_two_lobes.glsl", "lobe_visibility.glsl", "sg_shading.glsl")
-# The per-vertex precomputation this technique reads (bake.per_vertex kinds)
+# The per-vertex precomputation this technique reads (visibility.per_vertex kinds)
 VISIBILITY_KIND = "ssdf"
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
                  "alpha_x", "alpha_y", "nu", "nv", "normal_map")
@@ -50,7 +51,7 @@ class VariantKey:
     has_specular: bool = True       # False: zero specular colour, no texture: no BRDF slice code
     # vec4 of broad diffuse lobe visibility a vertex, from the per-vertex pass (0: none, or decoded per pixel)
     diffuse_visibility_rows: int = 0
-    # light x slice products take the light's visibility (core.shading.shares_light_visibility; with a bake,
+    # light x slice products take the light's visibility (techniques.sg_shading.shares_light_visibility; with a bake,
     # lights and a specular term)
     shared_light_visibility: bool = False
     warp_mode: str = warp.DEFAULT_MODE      # of the view slice (MaterialParams.warp_mode); with a specular term
@@ -84,7 +85,7 @@ class VariantKey:
 
 
 def diffuse_visibility_rows(environment):
-    """vec4 a vertex of the per-vertex pass (vertex_visibility.frag.glsl) for a core.shading.EnvironmentData:
+    """vec4 a vertex of the per-vertex pass (vertex_visibility.frag.glsl) for a techniques.sg_shading.EnvironmentData:
     its diffuse SG lobes four to a vec4, or the constant world's one lobe."""
     if environment.prefiltered is None:
         return 1
@@ -92,15 +93,15 @@ def diffuse_visibility_rows(environment):
 
 
 def warp_mode_of(material_params):
-    """The material's core.warp mode (MaterialParams.warp_mode; objects without it: the default)."""
+    """The material's spherical.warp mode (MaterialParams.warp_mode; objects without it: the default)."""
     mode = getattr(material_params, "warp_mode", warp.DEFAULT_MODE)
     if mode not in warp.MODES:
-        raise ValueError(f"unknown view warp {mode!r} (core.warp.MODES: {', '.join(warp.MODES)})")
+        raise ValueError(f"unknown view warp {mode!r} (spherical.warp.MODES: {', '.join(warp.MODES)})")
     return mode
 
 
 def warp_function(mode):
-    """(GLSL function, lobes per NDF lobe) of a core.warp mode (the mirror warps with the same)."""
+    """(GLSL function, lobes per NDF lobe) of a spherical.warp mode (the mirror warps with the same)."""
     return f"warp_lobes_{mode}", warp.nodes_per_lobe(mode)
 
 
@@ -115,8 +116,8 @@ def scene_fields(inputs, has_diffuse=True, has_specular=True):
     shared = False
     if layers and inputs.has_lights and has_specular:
         if "shared_light_visibility" not in memo:
-            memo["shared_light_visibility"] = inputs.bounds is not None and bool(shading.shares_light_visibility(
-                inputs.light_data, shading.world_bounds(inputs.bounds, inputs.matrix_world)))
+            memo["shared_light_visibility"] = inputs.bounds is not None and bool(sg_shading.shares_light_visibility(
+                inputs.light_data, sg_shading.world_bounds(inputs.bounds, inputs.matrix_world)))
         shared = memo["shared_light_visibility"]
     return dict(has_lights=bool(inputs.has_lights), has_environment=bool(inputs.has_environment),
                 gbuffer=inputs.gbuffer, visibility_layers=layers,
@@ -128,12 +129,12 @@ def _constants_source():
     """Constants taken from core/ at assembly time, so GLSL and numpy cannot drift apart."""
     rf0 = brdf.AshikhminShirley.__dataclass_fields__["rf0"].default
     return (f"const float BRDF_AS_RF0 = {shader_sources.float_literal(rf0)};\n"
-            f"const float VISIBILITY_SKIP_FRACTION = {shader_sources.float_literal(shading.VISIBILITY_SKIP_FRACTION)};\n")
+            f"const float VISIBILITY_SKIP_FRACTION = {shader_sources.float_literal(sg_shading.VISIBILITY_SKIP_FRACTION)};\n")
 
 
 def uses_clamped_cosine_table(key):
     """Whether a variant integrates lobes of per-pixel sharpness against the clamped cosine (lights,
-    slice lobes, their products): those read core.clamped_cosine_table."""
+    slice lobes, their products): those read spherical.clamped_cosine_table."""
     return key.has_lights or key.has_specular
 
 
@@ -154,7 +155,7 @@ class SGLobes(Technique):
     """wang2009's shading; subclasses give the model's lobes through the model_* hooks."""
 
     paper = "wang2009"
-    mirror = staticmethod(shading.shade_fragments)
+    mirror = staticmethod(sg_shading.shade_fragments)
 
     # ------------------------------------------------------------- model hooks
 
@@ -292,7 +293,7 @@ class SGLobes(Technique):
         shader = context.fixed_shader(("vertex_visibility", key.visibility_layers, rows, key.has_environment),
                                       lambda: vertex_visibility_calls(key.visibility_layers, rows,
                                                                       key.has_environment))
-        import gpu      # the gpu module exists only in Blender's GPU context
+        import gpu  # the gpu module exists only in Blender's GPU context
 
         with framebuffer.bind():
             gpu.state.depth_test_set("NONE")

@@ -2,7 +2,9 @@
 texture per pixel), GGX's two-lobe table and albedo tail, the anisotropic models' lobe tables."""
 import numpy as np
 
-from ..core import ggx_albedo, ndf_fit, shading, warp
+from ..reflectance import ggx_albedo, ndf_fit
+from ..spherical import warp
+from . import sg_shading
 from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_PARAMETRIC"
@@ -37,7 +39,7 @@ def ggx_table():
 
 
 def ggx_albedo_texture():
-    """core.ggx_albedo's table in every channel of a float texture."""
+    """reflectance.ggx_albedo's table in every channel of a float texture."""
     return np.repeat(ggx_albedo.albedo_table()[..., None], 4, axis=-1)
 
 
@@ -57,7 +59,7 @@ class SGParametric(SGLobes):
         model = params.model
         lobes = int(params.lobe_count) if model in ANISOTROPIC_MODELS else 1
         if model == "GGX":
-            lobes = shading.GGX_NDF_LOBES
+            lobes = sg_shading.GGX_NDF_LOBES
         has_diffuse, has_specular = material_terms(params)
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS
                                 and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
@@ -68,9 +70,9 @@ class SGParametric(SGLobes):
     def model_defines(self, key):
         if not uses_ggx_table(key):
             return {}
-        # GGX's energy beyond its two lobes, from its albedo table (core.ggx_albedo)
+        # GGX's energy beyond its two lobes, from its albedo table (reflectance.ggx_albedo)
         return {"ENVIRONMENT_TAIL": 1, "GGX_ALBEDO_SIZE": ggx_albedo.TABLE_SIZE,
-                "TAIL_SHARPNESS_RATIO": f"{shading.TAIL_SHARPNESS_RATIO!r}"}
+                "TAIL_SHARPNESS_RATIO": f"{sg_shading.TAIL_SHARPNESS_RATIO!r}"}
 
     def model_files(self, key):
         if key.model in ANISOTROPIC_MODELS:

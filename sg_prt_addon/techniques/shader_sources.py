@@ -36,7 +36,7 @@ LIMITS = {"SGPRT_MAX_POINT_LIGHTS": MAX_POINT_LIGHTS, "SGPRT_MAX_SUNS": MAX_SUNS
           "SGPRT_MAX_ENV_LOBES": MAX_ENV_LOBES, "SGPRT_MAX_LAYERS": MAX_LAYERS}
 
 # vec4 rows a vertex of one precomputation: each is a varying, and llvmpipe's budget of 32 vec4 varyings
-# holds the surface's own four, these and a pass's rows (bake.per_vertex uses the same limit)
+# holds the surface's own four, these and a pass's rows (visibility.per_vertex uses the same limit)
 MAX_PER_VERTEX_ROWS = 12
 
 GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")

@@ -1,5 +1,5 @@
 /* World behind the surfaces: the world colour, or the environment texture itself along
- * the view ray (Blender's equirect mapping, as core/equirect.py).  Drawn at the far plane
+ * the view ray (Blender's equirect mapping, as lighting/equirect.py).  Drawn at the far plane
  * after the surfaces, so the depth test keeps it behind them. */
 void main()
 {

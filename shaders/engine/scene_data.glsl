@@ -27,7 +27,7 @@ struct SceneData {
   /* diffuse environment SG mixture (env_fit) */
   vec4 env_axis_sharpness[SGPRT_MAX_ENV_LOBES];
   vec4 env_amplitude[SGPRT_MAX_ENV_LOBES];
-  /* lobe e's clamped_cosine_sharpness_terms (core.clamped_cosine.sharpness_terms): [2e], [2e + 1] */
+  /* lobe e's clamped_cosine_sharpness_terms (spherical.clamped_cosine.sharpness_terms): [2e], [2e + 1] */
   vec4 env_cosine_terms[2 * SGPRT_MAX_ENV_LOBES];
   /* world -> clip of the surface draws (push constants stay within 128 bytes: model matrix + G-buffer ids) */
   mat4 view_projection;

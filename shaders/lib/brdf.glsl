@@ -1,5 +1,5 @@
 /* Microfacet BRDF models split as rho_s(o, i) = M_o(i) D(h) (wang2009 eq. 9):
- * GLSL mirror of sg_prt_addon/core/brdf.py.  Depends on sg.glsl (safe_normalize, SG_PI).
+ * GLSL mirror of sg_prt_addon/reflectance/brdf.py.  Depends on sg.glsl (safe_normalize, SG_PI).
  *
  * Local frame: normal z+, tangent x+; wo towards the viewer, wi towards the light.
  * Per model <m>: <m>_ndf(h, ...) <- Model.ndf, <m>_m_factor(wo, wi, ...) <- Model.m_factor,

@@ -1,5 +1,5 @@
 /* The clamped cosine max(0, n.i) against SGs: GLSL mirror of
- * sg_prt_addon/core/clamped_cosine.py.  Depends on sg.glsl and hemisphere.glsl (erf_approx).
+ * sg_prt_addon/spherical/clamped_cosine.py.  Depends on sg.glsl and hemisphere.glsl (erf_approx).
  *
  *   clamped_cosine_lobe                 <- clamped_cosine.clamped_cosine_lobe (vec2(sharpness, amplitude))
  *   clamped_cosine_lobe_evaluate        <- clamped_cosine.clamped_cosine_lobe_evaluate

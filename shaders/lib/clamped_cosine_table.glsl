@@ -1,5 +1,5 @@
 /* The clamped-cosine integral I(c, lambda) read from its table (one bilinear fetch): GLSL mirror of
- * sg_prt_addon/core/clamped_cosine_table.py, whose docstring gives the layout.  Depends on sg.glsl.
+ * sg_prt_addon/spherical/clamped_cosine_table.py, whose docstring gives the layout.  Depends on sg.glsl.
  *
  *   clamped_cosine_tabulated            <- clamped_cosine_table.clamped_cosine_from_table
  *   sg_clamped_cosine_integral_tabulated <- clamped_cosine_table.sg_clamped_cosine_integral_tabulated

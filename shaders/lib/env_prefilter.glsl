@@ -1,5 +1,5 @@
 /* Lookup in the SG-prefiltered environment (wang2009 eq. 34-35): GLSL mirror
- * of the lookup half of sg_prt_addon/core/env_prefilter.py.  Depends on sg.glsl.
+ * of the lookup half of sg_prt_addon/lighting/env_prefilter.py.  Depends on sg.glsl.
  *
  *   env_sign_not_zero              <- env_prefilter._sign_not_zero
  *   oct_encode                     <- env_prefilter.oct_encode

@@ -1,5 +1,5 @@
 /* SG over a hemisphere at any angle (wang2009's fh): GLSL mirror of the fast
- * forms in sg_prt_addon/core/hemisphere.py.  Depends on sg.glsl.
+ * forms in sg_prt_addon/spherical/hemisphere.py.  Depends on sg.glsl.
  *
  *   erf_approx                    <- hemisphere.erf_approx
  *   fh_k                          <- hemisphere.fh_k

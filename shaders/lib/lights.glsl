@@ -1,5 +1,5 @@
 /* Local and distant lights as single SGs (wang2009 section 6, eq. 32-33):
- * GLSL mirror of sg_prt_addon/core/lights.py.  Depends on sg.glsl.
+ * GLSL mirror of sg_prt_addon/lighting/lights.py.  Depends on sg.glsl.
  *
  *   blender_point_light_intensity <- lights.blender_point_light_intensity
  *   sphere_light_sg               <- lights.sphere_light_sg(model="energy")

@@ -1,4 +1,4 @@
-/* Spherical Gaussian algebra: GLSL mirror of sg_prt_addon/core/sg.py.
+/* Spherical Gaussian algebra: GLSL mirror of sg_prt_addon/spherical/sg.py.
  *
  * G(v; p, lambda, mu) = mu exp(lambda (v.p - 1)); a lobe is passed as
  * (vec3 axis, float sharpness, float amplitude) in the order of sg.py.

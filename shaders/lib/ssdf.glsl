@@ -1,5 +1,5 @@
-/* SSDF visibility (wang2009 eq. 23-31): GLSL mirror of sg_prt_addon/bake/decode.py and
- * bake/hemisphere_map.py.  Depends on sg.glsl and hemisphere.glsl.
+/* SSDF visibility (wang2009 eq. 23-31): GLSL mirror of sg_prt_addon/visibility/decode.py and
+ * visibility/hemisphere_map.py.  Depends on sg.glsl and hemisphere.glsl.
  *
  *   ssdf_disc_to_square            <- hemisphere_map.disc_to_square
  *   ssdf_hemisphere_to_square      <- hemisphere_map.hemisphere_to_square

@@ -1,5 +1,5 @@
 /* Spherical warp of NDF lobes to the BRDF view slice (wang2009 eq. 17-22):
- * GLSL mirror of sg_prt_addon/core/warp.py.  Depends on sg.glsl.
+ * GLSL mirror of sg_prt_addon/spherical/warp.py.  Depends on sg.glsl.
  *
  *   warp_at             <- warp._warp_at (eq. 18-21 at one lobe centre, grazing clamp)
  *   warp_lobes_paper    <- warp.warp_lobes(mode="paper"): one lobe per NDF lobe

@@ -4,6 +4,7 @@ import json
 import os
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -48,6 +49,7 @@ def test_extension_builds_validates_installs_and_renders(tmp_path):
     finally:
         sys.path.pop(0)
     zip_path = build_extension.build(local_only=True, output_dir=tmp_path / "dist")  # raises unless validated
+    _check_contents(zip_path)
 
     environment = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
     environment.pop("PYTHONPATH", None)
@@ -59,3 +61,21 @@ def test_extension_builds_validates_installs_and_renders(tmp_path):
     assert result["enabled"] == ["bl_ext.user_default.sg_prt"]
     assert result["size"] == [64, 64]
     assert result["max"] > 0.05, "the installed engine rendered a black image"
+
+
+# What checks the engine and never runs in it (the top-level validation/ package, tests, benchmarks)
+VALIDATION_MODULES = {path.name for path in (ROOT / "validation").glob("*.py") if path.name != "__init__.py"}
+
+
+def _check_contents(zip_path):
+    """The zip ships the add-on, its shaders and its wheels, and none of the validation code."""
+    with zipfile.ZipFile(zip_path) as archive:
+        names = archive.namelist()
+    python = [name for name in names if name.endswith(".py")]
+    print(f"{len(names)} files in {zip_path.name}, {len(python)} Python modules:", *sorted(python), sep="\n  ")
+    assert not [name for name in names if name.split("/")[0] in ("validation", "tests", "benchmarks", "tools")]
+    shipped = {name.rsplit("/", 1)[-1] for name in python}
+    assert VALIDATION_MODULES and not shipped & VALIDATION_MODULES, sorted(shipped & VALIDATION_MODULES)
+    for required in ("techniques/sg_parametric.py", "techniques/sg_fitted.py", "engine/renderer.py",
+                     "shaders/techniques/sg/sg_shading.glsl", "shaders/engine/mesh.vert.glsl", "blender_manifest.toml"):
+        assert any(name.endswith(required) for name in names), f"{required} missing from the zip"

@@ -5,14 +5,14 @@ default AnalyticMaterial (about 1.5 s) and a 6 x 5 SVBRDF table (not square: a t
 layout would show).
 """
 import os
-import shutil
 
 import bpy
 import numpy as np
 import pytest
 
 from sg_prt_addon.blender import lobe_fit as lf
-from sg_prt_addon.core import brdf_generators, merl, microfacet_fit, svbrdf_table
+from sg_prt_addon.measured import merl, microfacet_fit, svbrdf_table
+from validation import brdf_generators
 
 
 @pytest.fixture(scope="module")
@@ -144,7 +144,7 @@ def test_table_fit_per_texel_layout_and_round_trip(material, data, tmp_path):
 
 
 def _bad_files(data):
-    """(name, bytes, expected message) made from a valid file written by core.merl.write_merl."""
+    """(name, bytes, expected message) made from a valid file written by measured.merl.write_merl."""
     valid = open(data["merl"], "rb").read()
     header = np.asarray(merl.DIMENSIONS, "<i4").tobytes()
     wrong_dims = np.asarray((90, 90, 360), "<i4").tobytes() + valid[12:]
@@ -166,7 +166,7 @@ def _bad_files(data):
 
 
 def _merl_bytes(rho):
-    """A MERL file of the samples rho (90, 90, 180, 3), as core.merl.write_merl writes it."""
+    """A MERL file of the samples rho (90, 90, 180, 3), as measured.merl.write_merl writes it."""
     import tempfile
 
     with tempfile.TemporaryDirectory() as folder:

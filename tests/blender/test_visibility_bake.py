@@ -7,10 +7,10 @@ import bpy
 import numpy as np
 import pytest
 
-from sg_prt_addon.bake import decode, hemisphere_map
-from sg_prt_addon.bake.pipeline import BakeOptions, bake_visibility
 from sg_prt_addon.blender import export
 from sg_prt_addon.blender import visibility_bake as vb
+from sg_prt_addon.visibility import decode, hemisphere_map
+from sg_prt_addon.visibility.pipeline import BakeOptions, bake_visibility
 
 SMALL = dict(resolution=12, refinement=3, term_mode="FIXED", terms=6, max_terms=47)
 

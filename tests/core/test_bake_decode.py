@@ -1,9 +1,9 @@
-"""sg_prt_addon.bake.decode: GPU-sampler bilinear mirror, packed GPU layout, lookups below the horizon,
+"""sg_prt_addon.visibility.decode: GPU-sampler bilinear mirror, packed GPU layout, lookups below the horizon,
 and the shadowed lobe integral against ray-traced visibility."""
 import numpy as np
 
-from sg_prt_addon.bake import decode, hemisphere_map, ssdf
-from sg_prt_addon.core import sg, texture_fetch
+from sg_prt_addon.spherical import sg, texture_fetch
+from sg_prt_addon.visibility import decode, hemisphere_map, ssdf
 
 
 def test_bilinear_is_exact_at_texel_centres_linear_between_and_clamped():

@@ -1,7 +1,7 @@
-"""sg_prt_addon.bake.hemisphere_map: the square <-> hemisphere map and local frames."""
+"""sg_prt_addon.visibility.hemisphere_map: the square <-> hemisphere map and local frames."""
 import numpy as np
 
-from sg_prt_addon.bake import hemisphere_map as hm
+from sg_prt_addon.visibility import hemisphere_map as hm
 
 
 def _square_points(count, seed=0):

@@ -1,9 +1,9 @@
-"""sg_prt_addon.bake.pca (wang2009 eq. 24): error falls with terms, the chosen terms meet the target,
+"""sg_prt_addon.visibility.pca (wang2009 eq. 24): error falls with terms, the chosen terms meet the target,
 the reported RMS error is the measured one."""
 import numpy as np
 import pytest
 
-from sg_prt_addon.bake import hemisphere_map, pca, ssdf
+from sg_prt_addon.visibility import hemisphere_map, pca, ssdf
 
 
 @pytest.fixture(scope="module")

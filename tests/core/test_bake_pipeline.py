@@ -1,11 +1,18 @@
-"""sg_prt_addon.bake: adaptive visibility vs the dense fine grid, the bake API, cancellation."""
+"""sg_prt_addon.visibility: adaptive visibility vs the dense fine grid, the bake API, cancellation."""
 import numpy as np
 import pytest
 
 from benchmarks.bake_speed import grid, icosphere, sphere_over_floor
-from sg_prt_addon.bake import BakeCancelled, BakeOptions, bake_visibility, hemisphere_map, topology_hash, visibility
-from sg_prt_addon.bake.pipeline import bake_ssdf
-from sg_prt_addon.core.raytrace import RayTracer
+from sg_prt_addon.visibility import (
+    BakeCancelled,
+    BakeOptions,
+    bake_visibility,
+    binary_visibility,
+    hemisphere_map,
+    topology_hash,
+)
+from sg_prt_addon.visibility.pipeline import bake_ssdf
+from sg_prt_addon.visibility.raytrace import RayTracer
 
 
 @pytest.fixture(scope="module")
@@ -17,8 +24,8 @@ def _adaptive_and_dense(vertices, triangles, points, normals):
     tracer = RayTracer(vertices, triangles, threads=2)
     frames = hemisphere_map.local_frame(normals)
     origins = points + tracer.offset * normals
-    adaptive, rays = visibility.adaptive_visibility(tracer, origins, frames, 32, 5)
-    dense = visibility.dense_visibility(tracer, origins, frames, 160)
+    adaptive, rays = binary_visibility.adaptive_visibility(tracer, origins, frames, 32, 5)
+    dense = binary_visibility.dense_visibility(tracer, origins, frames, 160)
     tracer.close()
     return adaptive, dense, rays
 

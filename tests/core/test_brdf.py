@@ -1,11 +1,12 @@
-"""Exact BRDF models of core.brdf against independent textbook formulas, reciprocity,
+"""Exact BRDF models of reflectance.brdf against independent textbook formulas, reciprocity,
 energy, normalization, Fresnel limits and the samplers' densities."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import integrate, stats
 
-from sg_prt_addon.core import brdf
+from sg_prt_addon.reflectance import brdf
 
 RNG_SEED = 1234
 

@@ -1,6 +1,6 @@
 import numpy as np
 
-from sg_prt_addon.core.camera import Camera
+from validation.camera import Camera
 
 
 def orthographic_camera(half_width, half_height, width, height, height_above=5.0):

@@ -1,13 +1,14 @@
-"""core/clamped_cosine.py against quadrature: the ring quadrature against an
+"""spherical/clamped_cosine.py against quadrature: the ring quadrature against an
 independent 2D Gauss-Legendre quadrature, the fast closed form against the ring
 quadrature (asserted error bounds), and wang2009 eq. 40's lobe measured."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import integrate
 
-from sg_prt_addon.core import clamped_cosine as cc
-from sg_prt_addon.core import sg
+from sg_prt_addon.spherical import clamped_cosine as cc
+from sg_prt_addon.spherical import sg
 
 SETTINGS = settings(max_examples=30, deadline=None)
 Z = np.array([0.0, 0.0, 1.0])

@@ -1,10 +1,10 @@
-"""core/clamped_cosine_table.py: the tabulated I(c, lambda) against the ring quadrature (asserted
+"""spherical/clamped_cosine_table.py: the tabulated I(c, lambda) against the ring quadrature (asserted
 error bounds, and a third of the closed form's), its row map and inverse, its edges."""
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import clamped_cosine as cc
-from sg_prt_addon.core import clamped_cosine_table as ct
+from sg_prt_addon.spherical import clamped_cosine as cc
+from sg_prt_addon.spherical import clamped_cosine_table as ct
 
 
 def random_arguments(low, high, count, seed):

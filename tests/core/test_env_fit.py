@@ -4,7 +4,8 @@ import time
 
 import numpy as np
 
-from sg_prt_addon.core import env_fit, equirect, sg
+from sg_prt_addon.lighting import env_fit, equirect
+from sg_prt_addon.spherical import sg
 
 
 def _sg_map(height=64):

@@ -2,10 +2,12 @@
 SG-mixture convolutions (the inner product of two SGs is closed form)."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from sg_prt_addon.core import env_prefilter as ep
-from sg_prt_addon.core import equirect, sg
+from sg_prt_addon.lighting import env_prefilter as ep
+from sg_prt_addon.lighting import equirect
+from sg_prt_addon.spherical import sg
 
 # an environment made of SG lobes: its SG convolution is exact (sg.inner_product)
 ENV_AXES = sg.normalize(np.array([[0.3, 0.2, 0.9], [-0.8, 0.1, -0.2], [0.1, -0.9, 0.3], [0.0, 0.0, -1.0]]))

@@ -1,10 +1,10 @@
-"""core.ggx_albedo: GGX's directional albedo by half-vector quadrature against a dense solid-angle
+"""reflectance.ggx_albedo: GGX's directional albedo by half-vector quadrature against a dense solid-angle
 quadrature of brdf.GGX itself, and the table the shader fetches."""
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import brdf, ggx_albedo
-from sg_prt_addon.core.shading import sample_texture
+from sg_prt_addon.reflectance import brdf, ggx_albedo
+from sg_prt_addon.techniques.sg_shading import sample_texture
 
 
 def _solid_angle_albedo(cos_o, roughness, nodes=700):
@@ -44,10 +44,11 @@ def test_bilinear_fetch_lands_on_the_texel_centres():
 
 
 def test_visible_part_offset_is_the_truncated_gaussian_mean():
-    """core.shading.visible_part_offset against phi(Phi^-1(v)) / v, the mean of a unit Gaussian cut so that
+    """techniques.sg_shading.visible_part_offset against phi(Phi^-1(v)) / v, the mean of a unit Gaussian cut so that
     the fraction v is kept: within 2.5% for v in [0.1, 0.9], never above it in the tails (a smaller turn)."""
     from scipy.stats import norm
-    from sg_prt_addon.core.shading import visible_part_offset
+
+    from sg_prt_addon.techniques.sg_shading import visible_part_offset
 
     v = np.linspace(0.1, 0.9, 81)
     exact = norm.pdf(norm.ppf(v)) / v

@@ -2,11 +2,12 @@
 independent ring-fraction quadrature; the fast form against the exact one."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import integrate, special
 
 from benchmarks.accuracy.hemisphere import triple_product_case
-from sg_prt_addon.core import hemisphere, sg
+from sg_prt_addon.spherical import hemisphere, sg
 
 SETTINGS = settings(max_examples=15, deadline=None)
 log_sharpness = st.floats(np.log(1e-4), np.log(1e6)).map(np.exp)
@@ -178,7 +179,7 @@ def test_clamped_cosine_identity(lam):
         I(c) = c (F + dF/dlambda) + (1 - c^2) / lambda dF/dx   at x = c = n.p.
     Checked with finite differences of fh_exact against the cosine-weighted quadrature
     and clamped_cosine's own (ring) quadrature."""
-    from sg_prt_addon.core import clamped_cosine
+    from sg_prt_addon.spherical import clamped_cosine
 
     c = np.array([-0.8, -0.2, 0.0, 0.3, 0.9])
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import image_error
+from validation import image_error
 
 
 def test_scores_of_known_differences():

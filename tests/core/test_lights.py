@@ -1,9 +1,11 @@
 """Point, sphere, spot and directional lights as SGs (wang2009 eq. 32-33) against exact cap integrals."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from sg_prt_addon.core import lights, sg
+from sg_prt_addon.lighting import lights
+from sg_prt_addon.spherical import sg
 
 
 def _cap_true_integral(distance, radius, intensity):

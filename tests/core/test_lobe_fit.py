@@ -1,8 +1,9 @@
-"""Microfacet factorization and SG lobe fitting of measured BRDFs (core.microfacet_fit)."""
+"""Microfacet factorization and SG lobe fitting of measured BRDFs (measured.microfacet_fit)."""
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import brdf_generators, merl, microfacet_fit
+from sg_prt_addon.measured import merl, microfacet_fit
+from validation import brdf_generators
 
 
 def test_half_difference_quadrature_integrates_cosines():
@@ -121,7 +122,8 @@ def test_free_axis_lobes_of_tabulated_anisotropic_ndfs(method):
     """Tabulated anisotropic Ward NDFs (theta x 32 azimuths) fitted with 4 free-axis lobes at
     least as well as the analytic anisotropy table of ndf_fit (measured 0.084 vs 0.089,
     0.174 vs 0.172, 0.017 vs 0.084)."""
-    from sg_prt_addon.core import brdf, ndf_fit, svbrdf_table
+    from sg_prt_addon.measured import svbrdf_table
+    from sg_prt_addon.reflectance import brdf, ndf_fit
     theta = svbrdf_table.default_ndf_theta(90)
     phi = 2 * np.pi * np.arange(32) / 32
     t, p = np.meshgrid(theta, phi, indexing="ij")

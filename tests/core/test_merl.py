@@ -1,10 +1,11 @@
-"""MERL binary BRDF files (core.merl): round trip, validation errors, sample cleaning, lookup."""
+"""MERL binary BRDF files (measured.merl): round trip, validation errors, sample cleaning, lookup."""
 import os
 
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import brdf_generators, merl
+from sg_prt_addon.measured import merl
+from validation import brdf_generators
 
 
 @pytest.fixture(scope="module")

@@ -1,10 +1,12 @@
-"""SG fits of NDFs (core.ndf_fit and the models' ndf_lobes) against the exact NDFs."""
+"""SG fits of NDFs (reflectance.ndf_fit and the models' ndf_lobes) against the exact NDFs."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.optimize import approx_fprime
 
-from sg_prt_addon.core import brdf, ndf_fit, sg
+from sg_prt_addon.reflectance import brdf, ndf_fit
+from sg_prt_addon.spherical import sg
 from validation import ndf_mappings
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from sg_prt_addon.core.raytrace import RayTracer, offset_origins
+from sg_prt_addon.visibility.raytrace import RayTracer, offset_origins
 
 TRIANGLE = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 

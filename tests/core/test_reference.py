@@ -3,10 +3,10 @@ import numpy as np
 import pytest
 
 from benchmarks.reference_speed import make_icosphere
-from sg_prt_addon.core import equirect
-from sg_prt_addon.core.camera import Camera
-from sg_prt_addon.core.env_sampling import EnvironmentSampler
-from sg_prt_addon.core.reference import DirectionalLight, Material, PointLight, Scene, render_reference
+from sg_prt_addon.lighting import equirect
+from validation.camera import Camera
+from validation.env_sampling import EnvironmentSampler
+from validation.reference import DirectionalLight, Material, PointLight, Scene, render_reference
 
 
 # -- helpers ------------------------------------------------------------------------------------
@@ -33,7 +33,7 @@ def _reflect_frame(axis):
 
 
 class PhongStandIn:
-    """Private glossy test model (not core.brdf): rho_s = (n + 2) / (2 pi) cos^n(angle to the mirror
+    """Private glossy test model (not reflectance.brdf): rho_s = (n + 2) / (2 pi) cos^n(angle to the mirror
     direction), sampled exactly from its cos^n lobe, in the local frame (normal z+)."""
 
     def __init__(self, exponent):
@@ -306,7 +306,7 @@ def test_glossy_plane_under_environment_matches_quadrature():
 
 
 def _core_brdf_models():
-    brdf = pytest.importorskip("sg_prt_addon.core.brdf")
+    brdf = pytest.importorskip("sg_prt_addon.reflectance.brdf")
     return [("ggx", lambda: brdf.GGX(roughness=0.5)), ("cook_torrance", lambda: brdf.CookTorrance(roughness=0.3)),
             ("ward_anisotropic", lambda: brdf.WardAnisotropic(alpha_x=0.35, alpha_y=0.15))]
 
@@ -404,7 +404,7 @@ def test_tangents_orient_the_local_frame(tangent, expected_x):
 
 
 def test_render_to_noise_reaches_the_target_and_stays_calibrated():
-    from sg_prt_addon.core.reference import mean_relative_error, render_to_noise
+    from validation.reference import mean_relative_error, render_to_noise
     scene = _constant_sky_scene()
     camera = orthographic_down(1.0, 16)
     image, error, samples = render_to_noise(scene, camera, relative_error=0.01, pilot_samples=4,
@@ -453,7 +453,7 @@ def test_glossy_highlight_of_a_small_cone_light_matches_quadrature(exponent):
 def test_textured_material_varies_albedo_and_glossiness_over_uv():
     """Left half of the plane (u < 0.5) albedo 0.2, right half 0.8, under a constant sky:
     R = albedo L per half; a textured specular model is evaluated with per-point parameters."""
-    from sg_prt_addon.core.brdf import GGX
+    from sg_prt_addon.reflectance.brdf import GGX
 
     vertices, triangles, normals = ground_plane(half_size=1.0)
     uvs = (vertices[:, :2] + 1.0) / 2.0

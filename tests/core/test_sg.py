@@ -1,4 +1,4 @@
-"""Property tests of core/sg.py against independent numerical integration.
+"""Property tests of spherical/sg.py against independent numerical integration.
 
 Quadrature on the sphere is done around a chosen pole with the substitution
 t = scale (1 - cos theta) (Gauss-Legendre in t, trapezoid in phi), so lobes
@@ -6,9 +6,10 @@ from sharpness 1e-4 to 1e4 are resolved to ~1e-12 relative.
 """
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from sg_prt_addon.core import sg
+from sg_prt_addon.spherical import sg
 
 SETTINGS = settings(max_examples=25, deadline=None)
 log_sharpness = st.floats(np.log(1e-4), np.log(1e4))

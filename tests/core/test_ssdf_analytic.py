@@ -1,7 +1,7 @@
 """SSDF (wang2009 eq. 23) of ray-traced analytic configurations against closed-form angular distances.
 
 One vertex at the origin, normal +z; the occluder is real geometry traced by
-core.raytrace through the bake (adaptive 32 x 32 coarse rays, x5 refinement).
+visibility.raytrace through the bake (adaptive 32 x 32 coarse rays, x5 refinement).
 The error budget: boundary midpoints lie within about half a fine texel
 diagonal (0.011 rad at 160 x 160) of the true boundary, plus float16 storage
 (<= 5e-4 rad); where a visible wedge meets the horizon at a shallow angle, its
@@ -12,9 +12,9 @@ the nearest boundary point of the occluded directions near that corner
 import numpy as np
 import pytest
 
-from sg_prt_addon.bake import BakeOptions, decode, hemisphere_map, ssdf
-from sg_prt_addon.bake.pipeline import bake_ssdf
-from sg_prt_addon.core.raytrace import RayTracer
+from sg_prt_addon.visibility import BakeOptions, decode, hemisphere_map, ssdf
+from sg_prt_addon.visibility.pipeline import bake_ssdf
+from sg_prt_addon.visibility.raytrace import RayTracer
 
 OPTIONS = BakeOptions(resolution=32, refinement=5)
 # Boundary sampling at 160 x 160, float16, and the lost wedge tip at the horizon (module docstring).

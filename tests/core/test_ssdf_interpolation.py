@@ -12,8 +12,8 @@ the closed-form crossing of the two exact signed distances.
 import numpy as np
 from scipy import optimize
 
-from sg_prt_addon.bake import decode, hemisphere_map, ssdf
-from sg_prt_addon.core import hemisphere
+from sg_prt_addon.spherical import hemisphere
+from sg_prt_addon.visibility import decode, hemisphere_map, ssdf
 
 RESOLUTION, REFINEMENT = 32, 5
 ELEVATION = np.radians(45.0)

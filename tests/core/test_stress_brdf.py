@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import brdf
+from sg_prt_addon.reflectance import brdf
 
 # 1e6 inputs per kernel, as the core issue asks (16 s of CPU for the file); SGPRT_STRESS_COUNT
 # runs a smaller or larger version.

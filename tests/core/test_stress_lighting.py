@@ -5,7 +5,8 @@ scales, zero and non-finite axes, sharpness 0, inside and far outside the level 
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import env_prefilter, lights, sg
+from sg_prt_addon.lighting import env_prefilter, lights
+from sg_prt_addon.spherical import sg
 
 COUNT = 1_000_000
 

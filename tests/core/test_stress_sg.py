@@ -7,8 +7,8 @@ import warnings
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import clamped_cosine as cc
-from sg_prt_addon.core import hemisphere, sg
+from sg_prt_addon.spherical import clamped_cosine as cc
+from sg_prt_addon.spherical import hemisphere, sg
 
 N = 1_000_000
 DTYPES = [np.float64, np.float32]

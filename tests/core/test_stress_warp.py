@@ -4,7 +4,7 @@ import functools
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import warp
+from sg_prt_addon.spherical import warp
 
 COUNT = 1_000_000
 

@@ -1,11 +1,13 @@
-"""The tabulated SVBRDF format (core.svbrdf_table): round trip, validation, evaluation."""
+"""The tabulated SVBRDF format (measured.svbrdf_table): round trip, validation, evaluation."""
 import dataclasses
 import os
 
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import brdf, brdf_generators, svbrdf_table
+from sg_prt_addon.measured import svbrdf_table
+from sg_prt_addon.reflectance import brdf
+from validation import brdf_generators
 
 
 @pytest.fixture(scope="module")

@@ -3,9 +3,10 @@ import importlib.util
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from sg_prt_addon.core import sg, warp
+from sg_prt_addon.spherical import sg, warp
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -202,7 +203,7 @@ def test_brdf_slice_against_exact_specular_integral():
 
 
 def ggx_slice_ratio(roughness, theta, mode):
-    from sg_prt_addon.core import brdf
+    from sg_prt_addon.reflectance import brdf
 
     model = brdf.GGX(roughness=roughness)
     axis, sharpness, amplitude = model.ndf_lobes()
@@ -216,9 +217,9 @@ def ggx_slice_ratio(roughness, theta, mode):
     return np.sum(sg.mixture_evaluate(directions, *lobes) * cosine * weights) / exact
 
 
-@pytest.mark.skipif(importlib.util.find_spec("sg_prt_addon.core.brdf") is None, reason="core.brdf not written yet")
+@pytest.mark.skipif(importlib.util.find_spec("sg_prt_addon.reflectance.brdf") is None, reason="reflectance.brdf not written yet")
 def test_spatially_varying_brdf_parameters_broadcast():
-    from sg_prt_addon.core import brdf
+    from sg_prt_addon.reflectance import brdf
 
     roughness = np.linspace(0.1, 0.9, 12).reshape(3, 4)
     model = brdf.GGX(roughness=roughness)
@@ -233,7 +234,7 @@ def test_spatially_varying_brdf_parameters_broadcast():
     np.testing.assert_allclose(out_axis[1, 2], lobes[0], atol=1e-12)
 
 
-@pytest.mark.skipif(importlib.util.find_spec("sg_prt_addon.core.brdf") is None, reason="core.brdf not written yet")
+@pytest.mark.skipif(importlib.util.find_spec("sg_prt_addon.reflectance.brdf") is None, reason="reflectance.brdf not written yet")
 @pytest.mark.parametrize("roughness, theta, expected", [
     # measured ratios (paper, split2, split3); the bounds are +-0.02 around them
     (0.3, 30, (0.991, 0.991, 0.991)),

@@ -3,7 +3,7 @@
 - `blender`: session-wide; imports pip `bpy` (skips the tests if it is
   missing) and resets it to empty factory settings once.
 - `glsl`: a callable `glsl(library, call, inputs, output_components=4,
-  textures=None)` around sg_prt_addon.engine.glsl_harness.run_glsl, where
+  textures=None)` around validation.glsl_harness.run_glsl, where
   `library` lists shaders/lib file names ("sg.glsl") and/or raw GLSL sources.
 - `fuzz`: a `Fuzz` (numpy rng seeded from the test name) generating
   float32-exact inputs, including the degenerate ones of the stress tests.
@@ -25,7 +25,7 @@ def blender():
 
 @pytest.fixture(scope="session")
 def glsl(blender):
-    from sg_prt_addon.engine import glsl_harness
+    from validation import glsl_harness
 
     def run(library, call, inputs, output_components=4, textures=None):
         sources = []

@@ -5,6 +5,7 @@ import os
 
 import numpy as np
 
+
 def studio_world_path(name="courtyard.exr"):
     import bpy
     return os.path.join(bpy.utils.system_resource("DATAFILES"), "studiolights", "world", name)
@@ -14,6 +15,7 @@ def ensure_registered():
     """The add-on (material settings, panels, engine), registered once per process: through
     sg_prt_addon.register() unless another tier's fixture already did it."""
     import bpy
+
     import sg_prt_addon
     from sg_prt_addon import registration
 
@@ -159,7 +161,7 @@ def variant_key(params, has_lights=False, has_environment=False, gbuffer=False, 
     lights and an environment): diffuse_rows and shared_light_visibility stand in for what the SG
     technique derives from the environment, the lights and the object's bounds."""
     from sg_prt_addon import techniques
-    from sg_prt_addon.core.shading import EnvironmentData, LightData
+    from sg_prt_addon.techniques.sg_shading import EnvironmentData, LightData
 
     inputs = techniques.ObjectInputs(LightData(), EnvironmentData(), gbuffer,
                                      {"ssdf": visibility_layers} if visibility_layers else {})
@@ -196,6 +198,7 @@ def render(scene, gbuffer=False, environment_layer_size=None):
     environment_layer_size: the prefilter's layer size for this render (small: fast), else the
     current setting."""
     import bpy
+
     from sg_prt_addon.engine import render_engine
 
     layer_size = render_engine.debug["environment_layer_size"]
@@ -216,6 +219,7 @@ def tracked_state(scene, view_layer):
     """A SceneState synced to the evaluated `view_layer` (dirty set consumed), fed every later edit of
     `scene` through a depsgraph_update_post handler, as view_update feeds it; yields the state."""
     import bpy
+
     from sg_prt_addon.engine import scene_state
 
     view_layer.update()             # evaluate the scene once, before tracking edits
@@ -277,11 +281,11 @@ def mesh_world_arrays(obj):
 
 
 def bake_objects(scene, receivers, resolution=16, terms=None, error_target=0.02, max_terms=47):
-    """bake.pipeline.bake_visibility of each receiver object against every mesh object of the scene;
+    """visibility.pipeline.bake_visibility of each receiver object against every mesh object of the scene;
     returns {object name: BakeResult} and installs it as engine.scene_state.visibility_provider
     (standing in for bakes stored in the .blend).  Call clear_bakes() afterwards."""
-    from sg_prt_addon.bake.pipeline import BakeOptions, bake_visibility
     from sg_prt_addon.engine import scene_state
+    from sg_prt_addon.visibility.pipeline import BakeOptions, bake_visibility
 
     scene.view_layers[0].update()       # the scene's own: matrix_world of objects made since (not the context's)
     arrays = {obj.name: mesh_world_arrays(obj) for obj in scene.objects if obj.type == "MESH"}
@@ -307,13 +311,13 @@ def clear_bakes():
 
 
 def pixel_visibility(result, mask):
-    """core.shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
+    """techniques.sg_shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
     as the GPU interpolates: the triangle (position.w - 1) of the object (normal.w - 1), barycentric
     weights from the interpolated world position, the corners' vertex rows and SSDF normals, and the
     broad diffuse lobes' visibility decoded at the corners' vertices.
     None when the object has no usable bake."""
     from sg_prt_addon.blender import export
-    from sg_prt_addon.core import shading
+    from sg_prt_addon.techniques import sg_shading
 
     passes, state = result["passes"], result["state"]
     object_index = np.unique(np.rint(passes["gbuffer_normal"][mask][:, 3]).astype(int) - 1)
@@ -338,12 +342,12 @@ def pixel_visibility(result, mask):
     rows = np.einsum("nk,nkc->nc", weights, data.packed[vertex].astype(np.float64))
     normal = np.einsum("nk,nkc->nc", weights, mesh.vertex_normals[vertex].astype(np.float64))
     # the broad diffuse lobes: decoded at the vertices, interpolated (renderer's per-vertex pass)
-    at_vertices = shading.vertex_diffuse_visibility(state.environment, shading.Visibility(
+    at_vertices = sg_shading.vertex_diffuse_visibility(state.environment, sg_shading.Visibility(
         rows=data.packed, normal=mesh.vertex_normals, basis_texture=data.basis_texture))
     diffuse = np.einsum("nk,nke->ne", weights, at_vertices[vertex].astype(np.float64))
     # the renderer's choice for the object: its local box, to world
-    shared_light = shading.shares_light_visibility(state.light_data(), shading.world_bounds(
+    shared_light = sg_shading.shares_light_visibility(state.light_data(), sg_shading.world_bounds(
         state.meshes[entry.mesh_key].positions, entry.matrix_world))
-    return shading.Visibility(rows=rows.astype(np.float32), normal=normal.astype(np.float32),
+    return sg_shading.Visibility(rows=rows.astype(np.float32), normal=normal.astype(np.float32),
                               basis_texture=data.basis_texture, diffuse=diffuse.astype(np.float32),
                               shared_light=shared_light)

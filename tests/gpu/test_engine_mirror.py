@@ -1,13 +1,12 @@
-"""The engine's GLSL against its numpy mirror (core/shading.py) on the same pixels.
+"""The engine's GLSL against its numpy mirror (techniques/sg_shading.py) on the same pixels.
 
 One render per scene writes the G-buffer (position, normal, tangent input, uv, material id);
-core.shading.shade_fragments shades those pixels from the same material, lights and
+techniques.sg_shading.shade_fragments shades those pixels from the same material, lights and
 environment data, and the two must agree to float32 round-off (max relative error 1e-3).
 """
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 TOLERANCE = 1e-3
 
@@ -20,7 +19,7 @@ def engine(blender):
 
 def _mirror(result, textures_by_material=None, use_visibility=True):
     """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask."""
-    from sg_prt_addon.core import shading
+    from sg_prt_addon.techniques import sg_shading
 
     passes, state = result["passes"], result["state"]
     camera = passes["camera"]
@@ -38,7 +37,7 @@ def _mirror(result, textures_by_material=None, use_visibility=True):
             if not mask.any():
                 continue
             view_origin = camera.position if camera.is_perspective else camera.forward
-            diffuse, specular = shading.shade_fragments(
+            diffuse, specular = sg_shading.shade_fragments(
                 state.materials[name], (textures_by_material or {}).get(name, {}),
                 passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
                 passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
@@ -218,7 +217,7 @@ def test_visibility_lights_and_world_colour(engine, bakes):
 def test_view_warps_with_visibility(engine, bakes, view_warp):
     """A material's view warp (material.sgprt.view_warp: one or two lobes per NDF lobe instead of three)
     reaches the shader (WARP_FUNCTION / WARP_NODES of its variant) and the mirror alike, shadows included."""
-    from sg_prt_addon.core import warp
+    from sg_prt_addon.spherical import warp
 
     scene, sphere, floor = _shadow_scene("mirror_warp_" + view_warp.lower(), 96)
     fx.world_colour(scene, (0.1, 0.12, 0.15))

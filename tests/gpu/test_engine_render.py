@@ -1,8 +1,7 @@
 """Final renders through bpy.ops.render.render: passes, world background, compile errors."""
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +47,7 @@ def test_passes_and_world_background(engine):
 
 def test_compile_error_names_variant_and_line(engine, monkeypatch):
     import bpy
+
     from sg_prt_addon.engine import render_engine, shader_cache
     from sg_prt_addon.techniques import sg_lobes
 
@@ -66,8 +66,8 @@ def test_compile_error_names_variant_and_line(engine, monkeypatch):
             bpy.ops.render.render(scene=scene.name, write_still=False)
     assert "frame_that_does_not_exist' undeclared" in str(raised.value)      # what the UI reports
     message = render_engine.last_render["error"]
-    from sg_prt_addon.core.shading import GGX_NDF_LOBES
     from sg_prt_addon import techniques
+    from sg_prt_addon.techniques.sg_shading import GGX_NDF_LOBES
     technique = techniques.get("SG_PARAMETRIC")
     lines = broken(technique, sg_lobes.VariantKey(ndf_lobes=GGX_NDF_LOBES)).split("\n")
     number = next(n for n, line in enumerate(lines, 1) if broken_line in line)
@@ -122,8 +122,9 @@ def test_awkward_geometry(engine):
 
 def test_environment_background_follows_blender_mapping(engine):
     """Background pixels = the world image bilinearly sampled along each pixel's view ray with
-    Blender's equirect mapping (core.equirect): orientation and flips end to end."""
-    from sg_prt_addon.core import equirect, shading
+    Blender's equirect mapping (lighting.equirect): orientation and flips end to end."""
+    from sg_prt_addon.lighting import equirect
+    from sg_prt_addon.techniques import sg_shading
 
     rng = np.random.default_rng(5)
     pixels = np.ones((32, 64, 4), np.float32)
@@ -144,7 +145,7 @@ def test_environment_background_follows_blender_mapping(engine):
     near = np.c_[ndc, -np.ones(len(ndc)), np.ones(len(ndc))] @ inverse.T
     direction = far[:, :3] / far[:, 3:] - near[:, :3] / near[:, 3:]
     u, v = equirect.direction_to_uv(direction / np.linalg.norm(direction, axis=1, keepdims=True))
-    expected = shading.sample_texture(pixels, np.stack([u, v], axis=1))[:, :3]
+    expected = sg_shading.sample_texture(pixels, np.stack([u, v], axis=1))[:, :3]
     actual = result["passes"]["Combined"].reshape(-1, 4)
     away_from_seam = (u > 1.5 / 64) & (u < 1 - 1.5 / 64)
     assert away_from_seam.mean() > 0.8
@@ -179,6 +180,7 @@ def test_second_view_layer_renders_its_own_objects(engine, tmp_path):
     """Each view layer's render() writes its own layer: a layer that excludes the sphere shows
     only the world."""
     import bpy
+
     from sg_prt_addon.engine import render_engine
 
     scene = fx.new_scene("render_layers", 32, 32)
@@ -210,6 +212,7 @@ def test_second_view_layer_renders_its_own_objects(engine, tmp_path):
 
 def test_srgb_byte_textures_are_linearised_for_colours_only(engine, tmp_path):
     import bpy
+
     from sg_prt_addon.blender import export
 
     image = bpy.data.images.new("srgb_bytes", 4, 2, alpha=True)       # byte buffer, sRGB
@@ -252,8 +255,8 @@ def test_furnace(engine, textured_world):
         assert np.abs(diffuse / c - 1).max() < 0.03
     else:
         np.testing.assert_allclose(diffuse, c, rtol=2e-6)
-    # the exact directional albedo at normal incidence, by importance sampling core.brdf.GGX
-    from sg_prt_addon.core import brdf
+    # the exact directional albedo at normal incidence, by importance sampling reflectance.brdf.GGX
+    from sg_prt_addon.reflectance import brdf
     model = brdf.GGX(roughness=0.5)
     wo = np.broadcast_to([0.0, 0.0, 1.0], (200000, 3))
     wi, pdf = model.sample(wo, np.random.default_rng(1).random((200000, 2)))
@@ -339,6 +342,7 @@ def test_render_border_writes_the_borders_pixels(engine, tmp_path, crop):
     """A render border (cropped or not) gets the frame's own pixels inside it, in a file as well (an OPEN_EXR
     write with the crop used to end the process)."""
     import bpy
+
     from sg_prt_addon import render as batch
 
     scene = fx.new_scene(f"border_{crop}", 64, 48)

@@ -9,10 +9,9 @@ Small resolutions: the file runs in well under a minute and a half on 2 cores.
 """
 import math
 
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 SIZE = 48
 PASSES = ("Combined", "Diffuse", "Specular")

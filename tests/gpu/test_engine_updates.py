@@ -3,10 +3,9 @@
 view_draw needs a window, but view_update's logic is plain Python over depsgraph.updates:
 it runs here from a depsgraph_update_post handler, as Blender calls it after each edit.
 """
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 
 @pytest.fixture()

@@ -1,16 +1,15 @@
-"""The engine's fitted-lobe variant (MODEL_FITTED) against its numpy mirror (core.shading).
+"""The engine's fitted-lobe variant (MODEL_FITTED) against its numpy mirror (techniques.sg_shading).
 
-A small generated SVBRDF table (core.brdf_generators.generate_svbrdf_table, 8 x 8 texels:
+A small generated SVBRDF table (validation.brdf_generators.generate_svbrdf_table, 8 x 8 texels:
 spatially varying kd, eta, roughness) is fitted by ``bpy.ops.sgprt.fit_lobes`` into a
 material's stored images; the engine renders it from the nearest texel's lobes (texelFetch),
 warped to the view, times M_o with S decoded from the stored shadowing PCA; the mirror shades
 the same G-buffer pixels from export.FittedLobes.  A material without a valid fit (here the
 floor, and the same material once its fit is switched off) renders with its model as before.
 """
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 TOLERANCE = 1e-3
 
@@ -18,8 +17,10 @@ TOLERANCE = 1e-3
 @pytest.fixture(scope="module")
 def fitted_material(blender, tmp_path_factory):
     import bpy
+
     from sg_prt_addon.blender import lobe_fit
-    from sg_prt_addon.core import brdf_generators, svbrdf_table
+    from sg_prt_addon.measured import svbrdf_table
+    from validation import brdf_generators
 
     fx.ensure_registered()
     path = str(tmp_path_factory.mktemp("fitted") / "table.npz")
@@ -33,7 +34,7 @@ def fitted_material(blender, tmp_path_factory):
 
 
 def _mirror(result):
-    from sg_prt_addon.core import shading
+    from sg_prt_addon.techniques import sg_shading
 
     passes, state = result["passes"], result["state"]
     camera = passes["camera"]
@@ -44,7 +45,7 @@ def _mirror(result):
     view_origin = camera.position if camera.is_perspective else camera.forward
     for material_id in np.unique(uv[covered][:, 2]).astype(int):
         mask = covered & (np.abs(uv[..., 2] - material_id) < 0.25)
-        diffuse, specular = shading.shade_fragments(
+        diffuse, specular = sg_shading.shade_fragments(
             state.materials[material_of_id[material_id]], {}, passes["gbuffer_position"][mask][:, :3],
             passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin,
             camera.is_perspective, state.light_data(), state.environment)
@@ -67,7 +68,6 @@ def _errors(result, mask=None):
 
 
 def test_fitted_lobes_engine_matches_mirror(fitted_material):
-    import bpy
     
     scene = fx.new_scene("fitted_mirror", 128, 128)
     fx.world_texture(scene, fx.studio_world_path(), strength=0.6)

@@ -2,18 +2,17 @@
 of the ORIGINAL analytic BRDF it was measured from.
 
 A GGX-like AnalyticMaterial (Lambert kd + F_eta(i.h) GGX with height-correlated Smith, roughness
-0.3, eta 1.5) is tabulated into a MERL file (core.brdf_generators.generate_merl: 2% noise, a few
+0.3, eta 1.5) is tabulated into a MERL file (validation.brdf_generators.generate_merl: 2% noise, a few
 corrupt bins), fitted with 2 SG lobes by bpy.ops.sgprt.fit_lobes, and the sphere is rendered under
 courtyard.exr from the stored fit; the reference renders the analytic BRDF itself
 (reference_scene.analytic_reference_material).  The score covers the whole chain: factorization
 into eq. 13, the 2-lobe SG fit, the view warp and the SG lighting."""
-import numpy as np
+import engine_fixtures as fx
 import pytest
 from scipy.ndimage import binary_erosion
 
-import engine_fixtures as fx
-from sg_prt_addon.core import image_error
-from sg_prt_addon.core.reference import render_to_noise
+from validation import image_error
+from validation.reference import render_to_noise
 
 SIZE = 64
 ANALYTIC = dict(diffuse=(0.35, 0.25, 0.15), oren_nayar_sigma=0.0, specular=(1.0, 1.0, 1.0), roughness=0.3,
@@ -24,9 +23,10 @@ RMSE_BOUND = 0.10
 def score_fitted_sphere(merl_path, name="fitted_reference", size=SIZE, seed=7):
     """(relative RMSE, mean bias, reference noise floor, engine render) over the sphere's interior pixels."""
     import bpy
+
     from sg_prt_addon.blender import lobe_fit
-    from sg_prt_addon.blender.reference_scene import analytic_reference_material, reference_inputs
-    from sg_prt_addon.core import brdf_generators
+    from validation import brdf_generators
+    from validation.reference_scene import analytic_reference_material, reference_inputs
 
     scene = fx.new_scene(name, size, size)
     fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
@@ -54,7 +54,7 @@ def score_fitted_sphere(merl_path, name="fitted_reference", size=SIZE, seed=7):
 
 @pytest.fixture(scope="module")
 def merl_file(blender, tmp_path_factory):
-    from sg_prt_addon.core import brdf_generators
+    from validation import brdf_generators
 
     fx.ensure_registered()
     path = str(tmp_path_factory.mktemp("fitted_reference") / "analytic_ggx.binary")

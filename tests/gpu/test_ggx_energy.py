@@ -2,11 +2,11 @@
 pixel is the model's directional albedo E(o) <= 1.  The slice lobes overshoot it at grazing views (up to 5x
 at roughness 1, cos theta_o 0.05) and undershoot it elsewhere (GGX's tail); capped at E(o) and topped up
 by the environment tail, the engine must return E(o) itself, for every roughness down to a near-mirror."""
+import engine_fixtures as fx
 import numpy as np
 import pytest
 
-import engine_fixtures as fx
-from sg_prt_addon.core import ggx_albedo
+from sg_prt_addon.reflectance import ggx_albedo
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +49,7 @@ def test_white_furnace_returns_the_albedo(engine, roughness):
 @pytest.mark.parametrize("roughness", [0.0, 0.01, 0.03, 0.1, 0.3])
 def test_a_sphere_light_in_a_near_mirror_stays_within_its_radiance(engine, roughness):
     """Nothing reflects more than the light's own radiance times ks; the SG light's peak is 1.15 L_e for a
-    mirror lobe (core.lights, the energy model), so the bound is 1.2 ks L_e.  Measured max 1.06 ks L_e at
+    mirror lobe (lighting.lights, the energy model), so the bound is 1.2 ks L_e.  Measured max 1.06 ks L_e at
     roughness 0-0.03; before the albedo cap (commit e7304ad) 575,000 ks L_e at roughness 0 and 57.5 at 0.01."""
     import math
 
@@ -58,7 +58,7 @@ def test_a_sphere_light_in_a_near_mirror_stays_within_its_radiance(engine, rough
     power, radius = 1000.0, 0.5
     fx.point_light(scene, name + "_light", (2.0, -3.0, 3.0), power, radius=radius)
     specular = fx.render(scene)["passes"]["Specular"][..., :3]
-    radiance = power / (math.pi * 4 * math.pi * radius ** 2)        # Blender's sphere light (core.lights)
+    radiance = power / (math.pi * 4 * math.pi * radius ** 2)        # Blender's sphere light (lighting.lights)
     print(f"roughness {roughness}: max Specular {specular.max():.2f} = {specular.max() / (0.25 * radiance):.3f} ks L_e")
     assert np.all(np.isfinite(specular))
     assert specular.max() <= 1.2 * 0.25 * radiance

@@ -1,17 +1,16 @@
 """Glossy GGX against the Monte Carlo reference where the SG lobes alone fall short (issue: the truth
 suite): a small point light, whose highlight on GGX has a long theta^-4 glow two SG lobes do not hold
-(the light tail, core.shading.light_tail); a sharp lobe under an HDRI, which the top prefiltered layer
-blurred (core.shading.environment_radiance); and GGX's energy beyond its lobes under an HDRI (the
-environment tail, core.shading.environment_tail).  The reference samples pixel centres, as the engine
+(the light tail, techniques.sg_shading.light_tail); a sharp lobe under an HDRI, which the top prefiltered layer
+blurred (techniques.sg_shading.environment_radiance); and GGX's energy beyond its lobes under an HDRI (the
+environment tail, techniques.sg_shading.environment_tail).  The reference samples pixel centres, as the engine
 does, so the scores measure shading, not anti-aliasing.  Bounds sit between the figures measured with
 the fixes and those measured before them (in each case's comment)."""
-import numpy as np
+import engine_fixtures as fx
 import pytest
 from scipy.ndimage import binary_erosion
 
-import engine_fixtures as fx
-from sg_prt_addon.core import image_error
-from sg_prt_addon.core.reference import render_reference
+from validation import image_error
+from validation.reference import render_reference
 
 SIZE = 96
 
@@ -41,7 +40,7 @@ def _glossy_sphere(name, roughness, world, floor=False):
 
 
 def _score(scene, samples):
-    from sg_prt_addon.blender.reference_scene import reference_inputs
+    from validation.reference_scene import reference_inputs
 
     result = fx.render(scene)
     assert "error" not in result, result.get("error")
@@ -63,7 +62,7 @@ def _score(scene, samples):
     ("glossy_courtyard_r010", 0.10, "courtyard", 48, 0.30, 0.03, False),
     # the environment tail: 0.140, bias +0.015; without it 0.157, bias -0.067
     ("glossy_courtyard_r035", 0.35, "courtyard", 48, 0.16, 0.03, False),
-    # over a baked floor, the visible-part lookup (core.shading.visible_part_axes): 0.150, bias -0.020;
+    # over a baked floor, the visible-part lookup (techniques.sg_shading.visible_part_axes): 0.150, bias -0.020;
     # reading the radiance at the occluded lobes' axes 0.158, -0.040 (their visible fraction is right: 0.54
     # against 0.51 ray-traced at the horizon band)
     ("glossy_floor_courtyard_r035", 0.35, "courtyard", 32, 0.165, 0.03, True),

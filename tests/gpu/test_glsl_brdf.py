@@ -1,4 +1,4 @@
-"""shaders/lib/brdf.glsl (float32) against sg_prt_addon/core/brdf.py (float64).
+"""shaders/lib/brdf.glsl (float32) against sg_prt_addon/reflectance/brdf.py (float64).
 
 ndf values are compared relative to the model's peak D(n) (exp(-E) loses
 ~E * 1e-7 relative far in the tail, where the value is negligible);
@@ -7,7 +7,7 @@ m_factor and lobes relative to themselves.
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import brdf
+from sg_prt_addon.reflectance import brdf
 
 N = 20000
 LIB = ["sg.glsl", "brdf.glsl"]

@@ -1,11 +1,11 @@
-"""shaders/lib/clamped_cosine.glsl and clamped_cosine_table.glsl (float32) against sg_prt_addon/core/clamped_cosine.py
+"""shaders/lib/clamped_cosine.glsl and clamped_cosine_table.glsl (float32) against sg_prt_addon/spherical/clamped_cosine.py
 and clamped_cosine_table.py (float64)."""
 import re
 
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import clamped_cosine
+from sg_prt_addon.spherical import clamped_cosine
 
 # the numpy closed form evaluates both sides of its np.where (e.g. c / tiny squared)
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
@@ -97,7 +97,7 @@ def test_tabulated(glsl, fuzz, record_error):
     """shaders/lib/clamped_cosine_table.glsl reading the uploaded table through the hardware's bilinear
     filter, against the numpy mirror of that filter (whose own error against quadrature
     tests/core/test_clamped_cosine_table.py bounds); and its constants against the module's."""
-    from sg_prt_addon.core import clamped_cosine_table
+    from sg_prt_addon.spherical import clamped_cosine_table
     from sg_prt_addon.techniques import shader_sources
 
     source = shader_sources.library_source("clamped_cosine_table.glsl")

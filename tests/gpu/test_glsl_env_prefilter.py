@@ -6,7 +6,7 @@ here is the driver's bilinear filtering and the GLSL arithmetic.
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import env_prefilter
+from sg_prt_addon.lighting import env_prefilter
 
 N = 20000
 LIB = ["sg.glsl", "env_prefilter.glsl"]

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from sg_prt_addon.engine import glsl_harness
+from validation import glsl_harness
 
 
 def test_rows_and_components(glsl):

@@ -1,7 +1,7 @@
-"""shaders/lib/hemisphere.glsl (float32) against sg_prt_addon/core/hemisphere.py (float64)."""
+"""shaders/lib/hemisphere.glsl (float32) against sg_prt_addon/spherical/hemisphere.py (float64)."""
 import numpy as np
 
-from sg_prt_addon.core import hemisphere
+from sg_prt_addon.spherical import hemisphere
 
 N = 20000
 LIB = ["sg.glsl", "hemisphere.glsl"]

@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from sg_prt_addon.engine import glsl_harness
+from validation import glsl_harness
 
 LIB_DIR = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", "lib")
 # file -> the files it needs before it (README.md's table)

@@ -1,7 +1,7 @@
-"""shaders/lib/lights.glsl (float32) against sg_prt_addon/core/lights.py (float64)."""
+"""shaders/lib/lights.glsl (float32) against sg_prt_addon/lighting/lights.py (float64)."""
 import numpy as np
 
-from sg_prt_addon.core import lights
+from sg_prt_addon.lighting import lights
 
 N = 20000
 LIB = ["sg.glsl", "lights.glsl"]

@@ -1,11 +1,11 @@
-"""shaders/lib/sg.glsl (float32, llvmpipe) against sg_prt_addon/core/sg.py (float64).
+"""shaders/lib/sg.glsl (float32, llvmpipe) against sg_prt_addon/spherical/sg.py (float64).
 
 Inputs are exactly float32 values, so the differences measured are the GLSL
 kernel's own arithmetic error.
 """
 import numpy as np
 
-from sg_prt_addon.core import sg
+from sg_prt_addon.spherical import sg
 
 N = 20000
 LIB = ["sg.glsl"]

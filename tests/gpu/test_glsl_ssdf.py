@@ -1,8 +1,8 @@
-"""shaders/lib/ssdf.glsl (float32, llvmpipe) against sg_prt_addon/bake (float64)."""
+"""shaders/lib/ssdf.glsl (float32, llvmpipe) against sg_prt_addon/visibility (float64)."""
 import numpy as np
 
-from sg_prt_addon.bake import decode, hemisphere_map
-from sg_prt_addon.core import hemisphere
+from sg_prt_addon.spherical import hemisphere
+from sg_prt_addon.visibility import decode, hemisphere_map
 
 N = 20000
 LIB = ["sg.glsl", "hemisphere.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl"]

@@ -167,7 +167,7 @@ def test_clamped_cosine_stress(glsl, fuzz):
 def test_clamped_cosine_table_stress(glsl, fuzz):
     """The tabulated integral over the same hostile lobes (NaN-free, lambda from 1e-38 to the cap, zero
     axes and normals, cosines outside [-1, 1]): finite, non-negative, at most pi times the amplitude."""
-    from sg_prt_addon.core import clamped_cosine_table
+    from sg_prt_addon.spherical import clamped_cosine_table
 
     axis, normal = _axis_pairs(fuzz, ROWS)
     sharpness = fuzz.stress_sharpness(ROWS)
@@ -450,7 +450,7 @@ def test_env_prefilter_helpers_stress(glsl, fuzz):
 
 
 def _ssdf_basis(rng, resolution=8, terms=9):
-    from sg_prt_addon.bake import decode
+    from sg_prt_addon.visibility import decode
 
     basis = np.asarray(rng.normal(size=(terms, resolution, resolution)) * 0.3, np.float32)
     mean = np.asarray(rng.uniform(-1.5, 1.5, (resolution, resolution)), np.float32)
@@ -460,7 +460,7 @@ def _ssdf_basis(rng, resolution=8, terms=9):
 def test_ssdf_stress(glsl, fuzz):
     """Every function of ssdf.glsl: degenerate directions and normals (zero, tiny, huge, poles, the
     frame's reference axis), points on the disc's axes and centre, any sharpness and theta_d."""
-    from sg_prt_addon.bake import hemisphere_map
+    from sg_prt_addon.visibility import hemisphere_map
 
     x = _sg_inputs()
     count = len(x["sharpness"])

@@ -1,8 +1,9 @@
-"""shaders/lib/warp.glsl (float32) against sg_prt_addon/core/warp.py (float64)."""
+"""shaders/lib/warp.glsl (float32) against sg_prt_addon/spherical/warp.py (float64)."""
 import numpy as np
 import pytest
 
-from sg_prt_addon.core import brdf, warp
+from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.spherical import warp
 
 N = 20000
 LIB = ["sg.glsl", "brdf.glsl", "warp.glsl"]

@@ -1,13 +1,13 @@
 """The engine scored against the Monte Carlo reference on a scene with no cast shadows
 (a convex sphere: its only occlusion is its own horizon, which the clamped cosine handles),
 so the score measures the SG approximations of lighting and reflectance, not missing shadows."""
+import engine_fixtures as fx
 import numpy as np
 import pytest
 from scipy.ndimage import binary_erosion
 
-import engine_fixtures as fx
-from sg_prt_addon.core import image_error
-from sg_prt_addon.core.reference import render_to_noise
+from validation import image_error
+from validation.reference import render_to_noise
 
 SIZE = 64
 POWER = 300.0
@@ -44,7 +44,7 @@ def _sphere_scene(name, model, **settings):
 
 
 def _score(scene):
-    from sg_prt_addon.blender.reference_scene import reference_inputs
+    from validation.reference_scene import reference_inputs
 
     result = fx.render(scene)
     assert "error" not in result, result.get("error")

@@ -1,10 +1,10 @@
 """Render Samples (scene.sgprt.render_samples): final renders average frames moved by sub-pixel offsets
 (engine.anti_aliasing.pixel_jitter).  Four samples sample the same points as a render twice as large, so their
 average must equal that render box-filtered down (Cycles' 1-pixel box filter); the render panel shows it."""
+import engine_fixtures as fx
 import numpy as np
 import pytest
 
-import engine_fixtures as fx
 from sg_prt_addon.engine import anti_aliasing
 
 
@@ -52,6 +52,7 @@ def test_four_samples_equal_a_box_filtered_double_size_render(engine):
 
 def test_render_panel_shows_the_setting(engine):
     import bpy
+
     from sg_prt_addon.blender import panels
 
     assert bpy.types.Scene.bl_rna.properties.get("sgprt") is not None

@@ -1,9 +1,8 @@
 """A .blend saved with SG-PRT materials reopens with identical settings and renders an
 identical image (textures packed, world image from disk)."""
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 
 @pytest.fixture(scope="module")

@@ -3,17 +3,17 @@ visibility): (a) the sharp shadow of a sphere lit by a small point light on a 64
 (b) environment shadows of the sphere under courtyard.exr.  Each scene is rendered twice by the
 engine, with the bakes (HAS_VISIBILITY) and without (unshadowed), and scored as
 test_reference_score.py scores: relative RMSE over the surface pixels (Diffuse-pass alpha,
-eroded by one pixel) against core.reference.render_to_noise.  The shadowed image must beat the
+eroded by one pixel) against validation.reference.render_to_noise.  The shadowed image must beat the
 unshadowed one clearly, so the shadows are real; the bounds are measured values + margin."""
 import os
 
+import engine_fixtures as fx
 import numpy as np
 import pytest
 from scipy.ndimage import binary_erosion
 
-import engine_fixtures as fx
-from sg_prt_addon.core import image_error
-from sg_prt_addon.core.reference import render_to_noise
+from validation import image_error
+from validation.reference import render_to_noise
 
 SIZE = 64
 BAKE_RESOLUTION = 16
@@ -52,7 +52,7 @@ def _engine_image(scene):
 
 
 def _reference(scene, relative_error):
-    from sg_prt_addon.blender.reference_scene import reference_inputs
+    from validation.reference_scene import reference_inputs
 
     depsgraph = scene.view_layers[0].depsgraph
     depsgraph.update()
@@ -109,12 +109,12 @@ def test_environment_shadows_under_courtyard(engine, bakes):
 def test_per_vertex_diffuse_visibility(engine, bakes, world):
     """The broad diffuse lobes (the environment's SG mixture, or the constant world's cosine lobe) take
     their visibility at the vertices (the renderer's per-vertex pass, interpolated): the Diffuse pass
-    against per-pixel decodes (core.shading, the same G-buffer pixels), relative RMSE over each object's
+    against per-pixel decodes (techniques.sg_shading, the same G-buffer pixels), relative RMSE over each object's
     pixels.  Measured (64 x 64, bake R = 16), courtyard: sphere 0.0016, floor 0.0005 (the courtyard
     score above moved from 0.0626 to 0.0627); colour: sphere 0.0008, floor 0.0001."""
     import dataclasses
 
-    from sg_prt_addon.core import shading
+    from sg_prt_addon.techniques import sg_shading
 
     scene, sphere, floor = _scene("shadow_per_vertex_" + world)
     if world == "courtyard":
@@ -136,7 +136,7 @@ def test_per_vertex_diffuse_visibility(engine, bakes, world):
         name = material_of_id[int(passes["gbuffer_uv"][mask][0, 2])]
 
         def diffuse(visibility):
-            return shading.shade_fragments(
+            return sg_shading.shade_fragments(
                 state.materials[name], {}, passes["gbuffer_position"][mask][:, :3],
                 passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask],
                 passes["gbuffer_uv"][mask][:, :2], camera.position, camera.is_perspective,
@@ -176,13 +176,14 @@ def test_per_vertex_pass_only_where_a_diffuse_term_reads_it(engine, bakes):
 
 
 def test_narrow_lights_share_their_visibility(engine, bakes):
-    """A light narrower than shading.SHARED_LIGHT_VISIBILITY_MAX_RADIUS on an object lends its own
+    """A light narrower than sg_shading.SHARED_LIGHT_VISIBILITY_MAX_RADIUS on an object lends its own
     visibility to its products with the slice lobes (SHARED_LIGHT_VISIBILITY, one decode a light): the
     image against a decode each NDF lobe's products (the variant without it), relative RMSE over the
     surface pixels.  Measured (64 x 64, bake R = 16, light radius 0.25, up to 0.13 rad seen from the
     sphere's box): 2e-4.  A broad light (radius 1.5) keeps the decodes."""
     import bpy
-    from sg_prt_addon.core import shading
+
+    from sg_prt_addon.techniques import sg_shading
 
     scene, sphere, floor = _scene("shared_light")
     fx.world_colour(scene, (0.02, 0.02, 0.02))
@@ -192,14 +193,14 @@ def test_narrow_lights_share_their_visibility(engine, bakes):
     bakes(scene, [sphere, floor], resolution=BAKE_RESOLUTION)
 
     def render(shared=None):
-        shares = shading.shares_light_visibility
+        shares = sg_shading.shares_light_visibility
         if shared is not None:
-            shading.shares_light_visibility = lambda light_data, bounds: shared
+            sg_shading.shares_light_visibility = lambda light_data, bounds: shared
         try:
             with fx.recorded_variant_keys() as keys:
                 image, surface, _ = _engine_image(scene)
         finally:
-            shading.shares_light_visibility = shares
+            sg_shading.shares_light_visibility = shares
         return image.copy(), surface, {key.shared_light_visibility for key in keys if key.visibility_layers}
 
     shared_image, surface, flags = render()

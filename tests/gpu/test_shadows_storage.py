@@ -1,10 +1,9 @@
 """Bakes stored in the .blend reach the engine (blender.visibility_bake.visibility_for_object, the
 default of engine.scene_state.visibility_for); stale bakes and bakes of another vertex count
 render unshadowed, never read out of bounds."""
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 
 @pytest.fixture(scope="module")
@@ -26,6 +25,7 @@ def _scene(name):
 
 def test_stored_bakes_shadow_and_stale_bakes_do_not(engine):
     import bmesh
+
     from sg_prt_addon.blender import visibility_bake
 
     scene, sphere, floor = _scene("stored_bakes")
@@ -70,8 +70,8 @@ def test_stored_bakes_shadow_and_stale_bakes_do_not(engine):
 
 
 def test_a_bake_of_another_vertex_count_is_refused(engine):
-    from sg_prt_addon.bake.pipeline import BakeResult
     from sg_prt_addon.engine import scene_state
+    from sg_prt_addon.visibility.pipeline import BakeResult
 
     scene, sphere, floor = _scene("mismatched_bake")
     vertex_count = len(floor.data.vertices)
@@ -106,7 +106,7 @@ def test_viewport_update_picks_up_a_new_bake_and_its_removal(blender):
     scene = bpy.context.scene
     for obj in list(scene.objects):
         bpy.data.objects.remove(obj)
-    sphere = fx.uv_sphere(scene, "viewport_bake_sphere", (0.0, 0.0, 1.0), segments=12, rings=6)
+    fx.uv_sphere(scene, "viewport_bake_sphere", (0.0, 0.0, 1.0), segments=12, rings=6)
     floor = fx.grid(scene, "viewport_bake_floor", (0.0, 0.0, 0.0), size=4.0, segments=8)
     view_layer = bpy.context.view_layer
     try:

@@ -4,11 +4,10 @@ loop, the shader cache and the scene state name no technique."""
 import os
 import re
 
-import numpy as np
-import pytest
-
 import engine_fixtures as fx
 import normal_display_technique as normal_display
+import numpy as np
+import pytest
 
 SIZE = 64
 ENGINE_DIR = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "sg_prt_addon", "engine")

@@ -12,10 +12,9 @@ Renderer.upload re-creates nothing whose input did not change.
 import re
 import types
 
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 SIZE = 96
 ENV_LAYER_SIZE = 16

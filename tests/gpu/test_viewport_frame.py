@@ -2,10 +2,9 @@
 GPU context: the scene is drawn again only when something changed, and the image is the final render's."""
 import dataclasses
 
+import engine_fixtures as fx
 import numpy as np
 import pytest
-
-import engine_fixtures as fx
 
 
 @pytest.fixture(scope="module")

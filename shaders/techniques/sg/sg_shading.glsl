@@ -1,5 +1,5 @@
 /* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43);
- * mirrored line by line by sg_prt_addon/core/shading.py.  Needs sg.glsl, hemisphere.glsl,
+ * mirrored line by line by sg_prt_addon/techniques/sg_shading.py.  Needs sg.glsl, hemisphere.glsl,
  * clamped_cosine.glsl, (lights or specular) clamped_cosine_table.glsl and the `clamped_cosine_table`
  * sampler (the clamped cosine of the lobes whose sharpness varies per pixel), (HAS_LIGHTS) lights.glsl,
  * (HAS_SPECULAR) brdf.glsl + warp.glsl,
@@ -9,7 +9,7 @@
  * variant's term is exactly zero).  DIFFUSE_VISIBILITY_ROWS (with HAS_VISIBILITY and HAS_DIFFUSE): the
  * broad diffuse lobes' visible fractions come interpolated from the vertices (diffuse_fractions, filled
  * by surface.frag.glsl from the pass of resources/vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with
- * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; core.shading.shares_light_visibility): every light is narrow on
+ * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; techniques.sg_shading.shares_light_visibility): every light is narrow on
  * the object, and its products with the slice lobes take its own visibility instead of a decode each. */
 
 #ifdef HAS_VISIBILITY
@@ -35,7 +35,7 @@ void shading_frame(vec3 normal, vec3 tangent, out vec3 n, out vec3 t, out vec3 b
   vec3 unit_tangent = safe_normalize(tangent, vec3(0.0));
   t = unit_tangent - n * dot(n, unit_tangent);
   /* within 0.06 degrees of the normal (or zero) what is left is rounding: take the fallback
-   * (1e-6 = core.shading.SHADING_FRAME_MIN_SINE squared) */
+   * (1e-6 = techniques.sg_shading.SHADING_FRAME_MIN_SINE squared) */
   if (dot(t, t) < 1.0e-6) {
     t = cross(n, abs(n.x) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0));
   }
@@ -93,7 +93,7 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
 }
 
 #ifdef MODEL_FITTED
-/* The stored lobe fit (blender.lobe_fit format 1, export.FittedLobes; mirrored by core.shading's
+/* The stored lobe fit (blender.lobe_fit format 1, export.FittedLobes; mirrored by techniques.sg_shading's
  * fitted_* functions).  fitted_layers: 0 base (kd RGB, eta), 1 + 2k lobe k (axis xyz local,
  * sharpness), 2 + 2k lobe k amplitude RGB, 1 + 2K + j shadowing PCA coefficients 4j..4j+3; read
  * with texelFetch at the nearest texel of the UV (the paper's per-texel free-axis lobes).
@@ -210,7 +210,7 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
 }
 
 #if defined(HAS_LIGHTS) && !defined(MODEL_FITTED)
-/* What the slice lobes miss of the model's own BRDF at a light's centre (core.shading.light_tail) */
+/* What the slice lobes miss of the model's own BRDF at a light's centre (techniques.sg_shading.light_tail) */
 #define LIGHT_TAIL
 
 /* rho_s(o, i) = M_o(i) D(h) of the model itself (brdf.glsl), local frame */
@@ -303,7 +303,7 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
 
 #if defined(HAS_VISIBILITY) && defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
-/* A partly occluded slice lobe reads the environment at the mean of its visible part (core.shading.
+/* A partly occluded slice lobe reads the environment at the mean of its visible part (techniques.sg_shading.
  * visible_part_offset): its visible and occluded parts see different light, which the product of the
  * visible fraction and the radiance at the lobe's axis ignores. */
 #define VISIBLE_PART_LOOKUP
@@ -319,7 +319,7 @@ float visible_part_offset(float v)
 }
 #endif
 /* The warped lobes of one NDF lobe lie close together: they share the visibility of the centre one
- * (core.shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3; split2 has
+ * (techniques.sg_shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3; split2 has
  * no centre node and takes node 0, the one towards the viewer (a valid half vector whenever the lobe's
  * centre is; the other can fall below the view's horizon at grazing views). */
 #define VISIBILITY_NODE ((WARP_NODES - 1) / 2)
@@ -390,8 +390,8 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     slice_albedo += slice_cosines[j];
   }
 #ifdef ENVIRONMENT_TAIL
-  /* GGX's exact albedo (core.ggx_albedo): the lobes keep at most it (at grazing views they overshoot it
-   * several times over), and the environment tail returns what they miss of it (core.shading.model_albedo) */
+  /* GGX's exact albedo (reflectance.ggx_albedo): the lobes keep at most it (at grazing views they overshoot it
+   * several times over), and the environment tail returns what they miss of it (techniques.sg_shading.model_albedo) */
   vec2 albedo_coords = (clamp(vec2(view_local.z, p.x), 0.0, 1.0) * float(GGX_ALBEDO_SIZE - 1) + 0.5) /
                        float(GGX_ALBEDO_SIZE);
   float model_albedo = texture(ggx_albedo_table, albedo_coords).r;
@@ -460,7 +460,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
 #ifdef LIGHT_TAIL
     /* the model's BRDF minus the slice lobes at the light's centre, times what the light delivers there,
-     * weighted by how narrow the light is against the BRDF's local scale s^2 (core.shading.light_tail) */
+     * weighted by how narrow the light is against the BRDF's local scale s^2 (techniques.sg_shading.light_tail) */
     float slice_value = 0.0;
     float scale2 = 1.0e30;
     for (int j = 0; j < SLICE_LOBES; j++) {
@@ -514,7 +514,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
 #ifdef ENVIRONMENT_TAIL
   /* GGX's energy beyond its slice lobes: its exact albedo minus theirs, as a broad lobe on the broader NDF
-   * lobe's centre node (core.shading.environment_tail) */
+   * lobe's centre node (techniques.sg_shading.environment_tail) */
   float tail_albedo = max(model_albedo - slice_albedo, 0.0) * tail_visibility;
 #ifdef HAS_ENVIRONMENT
   radiance += tail_albedo * environment_radiance(tail_axis, slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO);

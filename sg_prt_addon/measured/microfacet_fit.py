@@ -38,10 +38,17 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sparse
 
-from . import merl, ndf_fit
-from .brdf import fresnel_dielectric
-from .svbrdf_table import (SvbrdfTable, default_ndf_theta, default_shadowing_theta, evaluate_microfacet,
-                           interpolate_ndf, interpolate_shadowing)
+from ..reflectance import ndf_fit
+from ..reflectance.brdf import fresnel_dielectric
+from . import merl
+from .svbrdf_table import (
+    SvbrdfTable,
+    default_ndf_theta,
+    default_shadowing_theta,
+    evaluate_microfacet,
+    interpolate_ndf,
+    interpolate_shadowing,
+)
 
 HALF_PI = 0.5 * np.pi
 PAPER_ETA = 1.33

@@ -31,7 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import equirect, sg, texture_fetch
+from ..spherical import sg, texture_fetch
+from . import equirect
 
 DEFAULT_MIN_SHARPNESS = 0.125
 DEFAULT_MAX_SHARPNESS = 2048.0

@@ -8,14 +8,14 @@ then sum over layers of dot(texture(basis, (s, t, layer)), coefficients[layer]):
 one bilinear fetch per four terms, and bilinear filtering commutes with the
 linear PCA sum, so this equals the bilinear sample of the reconstructed image.
 
-``core.texture_fetch`` reproduces the GPU linear sampler with clamp-to-edge: texel
+``spherical.texture_fetch`` reproduces the GPU linear sampler with clamp-to-edge: texel
 centres at (k + 0.5) / R, weights from the fractional part.  Stored samples sit
 at the texel centres (``hemisphere_map.sample_texcoord``), so the lookup
 interpolates all the way to the horizon.
 """
 import numpy as np
 
-from ..core import hemisphere, sg, texture_fetch
+from ..spherical import hemisphere, sg, texture_fetch
 from . import hemisphere_map
 
 
@@ -49,7 +49,7 @@ def decode_image(image, local_direction):
 
 
 def visibility_product(axis_local, sharpness, amplitude, theta_d):
-    """Lobe (x) visibility, wang2009 eq. 31 in the integral-preserving form of core.hemisphere
+    """Lobe (x) visibility, wang2009 eq. 31 in the integral-preserving form of spherical.hemisphere
     (apply to the final product lobe).  theta_d = the decoded SSDF at the lobe axis."""
     return hemisphere.visibility_product_integral_preserving(axis_local, sharpness, amplitude, theta_d)
 

@@ -7,11 +7,13 @@ light transport differs.
 """
 import numpy as np
 
-from ..core import brdf, reference, shading
-from ..core.camera import Camera
-from . import export
+from sg_prt_addon.blender import export
+from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.techniques import sg_shading
+from validation import reference
+from validation.camera import Camera
 
-_MODEL_PARAMETERS = shading._MODEL_PARAMETERS   # the material fields each model reads
+_MODEL_PARAMETERS = sg_shading._MODEL_PARAMETERS   # the material fields each model reads
 
 
 def _texture_lookup(params, images):
@@ -22,13 +24,13 @@ def _texture_lookup(params, images):
         for name in ("diffuse_color", "specular_color"):
             colour = np.broadcast_to(np.asarray(getattr(params, name), np.float64), (count, 3))
             if name in images:
-                colour = colour * shading.sample_texture(images[name], uv)[:, :3]
+                colour = colour * sg_shading.sample_texture(images[name], uv)[:, :3]
             values[name] = colour
         model_parameters = {}
         for name in _MODEL_PARAMETERS[params.model]:
             value = np.full(count, float(getattr(params, name)))
             if name in images:
-                value = value * shading.sample_texture(images[name], uv)[:, 0]
+                value = value * sg_shading.sample_texture(images[name], uv)[:, 0]
             model_parameters[name] = value
         values["specular_model"] = brdf.model_from_name(params.model, **model_parameters)
         return values
@@ -36,7 +38,7 @@ def _texture_lookup(params, images):
 
 
 def reference_material(params, texture_pixels):
-    """core.reference.Material of an export.MaterialParams; texture_pixels(image name, slot) gives
+    """validation.reference.Material of an export.MaterialParams; texture_pixels(image name, slot) gives
     what the shader samples for that slot (export.texture_pixels), or None for a missing image."""
     constant = {name: float(getattr(params, name)) for name in _MODEL_PARAMETERS[params.model]}
     material = reference.Material(np.asarray(params.diffuse_color, float), np.asarray(params.specular_color, float),
@@ -79,12 +81,12 @@ def anisotropy_tangents(mesh, entry, materials):
         n = normals[corners]
         tangent = np.broadcast_to(linear @ np.asarray(params.tangent_axis, np.float64), n.shape) if object_axis \
             else tangents[corners]
-        tangents[corners] = shading.rotate_tangent(n, tangent, angle)
+        tangents[corners] = sg_shading.rotate_tangent(n, tangent, angle)
     return tangents
 
 
 def reference_scene(state, texture_pixels):
-    """core.reference.Scene of a synced engine SceneState; texture_pixels as reference_material takes it."""
+    """validation.reference.Scene of a synced engine SceneState; texture_pixels as reference_material takes it."""
     material_names = list(state.materials)
     materials = [reference_material(state.materials[name], texture_pixels) for name in material_names]
     vertices, normals, uvs, tangents, triangles, material_index = [], [], [], [], [], []
@@ -115,9 +117,10 @@ def reference_scene(state, texture_pixels):
 
 
 def reference_inputs(depsgraph, width, height):
-    """(core.reference.Scene, core.camera.Camera) of an evaluated depsgraph, as the engine sees it."""
+    """(validation.reference.Scene, validation.camera.Camera) of an evaluated depsgraph, as the engine sees it."""
     import bpy
-    from ..engine.scene_state import SceneState
+
+    from sg_prt_addon.engine.scene_state import SceneState
 
     state = SceneState()
     state.sync(depsgraph)
@@ -132,7 +135,7 @@ def reference_inputs(depsgraph, width, height):
 
 
 class AnalyticSpecular:
-    """core.reference's specular-model protocol for a core.brdf_generators.AnalyticMaterial's
+    """validation.reference's specular-model protocol for a validation.brdf_generators.AnalyticMaterial's
     glossy part (F_eta(i.h) x GGX, height-correlated Smith): specular(wo, wi) is its exact
     specular_scalar; sample / pdf are GGX's visible-normal sampling with its exact density
     (the estimator is unbiased whatever the proposal, as long as pdf is the proposal's)."""
@@ -152,7 +155,7 @@ class AnalyticSpecular:
 
 
 def analytic_reference_material(analytic):
-    """core.reference.Material rendering an AnalyticMaterial exactly, for the materials the
+    """validation.reference.Material rendering an AnalyticMaterial exactly, for the materials the
     reference's (kd, ks x scalar specular) form holds: Lambert diffuse (oren_nayar_sigma 0) and
     no retro-reflection; ValueError otherwise."""
     if float(np.max(analytic.oren_nayar_sigma)) != 0.0 or float(np.max(analytic.retro)) != 0.0:

@@ -4,7 +4,7 @@ Computes wang2009 eq. 1 at the first surface seen through each pixel:
 
     R(o) = integral L(i) V(i) rho(o, i) max(0, n.i) di,  rho = kd / pi + ks rho_s(o, i)
 
-with V by ray casts against every triangle of the scene (core.raytrace).  No
+with V by ray casts against every triangle of the scene (visibility.raytrace).  No
 indirect light.  Every sample of a pixel takes a new uniformly jittered
 position inside the pixel (anti-aliasing) and traces its own camera ray, so a
 pixel's value is the average of R over its footprint.
@@ -12,7 +12,7 @@ pixel's value is the average of R over its footprint.
 Estimators, per pixel sample (one camera ray):
   - environment (an equirect map, or a constant background colour):
     multiple importance sampling, power heuristic, of ``environment_samples``
-    (default 16, stratified 4x4) environment samples (core.env_sampling) and as
+    (default 16, stratified 4x4) environment samples (validation.env_sampling) and as
     many BRDF samples (cosine lobe or the specular model, picked by weight);
   - point lights (sphere of radius r, r = 0 a true point, optional spot cone)
     and directional lights (cone of angular radius a, a = 0 a delta): one light
@@ -29,7 +29,7 @@ Conventions:
     its horizon before the BRDF is evaluated.
   - BRDF models work in the local frame (normal z+, tangent x+) with the
     protocol specular(wo, wi) -> (N,), sample(wo, u) -> (wi, pdf), pdf(wo, wi)
-    (core.brdf); specular(wo, wi) is rho_s without the cosine.
+    (reflectance.brdf); specular(wo, wi) is rho_s without the cosine.
   - The standard error of a pixel is sqrt(sample variance / samples): the
     samples of a pixel are independent, so it is calibrated.
 """
@@ -40,8 +40,8 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
-from .env_sampling import EnvironmentSampler, LUMINANCE_WEIGHTS
-from .raytrace import RayTracer, offset_origins
+from sg_prt_addon.visibility.raytrace import RayTracer, offset_origins
+from validation.env_sampling import LUMINANCE_WEIGHTS, EnvironmentSampler
 
 INV_PI = 1.0 / np.pi
 # Lowest cosine of the view direction over the shading horizon (see module notes).
@@ -62,7 +62,7 @@ class Material:
 @dataclass
 class PointLight:
     """Point / sphere light, optionally a spot.  Blender: intensity = power / (4 pi)
-    (core.lights.blender_point_light_intensity), radius = shadow_soft_size."""
+    (lighting.lights.blender_point_light_intensity), radius = shadow_soft_size."""
     position: Any                             # (3,) world
     intensity: Any                            # (3,) W/sr
     radius: float = 0.0                       # > 0: a uniformly emitting sphere of the same intensity
@@ -73,7 +73,7 @@ class PointLight:
     def spot_falloff(self, to_light):
         """Intensity factor (N,) for unit directions (N, 3) from shading points to the light centre:
         smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) blend)), a the angle off the spot axis
-        (Cycles' round spot at unit scale, like core.lights.spot_light_sg)."""
+        (Cycles' round spot at unit scale, like lighting.lights.spot_light_sg)."""
         if self.spot_direction is None:
             return np.ones(len(to_light))
         axis = np.asarray(self.spot_direction, float)
@@ -108,7 +108,7 @@ class Scene:
 
 def render_reference(scene, camera, samples_per_pixel, seed=0, progress: Optional[Callable] = None,
                      batch_rays=1 << 16, tracer=None, threads=2, environment_samples=16, pixel_centres=False):
-    """Render ``scene`` through ``camera`` (core.camera.Camera).
+    """Render ``scene`` through ``camera`` (validation.camera.Camera).
 
     Returns (image, standard_error), both (H, W, 3) float64.  ``progress`` is
     called after every batch as progress(samples_done, samples_total) with

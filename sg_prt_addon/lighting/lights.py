@@ -32,7 +32,7 @@ it (exactly 2 S / (1 + cos(a/2)) since the disc is a cap).  Blender's default
 """
 import numpy as np
 
-from . import sg
+from ..spherical import sg
 
 MAX_SHARPNESS = 1e6  # sg.py kernels are stable up to here; radius 0 lights clamp to it
 _LN10 = np.log(10.0)

@@ -12,8 +12,8 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from ..core.raytrace import RayTracer
-from . import hemisphere_map, pca, ssdf, visibility
+from . import binary_visibility, hemisphere_map, pca, ssdf
+from .raytrace import RayTracer
 
 
 class BakeCancelled(Exception):
@@ -89,7 +89,7 @@ def bake_ssdf(vertices, normals, tracer, options, progress=None, tangents=None):
         pending = None
         for start in range(0, count, options.batch_vertices):
             part = slice(start, min(start + options.batch_vertices, count))
-            fine, _ = visibility.adaptive_visibility(tracer, origins[part], frames[part], resolution,
+            fine, _ = binary_visibility.adaptive_visibility(tracer, origins[part], frames[part], resolution,
                                                      options.refinement)
             if pending is not None:
                 pending.result()

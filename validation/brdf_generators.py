@@ -2,13 +2,13 @@
 
 ``AnalyticMaterial`` is deliberately not a sum of SGs and not exactly the microfacet
 form of wang2009 eq. 13: an Oren-Nayar base (qualitative model), a GGX lobe with
-dielectric Fresnel and height-correlated Smith shadowing (core.brdf.GGX), and a
+dielectric Fresnel and height-correlated Smith shadowing (reflectance.brdf.GGX), and a
 retro-reflective cosine-power lobe around the view direction.  Parameters are scalars
 or arrays with a leading texel axis (B,) for spatially-varying materials.
 
 ``generate_merl`` tabulates a material at the MERL bin centres with measurement-like
 noise (multiplicative log-normal, plus a few negative / NaN / Inf samples) and writes
-it; ``generate_svbrdf_table`` makes a small SVBRDF table (core.svbrdf_table) whose
+it; ``generate_svbrdf_table`` makes a small SVBRDF table (measured.svbrdf_table) whose
 NDF is a GGX / Beckmann blend (not a GGX) with noise and spatially varying roughness,
 colours and eta.
 """
@@ -16,8 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import brdf, merl
-from .svbrdf_table import SvbrdfTable, default_ndf_theta, default_shadowing_theta
+from sg_prt_addon.measured import merl
+from sg_prt_addon.measured.svbrdf_table import SvbrdfTable, default_ndf_theta, default_shadowing_theta
+from sg_prt_addon.reflectance import brdf
 
 HALF_PI = 0.5 * np.pi
 

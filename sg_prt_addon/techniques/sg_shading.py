@@ -23,7 +23,7 @@ With a visibility bake (``Visibility``: the pixel's interpolated SSDF PCA rows a
 SSDF-frame normal, the packed basis), every clamped-cosine integral I(G, n) above is
 multiplied by ``lobe_visibility(G)``: the product lobe P = G (x) C*(n) (eq. 40's cosine
 lobe), the SSDF theta_d decoded at P's axis in the vertex's local frame
-(bake.decode's lookup), and fh(theta_d, lambda_P) / fh(theta_h, lambda_P) clamped to
+(visibility.decode's lookup), and fh(theta_d, lambda_P) / fh(theta_h, lambda_P) clamped to
 [0, 1], theta_h the axis's angle to the SSDF normal's horizon (eq. 30-31: what the
 visibility keeps of P relative to what the horizon alone keeps, since I(G, n) clamps
 the horizon already).  G is the environment lobe (eq. 39), the light (eq. 42), the
@@ -48,7 +48,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import brdf, clamped_cosine, env_prefilter, equirect, ggx_albedo, lights, sg, texture_fetch, warp
+from ..lighting import env_prefilter, equirect, lights
+from ..reflectance import brdf, ggx_albedo
+from ..spherical import clamped_cosine, sg, texture_fetch, warp
 
 FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
@@ -71,7 +73,7 @@ SHARED_LIGHT_VISIBILITY_MAX_RADIUS = 0.15
 def _clamped_cosine_integral(axis, sharpness, amplitude, normal):
     """I(G, n) of a lobe whose sharpness varies per pixel (lights, slices, their products): from the
     table, as the shader reads it (clamped_cosine_table)."""
-    from . import clamped_cosine_table
+    from ..spherical import clamped_cosine_table
     return clamped_cosine_table.sg_clamped_cosine_integral_tabulated(axis, sharpness, amplitude, normal).astype(FLOAT)
 
 
@@ -117,9 +119,9 @@ class EnvironmentData:
 class Visibility:
     """Per-pixel SSDF inputs of the visibility variant (shaders: HAS_VISIBILITY).
 
-    rows (N, 4 L): interpolated [1, w_0, ...] (bake.decode.pack_coefficients layout);
+    rows (N, 4 L): interpolated [1, w_0, ...] (visibility.decode.pack_coefficients layout);
     normal (N, 3): interpolated SSDF-frame normal (the bake's vertex normals, world space);
-    basis_texture (L, R, R, 4): bake.decode.pack_basis_texture;
+    basis_texture (L, R, R, 4): visibility.decode.pack_basis_texture;
     diffuse (N, E), optional: the broad diffuse lobes' visible fractions interpolated from the vertices
     (vertex_diffuse_visibility; shaders: DIFFUSE_VISIBILITY_ROWS), in place of per-pixel decodes;
     shared_light: the light x slice products take their light's visibility (shares_light_visibility of the
@@ -134,7 +136,7 @@ class Visibility:
 
 def ssdf_decode_packed(rows, basis_texture, local_direction):
     """ssdf.glsl's ssdf_decode in numpy: rows (N, 4L), local directions (N, K, 3) -> (N, K) float32."""
-    from ..bake import decode
+    from ..visibility import decode
 
     layers, resolution = basis_texture.shape[0], basis_texture.shape[1]
     texcoord, below = decode.texcoord_of(local_direction, resolution)        # (N, K, 2), (N, K)
@@ -149,8 +151,8 @@ def ssdf_decode_packed(rows, basis_texture, local_direction):
 def lobe_visibility(axis, sharpness, n, visibility):
     """Visible fraction (N, K) of I(G, n) for lobes G with axis (N, K, 3), sharpness (N, K); n (N, 3)
     (sg_shading.glsl's lobe_visibility)."""
-    from ..bake import hemisphere_map
-    from . import hemisphere
+    from ..spherical import hemisphere
+    from ..visibility import hemisphere_map
 
     cosine_sharpness, _ = clamped_cosine.clamped_cosine_lobe()
     product_axis, product_sharpness, _ = sg.product(
@@ -212,7 +214,7 @@ def visible_part_axes(slice_axis, slice_sharpness, slice_visible, view, centre, 
 
 def model_albedo(model, params, view_local):
     """The model's exact directional albedo E(o) per pixel (N,) where the engine tabulates it (GGX:
-    core.ggx_albedo's table, one bilinear fetch, as sg_shading.glsl's ENVIRONMENT_TAIL), else None."""
+    reflectance.ggx_albedo's table, one bilinear fetch, as sg_shading.glsl's ENVIRONMENT_TAIL), else None."""
     if model != "GGX":
         return None
     table = ggx_albedo.albedo_table()[..., None]
@@ -355,7 +357,7 @@ def fitted_texel_values(fitted, uv):
     coefficients = np.concatenate([texel[1 + 2 * count + j] for j in range(fitted.shadowing_layers)],
                                   axis=1)[:, :fitted.components]
     table = np.asarray(fitted.table, np.float64)[..., 0]
-    from .microfacet_fit import decompress_shadowing
+    from ..measured.microfacet_fit import decompress_shadowing
     shadowing = decompress_shadowing(table[1], table[2:2 + fitted.components], coefficients.astype(np.float64))
     params = {"axis": sg.normalize(lobes[..., :3]), "sharpness": lobes[..., 3], "colour": colour,
               "eta": texel[0, :, 3], "shadowing": shadowing, "shadowing_theta": table[0]}
@@ -364,7 +366,7 @@ def fitted_texel_values(fitted, uv):
 
 def fitted_shadowing(params, direction):
     """S of each pixel's texel at local directions (N, M, 3) -> (N, M) (sg_shading.glsl's fitted_shadowing_of)."""
-    from .svbrdf_table import interpolate_shadowing
+    from ..measured.svbrdf_table import interpolate_shadowing
     w = sg.normalize(np.asarray(direction, FLOAT)).astype(np.float64)
     theta = np.arctan2(np.hypot(w[..., 0], w[..., 1]), np.maximum(w[..., 2], 0))
     return interpolate_shadowing(params["shadowing"], params["shadowing_theta"], theta)
@@ -403,7 +405,7 @@ def slice_colours(model, params, slice_count):
 
 
 def specular_slice(model, params, lobe_count, view_local, warp_mode=None):
-    """BRDF slice lobes (local frame) for the view: NDF lobes warped by ``warp_mode`` (core.warp's; None:
+    """BRDF slice lobes (local frame) for the view: NDF lobes warped by ``warp_mode`` (spherical.warp's; None:
     its default) times M_o at their centres."""
     if model == FITTED_MODEL:
         return fitted_slice(params, view_local, warp_mode)
@@ -450,16 +452,48 @@ def light_tail(model, params, view_local, frame, light_axis, light_sharpness, li
     return (narrow * light_cosine * (exact - slice_value)).astype(FLOAT)
 
 
-def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
-          light_data, environment, lobe_count=1, visibility=None, warp_mode=None):
-    """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
-    ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
-    applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
+@dataclass
+class _Pixels:
+    """What every term of shade() reads: the pixels' frame and view, and their BRDF slice lobes (warped,
+    capped at the model's albedo), with the visibility of lobes when there is a bake."""
+    position: np.ndarray
+    n: np.ndarray
+    frame: np.ndarray           # local -> world: columns t, b, n
+    view: np.ndarray
+    view_local: np.ndarray
+    model: str
+    params: dict
+    visibility: object
+    warp_mode: object
+    slice_axis: np.ndarray
+    slice_sharpness: np.ndarray
+    slice_amplitude: np.ndarray
+    slice_colour: np.ndarray
+    slice_cosine: np.ndarray    # I(S_j, n), unshadowed
+    albedo: object              # the model's directional albedo where it is tabulated, else None
 
-    view_origin: camera position (perspective) or the camera's forward direction (orthographic).
-    visibility: a Visibility (the SSDF shadows of the HAS_VISIBILITY variant) or None (unshadowed).
-    warp_mode: core.warp's mode of the view slice (the material's view warp; None: the default).
-    """
+    def visible(self, axis, sharpness):
+        if self.visibility is None:
+            return FLOAT(1)
+        shape = np.shape(sharpness)
+        flat_axis = np.asarray(axis, FLOAT).reshape(shape[0], -1, 3)
+        flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
+        return lobe_visibility(flat_axis, flat_sharpness, self.n, self.visibility).reshape(shape)
+
+    @property
+    def nodes(self):
+        return warp.nodes_per_lobe(self.warp_mode)
+
+    @property
+    def centre(self):
+        return visibility_node_indices(self.slice_sharpness.shape[1], self.warp_mode)
+
+    def per_node(self, group_values):   # (..., K) -> (..., K * nodes): each NDF lobe's to its warped nodes
+        return np.repeat(group_values, self.nodes, axis=-1)
+
+
+def _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
+            warp_mode):
     position = np.asarray(position, FLOAT)
     n, t, b = shading_frame(normal, tangent)
     if is_perspective:
@@ -477,33 +511,20 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     if slice_colour is None:
         slice_colour = np.ones(slice_sharpness.shape + (3,), FLOAT)
 
-    irradiance = np.zeros(position.shape, FLOAT)
-    specular = np.zeros(position.shape, FLOAT)
-    n_lobe = n[:, None, :]
-
-    def visible(axis, sharpness):
-        if visibility is None:
-            return FLOAT(1)
-        shape = np.shape(sharpness)
-        flat_axis = np.asarray(axis, FLOAT).reshape(shape[0], -1, 3)
-        flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
-        return lobe_visibility(flat_axis, flat_sharpness, n, visibility).reshape(shape)
-
-    nodes = warp.nodes_per_lobe(warp_mode)
-    centre = visibility_node_indices(slice_sharpness.shape[1], warp_mode)
-
-    def per_node(group_values):         # (..., K) -> (..., K * nodes): each NDF lobe's to its warped nodes
-        return np.repeat(group_values, nodes, axis=-1)
-
     # I(S_j, n) unshadowed: the lobes' albedo, capped at the model's own where it is known (GGX: the lobes
     # overshoot it several times over at grazing views), and the environment's weights below
-    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n_lobe)    # (N, J)
+    slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n[:, None, :])  # (N, J)
     albedo = model_albedo(model, params, view_local)
     if albedo is not None:
         scale = np.minimum(FLOAT(1), albedo / np.maximum(np.sum(slice_cosine, axis=1), FLOAT(1e-30)))[:, None]
         slice_amplitude = (slice_amplitude * scale).astype(FLOAT)
         slice_cosine = (slice_cosine * scale).astype(FLOAT)
+    return _Pixels(position, n, frame, view, view_local, model, params, visibility, warp_mode, slice_axis,
+                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo)
 
+
+def _light_sets(position, light_data):
+    """(axis (N, P, 3), sharpness (N, P), amplitude (N, P, 3)) of the point/spot lights, then of the suns."""
     light_sets = []
     if len(light_data.point_radius):
         light_sets.append(point_light_sgs(position, light_data))
@@ -512,36 +533,53 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
         light_sets.append((np.broadcast_to(light_data.sun_axis[None], (len(position), count, 3)),
                            np.broadcast_to(light_data.sun_sharpness[None], (len(position), count)),
                            np.broadcast_to(light_data.sun_amplitude[None], (len(position), count, 3))))
-    for light_axis, light_sharpness, light_amplitude in light_sets:
-        light_cosine = _clamped_cosine_integral(light_axis, light_sharpness, FLOAT(1), n_lobe)      # (N, P)
-        light_visible = visible(light_axis, light_sharpness)
-        irradiance += np.sum(light_amplitude * (light_cosine * light_visible)[..., None], axis=1)
-        # (N, P, 1) x (N, 1, J): every light against every slice lobe
-        axis_m, sharpness_m, amplitude_m = sg.product(
-            light_axis[:, :, None, :], light_sharpness[:, :, None], FLOAT(1),
-            slice_axis[:, None, :, :], slice_sharpness[:, None, :], slice_amplitude[:, None, :])
-        weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :])
-        if visibility is not None and visibility.shared_light:
-            weight = weight * light_visible[..., None]
-        elif visibility is not None:    # one decode per NDF lobe, if any of its products is not negligible
-            above = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
-            decoded = per_node(above.reshape(above.shape[:2] + (-1, nodes)).any(axis=-1))
-            weight = np.where(decoded, weight * per_node(visible(axis_m[:, :, centre], sharpness_m[:, :, centre])),
-                              weight)
-        weight = np.sum(weight[..., None] * slice_colour[:, None], axis=2)                         # (N, P, 3)
-        if model != FITTED_MODEL:
-            tail = light_tail(model, params, view_local, frame, light_axis, light_sharpness, light_cosine,
-                              slice_axis, slice_sharpness, slice_amplitude)
-            weight = np.maximum(weight + (tail * light_visible)[..., None], FLOAT(0))
-        specular += np.sum(light_amplitude * weight, axis=1)
+    return light_sets
 
-    tail = None if albedo is None else environment_tail(albedo, slice_axis, slice_sharpness, slice_cosine, warp_mode)
-    lookup_axis = slice_axis
+
+def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, specular):
+    """Lights' diffuse (eq. 42) and specular (eq. 43) terms, added to irradiance and specular in place."""
+    n = px.n
+    visibility = px.visibility
+    light_cosine = _clamped_cosine_integral(light_axis, light_sharpness, FLOAT(1), n[:, None, :])    # (N, P)
+    light_visible = px.visible(light_axis, light_sharpness)
+    irradiance += np.sum(light_amplitude * (light_cosine * light_visible)[..., None], axis=1)
+    # (N, P, 1) x (N, 1, J): every light against every slice lobe
+    axis_m, sharpness_m, amplitude_m = sg.product(
+        light_axis[:, :, None, :], light_sharpness[:, :, None], FLOAT(1),
+        px.slice_axis[:, None, :, :], px.slice_sharpness[:, None, :], px.slice_amplitude[:, None, :])
+    weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :])
+    if visibility is not None and visibility.shared_light:
+        weight = weight * light_visible[..., None]
+    elif visibility is not None:    # one decode per NDF lobe, if any of its products is not negligible
+        centre = px.centre
+        above = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
+        decoded = px.per_node(above.reshape(above.shape[:2] + (-1, px.nodes)).any(axis=-1))
+        weight = np.where(decoded, weight * px.per_node(px.visible(axis_m[:, :, centre], sharpness_m[:, :, centre])),
+                          weight)
+    weight = np.sum(weight[..., None] * px.slice_colour[:, None], axis=2)                          # (N, P, 3)
+    if px.model != FITTED_MODEL:
+        tail = light_tail(px.model, px.params, px.view_local, px.frame, light_axis, light_sharpness, light_cosine,
+                          px.slice_axis, px.slice_sharpness, px.slice_amplitude)
+        weight = np.maximum(weight + (tail * light_visible)[..., None], FLOAT(0))
+    specular += np.sum(light_amplitude * weight, axis=1)
+
+
+def _add_environment(px, environment, irradiance, specular):
+    """The environment's (or the world colour's) diffuse (eq. 39) and specular (eq. 41) terms, with GGX's
+    tail, added to irradiance and specular in place."""
+    n, visibility = px.n, px.visibility
+    n_lobe = n[:, None, :]
+    slice_cosine, slice_colour = px.slice_cosine, px.slice_colour
+    tail = None if px.albedo is None else environment_tail(px.albedo, px.slice_axis, px.slice_sharpness,
+                                                           slice_cosine, px.warp_mode)
+    lookup_axis = px.slice_axis
     if visibility is not None:
-        slice_visible = visible(slice_axis[:, centre], slice_sharpness[:, centre])                 # (N, K)
-        slice_cosine = slice_cosine * per_node(slice_visible)
+        centre = px.centre
+        slice_visible = px.visible(px.slice_axis[:, centre], px.slice_sharpness[:, centre])            # (N, K)
+        slice_cosine = slice_cosine * px.per_node(slice_visible)
         if environment.has_texture:
-            lookup_axis = visible_part_axes(slice_axis, slice_sharpness, slice_visible, view, centre, nodes)
+            lookup_axis = visible_part_axes(px.slice_axis, px.slice_sharpness, slice_visible, px.view, centre,
+                                            px.nodes)
         if tail is not None:
             tail = (tail[0] * slice_visible[:, 0], lookup_axis[:, centre[0]], tail[2])
     if environment.has_texture:
@@ -549,28 +587,46 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
             lobe_count_env = len(environment.lobe_sharpness)
             env_axis = np.broadcast_to(environment.lobe_axis[None], (len(n), lobe_count_env, 3))
             env_sharpness = np.broadcast_to(environment.lobe_sharpness[None], (len(n), lobe_count_env))
-            env_visible = visible(env_axis, env_sharpness) if visibility is None or visibility.diffuse is None \
+            env_visible = px.visible(env_axis, env_sharpness) if visibility is None or visibility.diffuse is None \
                 else np.asarray(visibility.diffuse, FLOAT)[:, :lobe_count_env]
             # the closed form, as the shader evaluates it from the lobes' sharpness terms (scene block)
             irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
                 env_visible)[..., None], axis=1)
-        radiance = environment_radiance(environment, lookup_axis, slice_sharpness)                  # (N, J, 3)
+        radiance = environment_radiance(environment, lookup_axis, px.slice_sharpness)               # (N, J, 3)
         specular += np.sum(radiance * (slice_cosine[..., None] * slice_colour), axis=1)
         if tail is not None:
             specular += tail[0][:, None] * environment_radiance(environment, tail[1], tail[2])
-    else:
-        colour = np.asarray(environment.colour, FLOAT)
-        if visibility is None:
-            irradiance += np.pi * colour
-        elif visibility.diffuse is not None:
-            irradiance += np.pi * colour * np.asarray(visibility.diffuse, FLOAT)[:, :1]
-        else:       # the cosine lobe alone: a zero-sharpness G at the normal
-            irradiance += np.pi * colour * visible(n_lobe, np.zeros((len(n), 1), FLOAT))
-        specular += np.sum(slice_cosine[..., None] * slice_colour, axis=1) * colour
-        if tail is not None:
-            specular += tail[0][:, None] * colour
+        return
+    colour = np.asarray(environment.colour, FLOAT)
+    if visibility is None:
+        irradiance += np.pi * colour
+    elif visibility.diffuse is not None:
+        irradiance += np.pi * colour * np.asarray(visibility.diffuse, FLOAT)[:, :1]
+    else:       # the cosine lobe alone: a zero-sharpness G at the normal
+        irradiance += np.pi * colour * px.visible(n_lobe, np.zeros((len(n), 1), FLOAT))
+    specular += np.sum(slice_cosine[..., None] * slice_colour, axis=1) * colour
+    if tail is not None:
+        specular += tail[0][:, None] * colour
 
+
+def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
+          light_data, environment, lobe_count=1, visibility=None, warp_mode=None):
+    """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
+    ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
+    applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
+
+    view_origin: camera position (perspective) or the camera's forward direction (orthographic).
+    visibility: a Visibility (the SSDF shadows of the HAS_VISIBILITY variant) or None (unshadowed).
+    warp_mode: spherical.warp's mode of the view slice (the material's view warp; None: the default).
+    """
+    px = _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
+                 warp_mode)
+    irradiance = np.zeros(px.position.shape, FLOAT)
+    specular = np.zeros(px.position.shape, FLOAT)
+    for light_axis, light_sharpness, light_amplitude in _light_sets(px.position, light_data):
+        _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, specular)
+    _add_environment(px, environment, irradiance, specular)
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
     return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * specular).astype(FLOAT)
 

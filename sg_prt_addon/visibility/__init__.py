@@ -1,6 +1,6 @@
 """Visibility bake: ray-traced hemispheres -> SSDF -> PCA (wang2009 section 5). Numpy only, no bpy.
 
-    from sg_prt_addon.bake import bake_visibility, BakeOptions, BakeCancelled
+    from sg_prt_addon.visibility import bake_visibility, BakeOptions, BakeCancelled
     result = bake_visibility(vertices, triangles, normals, scene_vertices, scene_triangles,
                              BakeOptions(resolution=32), progress=lambda f, msg: cancel_requested)
 

@@ -10,7 +10,7 @@ estimator L / pdf is unbiased for the piecewise-constant map.
 """
 import numpy as np
 
-from . import equirect
+from sg_prt_addon.lighting import equirect
 
 # Rec. 709 luminance weights (Blender's default scene-linear space).
 LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])

@@ -24,7 +24,8 @@ import re
 
 import numpy as np
 
-from .shader_cache import create_capturing_log
+from sg_prt_addon.engine.shader_cache import create_capturing_log
+from sg_prt_addon.techniques import shader_sources
 
 ENGINE_IDNAME = "SG_PRT_GLSL_HARNESS"
 SCENE_NAME = "SG_PRT_GLSL_HARNESS"
@@ -326,7 +327,7 @@ def run_glsl(library_sources, call, inputs, output_components=4, textures=None):
 
 def load_library(*file_names):
     """Sources of shaders/lib/<name> in the given order (e.g. "sg.glsl", "hemisphere.glsl")."""
-    library_dir = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", "lib")
+    library_dir = shader_sources.LIB_DIR
     sources = []
     for file_name in file_names:
         with open(os.path.join(library_dir, file_name), encoding="utf-8") as handle:

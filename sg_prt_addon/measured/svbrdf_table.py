@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .brdf import fresnel_dielectric
+from ..reflectance.brdf import fresnel_dielectric
 
 FORMAT_NAME = "sg-prt-svbrdf-table"
 FORMAT_VERSION = 1

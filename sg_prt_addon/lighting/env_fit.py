@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from . import equirect, sg
+from ..spherical import sg
+from . import equirect
 from .env_prefilter import _equirect_pyramid
 
 MIN_SHARPNESS = 0.05

@@ -169,7 +169,7 @@ def brdf_slice_lobes(axis, sharpness, amplitude, wo, m_factor, mode=DEFAULT_MODE
 
     m_factor is called with the lobe index as the LEADING axis, directions
     (K', ..., 3), so model parameters shaped like the pixels (...) broadcast
-    (core.brdf models with spatially varying roughness).
+    (reflectance.brdf models with spatially varying roughness).
     """
     warped_axis, warped_sharpness, warped_amplitude = warp_lobes(axis, sharpness, amplitude, wo, mode)
     wo_lobes = np.broadcast_to(sg.normalize(np.asarray(wo).astype(warped_axis.dtype, copy=False))[..., None, :],
