@@ -8,12 +8,10 @@ light transport differs.
 import numpy as np
 
 from sg_prt_addon.blender import export
-from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.reflectance import brdf, models
 from sg_prt_addon.techniques import sg_shading
 from validation import reference
 from validation.camera import Camera
-
-_MODEL_PARAMETERS = sg_shading._MODEL_PARAMETERS   # the material fields each model reads
 
 
 def _texture_lookup(params, images):
@@ -27,7 +25,7 @@ def _texture_lookup(params, images):
                 colour = colour * sg_shading.sample_texture(images[name], uv)[:, :3]
             values[name] = colour
         model_parameters = {}
-        for name in _MODEL_PARAMETERS[params.model]:
+        for name in models.BY_NAME[params.model].parameters:
             value = np.full(count, float(getattr(params, name)))
             if name in images:
                 value = value * sg_shading.sample_texture(images[name], uv)[:, 0]
@@ -40,7 +38,7 @@ def _texture_lookup(params, images):
 def reference_material(params, texture_pixels):
     """validation.reference.Material of an export.MaterialParams; texture_pixels(image name, slot) gives
     what the shader samples for that slot (export.texture_pixels), or None for a missing image."""
-    constant = {name: float(getattr(params, name)) for name in _MODEL_PARAMETERS[params.model]}
+    constant = {name: float(getattr(params, name)) for name in models.BY_NAME[params.model].parameters}
     material = reference.Material(np.asarray(params.diffuse_color, float), np.asarray(params.specular_color, float),
                                   brdf.model_from_name(params.model, **constant))
     images = {slot: texture_pixels(image, slot) for slot, image in params.textures.items() if slot != "normal_map"}

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import techniques
+from ..reflectance import models
 from ..techniques import sg_fitted
 
 # Mesh exports since import; tests read it to check what an update re-exported.
@@ -72,9 +73,7 @@ def finite_texels(pixels, what):
         warn(f"{what}: {int(np.count_nonzero(huge))} texels beyond {MAX_TEXEL_VALUE:g} clamped")
     return pixels
 
-MODELS = ("COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX")
-ANISOTROPIC_MODELS = ("WARD_ANISO", "ASHIKHMIN_SHIRLEY")
-SCALAR_PARAMETERS = ("roughness", "ior", "exponent", "alpha_x", "alpha_y", "nu", "nv")
+SCALAR_PARAMETERS = models.SCALAR_PARAMETERS
 COLOUR_PARAMETERS = ("diffuse_color", "specular_color")
 TEXTURED_PARAMETERS = COLOUR_PARAMETERS + SCALAR_PARAMETERS
 
@@ -399,7 +398,7 @@ def _warn_missing_uvs(object_eval):
         if textures:
             warn(f"object '{object_eval.name}' has no UV map: material '{material.name}' samples its textures "
                  f"({', '.join(textures)}) at UV (0, 0)")
-        if settings.model in ANISOTROPIC_MODELS and settings.tangent_source == "UV_MAP":
+        if settings.model in models.ANISOTROPIC and settings.tangent_source == "UV_MAP":
             warn(f"object '{object_eval.name}' has no UV map: material '{material.name}' (anisotropic, tangent "
                  f"source UV Map) gets tangents from the object's axes instead")
 

@@ -1,7 +1,7 @@
 """Properties-editor panels of the SG-PRT engine."""
 import bpy
 
-from .properties import ANISOTROPIC_MODELS, MODEL_PARAMETERS
+from ..reflectance import models
 
 ENGINE_ID = "SG_PRT"
 
@@ -28,7 +28,7 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
         layout.prop(settings, "technique")
         layout.prop(settings, "model")
         textured = settings.show_textures
-        for name in ("diffuse_color", "specular_color") + MODEL_PARAMETERS[settings.model]:
+        for name in ("diffuse_color", "specular_color") + models.BY_NAME[settings.model].panel_parameters:
             row = layout.row(align=True)
             row.prop(settings, name)
             if textured and hasattr(settings, f"{name}_texture"):
@@ -48,7 +48,7 @@ class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
         layout.use_property_split = True
         layout.template_ID(settings, "normal_map", open="image.open")
         layout.prop(settings, "normal_strength")
-        if settings.model in ANISOTROPIC_MODELS:
+        if settings.model in models.ANISOTROPIC:
             layout.prop(settings, "tangent_source")
             if settings.tangent_source == "OBJECT_AXIS":
                 layout.prop(settings, "tangent_axis")

@@ -17,28 +17,7 @@ from bpy.props import (
 )
 
 from .. import techniques
-
-MODELS = (
-    ("GGX", "GGX", "Microfacet GGX matching Blender's Glossy BSDF (alpha = roughness^2, "
-                   "height-correlated Smith shadowing, no Fresnel)"),
-    ("COOK_TORRANCE", "Cook-Torrance", "Cook-Torrance with the Gaussian NDF of wang2009 eq. 10-12 "
-                                       "and dielectric Fresnel"),
-    ("BLINN_PHONG", "Blinn-Phong", "Blinn-Phong specular lobe"),
-    ("WARD_ISO", "Ward Isotropic", "Isotropic Ward"),
-    ("WARD_ANISO", "Ward Anisotropic", "Anisotropic Ward, fitted with several SG lobes"),
-    ("ASHIKHMIN_SHIRLEY", "Ashikhmin-Shirley", "Anisotropic Ashikhmin-Shirley, fitted with several SG lobes"),
-)
-
-# The parameters each model reads, in panel order (diffuse and specular colour are shared).
-MODEL_PARAMETERS = {
-    "GGX": ("roughness",),
-    "COOK_TORRANCE": ("roughness", "ior"),
-    "BLINN_PHONG": ("exponent",),
-    "WARD_ISO": ("alpha_x",),
-    "WARD_ANISO": ("alpha_x", "alpha_y", "lobe_count"),
-    "ASHIKHMIN_SHIRLEY": ("nu", "nv", "lobe_count"),
-}
-ANISOTROPIC_MODELS = {"WARD_ANISO", "ASHIKHMIN_SHIRLEY"}
+from ..reflectance import models
 
 # How each NDF lobe is warped to the view slice: spherical.warp's modes, upper case (figures from its docstring).
 VIEW_WARPS = (
@@ -110,7 +89,7 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
     technique: EnumProperty(update=_tag_material_changed, name="Technique", items=technique_items, default=0,
                             description="The rendering method of this material (techniques/: the reference each "
                                         "implements is in its description)")
-    model: EnumProperty(update=_tag_material_changed, name="Model", items=MODELS, default="GGX",
+    model: EnumProperty(update=_tag_material_changed, name="Model", items=models.enum_items(), default="GGX",
                         description="Specular reflectance model, rendered with spherical Gaussian NDF lobes")
     diffuse_color: FloatVectorProperty(update=_tag_material_changed, name="Diffuse", subtype="COLOR", size=3, default=(0.5, 0.5, 0.5),
                                        min=0.0, soft_max=1.0, description="Lambertian albedo kd")

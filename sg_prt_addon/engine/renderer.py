@@ -55,7 +55,7 @@ def _uniform_buffer(data):
 
 
 def scene_block(camera, light_data, environment):
-    """SceneData (resources/scene_data.glsl) as float32 words, std140 (all vec4)."""
+    """SceneData (shaders/engine/scene_data.glsl) as float32 words, std140 (all vec4)."""
     def vec4_array(count, rows):
         block = np.zeros((count, 4), np.float32)
         rows = np.asarray(rows, np.float32).reshape(-1, 4) if len(rows) else np.zeros((0, 4), np.float32)
@@ -121,7 +121,7 @@ def material_block(params, material_id=0):
 
 
 PER_VERTEX_TEXTURE_WIDTH = 4096     # texels a row of a per-vertex texture (a multiple of its rows is used)
-MAX_TEXTURE_SIZE = 16384            # GPUTexture side limit measured here (DESIGN.md)
+MAX_TEXTURE_SIZE = 16384            # GPUTexture side limit measured with llvmpipe (2D; 2048 array layers)
 
 
 def vertices_per_row(layers):

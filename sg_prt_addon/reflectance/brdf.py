@@ -36,8 +36,6 @@ from . import ndf_fit
 COSINE_EPSILON = 1e-7
 INV_PI = 1.0 / np.pi
 
-MODEL_NAMES = ("COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX")
-
 
 # ----------------------------------------------------------------------------- helpers
 
@@ -378,7 +376,7 @@ class WardAnisotropic(_Microfacet):
 
         broad_lobe_correction applies the Ward isotropic L2 mapping at the geometric-mean
         width (much better for alpha >~ 0.3; off by default because the GLSL mirror,
-        shaders/resources/anisotropic_lobes.glsl, does not apply it yet).  refine (scalar
+        shaders/techniques/sg/anisotropic_lobes.glsl, does not apply it yet).  refine (scalar
         parameters only) fits the exact D on the sphere from there
         (ndf_fit.refined_anisotropic_lobes, cached)."""
         if refine:

@@ -108,7 +108,7 @@ def _cosine(axis, normal):
 
 def sg_clamped_cosine_integral_paper(axis, sharpness, amplitude, normal):
     """wang2009 eq. 39-40: integral of G(i; p, lambda, mu) C*(i; n), i.e. the SG inner
-    product (eq. 6) of the light lobe with the eq. 40 lobe (visibility left out)."""
+    product (eq. 5) of the light lobe with the eq. 40 lobe (visibility left out)."""
     normal = np.asarray(normal)
     dtype = _float_dtype(axis, sharpness, amplitude, normal)
     lobe_sharpness = np.asarray(CLAMPED_COSINE_SHARPNESS, dtype)

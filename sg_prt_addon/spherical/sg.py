@@ -96,7 +96,7 @@ def axis_hemisphere_integral(sharpness, amplitude=1.0):
 
 
 def inner_product(axis1, sharpness1, amplitude1, axis2, sharpness2, amplitude2):
-    """Integral over the sphere of G1 G2 (wang2009 eq. 6) in overflow-free form.
+    """Integral over the sphere of G1 G2 (wang2009 eq. 4) in overflow-free form.
 
     4 pi mu1 mu2 sinh(d)/d exp(-(l1 + l2)) is rewritten as
     sphere_integral of the product lobe: (1 - e^-2d)/(2d) * 4 pi * mu_m.

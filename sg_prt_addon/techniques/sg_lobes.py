@@ -13,7 +13,7 @@ decodes); a zero diffuse colour (without its texture), no irradiance (environmen
 lights' diffuse terms and their decodes).  A skipped term is exactly zero in the full variant (its
 colour is zero), so the image does not change.
 
-Fragment source = constants from core/ + the GLSL mirrors of core/ (shaders/lib) + the technique's
+Fragment source = constants from the maths + their GLSL mirrors (shaders/lib) + the technique's
 pieces (anisotropic_lobes, ggx_two_lobes, lobe_visibility, sg_shading) + the per-vertex rows' copy
 + surface.frag.glsl.
 """
@@ -126,7 +126,7 @@ def scene_fields(inputs, has_diffuse=True, has_specular=True):
 
 
 def _constants_source():
-    """Constants taken from core/ at assembly time, so GLSL and numpy cannot drift apart."""
+    """Constants taken from the numpy side at assembly time, so GLSL and numpy cannot drift apart."""
     rf0 = brdf.AshikhminShirley.__dataclass_fields__["rf0"].default
     return (f"const float BRDF_AS_RF0 = {shader_sources.float_literal(rf0)};\n"
             f"const float VISIBILITY_SKIP_FRACTION = {shader_sources.float_literal(sg_shading.VISIBILITY_SKIP_FRACTION)};\n")

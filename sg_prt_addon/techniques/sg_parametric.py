@@ -2,13 +2,12 @@
 texture per pixel), GGX's two-lobe table and albedo tail, the anisotropic models' lobe tables."""
 import numpy as np
 
-from ..reflectance import ggx_albedo, ndf_fit
+from ..reflectance import ggx_albedo, models, ndf_fit
 from ..spherical import warp
 from . import sg_shading
 from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_PARAMETRIC"
-ANISOTROPIC_MODELS = ("WARD_ANISO", "ASHIKHMIN_SHIRLEY")
 # Material textures that only the specular term reads (left out of a variant without it)
 SPECULAR_ONLY_TEXTURES = ("specular_color", "roughness", "ior", "exponent", "alpha_x", "alpha_y", "nu", "nv")
 
@@ -57,7 +56,7 @@ class SGParametric(SGLobes):
 
     def variant_key(self, params, inputs):
         model = params.model
-        lobes = int(params.lobe_count) if model in ANISOTROPIC_MODELS else 1
+        lobes = int(params.lobe_count) if model in models.ANISOTROPIC else 1
         if model == "GGX":
             lobes = sg_shading.GGX_NDF_LOBES
         has_diffuse, has_specular = material_terms(params)
@@ -75,19 +74,19 @@ class SGParametric(SGLobes):
                 "TAIL_SHARPNESS_RATIO": f"{sg_shading.TAIL_SHARPNESS_RATIO!r}"}
 
     def model_files(self, key):
-        if key.model in ANISOTROPIC_MODELS:
+        if key.model in models.ANISOTROPIC:
             return ("anisotropic_lobes.glsl",)
         return ("ggx_two_lobes.glsl",) if uses_ggx_table(key) else ()
 
     def model_samplers(self, key):
-        if key.model in ANISOTROPIC_MODELS:
+        if key.model in models.ANISOTROPIC:
             return [("FLOAT_2D", "anisotropy_table")]
         if uses_ggx_table(key):
             return [("FLOAT_2D", "ggx_table"), ("FLOAT_2D", "ggx_albedo_table")]      # ENVIRONMENT_TAIL
         return []
 
     def bind_model(self, shader, key, context):
-        if key.model in ANISOTROPIC_MODELS:
+        if key.model in models.ANISOTROPIC:
             shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", key.ndf_lobes),
                                                                      lambda: anisotropy_table(key.ndf_lobes)))
         if uses_ggx_table(key):

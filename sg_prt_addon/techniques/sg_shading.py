@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..lighting import env_prefilter, equirect, lights
-from ..reflectance import brdf, ggx_albedo
+from ..reflectance import brdf, ggx_albedo, models
 from ..spherical import clamped_cosine, sg, texture_fetch, warp
 
 FLOAT = np.float32
@@ -168,7 +168,7 @@ def lobe_visibility(axis, sharpness, n, visibility):
 
 
 def vertex_diffuse_visibility(environment, vertices):
-    """Visible fractions (V, E) of the broad diffuse lobes at mesh vertices (resources/
+    """Visible fractions (V, E) of the broad diffuse lobes at mesh vertices (shaders/techniques/sg/
     vertex_visibility.frag.glsl): the environment's SG mixture, or the constant world's cosine lobe
     (E = 1).  vertices: a Visibility of the vertices (their coefficient rows and world SSDF normals),
     whose normal also stands in for the shading normal in the product with the cosine lobe."""
@@ -332,7 +332,7 @@ def rotate_tangent(normal, tangent, rotation):
 def ndf_lobes(model, params, lobe_count=1):
     """The model's SG NDF lobes in the local frame: axis (N, K, 3), sharpness (N, K), amplitude (N, K)."""
     instance = brdf.model_from_name(model, **params)
-    if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY"):
+    if model in models.ANISOTROPIC:
         return instance.ndf_lobes(lobe_count)
     if model == "GGX":
         return instance.ndf_lobes(GGX_NDF_LOBES)
@@ -684,19 +684,10 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
                                           FLOAT(material.normal_strength))
     shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
     model = material.model
-    model_params = {key: params[key] for key in _MODEL_PARAMETERS[model]}
+    model_params = {key: params[key] for key in models.BY_NAME[model].parameters}
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
                  diffuse_color, specular_color, light_data, environment,
-                 lobe_count=material.lobe_count if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY") else 1,
+                 lobe_count=material.lobe_count if model in models.ANISOTROPIC else 1,
                  visibility=visibility, warp_mode=getattr(material, "warp_mode", None))
 
 
-# The material fields each model reads (names as brdf.model_from_name takes them).
-_MODEL_PARAMETERS = {
-    "GGX": ("roughness",),
-    "COOK_TORRANCE": ("roughness", "ior"),
-    "BLINN_PHONG": ("exponent",),
-    "WARD_ISO": ("alpha_x",),
-    "WARD_ANISO": ("alpha_x", "alpha_y"),
-    "ASHIKHMIN_SHIRLEY": ("nu", "nv"),
-}

@@ -1,6 +1,6 @@
 """GLSL every surface shader shares, and the pieces of its GPUShaderCreateInfo.
 
-shaders/lib: pure kernels mirroring core/ (lib/README.md); shaders/engine: the scene block, the vertex
+shaders/lib: pure kernels mirroring the maths packages (lib/README.md); shaders/engine: the scene block, the vertex
 stage and the engine's own passes (depth, background); shaders/techniques/<name>: a technique's own.
 
 The per-vertex rows of a precomputation (an SSDF bake's PCA coefficients, a pass's output laid out

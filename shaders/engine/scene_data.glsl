@@ -1,5 +1,6 @@
 /* Uniform buffer layouts (std140, vec4 slots only).  Filled by
- * sg_prt_addon/engine/gpu_resources.py; sizes come from the SGPRT_MAX_* defines. */
+ * sg_prt_addon/engine/renderer.py (scene_block, material_block); sizes come from the SGPRT_MAX_* defines
+ * (techniques/shader_sources.py LIMITS). */
 
 struct SceneData {
   /* xyz: camera position (perspective) or camera forward (orthographic); w: 1 perspective, 0 ortho */

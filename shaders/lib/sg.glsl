@@ -99,7 +99,7 @@ float sg_axis_hemisphere_integral(float sharpness, float amplitude)
   return SG_TWO_PI * amplitude * one_minus_exp_over_x(sharpness);
 }
 
-/* Integral of G1 G2 over the sphere (wang2009 eq. 6) as the sphere integral
+/* Integral of G1 G2 over the sphere (wang2009 eq. 4) as the sphere integral
  * of the product lobe: never forms sinh(d) exp(-(l1 + l2)). */
 float sg_inner_product(vec3 axis1, float sharpness1, float amplitude1,
                        vec3 axis2, float sharpness2, float amplitude2)

@@ -32,9 +32,12 @@ def test_defaults_are_a_plausible_glossy_material(empty_file):
 
 def test_every_model_lists_only_existing_parameters():
     names = set(properties.SGPRT_PG_material.__annotations__)
-    assert {model for model, _, _ in properties.MODELS} == set(properties.MODEL_PARAMETERS)
-    for parameters in properties.MODEL_PARAMETERS.values():
-        assert set(parameters) <= names
+    from sg_prt_addon.reflectance import models
+
+    assert [item.identifier for item in properties.SGPRT_PG_material.bl_rna.properties["model"].enum_items] \
+        == list(models.NAMES)
+    for model in models.MODELS:
+        assert set(model.panel_parameters) <= names
     for name in properties.TEXTURED_PARAMETERS:
         assert f"{name}_texture" in names
 

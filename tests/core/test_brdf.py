@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import integrate, stats
 
-from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.reflectance import brdf, models
 
 RNG_SEED = 1234
 
@@ -235,7 +235,7 @@ def test_model_from_name():
     model = brdf.model_from_name("COOK_TORRANCE", roughness=0.1, ior=1.4, exponent=5.0, nu=3.0)
     assert type(model) is brdf.CookTorrance and model.roughness == 0.1 and model.ior == 1.4
     assert type(brdf.model_from_name("WARD_ISO", alpha_x=0.2, alpha_y=0.9)) is brdf.WardIsotropic
-    for name in brdf.MODEL_NAMES:
+    for name in models.NAMES:
         assert brdf.model_from_name(name) is not None
     with pytest.raises(ValueError):
         brdf.model_from_name("PHONG")

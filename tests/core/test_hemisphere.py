@@ -95,7 +95,7 @@ def test_fast_normalized_against_exact(lam_low, lam_high, bound):
 
 
 def test_paper_sigmoid_is_far_off():
-    """DESIGN.md: the printed appendix sigmoid is off by 0.2-0.5 for lambda <= 100."""
+    """spherical/hemisphere.py fh_normalized_paper: the printed appendix sigmoid is off by 0.2-0.5 for lambda <= 100."""
     theta = np.linspace(-np.pi / 2, np.pi / 2, 41)
     lam = np.array([0.5, 5.0, 50.0])[:, None]
     error = np.abs(hemisphere.fh_normalized_paper(theta, lam) - hemisphere.fh_normalized_exact(theta, lam))

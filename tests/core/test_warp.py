@@ -71,7 +71,7 @@ def test_split_equals_paper_at_normal_incidence(mode):
 
 
 @pytest.mark.parametrize("alpha, paper_max, split_min, split_max", [
-    (0.1, 0.5, 0.95, 1.06),    # DESIGN.md: the paper keeps 0.46 of the energy at 85 deg
+    (0.1, 0.5, 0.95, 1.06),    # spherical/warp.py: the paper keeps 0.46 of the energy at 85 deg
     (0.3, 0.2, 0.95, 1.10),
     (0.5, 0.15, 0.50, 0.65),   # lambda 8: split capped (MAX_SPLIT_OFFSET), still 5x the paper's
 ])

@@ -8,7 +8,7 @@
  * (sg_parametric.material_terms): without one, its term is left out (its colour is zero, so the full
  * variant's term is exactly zero).  DIFFUSE_VISIBILITY_ROWS (with HAS_VISIBILITY and HAS_DIFFUSE): the
  * broad diffuse lobes' visible fractions come interpolated from the vertices (diffuse_fractions, filled
- * by surface.frag.glsl from the pass of resources/vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with
+ * by surface.frag.glsl from the pass of vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with
  * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; techniques.sg_shading.shares_light_visibility): every light is narrow on
  * the object, and its products with the slice lobes take its own visibility instead of a decode each. */
 
