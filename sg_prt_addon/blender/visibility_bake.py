@@ -66,7 +66,7 @@ import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 from ..visibility import decode
-from ..visibility.per_vertex import MAX_ROWS
+from ..visibility.per_vertex import MAX_ROWS, MAX_TERMS
 from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
 from . import export, per_vertex_store
 from .background_job import BackgroundJob, ModalJobOperator
@@ -380,10 +380,10 @@ def _option_properties():
                                description="How many PCA terms to keep"),
         error_target=FloatProperty(name="Error Target", default=0.02, min=0.001, max=0.5, subtype="ANGLE",
                                    description="RMS angular error of the compressed SSDFs"),
-        terms=IntProperty(name="Fixed Terms", default=24, min=0, max=47,
+        terms=IntProperty(name="Fixed Terms", default=24, min=0, max=MAX_TERMS,
                           description="PCA terms when the number is fixed"),
-        max_terms=IntProperty(name="Max Terms", default=47, min=1, max=47,
-                              description="Most PCA terms (47 + the mean fill 12 vec4 a vertex)"),
+        max_terms=IntProperty(name="Max Terms", default=MAX_TERMS, min=1, max=MAX_TERMS,
+                              description=f"Most PCA terms ({MAX_TERMS} + the mean fill {MAX_ROWS} vec4 a vertex)"),
     )
 
 

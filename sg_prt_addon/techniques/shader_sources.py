@@ -35,10 +35,6 @@ MAX_LAYERS = 48
 LIMITS = {"SGPRT_MAX_POINT_LIGHTS": MAX_POINT_LIGHTS, "SGPRT_MAX_SUNS": MAX_SUNS,
           "SGPRT_MAX_ENV_LOBES": MAX_ENV_LOBES, "SGPRT_MAX_LAYERS": MAX_LAYERS}
 
-# vec4 rows a vertex of one precomputation: each is a varying, and llvmpipe's budget of 32 vec4 varyings
-# holds the surface's own four, these and a pass's rows (visibility.per_vertex uses the same limit)
-MAX_PER_VERTEX_ROWS = 12
-
 GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
 
 
@@ -86,7 +82,7 @@ class PerVertexInput:
     """Rows of one per-vertex texture, read by the vertex stage and interpolated to the fragments.
 
     sampler: the texture (vertex v's row k at texel ((v % per_row) * rows + k, v // per_row),
-    per_row = its width / rows); rows: vec4 a vertex; varying: the varyings' name prefix (varying_0...);
+    per_row = its width / rows); rows: vec4 a vertex (visibility.per_vertex.MAX_ROWS at most); varying: the varyings' name prefix (varying_0...);
     array: the fragment stage's vec4 array the technique declares and the rows are copied into."""
     sampler: str
     rows: int

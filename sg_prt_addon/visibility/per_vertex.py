@@ -11,6 +11,8 @@ import numpy as np
 # vec4 rows a vertex of one kind: each becomes a varying of the surface shader (llvmpipe and the GL
 # minimum give 32 vec4; the surface uses 5 of its own and a pass's rows may follow: 12 leaves room)
 MAX_ROWS = 12
+# PCA terms of an SSDF bake that fit them: the rows hold [1, w_0, ..., w_{N-1}] (the mean's weight first)
+MAX_TERMS = 4 * MAX_ROWS - 1
 
 
 @dataclass

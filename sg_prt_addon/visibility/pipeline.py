@@ -13,6 +13,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from . import binary_visibility, hemisphere_map, pca, ssdf
+from .per_vertex import MAX_TERMS
 from .raytrace import RayTracer
 
 
@@ -26,7 +27,7 @@ class BakeOptions:
     refinement: int = 5             # odd supersampling factor of mixed coarse cells (fine grid 160 x 160)
     terms: Optional[int] = None     # PCA terms; None: the fewest reaching error_target
     error_target: float = 0.02      # RMS angular error of the PCA, radians (used when terms is None)
-    max_terms: int = 47             # wang2009 uses 48; 47 + the mean fill 12 vec4 (pack_coefficients)
+    max_terms: int = MAX_TERMS      # wang2009 uses 48; these and the mean fill MAX_ROWS vec4 (pack_coefficients)
     batch_vertices: int = 256       # vertices traced per RayTracer call (amortizes Python overhead)
     threads: int = 2
     relative_offset: float = 1e-4   # ray origin offset along the normal, times the occluders' diagonal

@@ -14,15 +14,15 @@
  * vertex-interpolated [1, w_0, w_1, ...] four to a vec4.  The R x R stored samples lie on the lattice
  * -1 + 2 k / (R - 1) of the square (outer rows on the horizon), at the texel centres: square (a, b) ->
  * texture coordinates (((a, b) + 1) / 2 (R - 1) + 1 / 2) / R (hemisphere_map.sample_texcoord).
- * #define SSDF_MAX_LAYERS before this file to change the array size (default 12: the mean and
- * 47 terms, BakeOptions.max_terms).
+ * #define SSDF_MAX_LAYERS (the vec4 rows a vertex, at most visibility.per_vertex.MAX_ROWS) before
+ * this file: the engine defines it from the bake's layers.
  *
  * Use: theta_d = ssdf_decode(basis, coefficients, layers, ssdf_to_local(product_axis, normal)), then
  * ssdf_visibility_amplitude on the final product lobe (e.g. C* (x) L* for eq. 39).
  */
 
 #ifndef SSDF_MAX_LAYERS
-#define SSDF_MAX_LAYERS 12
+#error "SSDF_MAX_LAYERS: define the coefficient rows a vertex before ssdf.glsl"
 #endif
 
 const float SSDF_QUARTER_PI = 0.25 * SG_PI;

@@ -6,6 +6,7 @@ import re
 
 import pytest
 
+from sg_prt_addon.visibility.per_vertex import MAX_ROWS
 from validation import glsl_harness
 
 LIB_DIR = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", "lib")
@@ -19,7 +20,7 @@ DEPENDENCIES = {
     "warp.glsl": ["sg.glsl"],
     "lights.glsl": ["sg.glsl"],
     "env_prefilter.glsl": ["sg.glsl"],
-    "ssdf.glsl": ["sg.glsl", "hemisphere.glsl"],
+    "ssdf.glsl": ["sg.glsl", "hemisphere.glsl", f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n"],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
          "lights.glsl", "env_prefilter.glsl", "ssdf.glsl"]
@@ -42,7 +43,7 @@ def test_file_compiles_with_its_dependencies(glsl, file_name):
 def test_all_files_together(glsl):
     call = ("vec4(sg_sphere_integral(a.x, 1.0), fh(0.0, a.x), clamped_cosine_from_cosine(1.0, a.x),"
             " ggx_ndf_lobe(0.5).x)")
-    out = glsl(ORDER, call, {"a": [0.0, 1.0]}, 4)
+    out = glsl(ORDER[:-1] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", ORDER[-1]], call, {"a": [0.0, 1.0]}, 4)
     assert out.shape == (2, 4)
     # lambda = 0: 4 pi, half of it, pi
     assert abs(out[0, 0] - 4 * 3.14159265) < 1e-5 and abs(out[0, 1] - 2 * 3.14159265) < 1e-5
