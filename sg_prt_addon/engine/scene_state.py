@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..blender import export
-from ..techniques import sg_shading
+from ..lighting.scene_lighting import EnvironmentData, LightData
 from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility import decode, per_vertex
 
@@ -71,7 +71,6 @@ SSDF = "ssdf"
 PER_VERTEX_KINDS = {SSDF: (visibility_for, ssdf_data)}
 
 
-
 @dataclass
 class ObjectEntry:
     name: str
@@ -104,7 +103,7 @@ class SceneState:
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
         self.world = export.WorldExport()
-        self.environment = sg_shading.EnvironmentData()
+        self.environment = EnvironmentData()
         self.dirty = Dirty()
         # bad input met while exporting (NaN texels, degenerate normals...): said once a render/redraw
         self.warnings = []
@@ -352,14 +351,14 @@ def _strongest(light_exports, max_points, max_suns):
 
 
 def light_data(light_exports):
-    """sg_shading.LightData (float32) from export.LightExport records (the shader's limits applied:
+    """LightData (float32) from export.LightExport records (the shader's limits applied:
     the dimmest lights beyond them are left out)."""
     from ..lighting import lights as core_lights
 
     kept = _strongest(light_exports, MAX_POINT_LIGHTS, MAX_SUNS)
     points = [light for light in kept if light.kind == "POINT"]
     suns = [light for light in kept if light.kind == "SUN"]
-    data = sg_shading.LightData()
+    data = LightData()
     f = np.float32
     if points:
         data.point_position = np.array([light.position for light in points], f)
@@ -390,10 +389,10 @@ def _geometry_may_differ(obj, edited_meshes):
 
 
 def environment_data(world, layer_size=None):
-    """sg_shading.EnvironmentData of an export.WorldExport (cached per image and pixels)."""
+    """EnvironmentData of an export.WorldExport (cached per image and pixels)."""
     colour = np.asarray(world.colour[:3], np.float32)
     if world.equirect is None:
-        return sg_shading.EnvironmentData(colour=colour)
+        return EnvironmentData(colour=colour)
     layer_size = layer_size or ENVIRONMENT_LAYER_SIZE
     image = world.equirect
     # keyed by the pixels themselves: a renamed or reloaded image with the same content hits the cache
@@ -404,7 +403,7 @@ def environment_data(world, layer_size=None):
         from ..lighting import env_prefilter
         prefiltered = env_prefilter.prefilter_environment(image, size=layer_size)
         lobes = _fit_environment(image)
-        cached = sg_shading.EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
+        cached = EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
                                          lobe_sharpness=lobes[1], lobe_amplitude=lobes[2], radiance=image)
     _environment_cache[key] = cached                 # (re)inserted last: the most recent
     while len(_environment_cache) > ENVIRONMENT_CACHE_SIZE:

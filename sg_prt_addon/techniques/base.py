@@ -24,7 +24,7 @@ import numpy as np
 class ObjectInputs:
     """What a variant may depend on besides its material: the scene and the object drawn.
 
-    light_data: techniques.sg_shading.LightData; environment: techniques.sg_shading.EnvironmentData; gbuffer: the draw
+    light_data: lighting.scene_lighting.LightData; environment: its EnvironmentData; gbuffer: the draw
     writes the G-buffer outputs; per_vertex: per-vertex kind ("ssdf", ...) -> vec4 rows a vertex of the
     object's usable precomputation (absent: none); bounds: (2, 3) local box or None; matrix_world (4, 4).
     Derived values a technique computes once per object go in ``memo``."""

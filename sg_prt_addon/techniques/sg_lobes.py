@@ -85,7 +85,7 @@ class VariantKey:
 
 
 def diffuse_visibility_rows(environment):
-    """vec4 a vertex of the per-vertex pass (vertex_visibility.frag.glsl) for a techniques.sg_shading.EnvironmentData:
+    """vec4 a vertex of the per-vertex pass (vertex_visibility.frag.glsl) for a lighting.scene_lighting.EnvironmentData:
     its diffuse SG lobes four to a vec4, or the constant world's one lobe."""
     if environment.prefiltered is None:
         return 1

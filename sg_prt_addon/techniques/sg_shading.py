@@ -44,7 +44,7 @@ environment_tail); lobes sharper than the top prefiltered layer read towards the
 Everything is computed in float32 like the GPU.  Directions: world space, all
 pointing away from the surface.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -75,44 +75,6 @@ def _clamped_cosine_integral(axis, sharpness, amplitude, normal):
     table, as the shader reads it (clamped_cosine_table)."""
     from ..spherical import clamped_cosine_table
     return clamped_cosine_table.sg_clamped_cosine_integral_tabulated(axis, sharpness, amplitude, normal).astype(FLOAT)
-
-
-@dataclass
-class LightData:
-    """Lights as the shader gets them (float32).
-
-    point: position (P, 3), radius (P,), intensity (P, 3) W/sr, spot: direction (P, 3),
-    spot_size (P,) full cone angle (negative: a point light), spot_blend (P,).
-    sun: axis (S, 3), sharpness (S,), amplitude (S, 3) (precomputed SGs).
-    """
-    point_position: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
-    point_radius: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
-    point_intensity: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
-    spot_direction: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
-    spot_size: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
-    spot_blend: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
-    sun_axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
-    sun_sharpness: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
-    sun_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
-
-    @property
-    def count(self):
-        return len(self.point_radius) + len(self.sun_sharpness)
-
-
-@dataclass
-class EnvironmentData:
-    """Constant colour, or SG mixture (diffuse) + prefiltered pyramid (specular)."""
-    colour: np.ndarray = field(default_factory=lambda: np.zeros(3, FLOAT))
-    lobe_axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
-    lobe_sharpness: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
-    lobe_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
-    prefiltered: object = None          # env_prefilter.PrefilteredEnvironment or None
-    radiance: np.ndarray = None         # the equirect map it was made of (H, W, 3), row 0 at the top
-
-    @property
-    def has_texture(self):
-        return self.prefiltered is not None
 
 
 @dataclass

@@ -161,7 +161,7 @@ def variant_key(params, has_lights=False, has_environment=False, gbuffer=False, 
     lights and an environment): diffuse_rows and shared_light_visibility stand in for what the SG
     technique derives from the environment, the lights and the object's bounds."""
     from sg_prt_addon import techniques
-    from sg_prt_addon.techniques.sg_shading import EnvironmentData, LightData
+    from sg_prt_addon.lighting.scene_lighting import EnvironmentData, LightData
 
     inputs = techniques.ObjectInputs(LightData(), EnvironmentData(), gbuffer,
                                      {"ssdf": visibility_layers} if visibility_layers else {})
