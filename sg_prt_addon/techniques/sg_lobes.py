@@ -13,8 +13,9 @@ decodes); a zero diffuse colour (without its texture), no irradiance (environmen
 lights' diffuse terms and their decodes).  A skipped term is exactly zero in the full variant (its
 colour is zero), so the image does not change.
 
-Fragment source = constants from the maths + their GLSL mirrors (shaders/lib) + the technique's
-pieces (anisotropic_lobes, ggx_two_lobes, lobe_visibility, sg_shading) + the per-vertex rows' copy
+Fragment source = constants from the maths + their GLSL mirrors (shaders/lib) + what surfaces share
+(techniques/common/surface_common.glsl) + the technique's pieces (anisotropic_lobes, ggx_two_lobes,
+lobe_visibility, sg_shading) + the per-vertex rows' copy
 + surface.frag.glsl.
 """
 from dataclasses import dataclass
@@ -229,6 +230,7 @@ class SGLobes(Technique):
     def fragment_source(self, key):
         parts = [_constants_source()]
         parts += [shader_sources.library_source(name) for name in self.library_files(key)]
+        parts.append(shader_sources.technique_source("common", "surface_common.glsl"))
         parts += [shader_sources.technique_source(GLSL_DIR, name) for name in self.technique_files(key)]
         if key.visibility_layers:
             parts.append(shader_sources.per_vertex_copy_source(per_vertex_inputs(key)))

@@ -316,8 +316,8 @@ def _glsl_function(source, name):
     raise AssertionError(f"unbalanced {name}")
 
 
-def _resource(file_name):
-    with open(os.path.join(SHADERS, "techniques", "sg", file_name), encoding="utf-8") as handle:
+def _resource(file_name, technique="sg"):
+    with open(os.path.join(SHADERS, "techniques", technique, file_name), encoding="utf-8") as handle:
         return handle.read()
 
 
@@ -541,12 +541,12 @@ def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
 
 RESOURCE_KERNELS = {
     "lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility"],
-    "sg_shading.glsl": ["shading_frame", "apply_normal_map",
-                        "rotate_tangent", "model_ndf_lobe", "model_m_factor", "fitted_layer",
+    "sg_shading.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_layer",
                         "fitted_select_texel", "fitted_node_theta", "fitted_node_value", "fitted_shadowing_at",
                         "fitted_shadowing_of", "fitted_m_factor"],
     "anisotropic_lobes.glsl": ["anisotropic_lobes"],
     "ggx_two_lobes.glsl": ["ggx_two_lobes"],
+    "../common/surface_common.glsl": ["shading_frame", "apply_normal_map", "rotate_tangent"],
 }
 LIBRARY_ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl", "warp.glsl", "lights.glsl"]
 
@@ -586,7 +586,7 @@ def test_shading_frame_stress(glsl, fuzz):
     sample[::5] = 0.5                                   # maps to the zero vector
     strength = fuzz.uniform(0.0, 10.0, SMALL_ROWS)
     rotation = fuzz.uniform(-100.0, 100.0, SMALL_ROWS)
-    shading = _resource("sg_shading.glsl")
+    shading = _resource("surface_common.glsl", "common")
     source = "".join(_glsl_function(shading, name) for name in ("shading_frame", "apply_normal_map", "rotate_tangent"))
     body = """
     vec3 n, t, b;
