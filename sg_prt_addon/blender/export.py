@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import techniques
 from ..reflectance import models
-from ..techniques import sg_fitted
+from ..techniques import factored, sg_fitted
 
 # Mesh exports since import; tests read it to check what an update re-exported.
 export_counter = {"meshes": 0}
@@ -419,6 +419,11 @@ def _usable_technique(material, params):
         warn(f"material '{material.name}': technique {name!r} is not available in this version "
              f"(registered: {', '.join(techniques.names())}): rendered with {techniques.DEFAULT}")
         return techniques.DEFAULT
+    if name == factored.NAME:
+        ignored = sorted(slot for slot in params.textures if slot not in factored.TEXTURE_SLOTS)
+        if ignored:
+            warn(f"material '{material.name}': {factored.TECHNIQUE.label} factorizes the model with uniform "
+                 f"parameters: the textures on {', '.join(ignored)} are not applied")
     if name == sg_fitted.NAME:
         params.fitted = export_fitted_lobes(material)
         if params.fitted is None:

@@ -116,11 +116,12 @@ def vertex_source(per_vertex=()):
     return (per_vertex_fetch_source(per_vertex) + source) if per_vertex else source
 
 
-def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=()):
+def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), push_constants=()):
     """The create-info calls of a surface shader (see base.Technique.create_info_calls): `defines` (name ->
     value, the scene limits added), the vertex stage with `per_vertex`'s fetch (PER_VERTEX_ROWS defined;
     the fragment source calls per_vertex_copy_source's load_per_vertex_rows), the scene and material
-    blocks at bindings 0 and 1, `samplers` ((kind, name) in slot order) and the outputs of output_names."""
+    blocks at bindings 0 and 1, `samplers` ((kind, name) in slot order), the technique's own push_constants
+    ((type, name)) after the model matrix, and the outputs of output_names."""
     defines = {**LIMITS, **defines, **({"PER_VERTEX_ROWS": 1} if per_vertex else {})}
     calls = [("define", (name, str(value))) for name, value in sorted(defines.items())]
     calls.append(("typedef_source", (typedef_source(),)))
@@ -137,6 +138,7 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=()):
     interface_name = "sgprt_surface_interface" + "".join(f"_{item.varying}{item.rows}" for item in per_vertex)
     calls.append(("vertex_out", (interface_name, tuple(interface))))
     calls.append(("push_constant", ("MAT4", "model_matrix")))
+    calls += [("push_constant", constant) for constant in push_constants]
     if gbuffer:
         calls += [("push_constant", ("INT", "gbuffer_object_index")),
                   ("push_constant", ("INT", "gbuffer_triangle_offset"))]

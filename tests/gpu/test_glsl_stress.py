@@ -547,6 +547,7 @@ RESOURCE_KERNELS = {
     "anisotropic_lobes.glsl": ["anisotropic_lobes"],
     "ggx_two_lobes.glsl": ["ggx_two_lobes"],
     "../common/surface_common.glsl": ["shading_frame", "apply_normal_map", "rotate_tangent"],
+    "../factored/factored_shading.glsl": ["parabolic_uv", "factored_brdf"],
 }
 LIBRARY_ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl", "warp.glsl", "lights.glsl"]
 
@@ -573,6 +574,41 @@ def test_lobe_visibility_stress(glsl, fuzz):
     _assert_finite(out, "lobe_visibility")
     assert out.min() >= 0 and out.max() <= 1
 
+
+def test_factored_brdf_stress(glsl, fuzz):
+    """The factored BRDF's lookups (techniques/factored): any view and light (zero, tiny, huge, below the
+    horizon, opposite), random log-factor maps: parabolic coordinates in [0, 1]^2, finite values, and the
+    numpy mirror's within 1e-4."""
+    from sg_prt_addon.techniques import factored_shading
+
+    wo = fuzz.stress_vectors(SMALL_ROWS)
+    wi = fuzz.stress_vectors(SMALL_ROWS)
+    wi[::4] = -wo[::4]
+    maps = {name: _f32(np.concatenate([fuzz.rng.normal(scale=0.7, size=shape + (3,)), np.zeros(shape + (1,))], -1))
+            for name, shape in (("p", (16, 16)), ("q", (16, 16)), ("r", (1, 16)))}
+    shading = _resource("factored_shading.glsl", "factored")
+    source = ("#define FACTOR_P_LIGHT 1\n#define FACTOR_R 1\nconst vec4 factor_scale = vec4(1.0);\n"
+              + "".join(_glsl_function(shading, name) for name in ("parabolic_uv", "factored_brdf")))
+    body = """
+    vec2 uv_o = parabolic_uv(wo.xyz);
+    result = vec4(factored_brdf(wo.xyz, wi.xyz), min(min(uv_o.x, uv_o.y), 1.0 - max(uv_o.x, uv_o.y)));
+    """
+    out = glsl(["sg.glsl", source], body, {"wo": wo, "wi": wi}, 4,
+               textures={"factor_p": maps["p"], "factor_q": maps["q"], "factor_r": maps["r"]})
+    _assert_finite(out, "factored_brdf")
+    assert out[:, 3].min() >= 0.0, "parabolic coordinates outside [0, 1]"
+    # the mirror on ordinary inputs: unit-ish lengths, away from the horizon and from o = -i (h undefined)
+    def unit(v):
+        return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    with np.errstate(all="ignore"):
+        lengths = np.stack([np.linalg.norm(wo, axis=1), np.linalg.norm(wi, axis=1)], 1)
+        h = unit(unit(wo) + unit(wi))
+        finite = np.all((lengths > 1e-3) & (lengths < 1e3), axis=1) & (np.linalg.norm(unit(wo) + unit(wi), axis=1) > 1e-2) \
+            & (np.abs(unit(wo)[:, 2]) > 1e-3) & (np.abs(unit(wi)[:, 2]) > 1e-3) & (np.abs(h[:, 2]) > 1e-3)
+    assert finite.mean() > 0.3
+    expected = factored_shading.factored_brdf(maps, "pqpr", wo[finite], wi[finite])[:, :3]
+    np.testing.assert_allclose(out[finite][:, :3], expected, rtol=1e-4)
 
 def test_shading_frame_stress(glsl, fuzz):
     """shading_frame, apply_normal_map and rotate_tangent with zero / parallel / huge tangents, zero
@@ -747,6 +783,7 @@ COVERED = {
                        "ssdf_to_local", "ssdf_decode", "ssdf_visibility_amplitude", "ssdf_shadowed_integral"],
     test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility"],
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
+    test_factored_brdf_stress: ["parabolic_uv", "factored_brdf"],
     test_model_lobes_stress: ["model_ndf_lobe", "model_m_factor"],
     test_table_lobes_stress: ["ggx_two_lobes", "anisotropic_lobes"],
     test_fitted_pieces_stress: ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",

@@ -1,7 +1,10 @@
 /* What every surface technique shares (techniques/sg_lobes.py and techniques/factored.py include it after
  * shaders/lib): the shading frame, the normal map and tangent rotation (mirrored by techniques.sg_shading's
  * shading_frame, apply_normal_map, rotate_tangent) and, with HAS_LIGHTS, the scene's lights as SGs
- * (lights.glsl; mirrored by sg_shading.point_light_sgs).  Needs sg.glsl and the `scene` block. */
+ * (lights.glsl; mirrored by sg_shading.point_light_sgs) and, with HAS_ENVIRONMENT and HAS_SPECULAR, the
+ * prefiltered environment's radiance for a lobe (env_prefilter.glsl and the environment_texture and
+ * equirect_texture samplers; mirrored by sg_shading.environment_radiance).  Needs sg.glsl and the
+ * `scene` block. */
 
 /* Unit normal, tangent by Gram-Schmidt (fallback if parallel), bitangent n x t. */
 void shading_frame(vec3 normal, vec3 tangent, out vec3 n, out vec3 t, out vec3 b)
@@ -58,5 +61,42 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
     sharpness = scene.sun_axis_sharpness[s].w;
     amplitude = scene.sun_amplitude[s].rgb;
   }
+}
+#endif
+
+#if defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
+/* env_prefilter_lookup (env_prefilter.glsl) step for step, with the per-layer texcoord
+ * transforms read from the scene block in place: passing them as the library's array
+ * argument copies the whole array for every lobe of every fragment. */
+vec3 environment_radiance(vec3 axis, float sharpness)
+{
+  vec2 coords = oct_encode(safe_normalize(axis));
+  int layer_count = scene.counts.w;
+  float position = env_prefilter_blend_parameter(sharpness, scene.prefilter_info.x, scene.prefilter_info.y,
+                                                 layer_count);
+  int last = layer_count - 1;
+  int lower = min(int(floor(position)), max(last - 1, 0));
+  int upper = min(lower + 1, last);
+  float fraction = position - float(lower);
+  vec2 lower_transform = scene.prefilter_scale_offset[lower].xy;
+  vec2 upper_transform = scene.prefilter_scale_offset[upper].xy;
+  vec4 lower_value = texture(environment_texture, vec3(coords * lower_transform.x + lower_transform.y, float(lower)));
+  vec4 upper_value = texture(environment_texture, vec3(coords * upper_transform.x + upper_transform.y, float(upper)));
+  vec3 value = (lower_value + (upper_value - lower_value) * fraction).rgb;
+  /* sharper than the top layer: towards the map's own radiance, reached where a lobe's width is one map row
+   * (env_prefilter.lookup's beyond_top_layer) */
+  float log2_top = scene.prefilter_info.x + float(last) / scene.prefilter_info.y;
+  float rows = float(textureSize(equirect_texture, 0).y);
+  float log2_raw = max(2.0 * log2(rows / SG_PI), log2_top + 1.0);
+  float beyond = clamp((log2(max(sharpness, 1.0e-30)) - log2_top) / (log2_raw - log2_top), 0.0, 1.0);
+  if (beyond > 0.0) {
+    vec3 d = safe_normalize(axis);
+    vec2 uv = vec2(0.5 - atan(d.y, d.x) / (2.0 * SG_PI), 0.5 + atan(d.z, length(d.xy)) / SG_PI);
+    value += (texture(equirect_texture, uv).rgb - value) * beyond;
+  }
+  /* below the broadest level: affine in lambda towards the mean radiance (world_colour.rgb when
+   * world_colour.w is 1) at lambda = 0 */
+  float below = clamp((isnan(sharpness) ? 0.0 : sharpness) / exp2(scene.prefilter_info.x), 0.0, 1.0);
+  return scene.world_colour.w > 0.5 ? scene.world_colour.rgb + (value - scene.world_colour.rgb) * below : value;
 }
 #endif

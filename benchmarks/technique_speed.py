@@ -1,0 +1,81 @@
+"""Frame time of each technique on the example scenes, beside EEVEE, in one process on one machine.
+
+Per scene (examples/build_scenes.py at --size): every material switched to each technique in turn
+(SG_PARAMETRIC unshadowed, SG_PARAMETRIC with the visibility bake, FACTORED, which has no shadows yet),
+the steady frame (draw + read back 3 passes, median of --redraws) and render() (median of --renders,
+after a first render that factorizes, prefilters and compiles), then EEVEE at 1 sample with matched node
+materials.  Ratios against EEVEE measured in the same run.
+
+    .venv/bin/python -m benchmarks.technique_speed [--size 512] [--scenes NAME ...]
+"""
+import argparse
+import os
+import statistics
+import sys
+import time
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+if REPO_ROOT not in sys.path:
+    sys.path.insert(0, REPO_ROOT)
+
+RUNS = (("SG_PARAMETRIC", False), ("SG_PARAMETRIC", True), ("FACTORED", False))
+
+
+def _set_technique(scene, technique):
+    for obj in scene.objects:
+        for slot in getattr(obj, "material_slots", ()):
+            if slot.material is not None:
+                slot.material.sgprt.technique = technique
+
+
+def measure_scene(name, size, renders, redraws):
+    import bpy
+
+    from benchmarks import matched_materials
+    from benchmarks.engine_vs_eevee import render_seconds, steady_frame
+    from examples import build_scenes
+
+    scene = build_scenes.SCENES[name](size)
+    figures = {}
+    for technique, baked in RUNS:
+        if baked and bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
+            raise RuntimeError(f"{name}: the visibility bake did not finish")
+        _set_technique(scene, technique)
+        label = technique + (" + bake" if baked else "")
+        start = time.perf_counter()
+        render_seconds()
+        figures[(label, "first")] = time.perf_counter() - start
+        figures[(label, "render")] = statistics.median(render_seconds() for _ in range(renders))
+        figures[(label, "frame")] = steady_frame(redraws)
+    matched_materials.match_scene(scene)
+    matched_materials.configure_eevee(scene, 1)
+    render_seconds()                                     # compiles EEVEE's shaders
+    figures[("EEVEE 1 sample", "render")] = statistics.median(render_seconds() for _ in range(renders))
+    return figures
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--size", type=int, default=512)
+    parser.add_argument("--scenes", nargs="*", default=["suzanne_courtyard", "brushed_metal"])
+    parser.add_argument("--renders", type=int, default=5)
+    parser.add_argument("--redraws", type=int, default=7)
+    arguments = parser.parse_args(argv)
+    import sg_prt_addon
+    sg_prt_addon.register()
+    results = {name: measure_scene(name, arguments.size, arguments.renders, arguments.redraws)
+               for name in arguments.scenes}
+    print(f"\n{arguments.size}x{arguments.size}, seconds (ratio to EEVEE 1 sample, same run)")
+    for name, figures in results.items():
+        eevee = figures[("EEVEE 1 sample", "render")]
+        print(f"\n{name}: EEVEE 1 sample render {eevee:.3f} s")
+        print(f"{'technique':28s} {'first render':>14s} {'render()':>16s} {'steady frame':>16s}")
+        for technique, baked in RUNS:
+            label = technique + (" + bake" if baked else "")
+            first, render, frame = (figures[(label, k)] for k in ("first", "render", "frame"))
+            print(f"{label:28s} {first:14.3f} {render:9.3f} ({render / eevee:4.2f}) {frame:9.3f} ({frame / eevee:4.2f})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,194 @@
+"""mccool2001's homomorphic factorization as a technique: the material's BRDF as p(o) q(h) p(i) r(o.h) texture
+lookups per light (measured/homomorphic.py fits them; shaders/techniques/factored/ renders them;
+techniques/factored_shading.py is the mirror).
+
+The specular BRDF of the material's model is factorized once per set of model parameters (about 2 s,
+cached for the process): model parameters are uniform over the material (their textures do not apply;
+the export warns), the colours and the normal map are per pixel.  Beyond the paper, which lights with
+point sources only: every light is taken at its SG's axis with its clamped-cosine integral (a sphere
+light's size enters the energy, not the lobe), and the environment lights the diffuse term through its SG
+mixture and the glossy term as the factored BRDF's directional albedo times the prefiltered radiance
+around the mirror direction, at the sharpness of the factored lobe (FactoredTables.lobe_sharpness).
+No SSDF visibility yet: baked objects render unshadowed with it.
+"""
+import collections
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..measured import homomorphic
+from ..reflectance import brdf, models
+from . import factored_shading, shader_sources
+from .base import Technique
+
+NAME = "FACTORED"
+GLSL_DIR = "factored"
+FORM = "pqpr"
+RESOLUTION = 64
+SAMPLES = 256                   # views x lights of the fit: SAMPLES^2 pairs
+TEXTURE_SLOTS = ("diffuse_color", "specular_color", "normal_map")
+LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "env_prefilter.glsl")
+CACHE_SIZE = 16
+
+
+@dataclass(frozen=True)
+class FactoredKey:
+    technique: str = NAME
+    form: str = FORM
+    textures: tuple = ()
+    has_lights: bool = False
+    has_environment: bool = False
+    gbuffer: bool = False
+
+    def describe(self):
+        parts = [homomorphic.FORM_LABELS[self.form], "lights" if self.has_lights else "no lights",
+                 "environment texture" if self.has_environment else "world colour"]
+        if self.textures:
+            parts.append("textures: " + ", ".join(self.textures))
+        if self.gbuffer:
+            parts.append("G-buffer")
+        return ", ".join(parts)
+
+
+@dataclass(frozen=True)
+class FactoredTables:
+    """The GPU tables of one factorization: log-factor maps (H, W, 4) float32 (p, q, r), the directional
+    albedo map of the factored BRDF (R, R, 4) over views (parabolic), the RGB scale alpha A and the
+    sharpness of its glossy environment lookup."""
+    factorization: object
+    maps: dict
+    albedo: np.ndarray
+    scale: np.ndarray
+    lobe_sharpness: float
+
+
+def _rgba(values):
+    values = np.asarray(values, np.float32)
+    out = np.zeros(values.shape[:-1] + (4,), np.float32)
+    out[..., :3] = values if values.shape[-1] == 3 else values[..., :1]
+    return out
+
+
+def _parabolic_directions(resolution):
+    """(R, R, 3) local directions at the texel centres of a parabolic map (outside the disk: its rim)."""
+    centres = (np.arange(resolution) + 0.5) / resolution
+    u, v = np.meshgrid(centres, centres)
+    s, t = 2 * u - 1, 2 * v - 1
+    r2 = s * s + t * t
+    inside = r2 <= 1
+    scale = np.where(inside, 1.0, 1 / np.sqrt(np.maximum(r2, 1e-30)))
+    s, t = s * scale, t * scale
+    r2 = np.minimum(r2, 1.0)
+    z = (1 - r2) / (1 + r2)
+    xy = np.stack([s, t], -1) * (1 + z)[..., None]
+    return np.concatenate([xy, z[..., None]], -1)
+
+
+def tables_of(factorization, albedo_samples=1024):
+    """FactoredTables of a homomorphic.Factorization: the maps padded to RGBA, its directional albedo
+    int f(o, i) cos(i) di at every texel's view (albedo_samples lattice lights), and the lobe sharpness
+    1 / E[1 - i.n] of f(n, i) cos(i) (the glossy environment lookup's; a Gaussian lobe of sharpness
+    lambda has E[1 - cos] = 1 / lambda)."""
+    maps = {name: _rgba(log_map) for name, log_map in factorization.log_factors.items()}
+    lights = homomorphic.hemisphere_points(albedo_samples)
+    views = _parabolic_directions(factorization.resolution).reshape(-1, 3)
+    def unscaled(wo, wi):
+        return factored_shading.factored_brdf(factorization.log_factors, factorization.form, wo, wi)
+
+    values = np.stack([unscaled(np.broadcast_to(view, lights.shape), lights) for view in views])   # (V, L, C)
+    albedo = np.sum(values * lights[None, :, 2:3], axis=1) * (2 * np.pi / albedo_samples)
+    normal_view = unscaled(np.broadcast_to([0.0, 0.0, 1.0], lights.shape), lights).mean(axis=-1) * lights[:, 2]
+    mean_angle = np.sum(normal_view * (1 - lights[:, 2])) / max(np.sum(normal_view), 1e-30)
+    scale = np.broadcast_to(factorization.alpha * factorization.scale, (3,)).astype(np.float32)
+    return FactoredTables(factorization, maps, _rgba(albedo.reshape(factorization.resolution, factorization.resolution,
+                                                                    -1)), scale, float(1 / max(mean_angle, 1e-3)))
+
+
+_cache = collections.OrderedDict()
+
+
+def model_tables(params):
+    """FactoredTables of an export.MaterialParams' specular model (its uniform parameters), cached."""
+    model = models.BY_NAME[params.model]
+    values = tuple((name, float(getattr(params, name))) for name in model.parameters)
+    key = (params.model, values, FORM, RESOLUTION, SAMPLES)
+    tables = _cache.get(key)
+    if tables is None:
+        exact = brdf.model_from_name(params.model, **dict(values))
+        wo, wi, samples = homomorphic.sample_brdf(exact.specular, SAMPLES, SAMPLES)
+        tables = _cache[key] = tables_of(homomorphic.factorize(wo, wi, samples, form=FORM, resolution=RESOLUTION))
+        while len(_cache) > CACHE_SIZE:
+            _cache.popitem(last=False)
+    else:
+        _cache.move_to_end(key)
+    return tables
+
+
+class Factored(Technique):
+    name = NAME
+    label = "Factored BRDF (McCool 2001)"
+    description = ("The material's BRDF factorized into p(o) q(h) p(i) r(o.h) texture lookups per light "
+                   "(McCool et al. 2001); no shadows yet")
+    number = 2
+    paper = "mccool2001"
+
+    mirror = staticmethod(factored_shading.shade_fragments)
+
+    def variant_key(self, params, inputs):
+        textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS))
+        return FactoredKey(textures=textures, has_lights=inputs.has_lights, has_environment=inputs.has_environment,
+                           gbuffer=inputs.gbuffer)
+
+    def defines(self, key):
+        out = {"FACTOR_P_LIGHT": 1} if homomorphic.FORMS[key.form][2] == "p" else {}
+        if "r" in homomorphic.FORMS[key.form]:
+            out["FACTOR_R"] = 1
+        if key.has_lights:
+            out["HAS_LIGHTS"] = 1
+        if key.has_environment:
+            out.update(HAS_ENVIRONMENT=1, HAS_SPECULAR=1, ENV_PREFILTER_MAX_LAYERS=shader_sources.MAX_LAYERS)
+        for name in key.textures:
+            out["HAS_NORMAL_MAP" if name == "normal_map" else "HAS_TEXTURE_" + name.upper()] = 1
+        if key.gbuffer:
+            out["GBUFFER"] = 1
+        return out
+
+    def samplers(self, key):
+        samplers = [("FLOAT_2D", "factor_p"), ("FLOAT_2D", "factor_q")]
+        if "r" in homomorphic.FORMS[key.form]:
+            samplers.append(("FLOAT_2D", "factor_r"))
+        samplers.append(("FLOAT_2D", "factored_albedo"))
+        if key.has_environment:
+            samplers += [("FLOAT_2D_ARRAY", "environment_texture"), ("FLOAT_2D", "equirect_texture")]
+        return samplers + [("FLOAT_2D", "texture_" + name) for name in key.textures]
+
+    def create_info_calls(self, key):
+        files = [name for name in LIBRARY_FILES if (name != "lights.glsl" or key.has_lights)
+                 and (name != "env_prefilter.glsl" or key.has_environment)]
+        sources = [shader_sources.library_source(name) for name in files]
+        sources.append(shader_sources.technique_source("common", "surface_common.glsl"))
+        sources += [shader_sources.technique_source(GLSL_DIR, name)
+                    for name in ("factored_shading.glsl", "surface.frag.glsl")]
+        return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
+                                            push_constants=(("VEC4", "factor_scale"),))
+
+    def bind(self, shader, key, context):
+        params = context.params
+        tables = model_tables(params)
+        shader.uniform_block("scene", context.scene_buffer)
+        shader.uniform_block("material", context.material_buffer)
+        shader.uniform_float("factor_scale", list(tables.scale) + [tables.lobe_sharpness])
+        for name in ("p", "q", "r"):
+            if name in tables.maps:
+                shader.uniform_sampler(f"factor_{name}", context.material_table(f"factor_{name}",
+                                                                                lambda name=name: tables.maps[name]))
+        shader.uniform_sampler("factored_albedo", context.material_table("factored_albedo", lambda: tables.albedo))
+        if key.has_environment:
+            layers, equirect = context.environment_textures()
+            shader.uniform_sampler("environment_texture", layers)
+            shader.uniform_sampler("equirect_texture", equirect)
+        for name in key.textures:
+            shader.uniform_sampler("texture_" + name, context.image(name))
+
+
+TECHNIQUE = Factored()

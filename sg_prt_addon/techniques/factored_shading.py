@@ -1,0 +1,79 @@
+"""Numpy mirror of the factored-BRDF technique's fragment shader (shaders/techniques/factored/): the same
+steps, per pixel, in float32 where the shader is.  tables: techniques.factored.FactoredTables."""
+import numpy as np
+
+from ..measured import homomorphic
+from ..spherical import clamped_cosine, sg, texture_fetch
+from . import sg_shading
+
+FLOAT = np.float32
+
+
+def factored_brdf(log_factors, form, wo, wi):
+    """exp of the summed log-factors at local directions (..., 3) -> (..., C), as factored_brdf() of the
+    shader reads its maps (GPU bilinear fetch; directions clamped to the hemisphere; no alpha A)."""
+    wo, wi = np.asarray(wo, np.float64), np.asarray(wi, np.float64)
+    log_value = 0.0
+    for name, uv in zip(homomorphic.FORMS[form], homomorphic.map_coordinates(wo, wi)):
+        if name is not None:
+            log_value = log_value + texture_fetch.bilinear(np.asarray(log_factors[name], np.float32),
+                                                           uv.astype(np.float32))
+    return np.exp(log_value)
+
+
+def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color, specular_color, light_data,
+          environment, tables):
+    """Diffuse and specular radiance (N, 3) float32 of pixels (as sg_shading.shade takes them)."""
+    position = np.asarray(position, FLOAT)
+    n, t, b = sg_shading.shading_frame(normal, tangent)
+    if is_perspective:
+        view = sg.normalize(np.asarray(view_origin, FLOAT)[None] - position)
+    else:
+        view = np.broadcast_to(-sg.normalize(np.asarray(view_origin, FLOAT)), position.shape)
+    frame = np.stack([t, b, n], axis=-1)
+    o = np.einsum("nji,nj->ni", frame, view)
+    maps, form = tables.factorization.log_factors, tables.factorization.form
+    scale = np.asarray(tables.scale, FLOAT)
+    irradiance = np.zeros(position.shape, FLOAT)
+    radiance = np.zeros(position.shape, FLOAT)
+    for axis, sharpness, amplitude in sg_shading._light_sets(position, light_data):
+        energy = amplitude * clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, FLOAT(1), n[:, None])[..., None]
+        irradiance += np.sum(energy, axis=1)
+        local = np.einsum("nji,nlj->nli", frame, axis)
+        f = scale * factored_brdf(maps, form, np.broadcast_to(o[:, None], local.shape), local)[..., :3]
+        radiance += np.sum(energy * f, axis=1).astype(FLOAT)
+    albedo = scale * texture_fetch.bilinear(tables.albedo, homomorphic.parabolic_coordinates(o).astype(FLOAT))[:, :3]
+    mirror = 2 * np.sum(n * view, axis=-1, keepdims=True) * n - view
+    if environment.has_texture:
+        irradiance += np.sum(environment.lobe_amplitude[None] * clamped_cosine.sg_clamped_cosine_integral(
+            environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n[:, None])[..., None], axis=1)
+        radiance += albedo * sg_shading.environment_radiance(environment, mirror, np.full(len(n), tables.lobe_sharpness,
+                                                                                         FLOAT))
+    else:
+        colour = np.asarray(environment.colour, FLOAT)
+        irradiance += np.pi * colour
+        radiance += albedo * colour
+    diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
+    return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * radiance).astype(FLOAT)
+
+
+def shade_fragments(material, textures, tables, position, normal, tangent, uv, view_origin, is_perspective,
+                    light_data, environment):
+    """Mirror of the technique's main(): per-fragment inputs as the G-buffer holds them (as
+    sg_shading.shade_fragments takes them), and the material's FactoredTables."""
+    count = len(position)
+    diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
+    specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
+    if "diffuse_color" in textures:
+        diffuse_color = diffuse_color * sg_shading.sample_texture(textures["diffuse_color"], uv)[:, :3]
+    if "specular_color" in textures:
+        specular_color = specular_color * sg_shading.sample_texture(textures["specular_color"], uv)[:, :3]
+    shading_normal = np.asarray(normal, FLOAT)
+    tangent = np.asarray(tangent, FLOAT)
+    if "normal_map" in textures:
+        shading_normal = sg_shading.apply_normal_map(shading_normal, tangent,
+                                                     sg_shading.sample_texture(textures["normal_map"], uv)[:, :3],
+                                                     FLOAT(material.normal_strength))
+    shading_tangent = sg_shading.rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+    return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
+                 specular_color, light_data, environment, tables)
