@@ -9,7 +9,8 @@ point sources only: every light is taken at its SG's axis with its clamped-cosin
 light's size enters the energy, not the lobe), and the environment lights the diffuse term through its SG
 mixture and the glossy term as the factored BRDF's directional albedo times the prefiltered radiance
 around the mirror direction, at the sharpness of the factored lobe (FactoredTables.lobe_sharpness).
-No SSDF visibility yet: baked objects render unshadowed with it.
+With a visibility bake each light, environment lobe and the glossy lookup is shadowed by the SSDF
+visibility of its lobe (common/lobe_visibility.glsl, as the SG techniques' diffuse terms).
 """
 import collections
 from dataclasses import dataclass
@@ -27,7 +28,8 @@ FORM = "pqpr"
 RESOLUTION = 64
 SAMPLES = 256                   # views x lights of the fit: SAMPLES^2 pairs
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "normal_map")
-LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "env_prefilter.glsl")
+LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "env_prefilter.glsl", "ssdf.glsl")
+VISIBILITY_KIND = "ssdf"        # the per-vertex precomputation it reads (visibility.per_vertex kinds)
 CACHE_SIZE = 16
 
 
@@ -39,6 +41,7 @@ class FactoredKey:
     has_lights: bool = False
     has_environment: bool = False
     gbuffer: bool = False
+    visibility_layers: int = 0      # vec4 of SSDF coefficients per vertex (0: no visibility bake)
 
     def describe(self):
         parts = [homomorphic.FORM_LABELS[self.form], "lights" if self.has_lights else "no lights",
@@ -47,6 +50,8 @@ class FactoredKey:
             parts.append("textures: " + ", ".join(self.textures))
         if self.gbuffer:
             parts.append("G-buffer")
+        if self.visibility_layers:
+            parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
         return ", ".join(parts)
 
 
@@ -128,7 +133,7 @@ class Factored(Technique):
     name = NAME
     label = "Factored BRDF (McCool 2001)"
     description = ("The material's BRDF factorized into p(o) q(h) p(i) r(o.h) texture lookups per light "
-                   "(McCool et al. 2001); no shadows yet")
+                   "(McCool et al. 2001), shadowed by the visibility bake")
     number = 2
     paper = "mccool2001"
 
@@ -137,7 +142,7 @@ class Factored(Technique):
     def variant_key(self, params, inputs):
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS))
         return FactoredKey(textures=textures, has_lights=inputs.has_lights, has_environment=inputs.has_environment,
-                           gbuffer=inputs.gbuffer)
+                           gbuffer=inputs.gbuffer, visibility_layers=int(inputs.per_vertex.get(VISIBILITY_KIND, 0)))
 
     def defines(self, key):
         out = {"FACTOR_P_LIGHT": 1} if homomorphic.FORMS[key.form][2] == "p" else {}
@@ -151,6 +156,8 @@ class Factored(Technique):
             out["HAS_NORMAL_MAP" if name == "normal_map" else "HAS_TEXTURE_" + name.upper()] = 1
         if key.gbuffer:
             out["GBUFFER"] = 1
+        if key.visibility_layers:
+            out.update(HAS_VISIBILITY=1, SSDF_MAX_LAYERS=key.visibility_layers)
         return out
 
     def samplers(self, key):
@@ -160,17 +167,31 @@ class Factored(Technique):
         samplers.append(("FLOAT_2D", "factored_albedo"))
         if key.has_environment:
             samplers += [("FLOAT_2D_ARRAY", "environment_texture"), ("FLOAT_2D", "equirect_texture")]
-        return samplers + [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        if key.visibility_layers:
+            samplers += [("FLOAT_2D", "visibility_coefficients"), ("FLOAT_2D_ARRAY", "visibility_basis")]
+        return samplers
+
+    def per_vertex_inputs(self, key):
+        if not key.visibility_layers:
+            return ()
+        return (shader_sources.PerVertexInput("visibility_coefficients", key.visibility_layers, "ssdf_coefficients",
+                                              "visibility_rows"),)
 
     def create_info_calls(self, key):
         files = [name for name in LIBRARY_FILES if (name != "lights.glsl" or key.has_lights)
-                 and (name != "env_prefilter.glsl" or key.has_environment)]
+                 and (name != "env_prefilter.glsl" or key.has_environment)
+                 and (name != "ssdf.glsl" or key.visibility_layers)]
         sources = [shader_sources.library_source(name) for name in files]
         sources.append(shader_sources.technique_source("common", "surface_common.glsl"))
+        per_vertex = self.per_vertex_inputs(key)
+        if per_vertex:
+            sources += [shader_sources.technique_source("common", "lobe_visibility.glsl"),
+                        shader_sources.per_vertex_copy_source(per_vertex)]
         sources += [shader_sources.technique_source(GLSL_DIR, name)
                     for name in ("factored_shading.glsl", "surface.frag.glsl")]
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
-                                            push_constants=(("VEC4", "factor_scale"),))
+                                            per_vertex, push_constants=(("VEC4", "factor_scale"),))
 
     def bind(self, shader, key, context):
         params = context.params
@@ -189,6 +210,10 @@ class Factored(Technique):
             shader.uniform_sampler("equirect_texture", equirect)
         for name in key.textures:
             shader.uniform_sampler("texture_" + name, context.image(name))
+        if key.visibility_layers:
+            buffers = context.per_vertex(VISIBILITY_KIND)
+            shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
+            shader.uniform_sampler("visibility_basis", buffers.basis_texture)
 
 
 TECHNIQUE = Factored()

@@ -22,8 +22,9 @@ def factored_brdf(log_factors, form, wo, wi):
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color, specular_color, light_data,
-          environment, tables):
-    """Diffuse and specular radiance (N, 3) float32 of pixels (as sg_shading.shade takes them)."""
+          environment, tables, visibility=None):
+    """Diffuse and specular radiance (N, 3) float32 of pixels (as sg_shading.shade takes them); visibility:
+    an sg_shading.Visibility (the HAS_VISIBILITY variant's SSDF inputs) or None."""
     position = np.asarray(position, FLOAT)
     n, t, b = sg_shading.shading_frame(normal, tangent)
     if is_perspective:
@@ -34,31 +35,45 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
     o = np.einsum("nji,nj->ni", frame, view)
     maps, form = tables.factorization.log_factors, tables.factorization.form
     scale = np.asarray(tables.scale, FLOAT)
+    def visible(axis, sharpness):      # every lobe's SSDF visibility, as FACTORED_VISIBILITY
+        if visibility is None:
+            return FLOAT(1)
+        shape = np.shape(sharpness)
+        flat_axis = np.broadcast_to(np.asarray(axis, FLOAT), shape + (3,)).reshape(shape[0], -1, 3)
+        flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
+        return sg_shading.lobe_visibility(flat_axis, flat_sharpness, n, visibility).reshape(shape)
+
     irradiance = np.zeros(position.shape, FLOAT)
     radiance = np.zeros(position.shape, FLOAT)
     for axis, sharpness, amplitude in sg_shading._light_sets(position, light_data):
-        energy = amplitude * clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, FLOAT(1), n[:, None])[..., None]
+        energy = amplitude * (clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, FLOAT(1), n[:, None])
+                              * visible(axis, sharpness))[..., None]
         irradiance += np.sum(energy, axis=1)
         local = np.einsum("nji,nlj->nli", frame, axis)
         f = scale * factored_brdf(maps, form, np.broadcast_to(o[:, None], local.shape), local)[..., :3]
         radiance += np.sum(energy * f, axis=1).astype(FLOAT)
     albedo = scale * texture_fetch.bilinear(tables.albedo, homomorphic.parabolic_coordinates(o).astype(FLOAT))[:, :3]
     mirror = 2 * np.sum(n * view, axis=-1, keepdims=True) * n - view
+    lobe = np.full((len(n), 1), tables.lobe_sharpness, FLOAT)
+    mirror_visible = np.asarray(visible(mirror[:, None], lobe), FLOAT).reshape(-1, 1)
     if environment.has_texture:
-        irradiance += np.sum(environment.lobe_amplitude[None] * clamped_cosine.sg_clamped_cosine_integral(
-            environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n[:, None])[..., None], axis=1)
-        radiance += albedo * sg_shading.environment_radiance(environment, mirror, np.full(len(n), tables.lobe_sharpness,
-                                                                                         FLOAT))
+        count = len(environment.lobe_sharpness)
+        env_axis = np.broadcast_to(environment.lobe_axis[None], (len(n), count, 3))
+        env_sharpness = np.broadcast_to(environment.lobe_sharpness[None], (len(n), count))
+        irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
+            env_axis, env_sharpness, FLOAT(1), n[:, None]) * visible(env_axis, env_sharpness))[..., None], axis=1)
+        radiance += albedo * sg_shading.environment_radiance(environment, mirror, lobe[:, 0]) * mirror_visible
     else:
         colour = np.asarray(environment.colour, FLOAT)
-        irradiance += np.pi * colour
-        radiance += albedo * colour
+        irradiance += np.pi * colour * np.asarray(visible(n[:, None], np.zeros((len(n), 1), FLOAT)),
+                                                  FLOAT).reshape(-1, 1)
+        radiance += albedo * colour * mirror_visible
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
     return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * radiance).astype(FLOAT)
 
 
 def shade_fragments(material, textures, tables, position, normal, tangent, uv, view_origin, is_perspective,
-                    light_data, environment):
+                    light_data, environment, visibility=None):
     """Mirror of the technique's main(): per-fragment inputs as the G-buffer holds them (as
     sg_shading.shade_fragments takes them), and the material's FactoredTables."""
     count = len(position)
@@ -76,4 +91,4 @@ def shade_fragments(material, textures, tables, position, normal, tangent, uv, v
                                                      FLOAT(material.normal_strength))
     shading_tangent = sg_shading.rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
-                 specular_color, light_data, environment, tables)
+                 specular_color, light_data, environment, tables, visibility)

@@ -30,7 +30,9 @@ GLSL_DIR = "sg"
 # Library files in dependency order (shaders/lib), then the technique's own (shaders/techniques/sg)
 LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "lights.glsl",
                  "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
-TECHNIQUE_FILES = ("anisotropic_lobes.glsl", "ggx_two_lobes.glsl", "lobe_visibility.glsl", "sg_shading.glsl")
+# (directory under shaders/techniques, file) in order: lobe_visibility is shared with other techniques
+TECHNIQUE_FILES = (("sg", "anisotropic_lobes.glsl"), ("sg", "ggx_two_lobes.glsl"), ("common", "lobe_visibility.glsl"),
+                   ("sg", "sg_shading.glsl"))
 # The per-vertex precomputation this technique reads (visibility.per_vertex kinds)
 VISIBILITY_KIND = "ssdf"
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
@@ -225,13 +227,13 @@ class SGLobes(Technique):
         wanted = set(self.model_files(key) if key.has_specular else ()) | {"sg_shading.glsl"}
         if key.visibility_layers:
             wanted.add("lobe_visibility.glsl")
-        return [name for name in TECHNIQUE_FILES if name in wanted]
+        return [(folder, name) for folder, name in TECHNIQUE_FILES if name in wanted]
 
     def fragment_source(self, key):
         parts = [_constants_source()]
         parts += [shader_sources.library_source(name) for name in self.library_files(key)]
         parts.append(shader_sources.technique_source("common", "surface_common.glsl"))
-        parts += [shader_sources.technique_source(GLSL_DIR, name) for name in self.technique_files(key)]
+        parts += [shader_sources.technique_source(folder, name) for folder, name in self.technique_files(key)]
         if key.visibility_layers:
             parts.append(shader_sources.per_vertex_copy_source(per_vertex_inputs(key)))
         parts.append(shader_sources.technique_source(GLSL_DIR, "surface.frag.glsl"))
@@ -321,8 +323,8 @@ def vertex_visibility_calls(visibility_layers, rows, has_environment):
               ("sampler", (2, "FLOAT_2D_ARRAY", "visibility_basis")), ("fragment_out", (0, "VEC4", "out_fractions"))]
     sources = [shader_sources.library_source(name)
                for name in ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "ssdf.glsl")]
-    sources += [shader_sources.technique_source(GLSL_DIR, name)
-                for name in ("lobe_visibility.glsl", "vertex_visibility.frag.glsl")]
+    sources += [shader_sources.technique_source("common", "lobe_visibility.glsl"),
+                shader_sources.technique_source(GLSL_DIR, "vertex_visibility.frag.glsl")]
     calls.append(("fragment_source", ("\n".join(sources),)))
     return calls
 

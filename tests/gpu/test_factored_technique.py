@@ -14,7 +14,9 @@ def engine(blender):
     return blender
 
 
-def _mirror_errors(result):
+def _mirror_errors(result, shadowed=False):
+    """Max relative error per (material, pass) of the shader against the mirror, the materials on one object
+    each (with shadowed, the pixels' SSDF inputs rebuilt as the GPU interpolates them)."""
     from sg_prt_addon.techniques import factored, factored_shading
 
     passes, state = result["passes"], result["state"]
@@ -29,7 +31,8 @@ def _mirror_errors(result):
         diffuse, specular = factored_shading.shade_fragments(
             params, {}, factored.model_tables(params), passes["gbuffer_position"][mask][:, :3],
             passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin,
-            camera.is_perspective, state.light_data(), state.environment)
+            camera.is_perspective, state.light_data(), state.environment,
+            visibility=fx.pixel_visibility(result, mask) if shadowed else None)
         for name, expected in (("Diffuse", diffuse), ("Specular", specular)):
             actual = passes[name][mask][:, :3]
             assert np.all(np.isfinite(actual)) and expected.max() > 0
@@ -63,6 +66,44 @@ def test_shader_matches_mirror(engine, world):
     assert covered.mean() > 0.2
     print("max relative error", errors)
     assert max(errors.values()) <= TOLERANCE
+
+
+@pytest.fixture
+def bakes():
+    yield fx.bake_objects
+    fx.clear_bakes()
+
+
+@pytest.mark.parametrize("world", ["colour", "environment"])
+def test_shadowed_shader_matches_mirror(engine, bakes, world):
+    """A sphere over a floor, both baked: every light, environment lobe and the glossy lookup shadowed by its
+    SSDF visibility, on the GPU as in the mirror; the floor darker under the sphere than without the bake."""
+    scene = fx.new_scene("factored_shadow_" + world, 96, 96)
+    scene.camera.location = (0.0, -5.0, 3.0)
+    scene.camera.rotation_euler = (1.05, 0.0, 0.0)
+    if world == "colour":
+        fx.world_colour(scene, (0.15, 0.17, 0.2))
+    else:
+        fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    fx.point_light(scene, "factored_shadow_light_" + world, (0.5, -0.5, 4.0), 800.0, radius=0.2)
+    sphere = fx.uv_sphere(scene, "factored_shadow_sphere_" + world, (0.0, 0.0, 1.0), radius=0.8, segments=24,
+                          rings=12)
+    sphere.data.materials.append(fx.material("factored_shadow_ggx_" + world, technique="FACTORED", model="GGX",
+                                             roughness=0.4, diffuse_color=(0.6, 0.5, 0.4)))
+    floor = fx.grid(scene, "factored_shadow_floor_" + world, (0.0, 0.0, 0.0), size=5.0, segments=24)
+    floor.data.materials.append(fx.material("factored_shadow_floor_mat_" + world, technique="FACTORED",
+                                            model="COOK_TORRANCE", roughness=0.3, diffuse_color=(0.7, 0.7, 0.7)))
+    unshadowed = fx.render(scene, gbuffer=True, environment_layer_size=32)["passes"]["Diffuse"].copy()
+    bakes(scene, [sphere, floor], resolution=12)
+    with fx.recorded_variant_keys() as keys:
+        result = fx.render(scene, gbuffer=True, environment_layer_size=32)
+    assert "error" not in result, result.get("error")
+    assert {key.visibility_layers > 0 for key in keys} == {True}
+    errors, covered = _mirror_errors(result, shadowed=True)
+    print("max relative error", errors)
+    assert max(errors.values()) <= TOLERANCE
+    darker = result["passes"]["Diffuse"][..., :3].sum() / unshadowed[..., :3].sum()
+    assert darker < 0.97, darker
 
 
 def test_technique_setting_survives_save_and_reopen(engine, tmp_path):

@@ -3,7 +3,8 @@
  * SG's axis) and the environment (beyond the paper: diffuse from its SG mixture, glossy as the factored
  * BRDF's directional albedo times the prefiltered radiance around the mirror direction).  Mirrored by
  * techniques/factored_shading.py.  Needs sg.glsl, hemisphere.glsl, clamped_cosine.glsl, surface_common.glsl,
- * (HAS_LIGHTS) lights.glsl, (HAS_ENVIRONMENT) env_prefilter.glsl, and the samplers factor_p, factor_q,
+ * (HAS_LIGHTS) lights.glsl, (HAS_ENVIRONMENT) env_prefilter.glsl, (HAS_VISIBILITY: every lobe shadowed by
+ * its SSDF visibility) ssdf.glsl and common/lobe_visibility.glsl, and the samplers factor_p, factor_q,
  * (FACTOR_R) factor_r and factored_albedo; factor_scale: rgb = alpha A (eq. 20, eq. 6), w = the sharpness
  * of the glossy environment lookup.  The maps hold log-factors, interpolated and then exponentiated:
  * what the factorization fitted. */
@@ -29,6 +30,12 @@ vec3 factored_brdf(vec3 o, vec3 i)
   return factor_scale.rgb * exp(log_f);
 }
 
+#ifdef HAS_VISIBILITY
+#define FACTORED_VISIBILITY(axis, sharpness) lobe_visibility(axis, sharpness, n)
+#else
+#define FACTORED_VISIBILITY(axis, sharpness) 1.0
+#endif
+
 void shade_factored(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3 specular_color,
                     out vec3 diffuse, out vec3 specular)
 {
@@ -45,7 +52,8 @@ void shade_factored(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color
     float light_sharpness;
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
-    vec3 light_energy = light_amplitude * sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n);
+    vec3 light_energy = light_amplitude * (sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n) *
+                                           FACTORED_VISIBILITY(light_axis, light_sharpness));
     irradiance += light_energy;
     radiance += light_energy * factored_brdf(o, light_axis * frame);      /* eq. 20 */
   }
@@ -54,13 +62,15 @@ void shade_factored(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color
   vec3 mirror = 2.0 * dot(n, view) * n - view;
 #ifdef HAS_ENVIRONMENT
   for (int e = 0; e < scene.counts.z; e++) {
-    irradiance += scene.env_amplitude[e].rgb *
-                  sg_clamped_cosine_integral(scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w, 1.0, n);
+    vec3 env_axis = scene.env_axis_sharpness[e].xyz;
+    float env_sharpness = scene.env_axis_sharpness[e].w;
+    irradiance += scene.env_amplitude[e].rgb * (sg_clamped_cosine_integral(env_axis, env_sharpness, 1.0, n) *
+                                                FACTORED_VISIBILITY(env_axis, env_sharpness));
   }
-  radiance += albedo * environment_radiance(mirror, factor_scale.w);
+  radiance += albedo * environment_radiance(mirror, factor_scale.w) * FACTORED_VISIBILITY(mirror, factor_scale.w);
 #else
-  irradiance += SG_PI * scene.world_colour.rgb;
-  radiance += albedo * scene.world_colour.rgb;
+  irradiance += SG_PI * scene.world_colour.rgb * FACTORED_VISIBILITY(n, 0.0);
+  radiance += albedo * scene.world_colour.rgb * FACTORED_VISIBILITY(mirror, factor_scale.w);
 #endif
   diffuse = diffuse_color * (1.0 / SG_PI) * irradiance;
   specular = specular_color * radiance;

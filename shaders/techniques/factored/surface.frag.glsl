@@ -5,6 +5,10 @@ void main()
 {
   bool front = gl_FrontFacing != (determinant(mat3(model_matrix)) < 0.0);
   vec3 normal = front ? world_normal : -world_normal;
+#ifdef HAS_VISIBILITY
+  set_visibility_frame(world_vertex_normal);     /* the bake's frame: not flipped for back faces */
+  load_per_vertex_rows();
+#endif
   vec3 diffuse_color = material.diffuse_color.rgb;
   vec3 specular_color = material.specular_color.rgb;
 #ifdef HAS_TEXTURE_DIFFUSE_COLOR

@@ -1,6 +1,6 @@
 /* SSDF visibility of one SG lobe against the clamped cosine (wang2009 eq. 39-43 with eq. 30-31), shared by
- * the surface shader (sg_shading.glsl) and the per-vertex pass of the broad diffuse lobes
- * (vertex_visibility.frag.glsl).  Needs sg.glsl, hemisphere.glsl, clamped_cosine.glsl, ssdf.glsl
+ * the SG surface shader (techniques/sg/sg_shading.glsl), its per-vertex pass of the broad diffuse lobes
+ * (techniques/sg/vertex_visibility.frag.glsl) and the factored technique (techniques/factored).  Needs sg.glsl, hemisphere.glsl, clamped_cosine.glsl, ssdf.glsl
  * and the `visibility_basis` sampler. */
 
 /* The pixel's (or vertex's) SSDF coefficient rows and the bake's local frame of its SSDF normal
