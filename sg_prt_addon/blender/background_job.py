@@ -3,9 +3,12 @@ with a progress bar and Esc, in the UI.
 
 BackgroundJob: the work, in a thread that never touches bpy; progress and cancellation
 are shared through a lock and an event.  ModalJobOperator: the operator side of the UI
-path (timer, progress bar, status text, Esc, clean-up on every exit).
+path (timer, progress bar, status text, Esc, clean-up on every exit); FileJobOperator: an operator on a
+file (the lobe fit, the BRDF factorization).
 """
 import threading
+
+import bpy
 
 
 class BackgroundJob:
@@ -124,3 +127,38 @@ class ModalJobOperator:
             job.cancel()
             job.join()
         self._cleanup(context)
+
+
+class FileJobOperator(ModalJobOperator):
+    """ModalJobOperator for a job on a file: `filepath` (the file browser opens without one), _prepare(context)
+    -> (target, job) or None after reporting why not; execute runs the job synchronously (blender -b,
+    scripts), invoke in a thread with progress and Esc."""
+
+    def execute(self, context):
+        if getattr(self, "_from_browser", False) and not bpy.app.background and context.window is not None:
+            # the file browser confirms through execute(); Blender keeps an operator whose execute
+            # returns RUNNING_MODAL (it frees it only on FINISHED / CANCELLED): go on as a modal job
+            self._from_browser = False
+            return self._start_modal(context)
+        prepared = self._prepare(context)
+        if prepared is None:
+            return {"CANCELLED"}
+        _, job = prepared
+        job.verbose = True          # "[sg-prt] fit 30% ..." lines
+        job.run()
+        return self._finish(context, job)
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        if not self.filepath:
+            self._from_browser = True
+            context.window_manager.fileselect_add(self)
+            return {"RUNNING_MODAL"}
+        return self._start_modal(context)
+
+    def _start_modal(self, context):
+        prepared = self._prepare(context)
+        if prepared is None:
+            return {"CANCELLED"}
+        return self.start_modal(context, prepared[1], interval=0.2)

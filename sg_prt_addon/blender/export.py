@@ -119,10 +119,11 @@ class MaterialParams:
     textures: dict = field(default_factory=dict)     # parameter name or "normal_map" -> image name
     technique: str = techniques.DEFAULT    # the registered technique that renders it (techniques/)
     fitted: object = None          # FittedLobes with the fitted-lobes technique and a VALID stored fit
+    factorization: object = None   # techniques.factored.FactoredTables of VALID stored factors (factored technique)
 
     def values_key(self):
         """Everything but textures, hashable: the material UBO is rebuilt when this changes."""
-        return tuple((k, v.signature if k == "fitted" and v is not None else v)
+        return tuple((k, v.signature if k in ("fitted", "factorization") and v is not None else v)
                      for k, v in self.__dict__.items() if k != "textures")
 
 
@@ -420,6 +421,12 @@ def _usable_technique(material, params):
              f"(registered: {', '.join(techniques.names())}): rendered with {techniques.DEFAULT}")
         return techniques.DEFAULT
     if name == factored.NAME:
+        from . import brdf_factorization
+
+        params.factorization = brdf_factorization.stored_tables(material)
+        state, message = brdf_factorization.factorization_status(material)
+        if state == "INVALID":
+            warn(f"material '{material.name}': stored BRDF factors unusable ({message}): its model is factorized")
         ignored = sorted(slot for slot in params.textures if slot not in factored.TEXTURE_SLOTS)
         if ignored:
             warn(f"material '{material.name}': {factored.TECHNIQUE.label} factorizes the model with uniform "

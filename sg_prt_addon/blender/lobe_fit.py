@@ -69,7 +69,7 @@ from .. import techniques
 from ..measured import merl as merl_format
 from ..measured import microfacet_fit, svbrdf_table
 from ..techniques import sg_fitted
-from .background_job import BackgroundJob, ModalJobOperator
+from .background_job import BackgroundJob, FileJobOperator
 from .panels import MaterialPanel
 
 FORMAT_VERSION = 1
@@ -255,7 +255,7 @@ class _Cancelled(Exception):
 
 # --------------------------------------------------------------------------- storage (main thread)
 
-def _new_image(name, array):
+def new_float_image(name, array):
     """A packed FLOAT RGBA Non-Color image of array (rows, columns, 4), Blender row order as given."""
     rows, columns = array.shape[:2]
     image = bpy.data.images.new(name, width=columns, height=rows, alpha=True, float_buffer=True, is_data=True)
@@ -267,7 +267,7 @@ def _new_image(name, array):
     return image
 
 
-def _image_array(image, rows, columns):
+def float_image_array(image, rows, columns):
     if tuple(image.size) != (columns, rows) or image.channels != 4:
         raise ValueError(f"image '{image.name}' is {tuple(image.size)} x {image.channels}, "
                          f"expected {(columns, rows)} x 4")
@@ -308,8 +308,8 @@ def store_lobe_fit(material, result, path, free_axes=None):
     made = []
     try:
         for role, array in result["layers"].items():
-            made.append((role, _new_image(image_name(material, role), array[::-1])))
-        made.append(("shadowing_table", _new_image(image_name(material, "shadowing_table"),
+            made.append((role, new_float_image(image_name(material, role), array[::-1])))
+        made.append(("shadowing_table", new_float_image(image_name(material, "shadowing_table"),
                                                    result["shadowing_table"])))
     except Exception:
         for _, image in made:
@@ -380,9 +380,9 @@ def lobe_fit_images(material):
     out = {}
     for item in settings.images:
         if item.role == "shadowing_table":
-            out[item.role] = _image_array(item.image, settings.shadowing_components + 2, settings.shadowing_samples)
+            out[item.role] = float_image_array(item.image, settings.shadowing_components + 2, settings.shadowing_samples)
         else:
-            out[item.role] = _image_array(item.image, settings.height, settings.width)[::-1]
+            out[item.role] = float_image_array(item.image, settings.height, settings.width)[::-1]
     return out
 
 
@@ -419,7 +419,7 @@ AXES = (("AUTO", "Auto", "Lobes around the normal for 1-2 lobes and isotropic da
         ("FREE", "Free", "Every lobe's axis fitted freely"))
 
 
-class SGPRT_OT_fit_lobes(ModalJobOperator, bpy.types.Operator):
+class SGPRT_OT_fit_lobes(FileJobOperator, bpy.types.Operator):
     """Fit SG lobes to a measured BRDF (MERL .binary) or an SVBRDF table (.npz) and store them in the active material"""
     bl_idname = "sgprt.fit_lobes"
     bl_label = "Fit Lobes"
@@ -484,35 +484,6 @@ class SGPRT_OT_fit_lobes(ModalJobOperator, bpy.types.Operator):
                     + (f"; {job.result['invalid_samples']} negative/NaN/Inf samples ignored"
                        if job.result["invalid_samples"] else ""))
         return {"FINISHED"}
-
-    def execute(self, context):
-        if getattr(self, "_from_browser", False) and not bpy.app.background and context.window is not None:
-            # the file browser confirms through execute(); Blender keeps an operator whose execute
-            # returns RUNNING_MODAL (it frees it only on FINISHED / CANCELLED): go on as a modal job
-            self._from_browser = False
-            return self._start_modal(context)
-        prepared = self._prepare(context)
-        if prepared is None:
-            return {"CANCELLED"}
-        _, job = prepared
-        job.verbose = True          # "[sg-prt] fit 30% ..." lines
-        job.run()
-        return self._finish(context, job)
-
-    def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
-        if not self.filepath:
-            self._from_browser = True
-            context.window_manager.fileselect_add(self)
-            return {"RUNNING_MODAL"}
-        return self._start_modal(context)
-
-    def _start_modal(self, context):
-        prepared = self._prepare(context)
-        if prepared is None:
-            return {"CANCELLED"}
-        return self.start_modal(context, prepared[1], interval=0.2)
 
 
 class SGPRT_OT_clear_lobe_fit(bpy.types.Operator):

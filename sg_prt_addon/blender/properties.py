@@ -84,6 +84,24 @@ class SGPRT_PG_lobe_fit(bpy.types.PropertyGroup):
     images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
 
 
+class SGPRT_PG_factorization(bpy.types.PropertyGroup):
+    """A measured BRDF factorized by sgprt.factor_brdf (layout: blender/brdf_factorization.py)."""
+    format_version: IntProperty(name="Format Version", default=0, description="0: no factors stored")
+    source_file: StringProperty(name="Source File", description="File name the factors were made from")
+    source_path: StringProperty(name="Source Path", description="Full path the factors were made from")
+    form: StringProperty(name="Form", description="measured.homomorphic.FORMS key")
+    resolution: IntProperty(name="Resolution", default=0, min=0)
+    alpha_scale: FloatVectorProperty(name="Scale", size=3, default=(1.0, 1.0, 1.0),
+                                     description="alpha A of the factored BRDF (RGB)")
+    lobe_sharpness: FloatProperty(name="Lobe Sharpness", default=1.0, description="Of the glossy environment lookup")
+    samples: IntProperty(name="Samples", default=0, min=0)
+    masked: IntProperty(name="Masked Samples", default=0, min=0, description="NaN, Inf and negative samples left out")
+    error: FloatProperty(name="Error", default=0.0, description="Relative RMS against the source, cosine weighted")
+    date: StringProperty(name="Date", description="When the factors were stored (ISO 8601 UTC)")
+    seconds: FloatProperty(name="Seconds", default=0.0)
+    images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
+
+
 class SGPRT_PG_material(bpy.types.PropertyGroup):
     # default 0: the number of techniques.DEFAULT; a file without the setting: techniques.of_settings
     technique: EnumProperty(update=_tag_material_changed, name="Technique", items=technique_items, default=0,
@@ -140,6 +158,8 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                                     description="Rotation of the tangent about the normal")
     show_textures: BoolProperty(update=_tag_material_changed, name="Show Textures", default=True,
                                 description="Show the texture slot next to each parameter")
+    factorization: PointerProperty(type=SGPRT_PG_factorization, name="BRDF Factors",
+                                   description="A measured BRDF factorized by sgprt.factor_brdf")
     lobe_fit: PointerProperty(type=SGPRT_PG_lobe_fit, name="Lobe Fit",
                               description="SG lobes fitted to a measured BRDF (sgprt.fit_lobes)")
 
@@ -153,7 +173,7 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
                                             "viewport draws one")
 
 
-classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_material, SGPRT_PG_scene)
+classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_factorization, SGPRT_PG_material, SGPRT_PG_scene)
 
 
 def register():

@@ -55,16 +55,17 @@ class FactoredKey:
         return ", ".join(parts)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FactoredTables:
     """The GPU tables of one factorization: log-factor maps (H, W, 4) float32 (p, q, r), the directional
     albedo map of the factored BRDF (R, R, 4) over views (parabolic), the RGB scale alpha A and the
-    sharpness of its glossy environment lookup."""
+    sharpness of its glossy environment lookup.  Compared by identity (the material's UBO signature)."""
     factorization: object
     maps: dict
     albedo: np.ndarray
     scale: np.ndarray
     lobe_sharpness: float
+    signature: tuple = ()           # hashable identity of stored factors (blender.brdf_factorization)
 
 
 def _rgba(values):
@@ -110,6 +111,13 @@ def tables_of(factorization, albedo_samples=1024):
 
 
 _cache = collections.OrderedDict()
+
+
+def tables_for(params):
+    """The FactoredTables a material renders with: its stored factors (a measured BRDF factorized by the
+    Factor BRDF operator: MaterialParams.factorization), else its model's."""
+    stored = getattr(params, "factorization", None)
+    return stored if stored is not None else model_tables(params)
 
 
 def model_tables(params):
@@ -194,8 +202,7 @@ class Factored(Technique):
                                             per_vertex, push_constants=(("VEC4", "factor_scale"),))
 
     def bind(self, shader, key, context):
-        params = context.params
-        tables = model_tables(params)
+        tables = tables_for(context.params)
         shader.uniform_block("scene", context.scene_buffer)
         shader.uniform_block("material", context.material_buffer)
         shader.uniform_float("factor_scale", list(tables.scale) + [tables.lobe_sharpness])

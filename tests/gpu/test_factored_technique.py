@@ -29,7 +29,7 @@ def _mirror_errors(result, shadowed=False):
         mask = covered & (np.abs(uv[..., 2] - material_id) < 0.25)
         view_origin = camera.position if camera.is_perspective else camera.forward
         diffuse, specular = factored_shading.shade_fragments(
-            params, {}, factored.model_tables(params), passes["gbuffer_position"][mask][:, :3],
+            params, {}, factored.tables_for(params), passes["gbuffer_position"][mask][:, :3],
             passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin,
             camera.is_perspective, state.light_data(), state.environment,
             visibility=fx.pixel_visibility(result, mask) if shadowed else None)
@@ -115,3 +115,28 @@ def test_technique_setting_survives_save_and_reopen(engine, tmp_path):
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.open_mainfile(filepath=str(path))
     assert bpy.data.materials["factored_saved"].sgprt.technique == "FACTORED"
+
+
+def test_stored_factors_of_a_measured_brdf_render(engine, tmp_path):
+    """A material with factors stored by the Factor BRDF operator (a generated MERL file) renders them, RGB,
+    on the GPU as in the mirror; its own model's factorization is not used."""
+    import bpy
+
+    from sg_prt_addon.techniques import factored
+    from validation import brdf_generators
+
+    path = str(tmp_path / "measured.binary")
+    brdf_generators.generate_merl(path)
+    scene = _scene("factored_stored", "colour")
+    material = bpy.data.materials["factored_stored_ggx"]
+    sphere = bpy.data.objects["factored_stored_a"]
+    with bpy.context.temp_override(scene=scene, object=sphere, material=material):
+        assert bpy.ops.sgprt.factor_brdf(filepath=path, resolution=16) == {"FINISHED"}
+    result = fx.render(scene, gbuffer=True)
+    assert "error" not in result, result.get("error")
+    params = result["state"].materials["factored_stored_ggx"]
+    assert params.factorization is not None and factored.tables_for(params) is params.factorization
+    assert params.factorization.maps["p"].shape == (16, 16, 4)
+    errors, _ = _mirror_errors(result)
+    print("max relative error", errors)
+    assert max(errors.values()) <= TOLERANCE

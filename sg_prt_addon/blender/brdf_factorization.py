@@ -1,0 +1,308 @@
+"""Factor BRDF operator: a measured BRDF (MERL .binary) factorized into p(o) q(h) p(i) r(o.h) maps
+(measured/homomorphic.py, mccool2001) and stored in the active material for the factored technique.
+
+Storage, per material (format 1): ``material.sgprt.factorization`` (properties.SGPRT_PG_factorization):
+``format_version``, ``source_file``, ``source_path``, ``form``, ``resolution``, ``alpha_scale`` (alpha A, RGB),
+``lobe_sharpness`` (the glossy environment lookup's), ``samples`` (valid BRDF samples fitted), ``masked`` (the
+NaN, Inf and negative channel samples left out), ``error`` (relative RMS against the source, cosine weighted),
+``date``, ``seconds``, and ``images``: (``role``, ``image``) for p, q, r (the log-factor maps, RGB) and
+albedo, packed FLOAT RGBA images whose pixels round-trip bit-exactly through save and reopen.
+A factorization sets the material's technique to FACTORED; clearing it sets the default back.
+Results are written only when the job finished: a failed or cancelled one leaves the previous factors.
+"""
+import datetime
+import os
+import time
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty, IntProperty, StringProperty
+
+from .. import techniques
+from ..measured import homomorphic, merl
+from ..techniques import factored
+from . import lobe_fit
+from .background_job import BackgroundJob, FileJobOperator
+from .panels import MaterialPanel
+
+FORMAT_VERSION = 1
+IMAGE_PREFIX = "SGPRT factors"
+ROLES = ("p", "q", "r", "albedo")
+FORMS = tuple((form, homomorphic.FORM_LABELS[form], f"mccool2001 factors {homomorphic.FORM_LABELS[form]}")
+              for form in ("pqpr", "pqp", "pq"))
+SAMPLES = 256          # views x lights of the fit
+
+# Tests (and scripts) may set this to a callable(fraction, message) -> bool: True cancels the job.
+progress_hook = None
+
+
+class FactorError(ValueError):
+    """Why a source cannot be factorized (the operator reports it; nothing is written)."""
+
+
+def merl_samples(source, count=SAMPLES):
+    """(wo, wi, values) of a MerlBrdf on count x count hemisphere pairs; invalid bins are NaN (masked and
+    counted by the factorization), not zero."""
+    def evaluate(wo, wi):
+        theta_h, theta_d, phi_d, _above = merl.bin_indices(wo, wi)
+        value = source.rho[theta_h, theta_d, phi_d]
+        return np.where((source.valid[theta_h, theta_d, phi_d])[..., None], value, np.nan)
+
+    return homomorphic.sample_brdf(evaluate, count, count)
+
+
+class FactorJob(BackgroundJob):
+    """Reads and factorizes one file; run() synchronously or start() a thread.  Never touches bpy."""
+
+    verb = "factorization"
+    thread_name = "sgprt-factor-brdf"
+
+    def __init__(self, path, form, resolution, verbose=False, hook=None):
+        super().__init__(verbose, hook)
+        self.path, self.form, self.resolution = path, form, int(resolution)
+        self.result = None
+
+    def run(self):
+        started = time.perf_counter()
+        name = os.path.basename(self.path)
+        try:
+            if self.record_progress(0.0, f"reading {name}"):
+                return self._cancelled()
+            kind, source = lobe_fit.read_source(self.path)
+            if kind != "MERL":
+                raise FactorError(f"{name}: an SVBRDF table; Factor BRDF reads MERL .binary files (a table's texels "
+                                  "vary: fit its lobes with Fit Lobes)")
+            lobe_fit.check_merl_samples(source, name)
+            wo, wi, values = merl_samples(source)
+            if self.record_progress(0.2, f"factorizing {name}"):
+                return self._cancelled()
+            factorization = homomorphic.factorize(wo, wi, values, form=self.form, resolution=self.resolution)
+            if self.record_progress(0.8, "tabulating the albedo"):
+                return self._cancelled()
+            tables = factored.tables_of(factorization)
+            ok = np.all(np.isfinite(values), axis=1)
+            approximation = factorization.evaluate(wo[ok], wi[ok])
+            weight = wi[ok, 2:3]
+            error = float(np.sqrt(np.sum(((approximation - values[ok]) * weight) ** 2)
+                                  / max(np.sum((values[ok] * weight) ** 2), 1e-300)))
+            arrays = dict(tables.maps, albedo=tables.albedo)
+            if not all(np.all(np.isfinite(array)) for array in arrays.values()):
+                raise FactorError(f"the factorization of {name} produced NaN or Inf values")
+            if self.record_progress(1.0, f"factorized {name}"):
+                return self._cancelled()
+        except (FactorError, lobe_fit.FitError) as error:
+            self.error = str(error)
+        except Exception as error:      # reported by the operator, nothing written
+            self.error = f"{type(error).__name__}: {error}"
+        else:
+            self.result = dict(tables=tables, arrays=arrays, error=error, masked=sum(factorization.counts.values()),
+                               samples=factorization.sample_count, seconds=time.perf_counter() - started)
+        if self.error and self.verbose:
+            print(f"[sg-prt] factorization failed: {self.error}", flush=True)
+
+    def _cancelled(self):
+        self.cancelled = True
+        if self.verbose:
+            print("[sg-prt] factorization cancelled: nothing written", flush=True)
+
+
+# --------------------------------------------------------------------------- storage (main thread)
+
+def image_name(material, role):
+    return f"{IMAGE_PREFIX} {material.name} {role}"
+
+
+def clear_factorization(material):
+    """Remove stored factors (metadata, references, and their images if nothing else uses them)."""
+    settings = material.sgprt.factorization
+    images = [item.image for item in settings.images if item.image is not None]
+    found = settings.format_version != 0 or bool(images)
+    settings.images.clear()
+    for name in ("format_version", "source_file", "source_path", "form", "resolution", "alpha_scale",
+                 "lobe_sharpness", "samples", "masked", "error", "date", "seconds"):
+        settings.property_unset(name)
+    if techniques.of_settings(material.sgprt) == factored.NAME:
+        material.sgprt.technique = techniques.DEFAULT
+    for image in images:
+        if image.users == 0:
+            bpy.data.images.remove(image)
+    return found
+
+
+def store_factorization(material, result, path, form):
+    """Write a finished job's factors to a material, replacing any previous ones."""
+    made = [(role, lobe_fit.new_float_image(image_name(material, role), result["arrays"][role]))
+            for role in ROLES if role in result["arrays"]]
+    clear_factorization(material)
+    settings = material.sgprt.factorization
+    for role, image in made:
+        image.name = image_name(material, role)
+        item = settings.images.add()
+        item.role, item.image = role, image
+    tables = result["tables"]
+    settings.source_file, settings.source_path = os.path.basename(path), os.path.abspath(path)
+    settings.form, settings.resolution = form, int(tables.factorization.resolution)
+    settings.alpha_scale = tuple(float(x) for x in tables.scale)
+    settings.lobe_sharpness = float(tables.lobe_sharpness)
+    settings.samples, settings.masked = int(result["samples"]), int(result["masked"])
+    settings.error, settings.seconds = float(result["error"]), float(result["seconds"])
+    settings.date = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    settings.format_version = FORMAT_VERSION
+    material.sgprt.technique = factored.NAME
+    material.update_tag()
+
+
+def factorization_status(material):
+    """('NONE' | 'VALID' | 'INVALID', message) of a material's stored factors."""
+    settings = material.sgprt.factorization
+    if settings.format_version == 0 and not len(settings.images):
+        return "NONE", ""
+    if settings.format_version != FORMAT_VERSION:
+        return "INVALID", f"factors format {settings.format_version}, this add-on reads {FORMAT_VERSION}: factor again"
+    roles = {item.role: item.image for item in settings.images}
+    wanted = [role for role in ROLES if role != "r" or "r" in homomorphic.FORMS.get(settings.form, ())]
+    missing = [role for role in wanted if roles.get(role) is None]
+    if missing or settings.form not in homomorphic.FORMS:
+        return "INVALID", f"stored factors damaged (missing {', '.join(missing) or 'form'}): factor again"
+    return "VALID", (f"{settings.source_file}: {homomorphic.FORM_LABELS[settings.form]}, {settings.resolution}^2, "
+                     f"error {settings.error:.3f}")
+
+
+def stored_tables(material):
+    """factored.FactoredTables of a material's VALID stored factors, else None (factorization_status says why)."""
+    if factorization_status(material)[0] != "VALID":
+        return None
+    settings = material.sgprt.factorization
+    roles = {item.role: item.image for item in settings.images}
+    size = int(settings.resolution)
+    shapes = {"p": (size, size), "q": (size, size), "r": (1, size), "albedo": (size, size)}
+    try:
+        arrays = {role: lobe_fit.float_image_array(roles[role], *shapes[role]) for role in roles if role in shapes}
+    except ValueError:
+        return None
+    channels = 3
+    log_factors = {role: arrays[role][..., :channels] for role in ("p", "q", "r") if role in arrays}
+    factorization = homomorphic.Factorization(settings.form, size, log_factors, np.ones(channels), np.ones(channels))
+    signature = (settings.date, settings.source_path, settings.seconds, settings.form, size,
+                 tuple(item.image.name for item in settings.images if item.image is not None))
+    return factored.FactoredTables(factorization, {role: arrays[role] for role in log_factors}, arrays["albedo"],
+                                   np.asarray(settings.alpha_scale, np.float32), float(settings.lobe_sharpness),
+                                   signature)
+
+
+# --------------------------------------------------------------------------- operators and panel
+
+def _material(context):
+    material = getattr(context, "material", None)
+    if material is None and context.object is not None:
+        material = context.object.active_material
+    return material
+
+
+class SGPRT_OT_factor_brdf(FileJobOperator, bpy.types.Operator):
+    """Factorize a measured BRDF (MERL .binary) into p(o) q(h) p(i) r(o.h) maps (McCool 2001) and store them in the active material"""
+    bl_idname = "sgprt.factor_brdf"
+    bl_label = "Factor BRDF"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: StringProperty(name="File", subtype="FILE_PATH", options={"SKIP_SAVE"}, description="MERL .binary")
+    filter_glob: StringProperty(default="*.binary", options={"HIDDEN"})
+    form: EnumProperty(name="Factors", items=FORMS, default="pqpr", description="The factored form")
+    resolution: IntProperty(name="Resolution", default=64, min=8, max=128, description="Texels a side of each map")
+
+    job_label = "SG-PRT factorization"
+    _running = False
+
+    @classmethod
+    def poll(cls, context):
+        return not SGPRT_OT_factor_brdf._running and _material(context) is not None
+
+    def _prepare(self, context):
+        material = _material(context)
+        if material is None:
+            self.report({"ERROR"}, "SG-PRT factorization: no active material")
+            return None
+        if material.library is not None:
+            self.report({"ERROR"}, f"SG-PRT factorization: material '{material.name}' is linked and cannot store factors")
+            return None
+        if not self.filepath:
+            self.report({"ERROR"}, "SG-PRT factorization: no file given")
+            return None
+        path = bpy.path.abspath(self.filepath)
+        if not os.path.isfile(path):
+            self.report({"ERROR"}, f"SG-PRT factorization: file not found: {path}")
+            return None
+        self._material_name = material.name
+        return material, FactorJob(path, self.form, self.resolution, hook=progress_hook)
+
+    def _finish(self, context, job):
+        if job.cancelled:
+            self.report({"WARNING"}, "SG-PRT factorization cancelled: nothing written, the previous factors are kept")
+            return {"CANCELLED"}
+        if job.error is not None:
+            self.report({"ERROR"}, f"SG-PRT factorization failed, nothing written: {job.error}")
+            return {"CANCELLED"}
+        material = bpy.data.materials.get(self._material_name)
+        if material is None:
+            self.report({"ERROR"}, f"SG-PRT factorization: material '{self._material_name}' was removed: nothing written")
+            return {"CANCELLED"}
+        try:
+            store_factorization(material, job.result, job.path, job.form)
+        except Exception as error:
+            self.report({"ERROR"}, f"SG-PRT factors could not be stored, previous factors kept: {error}")
+            return {"CANCELLED"}
+        settings = material.sgprt.factorization
+        self.report({"INFO"}, f"SG-PRT factorized {settings.source_file} on '{material.name}' "
+                              f"({homomorphic.FORM_LABELS[settings.form]}, {settings.resolution}^2, error "
+                              f"{settings.error:.3f}, {settings.seconds:.1f} s"
+                              + (f", {settings.masked} NaN/Inf/negative samples left out)" if settings.masked else ")"))
+        return {"FINISHED"}
+
+
+class SGPRT_OT_clear_factorization(bpy.types.Operator):
+    """Remove the stored BRDF factors of the active material (and their images)"""
+    bl_idname = "sgprt.clear_factorization"
+    bl_label = "Clear BRDF Factors"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return _material(context) is not None and not SGPRT_OT_factor_brdf._running
+
+    def execute(self, context):
+        if not clear_factorization(_material(context)):
+            self.report({"INFO"}, "SG-PRT: no stored factors")
+        return {"FINISHED"}
+
+
+class SGPRT_PT_material_factorization(MaterialPanel, bpy.types.Panel):
+    bl_label = "BRDF Factors"
+    bl_parent_id = "SGPRT_PT_material"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        material = context.material
+        row = layout.row(align=True)
+        row.operator(SGPRT_OT_factor_brdf.bl_idname, icon="FILE_FOLDER")
+        row.operator(SGPRT_OT_clear_factorization.bl_idname, text="", icon="X")
+        state, message = factorization_status(material)
+        column = layout.column(align=True)
+        if state == "NONE":
+            column.label(text="No stored factors: the factored technique factorizes the model", icon="INFO")
+            return
+        column.alert = state == "INVALID"
+        column.label(text=message, icon="ERROR" if state == "INVALID" else "CHECKMARK")
+
+
+classes = (SGPRT_OT_factor_brdf, SGPRT_OT_clear_factorization, SGPRT_PT_material_factorization)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
