@@ -19,7 +19,7 @@ import numpy as np
 from bpy.props import EnumProperty, IntProperty, StringProperty
 
 from .. import techniques
-from ..measured import homomorphic, merl
+from ..measured import homomorphic
 from ..techniques import factored
 from . import lobe_fit
 from .background_job import BackgroundJob, FileJobOperator
@@ -38,17 +38,6 @@ progress_hook = None
 
 class FactorError(ValueError):
     """Why a source cannot be factorized (the operator reports it; nothing is written)."""
-
-
-def merl_samples(source, count=SAMPLES):
-    """(wo, wi, values) of a MerlBrdf on count x count hemisphere pairs; invalid bins are NaN (masked and
-    counted by the factorization), not zero."""
-    def evaluate(wo, wi):
-        theta_h, theta_d, phi_d, _above = merl.bin_indices(wo, wi)
-        value = source.rho[theta_h, theta_d, phi_d]
-        return np.where((source.valid[theta_h, theta_d, phi_d])[..., None], value, np.nan)
-
-    return homomorphic.sample_brdf(evaluate, count, count)
 
 
 class FactorJob(BackgroundJob):
@@ -73,7 +62,7 @@ class FactorJob(BackgroundJob):
                 raise FactorError(f"{name}: an SVBRDF table; Factor BRDF reads MERL .binary files (a table's texels "
                                   "vary: fit its lobes with Fit Lobes)")
             lobe_fit.check_merl_samples(source, name)
-            wo, wi, values = merl_samples(source)
+            wo, wi, values = homomorphic.sample_merl(source, SAMPLES)
             if self.record_progress(0.2, f"factorizing {name}"):
                 return self._cancelled()
             factorization = homomorphic.factorize(wo, wi, values, form=self.form, resolution=self.resolution)

@@ -29,6 +29,8 @@ import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
+from . import merl
+
 EPSILON = 1e-5                  # eq. 6's bias, as the paper fixes it
 FORMS = {
     # factor texture of each projection, in order: view o, half vector h, light i, o.h (= i.h)
@@ -156,6 +158,16 @@ def sample_brdf(brdf, view_count=256, light_count=256):
 def map_shape(name, resolution):
     """(height, width) of a factor's map."""
     return (1, resolution) if name in ONE_DIMENSIONAL else (resolution, resolution)
+
+
+def sample_merl(source, count=256):
+    """(wo, wi, values (K, 3)) of a merl.MerlBrdf on count x count hemisphere pairs, by its nearest bin; the
+    file's invalid bins are NaN (masked and counted by factorize), not zero."""
+    def evaluate(wo, wi):
+        theta_h, theta_d, phi_d, _above = merl.bin_indices(wo, wi)
+        return np.where(source.valid[theta_h, theta_d, phi_d][..., None], source.rho[theta_h, theta_d, phi_d], np.nan)
+
+    return sample_brdf(evaluate, count, count)
 
 
 def _system(form, wo, wi, resolution):
