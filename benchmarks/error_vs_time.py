@@ -17,8 +17,8 @@ on one machine:
    target for the PCA terms); fixed PCA terms 4 / 8 / 16 / all 47 at resolution 32; prefilter
    layer size 64 / 256 (128 is the default); NDF lobe count 2 / 4 / 8 of the anisotropic
    material (6 is the scene's); every material's view warp with one or two lobes per NDF lobe
-   (material.sgprt.view_warp PAPER and SPLIT2; SPLIT3, three, is the default).  Bake time is
-   reported apart (a precomputation);
+   (material.sgprt.view_warp PAPER and SPLIT2; SPLIT3, three, is the default); every material with the
+   factored-BRDF technique (mccool2001), unshadowed and baked.  Bake time is reported apart (a precomputation);
 3. baselines: the reference renderer at 1 / 4 / 16 samples per pixel (independent seeds), EEVEE
    at 1 / 16 / 64 samples and Cycles (CPU, direct light only) at 1 / 4 / 16 / 64 samples, both
    with node materials matched to ``material.sgprt`` (benchmarks/matched_materials.py says how
@@ -538,9 +538,27 @@ class SceneRun:
             finally:
                 for material in materials:
                     material.sgprt.view_warp = defaults[material.name]
+            self.factored_stage(materials, default_bakes, resolution)
         finally:
             scene_state.visibility_provider = None
             render_engine.debug["timed_redraws"] = 0
+
+    def factored_stage(self, materials, bakes, resolution):
+        """Every material with the factored-BRDF technique (mccool2001): unshadowed and with the bakes (the
+        warm-up render factorizes each model; the timed one reuses the factors)."""
+        defaults = {material.name: material.sgprt.technique for material in materials}
+        try:
+            for material in materials:
+                material.sgprt.technique = "FACTORED"
+            self.use_bakes(None)
+            self.engine_render("factored BRDF (mccool2001), unshadowed", "Factored BRDF",
+                               {"technique": "FACTORED", "bake": None})
+            self.use_bakes(bakes)
+            self.engine_render(f"factored BRDF, bake R={resolution}", "Factored BRDF",
+                               {"technique": "FACTORED", "bake_resolution": resolution})
+        finally:
+            for material in materials:
+                material.sgprt.technique = defaults[material.name]
 
     def _materials(self):
         found = {}
@@ -588,7 +606,7 @@ def plot(data, path):
 
     styles = {"SG-PRT unshadowed": ("#9467bd", "v"), "SG-PRT bake R": ("#d62728", "o"),
               "SG-PRT terms": ("#ff7f0e", "s"), "SG-PRT layers": ("#e377c2", "D"), "SG-PRT lobes": ("#8c564b", "^"),
-              "SG-PRT warp": ("#7f7f7f", "<"),
+              "SG-PRT warp": ("#7f7f7f", "<"), "Factored BRDF": ("#bcbd22", ">"),
               "reference": ("#2ca02c", "P"), "EEVEE": ("#1f77b4", "X"), "Cycles": ("#17becf", "h")}
     scenes = list(data["scenes"])
     figure, axes = plt.subplots(1, len(scenes), figsize=(6.0 * len(scenes), 4.6), squeeze=False)

@@ -59,7 +59,8 @@ class FactoredKey:
 class FactoredTables:
     """The GPU tables of one factorization: log-factor maps (H, W, 4) float32 (p, q, r), the directional
     albedo map of the factored BRDF (R, R, 4) over views (parabolic), the RGB scale alpha A and the
-    sharpness of its glossy environment lookup.  Compared by identity (the material's UBO signature)."""
+    sharpness of its glossy environment lookup.  Compared by identity; stored factors carry a signature
+    (export.MaterialParams.values_key reads it)."""
     factorization: object
     maps: dict
     albedo: np.ndarray
@@ -98,6 +99,7 @@ def tables_of(factorization, albedo_samples=1024):
     maps = {name: _rgba(log_map) for name, log_map in factorization.log_factors.items()}
     lights = homomorphic.hemisphere_points(albedo_samples)
     views = _parabolic_directions(factorization.resolution).reshape(-1, 3)
+
     def unscaled(wo, wi):
         return factored_shading.factored_brdf(factorization.log_factors, factorization.form, wo, wi)
 
