@@ -6,6 +6,7 @@ are shared through a lock and an event.  ModalJobOperator: the operator side of 
 path (timer, progress bar, status text, Esc, clean-up on every exit); FileJobOperator: an operator on a
 file (the lobe fit, the BRDF factorization).
 """
+import os
 import threading
 
 import bpy
@@ -162,3 +163,64 @@ class FileJobOperator(ModalJobOperator):
         if prepared is None:
             return {"CANCELLED"}
         return self.start_modal(context, prepared[1], interval=0.2)
+
+
+def active_material(context):
+    """The material an operator on 'the active material' acts on: the context's, else the active object's."""
+    material = getattr(context, "material", None)
+    if material is None and context.active_object is not None:
+        material = context.active_object.active_material
+    return material
+
+
+class MaterialFileJobOperator(FileJobOperator):
+    """A FileJobOperator that stores what its job makes from a file in the active material (Fit Lobes, Factor
+    BRDF): the checks before the job and the outcomes after it, worded from `job_label` ("SG-PRT fit"),
+    `stored_as` ("a fit": what a linked material cannot store), `result_label` ("SG-PRT fit": what could
+    not be stored) and `previous` ("fit": what is kept).  Subclasses give _make_job(path) and, on success,
+    _store(material, job) and _done_message(material, job)."""
+
+    stored_as = "a result"
+    result_label = "SG-PRT result"
+    previous = "result"
+    previous_verb = "is"
+
+    def _prepare(self, context):
+        """(material, job) or None after reporting why not."""
+        material = active_material(context)
+        if material is None:
+            self.report({"ERROR"}, f"{self.job_label}: no active material")
+            return None
+        if material.library is not None:
+            self.report({"ERROR"}, f"{self.job_label}: material '{material.name}' is linked and cannot store "
+                                   f"{self.stored_as}")
+            return None
+        if not self.filepath:
+            self.report({"ERROR"}, f"{self.job_label}: no file given")
+            return None
+        path = bpy.path.abspath(self.filepath)
+        if not os.path.isfile(path):
+            self.report({"ERROR"}, f"{self.job_label}: file not found: {path}")
+            return None
+        self._material_name = material.name
+        return material, self._make_job(path)
+
+    def _finish(self, context, job):
+        if job.cancelled:
+            self.report({"WARNING"}, f"{self.job_label} cancelled: nothing written, the previous {self.previous} "
+                                     f"{self.previous_verb} kept")
+            return {"CANCELLED"}
+        if job.error is not None:
+            self.report({"ERROR"}, f"{self.job_label} failed, nothing written: {job.error}")
+            return {"CANCELLED"}
+        material = bpy.data.materials.get(self._material_name)
+        if material is None:
+            self.report({"ERROR"}, f"{self.job_label}: material '{self._material_name}' was removed: nothing written")
+            return {"CANCELLED"}
+        try:
+            self._store(material, job)
+        except Exception as error:
+            self.report({"ERROR"}, f"{self.result_label} could not be stored, previous {self.previous} kept: {error}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, self._done_message(material, job))
+        return {"FINISHED"}

@@ -22,7 +22,7 @@ from .. import techniques
 from ..measured import homomorphic
 from ..techniques import factored
 from . import lobe_fit
-from .background_job import BackgroundJob, FileJobOperator
+from .background_job import BackgroundJob, MaterialFileJobOperator, active_material
 from .panels import MaterialPanel
 
 FORMAT_VERSION = 1
@@ -181,14 +181,7 @@ def stored_tables(material):
 
 # --------------------------------------------------------------------------- operators and panel
 
-def _material(context):
-    material = getattr(context, "material", None)
-    if material is None and context.object is not None:
-        material = context.object.active_material
-    return material
-
-
-class SGPRT_OT_factor_brdf(FileJobOperator, bpy.types.Operator):
+class SGPRT_OT_factor_brdf(MaterialFileJobOperator, bpy.types.Operator):
     """Factorize a measured BRDF (MERL .binary) into p(o) q(h) p(i) r(o.h) maps (McCool 2001) and store them in the active material"""
     bl_idname = "sgprt.factor_brdf"
     bl_label = "Factor BRDF"
@@ -200,52 +193,25 @@ class SGPRT_OT_factor_brdf(FileJobOperator, bpy.types.Operator):
     resolution: IntProperty(name="Resolution", default=64, min=8, max=128, description="Texels a side of each map")
 
     job_label = "SG-PRT factorization"
+    stored_as, result_label, previous, previous_verb = "factors", "SG-PRT factors", "factors", "are"
     _running = False
 
     @classmethod
     def poll(cls, context):
-        return not SGPRT_OT_factor_brdf._running and _material(context) is not None
+        return not SGPRT_OT_factor_brdf._running and active_material(context) is not None
 
-    def _prepare(self, context):
-        material = _material(context)
-        if material is None:
-            self.report({"ERROR"}, "SG-PRT factorization: no active material")
-            return None
-        if material.library is not None:
-            self.report({"ERROR"}, f"SG-PRT factorization: material '{material.name}' is linked and cannot store factors")
-            return None
-        if not self.filepath:
-            self.report({"ERROR"}, "SG-PRT factorization: no file given")
-            return None
-        path = bpy.path.abspath(self.filepath)
-        if not os.path.isfile(path):
-            self.report({"ERROR"}, f"SG-PRT factorization: file not found: {path}")
-            return None
-        self._material_name = material.name
-        return material, FactorJob(path, self.form, self.resolution, hook=progress_hook)
+    def _make_job(self, path):
+        return FactorJob(path, self.form, self.resolution, hook=progress_hook)
 
-    def _finish(self, context, job):
-        if job.cancelled:
-            self.report({"WARNING"}, "SG-PRT factorization cancelled: nothing written, the previous factors are kept")
-            return {"CANCELLED"}
-        if job.error is not None:
-            self.report({"ERROR"}, f"SG-PRT factorization failed, nothing written: {job.error}")
-            return {"CANCELLED"}
-        material = bpy.data.materials.get(self._material_name)
-        if material is None:
-            self.report({"ERROR"}, f"SG-PRT factorization: material '{self._material_name}' was removed: nothing written")
-            return {"CANCELLED"}
-        try:
-            store_factorization(material, job.result, job.path, job.form)
-        except Exception as error:
-            self.report({"ERROR"}, f"SG-PRT factors could not be stored, previous factors kept: {error}")
-            return {"CANCELLED"}
+    def _store(self, material, job):
+        store_factorization(material, job.result, job.path, job.form)
+
+    def _done_message(self, material, job):
         settings = material.sgprt.factorization
-        self.report({"INFO"}, f"SG-PRT factorized {settings.source_file} on '{material.name}' "
-                              f"({homomorphic.FORM_LABELS[settings.form]}, {settings.resolution}^2, error "
-                              f"{settings.error:.3f}, {settings.seconds:.1f} s"
-                              + (f", {settings.masked} NaN/Inf/negative samples left out)" if settings.masked else ")"))
-        return {"FINISHED"}
+        return (f"SG-PRT factorized {settings.source_file} on '{material.name}' "
+                f"({homomorphic.FORM_LABELS[settings.form]}, {settings.resolution}^2, error {settings.error:.3f}, "
+                f"{settings.seconds:.1f} s"
+                + (f", {settings.masked} NaN/Inf/negative samples left out)" if settings.masked else ")"))
 
 
 class SGPRT_OT_clear_factorization(bpy.types.Operator):
@@ -256,10 +222,10 @@ class SGPRT_OT_clear_factorization(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _material(context) is not None and not SGPRT_OT_factor_brdf._running
+        return active_material(context) is not None and not SGPRT_OT_factor_brdf._running
 
     def execute(self, context):
-        if not clear_factorization(_material(context)):
+        if not clear_factorization(active_material(context)):
             self.report({"INFO"}, "SG-PRT: no stored factors")
         return {"FINISHED"}
 

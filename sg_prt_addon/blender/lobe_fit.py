@@ -69,7 +69,7 @@ from .. import techniques
 from ..measured import merl as merl_format
 from ..measured import microfacet_fit, svbrdf_table
 from ..techniques import sg_fitted
-from .background_job import BackgroundJob, FileJobOperator
+from .background_job import BackgroundJob, MaterialFileJobOperator, active_material
 from .panels import MaterialPanel
 
 FORMAT_VERSION = 1
@@ -408,18 +408,11 @@ def stored_lobe_fit(material):
 
 # --------------------------------------------------------------------------- operators and panel
 
-def _material(context):
-    material = getattr(context, "material", None)
-    if material is None and context.active_object is not None:
-        material = context.active_object.active_material
-    return material
-
-
 AXES = (("AUTO", "Auto", "Lobes around the normal for 1-2 lobes and isotropic data, else free axes"),
         ("FREE", "Free", "Every lobe's axis fitted freely"))
 
 
-class SGPRT_OT_fit_lobes(FileJobOperator, bpy.types.Operator):
+class SGPRT_OT_fit_lobes(MaterialFileJobOperator, bpy.types.Operator):
     """Fit SG lobes to a measured BRDF (MERL .binary) or an SVBRDF table (.npz) and store them in the active material"""
     bl_idname = "sgprt.fit_lobes"
     bl_label = "Fit Lobes"
@@ -435,55 +428,27 @@ class SGPRT_OT_fit_lobes(FileJobOperator, bpy.types.Operator):
                                       description="PCA components of the shadowing S(theta) (tables)")
 
     job_label = "SG-PRT fit"
+    stored_as, result_label, previous = "a fit", "SG-PRT fit", "fit"
     _running = False        # one fit at a time
 
     @classmethod
     def poll(cls, context):
-        return not SGPRT_OT_fit_lobes._running and _material(context) is not None
+        return not SGPRT_OT_fit_lobes._running and active_material(context) is not None
 
-    def _prepare(self, context):
-        """(material, FitJob) or None after reporting why not."""
-        material = _material(context)
-        if material is None:
-            self.report({"ERROR"}, "SG-PRT fit: no active material")
-            return None
-        if material.library is not None:
-            self.report({"ERROR"}, f"SG-PRT fit: material '{material.name}' is linked and cannot store a fit")
-            return None
-        if not self.filepath:
-            self.report({"ERROR"}, "SG-PRT fit: no file given")
-            return None
-        path = bpy.path.abspath(self.filepath)
-        if not os.path.isfile(path):
-            self.report({"ERROR"}, f"SG-PRT fit: file not found: {path}")
-            return None
-        self._material_name = material.name
+    def _make_job(self, path):
         free_axes = True if self.axes == "FREE" else None
-        return material, FitJob(path, self.lobe_count, free_axes, self.shadowing_components, hook=progress_hook)
+        return FitJob(path, self.lobe_count, free_axes, self.shadowing_components, hook=progress_hook)
 
-    def _finish(self, context, job):
-        if job.cancelled:
-            self.report({"WARNING"}, "SG-PRT fit cancelled: nothing written, the previous fit is kept")
-            return {"CANCELLED"}
-        if job.error is not None:
-            self.report({"ERROR"}, f"SG-PRT fit failed, nothing written: {job.error}")
-            return {"CANCELLED"}
-        material = bpy.data.materials.get(self._material_name)
-        if material is None:
-            self.report({"ERROR"}, f"SG-PRT fit: material '{self._material_name}' was removed: nothing written")
-            return {"CANCELLED"}
-        try:
-            store_lobe_fit(material, job.result, job.path, job.free_axes)
-        except Exception as error:
-            self.report({"ERROR"}, f"SG-PRT fit could not be stored, previous fit kept: {error}")
-            return {"CANCELLED"}
+    def _store(self, material, job):
+        store_lobe_fit(material, job.result, job.path, job.free_axes)
+
+    def _done_message(self, material, job):
         settings = material.sgprt.lobe_fit
-        self.report({"INFO"}, f"SG-PRT fitted {settings.lobe_count} lobe(s) to {settings.source_file} on "
-                              f"'{material.name}' ({settings.width}x{settings.height}, error "
-                              f"{settings.fit_error:.3f}, {settings.seconds:.1f} s)"
-                    + (f"; {job.result['invalid_samples']} negative/NaN/Inf samples ignored"
-                       if job.result["invalid_samples"] else ""))
-        return {"FINISHED"}
+        return (f"SG-PRT fitted {settings.lobe_count} lobe(s) to {settings.source_file} on "
+                f"'{material.name}' ({settings.width}x{settings.height}, error "
+                f"{settings.fit_error:.3f}, {settings.seconds:.1f} s)"
+                + (f"; {job.result['invalid_samples']} negative/NaN/Inf samples ignored"
+                   if job.result["invalid_samples"] else ""))
 
 
 class SGPRT_OT_clear_lobe_fit(bpy.types.Operator):
@@ -494,10 +459,10 @@ class SGPRT_OT_clear_lobe_fit(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _material(context) is not None and not SGPRT_OT_fit_lobes._running
+        return active_material(context) is not None and not SGPRT_OT_fit_lobes._running
 
     def execute(self, context):
-        material = _material(context)
+        material = active_material(context)
         if not clear_lobe_fit(material):
             self.report({"INFO"}, f"SG-PRT: '{material.name}' has no lobe fit")
             return {"CANCELLED"}
