@@ -1,6 +1,7 @@
 """Accuracy of the homomorphic factorization (measured/homomorphic.py, mccool2001): the factored BRDF
 against its source at every pair of a 128 x 128 hemisphere lattice (not the fit's 256 x 256), cosine
-weighted, per model, form and resolution; and, on one measured BRDF (a MERL file of the generated
+weighted, per model, form, resolution and map (parabolic, the paper's and the technique's, and
+hemi-octahedral for the three-factor form with r); and, on one measured BRDF (a MERL file of the generated
 material), the Fit Lobes operator's SG lobe fit (wang2009) beside the Factor BRDF operator's factors, both
 scored against the analytic material the file was made from."""
 import os
@@ -13,6 +14,7 @@ from sg_prt_addon.reflectance import brdf
 from validation import brdf_generators
 from validation.brdf_generators import AnalyticMaterial
 
+RESOLUTIONS = (16, 32, 64, 128)
 SOURCES = {
     "GGX r=0.3": lambda wo, wi: brdf.GGX(roughness=0.3).specular(wo, wi),
     "GGX r=0.6": lambda wo, wi: brdf.GGX(roughness=0.6).specular(wo, wi),
@@ -28,18 +30,20 @@ def measure():
     rows = []
     for name, source in SOURCES.items():
         wo, wi, values = homomorphic.sample_brdf(source, 256, 256)
-        for form in ("pq", "pqp", "pqpr"):
+        cases = [(form, "parabolic") for form in ("pq", "pqp", "pqpr")] + [("pqpr", "octahedral")]
+        for form, mapping in cases:
             errors = {}
-            for resolution in (16, 32, 64):
-                factorization = homomorphic.factorize(wo, wi, values, form=form, resolution=resolution)
+            for resolution in RESOLUTIONS:
+                factorization = homomorphic.factorize(wo, wi, values, form=form, resolution=resolution,
+                                                      mapping=mapping)
                 errors[resolution] = (homomorphic.relative_rms(factorization, source), factorization.seconds)
             best = min(errors, key=lambda r: errors[r][0])
             rows.append(dict(
-                name=f"{name}: {homomorphic.FORM_LABELS[form]}",
+                name=f"{name}: {homomorphic.FORM_LABELS[form]}" + (", octahedral maps" if mapping != "parabolic" else ""),
                 reference="the source BRDF, 128 x 128 hemisphere pairs",
-                metric="relative RMS of f (n.i), resolution 32 (max: the worst of 16 / 32 / 64)",
-                max_error=max(error for error, _ in errors.values()), mean_error=errors[32][0],
-                paper="pqp" if form == "pqp" else None,
+                metric="relative RMS of f (n.i), resolution 64 (max: the worst of 16 / 32 / 64 / 128)",
+                max_error=max(error for error, _ in errors.values()), mean_error=errors[64][0],
+                paper="pqp" if (form, mapping) == ("pqp", "parabolic") else None,
                 note=", ".join(f"{r}: {e:.3f} ({s:.1f} s)" for r, (e, s) in errors.items()) + f"; best {best}"))
     return rows + _measured_rows()
 

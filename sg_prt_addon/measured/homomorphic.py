@@ -5,8 +5,8 @@ f ~ p(o) q(h).  In log space (eq. 5, 10) each BRDF sample gives one linear equat
 log-factors: the bilinear weights of its projections (eq. 11-14; two projections landing on one texel
 add).  The Laplacian of every factor texture, weighted by `smoothness` (eq. 17, the masks of Fig. 3: the
 grid graph's Laplacian), constrains texels no sample reaches and fills gaps.  The sparse system is solved
-in the least-squares sense (scipy's LSMR; the paper used QMR) coarse to fine: each level's solution,
-upsampled, starts the next (the paper's multiresolution start).  Minimising the log residual minimises
+in the least-squares sense (scipy's LSMR with Jacobi column scaling; the paper used QMR) coarse to fine:
+each level's solution, upsampled, starts the next (the paper's multiresolution start).  Minimising the log residual minimises
 relative error (3.1.2).
 
 Maps: parabolic (the paper's, 4.1): a local direction d with d_z >= 0 at
@@ -14,9 +14,11 @@ u = (d_x / (1 + d_z) + 1) / 2, v likewise, the hemisphere filling the disk inscr
 Texel k of a side of R texels has its centre at (k + 1/2) / R, as the GPU samples it, so bilinear
 interpolation of the stored log-texels at (u, v), then exp, is exactly what was fitted: the engine stores
 the log-factors in float textures and exponentiates after the fetch (the paper interpolated the factors
-themselves, which did not match its fit).
+themselves, which did not match its fit).  The hemi-octahedral map (MAPPINGS) fills the whole square and
+wins on coarse maps (16^2), but its creases, the square's diagonals, meet at the pole where q's peak lies:
+at the technique's 64^2 the parabolic map is as good or better for every model measured (docs/ACCURACY.md).
 
-Samples: f is sampled on a Fibonacci lattice of each hemisphere (uniform in solid angle, the paper's even
+Samples: f (an analytic model, a MERL file, or one texel of an SVBRDF table) is sampled on a Fibonacci lattice of each hemisphere (uniform in solid angle, the paper's even
 distribution, 4.3), every view with every light; NaN, Inf and negative values are masked and counted
 (measured data has them).  Zero is fine: the log takes f + eps A (eq. 6, eps = 1e-5, A the mean sample).
 alpha (eq. 20's correction) scales the product so the energy it reflects over the samples, sum f (n.i),
@@ -42,6 +44,7 @@ FORMS = {
 FORM_LABELS = {"pqp": "p(o) q(h) p(i)", "pq": "p(o) q(h)", "pqpr": "p(o) q(h) p(i) r(o.h)"}
 ONE_DIMENSIONAL = {"r"}         # factors of o.h: a (1, R) map over u = o.h
 DEFAULT_FORM = "pqp"
+DEFAULT_MAPPING = "parabolic"
 
 
 @dataclass
@@ -57,12 +60,13 @@ class Factorization:
     counts: dict = field(default_factory=dict)
     sample_count: int = 0
     seconds: float = 0.0
+    mapping: str = DEFAULT_MAPPING      # a key of MAPPINGS: the 2D maps' parameterization
 
     def evaluate(self, wo, wi):
         """The factored BRDF (..., C) at local directions (..., 3); zero where either is below the horizon."""
         wo, wi = np.asarray(wo, np.float64), np.asarray(wi, np.float64)
         log_value = np.zeros(np.broadcast_shapes(wo.shape, wi.shape)[:-1] + (len(self.alpha),))
-        for name, uv in zip(FORMS[self.form], map_coordinates(wo, wi)):
+        for name, uv in zip(FORMS[self.form], map_coordinates(wo, wi, self.mapping)):
             if name is not None:
                 log_value = log_value + sample_map(self.log_factors[name], uv)
         value = self.alpha * self.scale * np.exp(log_value)
@@ -77,12 +81,13 @@ def projections(wo, wi):
     return wo, h, wi
 
 
-def map_coordinates(wo, wi):
-    """(u, v) (..., 2) of each projection of FORMS' order: parabolic o, h, i, and (o.h, 1/2) of the 1D map."""
+def map_coordinates(wo, wi, mapping=DEFAULT_MAPPING):
+    """(u, v) (..., 2) of each projection of FORMS' order: o, h, i on the 2D map of MAPPINGS[mapping], and
+    (o.h, 1/2) of the 1D map."""
     o, h, i = projections(wo, wi)
+    coordinates = MAPPINGS[mapping]
     cosine = np.clip(np.sum(o * h, axis=-1), 0.0, 1.0)
-    return (parabolic_coordinates(o), parabolic_coordinates(h), parabolic_coordinates(i),
-            np.stack([cosine, np.full_like(cosine, 0.5)], axis=-1))
+    return (coordinates(o), coordinates(h), coordinates(i), np.stack([cosine, np.full_like(cosine, 0.5)], axis=-1))
 
 
 def parabolic_coordinates(direction):
@@ -94,6 +99,19 @@ def parabolic_coordinates(direction):
     # below the horizon: the horizon point of the same azimuth (the disk's rim)
     xy = np.where(d[..., 2:3] >= 0, d[..., :2], d[..., :2] / np.maximum(tangential, 1e-30))
     return 0.5 * (xy / (1.0 + z)[..., None] + 1.0)
+
+
+def octahedral_coordinates(direction):
+    """(u, v) (..., 2) in [0, 1]^2 of local directions (..., 3) on the hemi-octahedral map: d / |d|_1 projected
+    onto the plane and turned 45 degrees, so the upper hemisphere fills the whole square (the parabolic disk
+    leaves 1 - pi/4 of it unused) and the square's border is the horizon.  Below the horizon: z = 0."""
+    d = np.asarray(direction, np.float64)
+    d = np.concatenate([d[..., :2], np.maximum(d[..., 2:3], 0.0)], axis=-1)
+    p = d[..., :2] / np.maximum(np.sum(np.abs(d), axis=-1, keepdims=True), 1e-30)
+    return 0.5 * (np.stack([p[..., 0] + p[..., 1], p[..., 0] - p[..., 1]], axis=-1) + 1.0)
+
+
+MAPPINGS = {"parabolic": parabolic_coordinates, "octahedral": octahedral_coordinates}
 
 
 def hemisphere_points(count):
@@ -169,13 +187,22 @@ def sample_merl(source, count=256):
     return sample_brdf(evaluate, count, count)
 
 
-def _system(form, wo, wi, resolution):
+def sample_table_texel(table, texel, count=256):
+    """(wo, wi, values (K, 3)) of one texel (row-major index) of a svbrdf_table.SvbrdfTable on count x count
+    hemisphere pairs: a spatially varying table's BRDF at one point, factorized as one BRDF."""
+    def evaluate(wo, wi):
+        return table.evaluate(wo, wi, texels=[int(texel)])[0]
+
+    return sample_brdf(evaluate, count, count)
+
+
+def _system(form, wo, wi, resolution, mapping):
     """The data rows (K, texels of every factor), the factor names in column order and their offsets."""
     names = sorted({name for name in FORMS[form] if name is not None})
     offsets = np.cumsum([0] + [int(np.prod(map_shape(name, resolution))) for name in names])
     rows, cols, vals = [], [], []
     sample = np.arange(len(wo))
-    for name, uv in zip(FORMS[form], map_coordinates(wo, wi)):
+    for name, uv in zip(FORMS[form], map_coordinates(wo, wi, mapping)):
         if name is None:
             continue
         height, width = map_shape(name, resolution)
@@ -195,12 +222,12 @@ def _upsample(log_map, shape):
 
 
 def factorize(wo, wi, values, form=DEFAULT_FORM, resolution=32, smoothness=0.02, levels=3, iterations=400,
-              epsilon=EPSILON):
+              epsilon=EPSILON, mapping=DEFAULT_MAPPING):
     """Factorization of samples values (K, C) at local directions wo, wi (K, 3) (see the module docstring).
 
     smoothness: lambda of eq. 17, relative to the data rows' scale (it multiplies sqrt(K / texels), so the
     same value smooths alike at any sample count); levels: resolutions resolution / 2^k solved first;
-    epsilon: eq. 6's bias (0 only for data without zeros)."""
+    epsilon: eq. 6's bias (0 only for data without zeros); mapping: the 2D maps' parameterization (MAPPINGS)."""
     start = time.perf_counter()
     values = np.asarray(values, np.float64).reshape(len(wo), -1)
     finite = np.isfinite(values)
@@ -217,7 +244,7 @@ def factorize(wo, wi, values, form=DEFAULT_FORM, resolution=32, smoothness=0.02,
     log_maps = None
     for level in reversed(range(max(int(levels), 1))):
         size = max(resolution >> level, 2)
-        matrix, names, offsets = _system(form, wo, wi, size)
+        matrix, names, offsets = _system(form, wo, wi, size, mapping)
         shapes = [map_shape(name, size) for name in names]
         weight = smoothness * np.sqrt(len(wo) / (size * size))
         laplacians = [grid_laplacian(shape[1], shape[0]) * weight for shape in shapes]
@@ -228,11 +255,16 @@ def factorize(wo, wi, values, form=DEFAULT_FORM, resolution=32, smoothness=0.02,
             guess = np.concatenate([_upsample(log_maps[name], shape).reshape(-1, channels)
                                     for name, shape in zip(names, shapes)])
         right = np.concatenate([target, np.zeros((system.shape[0] - len(target), channels))])
+        # Jacobi column scaling: a texel's column norm grows with the samples landing on it (many on q's
+        # centre, few on p's rim); equalised, LSMR converges in far fewer iterations
+        column_norm = np.sqrt(np.asarray(system.multiply(system).sum(axis=0)).ravel())
+        column_scale = 1.0 / np.maximum(column_norm, 1e-12)
+        scaled = system @ scipy.sparse.diags(column_scale)
         solution = np.empty_like(guess)
         for c in range(channels):
             residual = right[:, c] - system @ guess[:, c]
-            step = scipy.sparse.linalg.lsmr(system, residual, atol=1e-10, btol=1e-10, maxiter=iterations)[0]
-            solution[:, c] = guess[:, c] + step
+            step = scipy.sparse.linalg.lsmr(scaled, residual, atol=1e-10, btol=1e-10, maxiter=iterations)[0]
+            solution[:, c] = guess[:, c] + column_scale * step
         log_maps = {name: solution[offsets[k]:offsets[k + 1]].reshape(shapes[k] + (channels,))
                     for k, name in enumerate(names)}
     # the gauge: p + c, q - (uses of p) c gives the same product; centre log p on the samples' mean
@@ -243,7 +275,7 @@ def factorize(wo, wi, values, form=DEFAULT_FORM, resolution=32, smoothness=0.02,
         shift = log_maps["r"].mean(axis=(0, 1))
         log_maps["r"], log_maps["q"] = log_maps["r"] - shift, log_maps["q"] + shift
     result = Factorization(form, resolution, {k: v.astype(np.float32) for k, v in log_maps.items()},
-                           np.ones(channels), scale, counts, int(len(values)))
+                           np.ones(channels), scale, counts, int(len(values)), mapping=mapping)
     # eq. 20's alpha: the reflected energy of the samples, sum f (n.i), kept (3.1.1: the log fit is biased
     # low); matching the plain mean instead lets a sharp peak the maps cannot resolve scale every tail up
     # (Ashikhmin-Shirley 50 x 800: alpha 3.3 against 1.75, the brushed torus 27% too bright)
