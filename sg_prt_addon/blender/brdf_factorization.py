@@ -1,9 +1,10 @@
-"""Factor BRDF operator: a measured BRDF (MERL .binary) factorized into p(o) q(h) p(i) r(o.h) maps
-(measured/homomorphic.py, mccool2001) and stored in the active material for the factored technique.
+"""Factor BRDF operator: a measured BRDF (a MERL .binary, or one texel of an SVBRDF table .npz) factorized into
+p(o) q(h) p(i) r(o.h) maps (measured/homomorphic.py, mccool2001) and stored in the active material for the
+factored technique.  The factors are one BRDF for the whole surface: a table's spatial variation is Fit Lobes'.
 
 Storage, per material (format 1): ``material.sgprt.factorization`` (properties.SGPRT_PG_factorization):
-``format_version``, ``source_file``, ``source_path``, ``form``, ``resolution``, ``alpha_scale`` (alpha A, RGB),
-``lobe_sharpness`` (the glossy environment lookup's), ``samples`` (valid BRDF samples fitted), ``masked`` (the
+``format_version``, ``source_file``, ``source_path``, ``source_texel`` (-1: a MERL file), ``form``,
+``resolution``, ``alpha_scale`` (alpha A, RGB), ``lobe_sharpness`` (the glossy environment lookup's), ``samples`` (valid BRDF samples fitted), ``masked`` (the
 NaN, Inf and negative channel samples left out), ``error`` (relative RMS against the source, cosine weighted),
 ``date``, ``seconds``, and ``images``: (``role``, ``image``) for p, q, r (the log-factor maps, RGB) and
 albedo, packed FLOAT RGBA images whose pixels round-trip bit-exactly through save and reopen.
@@ -46,9 +47,10 @@ class FactorJob(BackgroundJob):
     verb = "factorization"
     thread_name = "sgprt-factor-brdf"
 
-    def __init__(self, path, form, resolution, verbose=False, hook=None):
+    def __init__(self, path, form, resolution, texel=0, verbose=False, hook=None):
         super().__init__(verbose, hook)
-        self.path, self.form, self.resolution = path, form, int(resolution)
+        self.path, self.form, self.resolution, self.texel = path, form, int(resolution), int(texel)
+        self.source_texel = -1
         self.result = None
 
     def run(self):
@@ -58,11 +60,8 @@ class FactorJob(BackgroundJob):
             if self.record_progress(0.0, f"reading {name}"):
                 return self._cancelled()
             kind, source = lobe_fit.read_source(self.path)
-            if kind != "MERL":
-                raise FactorError(f"{name}: an SVBRDF table; Factor BRDF reads MERL .binary files (a table's texels "
-                                  "vary: fit its lobes with Fit Lobes)")
-            lobe_fit.check_merl_samples(source, name)
-            wo, wi, values = homomorphic.sample_merl(source, SAMPLES)
+            self.source_texel = -1 if kind == "MERL" else self.texel
+            wo, wi, values = self._samples(kind, source, name)
             if self.record_progress(0.2, f"factorizing {name}"):
                 return self._cancelled()
             factorization = homomorphic.factorize(wo, wi, values, form=self.form, resolution=self.resolution)
@@ -89,6 +88,16 @@ class FactorJob(BackgroundJob):
         if self.error and self.verbose:
             print(f"[sg-prt] factorization failed: {self.error}", flush=True)
 
+    def _samples(self, kind, source, name):
+        if kind == "MERL":
+            lobe_fit.check_merl_samples(source, name)
+            return homomorphic.sample_merl(source, SAMPLES)
+        height, width = source.shape
+        if not 0 <= self.texel < source.texel_count:
+            raise FactorError(f"{name}: texel {self.texel} is outside the table's {height} x {width} = "
+                              f"{source.texel_count} texels (row-major, 0 to {source.texel_count - 1})")
+        return homomorphic.sample_table_texel(source, self.texel, SAMPLES)
+
     def _cancelled(self):
         self.cancelled = True
         if self.verbose:
@@ -107,7 +116,7 @@ def clear_factorization(material):
     images = [item.image for item in settings.images if item.image is not None]
     found = settings.format_version != 0 or bool(images)
     settings.images.clear()
-    for name in ("format_version", "source_file", "source_path", "form", "resolution", "alpha_scale",
+    for name in ("format_version", "source_file", "source_path", "source_texel", "form", "resolution", "alpha_scale",
                  "lobe_sharpness", "samples", "masked", "error", "date", "seconds"):
         settings.property_unset(name)
     if techniques.of_settings(material.sgprt) == factored.NAME:
@@ -118,7 +127,7 @@ def clear_factorization(material):
     return found
 
 
-def store_factorization(material, result, path, form):
+def store_factorization(material, result, path, form, texel=-1):
     """Write a finished job's factors to a material, replacing any previous ones."""
     made = [(role, lobe_fit.new_float_image(image_name(material, role), result["arrays"][role]))
             for role in ROLES if role in result["arrays"]]
@@ -130,6 +139,7 @@ def store_factorization(material, result, path, form):
         item.role, item.image = role, image
     tables = result["tables"]
     settings.source_file, settings.source_path = os.path.basename(path), os.path.abspath(path)
+    settings.source_texel = int(texel)
     settings.form, settings.resolution = form, int(tables.factorization.resolution)
     settings.alpha_scale = tuple(float(x) for x in tables.scale)
     settings.lobe_sharpness = float(tables.lobe_sharpness)
@@ -153,8 +163,14 @@ def factorization_status(material):
     missing = [role for role in wanted if roles.get(role) is None]
     if missing or settings.form not in homomorphic.FORMS:
         return "INVALID", f"stored factors damaged (missing {', '.join(missing) or 'form'}): factor again"
-    return "VALID", (f"{settings.source_file}: {homomorphic.FORM_LABELS[settings.form]}, {settings.resolution}^2, "
+    return "VALID", (f"{source_label(settings)}: {homomorphic.FORM_LABELS[settings.form]}, {settings.resolution}^2, "
                      f"error {settings.error:.3f}")
+
+
+def source_label(settings):
+    """The stored factors' source: the file name, and the texel of a table."""
+    texel = f" texel {settings.source_texel}" if settings.source_texel >= 0 else ""
+    return settings.source_file + texel
 
 
 def stored_tables(material):
@@ -182,15 +198,19 @@ def stored_tables(material):
 # --------------------------------------------------------------------------- operators and panel
 
 class SGPRT_OT_factor_brdf(MaterialFileJobOperator, bpy.types.Operator):
-    """Factorize a measured BRDF (MERL .binary) into p(o) q(h) p(i) r(o.h) maps (McCool 2001) and store them in the active material"""
+    """Factorize a measured BRDF (MERL .binary, or one texel of an SVBRDF table .npz) into p(o) q(h) p(i) r(o.h) maps (McCool 2001) and store them in the active material"""
     bl_idname = "sgprt.factor_brdf"
     bl_label = "Factor BRDF"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: StringProperty(name="File", subtype="FILE_PATH", options={"SKIP_SAVE"}, description="MERL .binary")
-    filter_glob: StringProperty(default="*.binary", options={"HIDDEN"})
+    filepath: StringProperty(name="File", subtype="FILE_PATH", options={"SKIP_SAVE"},
+                             description="MERL .binary or SVBRDF table .npz")
+    filter_glob: StringProperty(default="*.binary;*.npz", options={"HIDDEN"})
     form: EnumProperty(name="Factors", items=FORMS, default="pqpr", description="The factored form")
     resolution: IntProperty(name="Resolution", default=64, min=8, max=128, description="Texels a side of each map")
+    texel: IntProperty(name="Texel", default=0, min=0,
+                       description="For an SVBRDF table: the texel (row-major index) whose BRDF is factorized, as one "
+                                   "BRDF for the whole surface")
 
     job_label = "SG-PRT factorization"
     stored_as, result_label, previous, previous_verb = "factors", "SG-PRT factors", "factors", "are"
@@ -201,14 +221,14 @@ class SGPRT_OT_factor_brdf(MaterialFileJobOperator, bpy.types.Operator):
         return not SGPRT_OT_factor_brdf._running and active_material(context) is not None
 
     def _make_job(self, path):
-        return FactorJob(path, self.form, self.resolution, hook=progress_hook)
+        return FactorJob(path, self.form, self.resolution, self.texel, hook=progress_hook)
 
     def _store(self, material, job):
-        store_factorization(material, job.result, job.path, job.form)
+        store_factorization(material, job.result, job.path, job.form, job.source_texel)
 
     def _done_message(self, material, job):
         settings = material.sgprt.factorization
-        return (f"SG-PRT factorized {settings.source_file} on '{material.name}' "
+        return (f"SG-PRT factorized {source_label(settings)} on '{material.name}' "
                 f"({homomorphic.FORM_LABELS[settings.form]}, {settings.resolution}^2, error {settings.error:.3f}, "
                 f"{settings.seconds:.1f} s"
                 + (f", {settings.masked} NaN/Inf/negative samples left out)" if settings.masked else ")"))

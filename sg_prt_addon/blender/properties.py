@@ -89,6 +89,8 @@ class SGPRT_PG_factorization(bpy.types.PropertyGroup):
     format_version: IntProperty(name="Format Version", default=0, description="0: no factors stored")
     source_file: StringProperty(name="Source File", description="File name the factors were made from")
     source_path: StringProperty(name="Source Path", description="Full path the factors were made from")
+    source_texel: IntProperty(name="Source Texel", default=-1, min=-1,
+                              description="The SVBRDF table texel factorized (row-major); -1: a MERL file")
     form: StringProperty(name="Form", description="measured.homomorphic.FORMS key")
     resolution: IntProperty(name="Resolution", default=0, min=0)
     alpha_scale: FloatVectorProperty(name="Scale", size=3, default=(1.0, 1.0, 1.0),

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from sg_prt_addon.blender import brdf_factorization as bf
-from sg_prt_addon.measured import homomorphic, merl
+from sg_prt_addon.measured import homomorphic, merl, svbrdf_table
 from validation import brdf_generators
 
 
@@ -16,7 +16,9 @@ def data(tmp_path_factory):
     brdf_generators.generate_merl(path, corrupt_fraction=1e-4)
     clean = str(directory / "clean.binary")
     brdf_generators.generate_merl(clean, corrupt_fraction=0.0)
-    return dict(directory=directory, merl=path, clean=clean)
+    table = str(directory / "table.npz")
+    svbrdf_table.write_svbrdf_table(table, brdf_generators.generate_svbrdf_table(size=3)[0])
+    return dict(directory=directory, merl=path, clean=clean, table=table)
 
 
 @pytest.fixture
@@ -32,8 +34,9 @@ def material(addon):
 
 def _snapshot(material):
     settings = material.sgprt.factorization
-    meta = {name: getattr(settings, name) for name in ("format_version", "source_file", "form", "resolution",
-                                                        "lobe_sharpness", "samples", "masked", "error", "date")}
+    names = ("format_version", "source_file", "source_texel", "form", "resolution", "lobe_sharpness", "samples",
+             "masked", "error", "date")
+    meta = {name: getattr(settings, name) for name in names}
     meta["alpha_scale"] = tuple(settings.alpha_scale)
     pixels = {}
     for item in settings.images:
@@ -66,6 +69,30 @@ def test_factors_are_stored_and_survive_save_and_reopen(material, data, tmp_path
     assert tables is not None and tables.factorization.form == "pqpr" and tables.maps["r"].shape == (1, 32, 4)
 
 
+def test_a_table_texel_is_factorized_as_one_brdf(material, data, tmp_path):
+    """Texel 5 of a 3 x 3 SVBRDF table: the stored maps are the direct factorization of that texel's BRDF
+    (float32), its index survives save and reopen; a texel outside the table is refused, nothing lost."""
+    assert bpy.ops.sgprt.factor_brdf(filepath=data["table"], form="pqpr", resolution=16, texel=5) == {"FINISHED"}
+    settings = material.sgprt.factorization
+    assert settings.source_texel == 5 and "table.npz texel 5" in bf.factorization_status(material)[1]
+    table = svbrdf_table.read_svbrdf_table(data["table"])
+    direct = homomorphic.factorize(*homomorphic.sample_table_texel(table, 5, bf.SAMPLES), form="pqpr", resolution=16)
+    stored = bf.stored_tables(material)
+    for role in ("p", "q", "r"):
+        np.testing.assert_allclose(stored.maps[role][..., :3], direct.log_factors[role], rtol=0, atol=1e-5)
+    # texels differ (the table's roughness varies): texel 5's BRDF, not texel 0's
+    other = homomorphic.factorize(*homomorphic.sample_table_texel(table, 0, 64), form="pqpr", resolution=16)
+    assert np.max(np.abs(other.log_factors["q"] - direct.log_factors["q"])) > 0.1
+    assert 0 < settings.error < 0.5
+    before = _snapshot(material)
+    with pytest.raises(RuntimeError, match="texel 9 is outside the table's 3 x 3 = 9 texels"):
+        bpy.ops.sgprt.factor_brdf(filepath=data["table"], texel=9, resolution=16)
+    assert _same(_snapshot(material), before)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "texel.blend"))
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "texel.blend"))
+    assert bpy.data.materials["Measured"].sgprt.factorization.source_texel == 5
+
+
 def test_corrupt_samples_change_the_count_not_the_factors(material, data):
     """NaN/Inf bins of a MERL file are masked and counted (the clean file has its own invalid bins: MERL marks
     bins whose centre lies below the horizon, which grazing pairs reach); the factored BRDF moves by < 1%."""
@@ -94,7 +121,7 @@ def test_bad_files_are_reported_and_previous_factors_kept(material, data, tmp_pa
     table = tmp_path / "table.npz"
     table.write_bytes(b"PK\x03\x04" + b"\x00" * 64)
     for path, message in ((tmp_path / "missing.binary", "not found"), (garbage, "not a valid MERL"),
-                          (table, "")):
+                          (table, "not a valid SVBRDF table")):
         with pytest.raises(RuntimeError, match=message):
             bpy.ops.sgprt.factor_brdf(filepath=str(path), resolution=16)
         assert _same(_snapshot(material), before)
