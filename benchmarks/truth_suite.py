@@ -23,7 +23,8 @@ process, by:
    and silhouettes that alone makes most of SG-PRT's RMSE (ggx030_point at 128 px: 1.46 at the
    pixel centres, 0.36 box-filtered from 2x), a diagnostic row, not the engine's output.  SG-PRT
    reads only ``material.sgprt``; it renders before the node trees are rewritten for Cycles and
-   EEVEE (step 2), in every scene;
+   EEVEE (step 2), in every scene; then the same bake rendered by each of the engine's other
+   techniques (TECHNIQUE_METHODS: every material switched to it, then back);
 2. the truth: Cycles on the CPU, direct light only (``max_bounces`` 0, 1-pixel box filter, no
    denoising), node materials matched to the SG-PRT settings (benchmarks/matched_materials.py),
    ``--cycles-samples`` per pixel, rendered twice with seeds 1 and 2; the truth is the mean of the
@@ -94,8 +95,10 @@ GLOSSY_MIN_ROUGHNESS = 0.1
 FULL = dict(size=256, cycles_samples=512, eevee_samples=(1, 16, 64))
 QUICK = dict(size=64, cycles_samples=32, eevee_samples=(1, 16))
 
-METHODS = ("SG-PRT", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Cycles", "Cycles 1 sample",
-           "Cycles equal time", "EEVEE")
+METHODS = ("SG-PRT", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Factored BRDF", "Cycles",
+           "Cycles 1 sample", "Cycles equal time", "EEVEE")
+# the engine's other techniques, each with the same bake: method -> the technique every material is switched to
+TECHNIQUE_METHODS = {"Factored BRDF": "FACTORED"}
 ANTI_ALIASING_SAMPLES = 16  # "SG-PRT 16 samples": the engine's Render Samples (scene.sgprt.render_samples), 4 x 4
 SUPERSAMPLING = 2          # "SG-PRT 2x2": the engine at twice the size, box-filtered down (Cycles' pixel filter)
 
@@ -230,6 +233,27 @@ def markdown_table(rows, scenes):
     return "\n".join(lines)
 
 
+def techniques_table(rows, scenes):
+    """One line per scene: every technique of the engine (the SG lobes and TECHNIQUE_METHODS), relative RMSE /
+    HDR-FLIP / render() seconds, with the same bake."""
+    methods = ["SG-PRT"] + list(TECHNIQUE_METHODS)
+    lines = ["| scene | kind | " + " | ".join(f"{'SG lobes' if m == 'SG-PRT' else m} RMSE / HDR-FLIP / s"
+                                           for m in methods) + " | noise floor |",
+             "|---|---|" + "---|" * len(methods) + "---|"]
+    for name, info in scenes.items():
+        kind = info.get("kind", "-")
+        if kind == "glossy" and info.get("roughness") is not None:
+            kind = f"glossy {info['roughness']:g}"
+        cells = []
+        for method in methods:
+            row = find_row(rows, name, method) or {}
+            cells.append(f"{_number(row.get('relative_rmse'))} / {_number(row.get('hdr_flip'))} / "
+                         f"{_number(row.get('seconds'))}")
+        truth = find_row(rows, name, "Cycles") or {}
+        lines.append(f"| {name} | {kind} | " + " | ".join(cells) + f" | {_number(truth.get('noise_floor'))} |")
+    return "\n".join(lines)
+
+
 def goal_lines(checks):
     """One line per scene: the two goals, met or not."""
     lines = []
@@ -302,6 +326,10 @@ def markdown_section(data, before=None):
         "4 x 4 grid per pixel, the same box filter as the truth's), render() seconds beside.",
         "",
         markdown_table(data["rows"], data["scenes"]), "",
+        "The engine's techniques on the same scenes, each with the same bake (SG lobes: wang2009, the SG-PRT "
+        "column above; Factored BRDF: mccool2001's p(o) q(h) p(i) r(o.h) of each material's model, 64 x 64 "
+        "parabolic maps, its environment term as techniques/factored.py says):", "",
+        techniques_table(data["rows"], data["scenes"]), "",
         f"Goals (relative RMSE < {GLOSSY_RMSE_GOAL:.2f} glossy of roughness >= {GLOSSY_MIN_ROUGHNESS:g}, "
         f"< {DIFFUSE_RMSE_GOAL:.2f} diffuse): {goal_summary(checks)}.", ""]
     lines += [f"- {line}" for line in goal_lines(checks)]
@@ -833,6 +861,24 @@ class SceneRun:
                 settings.render_samples = 1
             self.add("SG-PRT 16 samples", f"bake R={resolution}, Render Samples {ANTI_ALIASING_SAMPLES}", seconds,
                      image, warm_up_seconds=warm)
+        for method, technique in TECHNIQUE_METHODS.items():
+            if method in self.methods:
+                seconds, image, warm = self.technique_render(technique)
+                self.add(method, f"bake R={resolution}, technique {technique}", seconds, image, warm_up_seconds=warm)
+
+    def technique_render(self, technique):
+        """engine_render() with every material switched to ``technique``, then switched back."""
+        import bpy
+
+        materials = [m for m in bpy.data.materials if hasattr(m, "sgprt")]
+        before = {material.name: material.sgprt.technique for material in materials}
+        try:
+            for material in materials:
+                material.sgprt.technique = technique
+            return self.engine_render()
+        finally:
+            for material in materials:
+                material.sgprt.technique = before[material.name]
 
     def _cycles(self, samples, seed, folder):
         import bpy
@@ -934,6 +980,8 @@ def score_scene(name, size, cycles_samples, methods=("SG-PRT", "Cycles"), eevee_
 def print_summary(data):
     print()
     print(markdown_table(data["rows"], data["scenes"]))
+    print()
+    print(techniques_table(data["rows"], data["scenes"]))
     print()
     checks = [goal_check(data["rows"], name, info.get("kind"), info.get("roughness"))
               for name, info in data["scenes"].items()]

@@ -91,6 +91,7 @@ def _rows():
             ts.make_row("a", "EEVEE", "16 samples", 8.0, 0.1, 0.0, 0.08, 0.01, samples=16),
             ts.make_row("a", "Cycles", "512 spp x 2 seeds (truth)", 30.0, None, None, None, 0.01, samples=512),
             ts.make_row("a", "Cycles equal time", "3 spp", 0.25, 0.5, 0.0, 0.4, 0.01, samples=3),
+            ts.make_row("a", "Factored BRDF", "bake R=32, technique FACTORED", 0.1, 0.07, 0.02, 0.06, 0.01),
             ts.make_row("b", "SG-PRT", "bake R=32", 0.3, 0.12, -0.05, 0.2, 0.02),
             ts.make_row("b", "EEVEE", "16 samples", 8.0, 0.3, 0.0, 0.15, 0.02, samples=16),
             ts.make_row("c", "SG-PRT", "bake R=32", 0.3, 0.3, 0.0, None, 0.02)]
@@ -120,6 +121,15 @@ def test_markdown_table_has_a_line_per_scene_in_order():
     assert table[2].startswith("| b | glossy 0.3 | 0.120 | -0.050 | 0.200 | - | 0.150 | 0.300 | - | 0.020 |")
     assert table[3].startswith("| a | diffuse | 0.040 | +0.010 | 0.050 | 0.200 | 0.080 | 0.100 | 0.400 (3) | "
                                "0.010 | 0.200 | 30.0 |")
+
+
+def test_techniques_table_puts_each_technique_beside_the_sg_lobes():
+    scenes = {"a": {"kind": "diffuse", "roughness": None}, "b": {"kind": "glossy", "roughness": 0.3}}
+    table = ts.techniques_table(_rows(), scenes).splitlines()
+    assert table[0] == ("| scene | kind | SG lobes RMSE / HDR-FLIP / s | Factored BRDF RMSE / HDR-FLIP / s "
+                        "| noise floor |")
+    assert table[2] == "| a | diffuse | 0.040 / 0.050 / 0.200 | 0.070 / 0.060 / 0.100 | 0.010 |"
+    assert table[3] == "| b | glossy 0.3 | 0.120 / 0.200 / 0.300 | - / - / - | - |"
 
 
 def _data():
