@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import techniques
 from ..reflectance import models
-from ..techniques import factored, sg_fitted
+from ..techniques import factored, sg_fitted, spherical_harmonics
 
 # Mesh exports since import; tests read it to check what an update re-exported.
 export_counter = {"meshes": 0}
@@ -112,6 +112,8 @@ class MaterialParams:
     nv: float = 1000.0
     lobe_count: int = 4
     warp_mode: str = "split3"      # spherical.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.view_warp)
+    sh_order: int = 5              # the SH technique's order and window (harmonics.projection's names, or "none")
+    sh_window: str = "none"
     normal_strength: float = 1.0
     tangent_source: str = "UV_MAP"
     tangent_axis: tuple = (1.0, 0.0, 0.0)
@@ -431,6 +433,11 @@ def _usable_technique(material, params):
         if ignored:
             warn(f"material '{material.name}': {factored.TECHNIQUE.label} factorizes the model with uniform "
                  f"parameters: the textures on {', '.join(ignored)} are not applied")
+    if name == spherical_harmonics.NAME:
+        ignored = sorted(slot for slot in params.textures if slot not in spherical_harmonics.texture_slots(params))
+        if ignored:
+            warn(f"material '{material.name}': {spherical_harmonics.TECHNIQUE.label} tabulates the model with "
+                 f"uniform {', '.join(ignored)}: those textures are not applied")
     if name == sg_fitted.NAME:
         params.fitted = export_fitted_lobes(material)
         if params.fitted is None:
@@ -457,6 +464,8 @@ def export_material(material):
         setattr(params, name, float(getattr(settings, name)))
     params.lobe_count = int(settings.lobe_count)
     params.warp_mode = settings.view_warp.lower()       # properties.VIEW_WARPS: spherical.warp's mode names
+    params.sh_order = int(settings.sh_order)
+    params.sh_window = settings.sh_window.lower()       # properties.SH_WINDOWS: harmonics.projection's names
     params.normal_strength = float(settings.normal_strength)
     params.tangent_source = settings.tangent_source
     params.tangent_axis = tuple(settings.tangent_axis)

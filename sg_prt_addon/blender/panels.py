@@ -1,7 +1,9 @@
 """Properties-editor panels of the SG-PRT engine."""
 import bpy
 
+from .. import techniques
 from ..reflectance import models
+from ..techniques import spherical_harmonics
 
 ENGINE_ID = "SG_PRT"
 
@@ -33,7 +35,11 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
             row.prop(settings, name)
             if textured and hasattr(settings, f"{name}_texture"):
                 row.template_ID(settings, f"{name}_texture", open="image.open")
-        layout.prop(settings, "view_warp")
+        if techniques.of_settings(settings) == spherical_harmonics.NAME:
+            layout.prop(settings, "sh_order")
+            layout.prop(settings, "sh_window")
+        else:
+            layout.prop(settings, "view_warp")
         layout.prop(settings, "show_textures")
 
 

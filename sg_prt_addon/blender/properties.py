@@ -20,6 +20,9 @@ from .. import techniques
 from ..reflectance import models
 
 # How each NDF lobe is warped to the view slice: spherical.warp's modes, upper case (figures from its docstring).
+SH_WINDOWS = (("NONE", "None", "The bands as projected (sharpest; rings around small bright lights)"),
+              ("HANNING", "Hanning", "(1 + cos(pi l / N)) / 2 per band: the least ringing, the most blur"),
+              ("LANCZOS", "Lanczos", "sinc(l / N) per band: less blur than Hanning, more ringing"))
 VIEW_WARPS = (
     ("SPLIT3", "3 Lobes", "Three warped lobes per NDF lobe (default): the most accurate at grazing views "
                           "(mean energy error 0.09 at 75 degrees)"),
@@ -145,6 +148,11 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
     view_warp: EnumProperty(update=_tag_material_changed, name="View Warp", items=VIEW_WARPS, default="SPLIT3",
                             description="Lobes each NDF lobe becomes in the view slice (wang2009 eq. 17-22 and its "
                                         "split): fewer render faster, more are more accurate at grazing views")
+    sh_order: IntProperty(update=_tag_material_changed, name="SH Order", default=5, min=2, max=8,
+                          description="Bands of the spherical-harmonic technique (order N: N^2 coefficients; "
+                                      "Kautz 2002 used 5): higher follows sharper lights and glossier lobes")
+    sh_window: EnumProperty(update=_tag_material_changed, name="SH Window", items=SH_WINDOWS, default="NONE",
+                            description="Smoothing of the lighting's bands against ringing (it blurs)")
     normal_map: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Normal Map",
                                 description="Tangent-space normal map (OpenGL convention, +Y up)")
     normal_strength: FloatProperty(update=_tag_material_changed, name="Strength", default=1.0, min=0.0, max=10.0,

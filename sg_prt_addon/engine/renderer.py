@@ -242,10 +242,11 @@ def environment_textures(environment, equirect):
 class _DrawContext(techniques.DrawContext):
     """The renderer's side of the technique seam for one object (and, in bind, one material slot)."""
 
-    def __init__(self, renderer, object_key, entry, buffers):
+    def __init__(self, renderer, object_key, entry, buffers, inputs):
         self.renderer = renderer
         self.object_key = object_key
         self.buffers = buffers
+        self.inputs = inputs
         self.model_matrix = _column_major(entry.matrix_world)
         self.scene_buffer = renderer.scene_buffer
         self.material_buffer = None
@@ -412,7 +413,8 @@ class Renderer:
                     name = ""
                 technique = techniques.for_material(params)
                 slots.append((first_triangle, batch, name, params, technique, technique.variant_key(params, inputs)))
-            draws.append((object_index, object_key, entry, _DrawContext(self, object_key, entry, buffers), slots))
+            draws.append((object_index, object_key, entry, _DrawContext(self, object_key, entry, buffers, inputs),
+                          slots))
         return draws
 
     def draw(self, state, camera, background_alpha=1.0):

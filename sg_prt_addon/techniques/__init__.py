@@ -3,9 +3,10 @@
 A technique (base.Technique) plugs in by registering: ``register(MyTechnique())``.  The draw loop,
 the shader cache and the scene state look techniques up here by the material's choice
 (MaterialParams.technique); none is named in them.  Built in: wang2009's SG lobes, parametric
-(sg_parametric) and from a stored lobe fit (sg_fitted); mccool2001's factored BRDF (factored).
+(sg_parametric) and from a stored lobe fit (sg_fitted); mccool2001's factored BRDF (factored); kautz2002's
+spherical harmonics (spherical_harmonics).
 """
-from . import factored, sg_fitted, sg_parametric
+from . import factored, sg_fitted, sg_parametric, spherical_harmonics
 from .base import DrawContext, ObjectInputs, Technique
 
 DEFAULT = sg_parametric.NAME
@@ -62,6 +63,7 @@ def enum_items():
 register(sg_parametric.TECHNIQUE)
 register(sg_fitted.TECHNIQUE)
 register(factored.TECHNIQUE)
+register(spherical_harmonics.TECHNIQUE)
 
 __all__ = ["DEFAULT", "DrawContext", "ObjectInputs", "Technique", "enum_items", "for_material", "get", "names",
            "of_settings", "register", "unregister"]

@@ -51,6 +51,7 @@ class DrawContext:
     """What the engine offers a technique's bind() and prepare_object() (engine/renderer.py implements it).
 
     scene_buffer, material_buffer: the SceneData and MaterialData uniform buffers of the draw;
+    inputs: the object's ObjectInputs (what its variant keys were made from: the lights, the environment);
     per_vertex(kind): the object's engine.per_vertex.PerVertexBuffers of that kind;
     environment_textures(): (prefiltered layers, equirect map) GPU textures of the scene's environment;
     table(name, build): a GPU texture of build()'s float32 array ((H, W, 4) or (L, H, W, 4)), made once

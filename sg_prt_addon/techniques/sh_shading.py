@@ -1,0 +1,134 @@
+"""Numpy mirror of the SH technique's fragment shader (shaders/techniques/sh/): the same steps per pixel, in
+float32 where the shader is.  table: a harmonics.brdf_table.BrdfTable; environment: (>= N^2, 3) SH
+coefficients of the world lighting (spherical_harmonics.environment_coefficients)."""
+import math
+
+import numpy as np
+
+from ..harmonics import basis, brdf_table, projection, rotation
+from ..spherical import sg, texture_fetch
+from . import sg_shading
+
+FLOAT = np.float32
+
+
+def _table_coefficients(table, o, parameter):
+    """The shader's sh_table_lookup: (N, N^2) at local views o (N, 3)."""
+    layers = brdf_table.texture_layers(table)
+    if table.layout == "theta":
+        theta = np.arctan2(np.linalg.norm(o[:, :2], axis=-1), np.maximum(o[:, 2], 0))
+        uv = np.stack([theta * FLOAT(2 / np.pi), table.parameter_coordinate(parameter)], -1).astype(FLOAT)
+    else:
+        uv = brdf_table.parabolic_coordinates(o).astype(FLOAT)
+    count = table.coefficients.shape[-1]
+    samples = np.concatenate([texture_fetch.bilinear(layers[k], uv) for k in range(len(layers))], axis=-1)
+    return samples[:, :count].astype(FLOAT)
+
+
+def _cap_flux_and_factors(position, light_data, order):
+    """(axis (N, P, 3), flux (N, P, 3), g (N, P, order)) of the point and spot lights as uniform caps."""
+    to_light = light_data.point_position[None] - position[:, None]
+    distance2 = np.sum(to_light * to_light, axis=-1)
+    radius2 = light_data.point_radius[None] ** 2
+    effective2 = np.maximum(np.maximum(distance2, radius2), FLOAT(1e-12) * np.maximum(radius2, FLOAT(1)))
+    axis = sg.normalize(to_light)
+    sin2 = radius2 / effective2
+    cos_half = np.sqrt(np.maximum(1 - sin2, 0)).astype(FLOAT)
+    g = projection.cap_factors(sin2 / (1 + cos_half), order, FLOAT)
+    flux = light_data.point_intensity[None] * (2 / (effective2 * (1 + cos_half)))[..., None]
+    spot = light_data.spot_size >= 0
+    if np.any(spot):
+        cos_angle = np.sum(-axis * sg.normalize(light_data.spot_direction)[None], axis=-1)
+        cos_spot = np.cos(FLOAT(0.5) * light_data.spot_size)[None]
+        width = np.maximum((1 - cos_spot) * light_data.spot_blend[None], FLOAT(1e-12))
+        s = np.clip((cos_angle - cos_spot) / width, 0, 1)
+        flux = flux * np.where(spot[None], s * s * (3 - 2 * s), FLOAT(1))[..., None]
+    return axis.astype(FLOAT), flux.astype(FLOAT), g
+
+
+def _light_sets(position, light_data, order):
+    sets = []
+    if len(light_data.point_radius):
+        sets.append(_cap_flux_and_factors(position, light_data, order))
+    if len(light_data.sun_sharpness):
+        count = len(light_data.sun_sharpness)
+        flux = light_data.sun_amplitude * sg.sphere_integral(light_data.sun_sharpness, FLOAT(1))[:, None]
+        g = projection.sg_factors(light_data.sun_sharpness, order, FLOAT)
+        sets.append((np.broadcast_to(light_data.sun_axis[None], (len(position), count, 3)),
+                     np.broadcast_to(flux[None], (len(position), count, 3)).astype(FLOAT),
+                     np.broadcast_to(g[None], (len(position), count, order))))
+    return sets
+
+
+def _zonal_sum(weights, t):
+    """sh_zonal_sum: sum_l weights[..., l] (2l + 1) / (4 pi) P_l(t)."""
+    order = weights.shape[-1]
+    p = projection.legendre_polynomials(t.astype(FLOAT), max(order - 1, 1))
+    bands = np.arange(order)
+    return np.sum(weights * ((2 * bands + 1) / FLOAT(4 * np.pi)).astype(FLOAT)
+                  * np.stack(p[:order], -1).astype(FLOAT), axis=-1)
+
+
+def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color, specular_color, parameter,
+          light_data, environment, table, window=None):
+    """Diffuse and specular radiance (N, 3) float32 of pixels."""
+    order = table.order
+    count = order * order
+    position = np.asarray(position, FLOAT)
+    n, t, b = sg_shading.shading_frame(normal, tangent)
+    if is_perspective:
+        view = sg.normalize(np.asarray(view_origin, FLOAT)[None] - position)
+    else:
+        view = np.broadcast_to(-sg.normalize(np.asarray(view_origin, FLOAT)), position.shape)
+    if table.layout == "theta":
+        along = view - n * np.sum(n * view, axis=-1, keepdims=True)
+        turn = np.sum(along * along, axis=-1, keepdims=True) > FLOAT(1e-12)
+        t = np.where(turn, sg.normalize(along), t)
+        b = np.where(turn, np.cross(n, t), b).astype(FLOAT)
+    frame = np.stack([t, b, n], axis=-1)                                  # local -> world, columns t, b, n
+    o = np.einsum("nji,nj->ni", frame, view)
+    c = _table_coefficients(table, o, parameter)
+    c = rotation.rotate_zyz_many(c, frame).astype(FLOAT)                  # the product in world coordinates
+    window_factors = projection.window_factors(window, order).astype(FLOAT)
+    cosine = (projection.clamped_cosine_zonal(order)
+              / [basis.normalization(band, 0) for band in range(order)]).astype(FLOAT)
+    bands, _ = basis.band_of(count)
+    light = (window_factors[bands][:, None] * np.asarray(environment, FLOAT)[:count, :3]).astype(FLOAT)
+    radiance = c @ light
+    irradiance = (basis.evaluate(n, order).astype(FLOAT) * cosine[bands]) @ light
+    for axis, flux, g in _light_sets(position, light_data, order):
+        weight = window_factors * g                                       # (N, P, order)
+        y = basis.evaluate(axis, order).astype(FLOAT)                     # (N, P, N^2)
+        glossy = np.sum(weight[..., bands] * c[:, None, :] * y, axis=-1)
+        radiance = radiance + np.sum(flux * glossy[..., None], axis=1)
+        diffuse_weight = _zonal_sum(weight * cosine, np.sum(n[:, None] * axis, axis=-1))
+        irradiance = irradiance + np.sum(flux * diffuse_weight[..., None], axis=1)
+    diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / math.pi) * np.maximum(irradiance, 0)
+    specular = np.asarray(specular_color, FLOAT) * np.maximum(radiance, 0)
+    return diffuse.astype(FLOAT), specular.astype(FLOAT)
+
+
+def shade_fragments(material, textures, table, environment, position, normal, tangent, uv, view_origin,
+                    is_perspective, light_data):
+    """Mirror of the technique's main(): per-fragment inputs as the G-buffer holds them, the material's
+    BrdfTable and the environment's coefficients."""
+    count = len(position)
+    diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
+    specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
+    if "diffuse_color" in textures:
+        diffuse_color = diffuse_color * sg_shading.sample_texture(textures["diffuse_color"], uv)[:, :3]
+    if "specular_color" in textures:
+        specular_color = specular_color * sg_shading.sample_texture(textures["specular_color"], uv)[:, :3]
+    parameter = np.full(count, FLOAT(getattr(material, table.parameter)) if table.parameter else 0, FLOAT)
+    if table.parameter in textures:
+        parameter = parameter * sg_shading.sample_texture(textures[table.parameter], uv)[:, 0]
+    shading_normal = np.asarray(normal, FLOAT)
+    tangent = np.asarray(tangent, FLOAT)
+    if "normal_map" in textures:
+        shading_normal = sg_shading.apply_normal_map(shading_normal, tangent,
+                                                     sg_shading.sample_texture(textures["normal_map"], uv)[:, :3],
+                                                     FLOAT(material.normal_strength))
+    shading_tangent = sg_shading.rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+    window = None if getattr(material, "sh_window", "none") == "none" else material.sh_window
+    return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
+                 specular_color, parameter, light_data, environment, table, window)

@@ -1,0 +1,118 @@
+/* kautz2002: the BRDF times the cosine as SH coefficients per local view (a table), the lighting as SH, the
+ * shading integral as their dot product (eq. 1).  Per pixel, in the paper's steps: the view into the local
+ * frame, the table lookup by it, then (ours, on the GPU) one rotation (sh_rotate) of the looked-up vector
+ * into the world frame, where the environment's coefficients live (the same dot product as rotating the
+ * lighting into the local frame, one vector instead of three colours).  Lights are caps (point and spot
+ * lights, by sphere_light_cap) and SGs (suns), zonal about their direction: Phi g_l Y_lm(axis).  Diffuse:
+ * the clamped cosine's bands A_l (Funk-Hecke), the lights' by the addition theorem.  Every band of the
+ * lighting is scaled by the window's SH_WINDOW[l].  Mirrored by techniques/sh_shading.py.
+ *
+ * Needs sh_library.glsl and its generated constants, surface_common.glsl, (HAS_LIGHTS) lights.glsl, the
+ * samplers sh_table (the BRDF product, ceil(SH_COUNT / 4) layers) and sh_environment (SH_COUNT x 1, rgb),
+ * and the push constant sh_axis of the table's parameter axis (harmonics.brdf_table.BrdfTable.parameter_coordinate):
+ * x 1 / (high - low) (a log axis: 1 / log(high / low)), y low, z 1 for a log axis, w the node count. */
+
+float sh_parameter_coordinate(float value)
+{
+  float t = sh_axis.z > 0.5 ? log(max(value, sh_axis.y) / sh_axis.y) : value - sh_axis.y;
+  return (clamp(t * sh_axis.x, 0.0, 1.0) * (sh_axis.w - 1.0) + 0.5) / sh_axis.w;
+}
+
+/* The table's coefficients at local view o (and parameter coordinate p, isotropic layout). */
+void sh_table_lookup(vec3 o, float p, out float c[SH_COUNT])
+{
+#ifdef SH_ISOTROPIC
+  /* theta_v by atan: llvmpipe's acos is off by up to 1.6e-4 rad, its atan by 3e-6 */
+  vec2 uv = vec2(atan(length(o.xy), max(o.z, 0.0)) * (2.0 / 3.14159265358979), p);
+#else
+  vec3 d = safe_normalize(o);
+  vec2 xy = d.z >= 0.0 ? d.xy : d.xy / max(length(d.xy), 1.0e-30);
+  vec2 uv = 0.5 * (xy / (1.0 + max(d.z, 0.0)) + 1.0);
+#endif
+  for (int k = 0; k < (SH_COUNT + 3) / 4; k++) {
+    vec4 value = texture(sh_table, vec3(uv, float(k)));
+    for (int j = 0; j < 4; j++) {
+      if (4 * k + j < SH_COUNT) {
+        c[4 * k + j] = value[j];
+      }
+    }
+  }
+}
+
+void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3 specular_color, float parameter,
+              out vec3 diffuse, out vec3 specular)
+{
+  vec3 n, t, b;
+  shading_frame(normal, tangent, n, t, b);
+  vec3 view = scene.camera.w > 0.5 ? safe_normalize(scene.camera.xyz - position) : -safe_normalize(scene.camera.xyz);
+#ifdef SH_ISOTROPIC
+  /* turn the frame about n until the view lies in its x-z plane (the table's phi_v = 0) */
+  vec3 along = view - n * dot(n, view);
+  if (dot(along, along) > 1.0e-12) {
+    t = normalize(along);
+    b = cross(n, t);
+  }
+#endif
+  mat3 frame = mat3(t, b, n);                   /* local -> world */
+  vec3 o = view * frame;                        /* world -> local: the rows */
+  float c[SH_COUNT];
+  sh_table_lookup(o, sh_parameter_coordinate(parameter), c);
+  sh_rotate(c, frame);                          /* the product in world coordinates */
+  float y[SH_COUNT];
+  sh_basis(n, y);
+  vec3 radiance = vec3(0.0);
+  vec3 irradiance = vec3(0.0);
+  for (int l = 0; l < SH_ORDER; l++) {
+    for (int i = l * l; i < (l + 1) * (l + 1); i++) {
+      vec3 light = SH_WINDOW[l] * texelFetch(sh_environment, ivec2(i, 0), 0).rgb;
+      radiance += c[i] * light;
+      irradiance += (SH_COSINE[l] * y[i]) * light;
+    }
+  }
+#ifdef HAS_LIGHTS
+  for (int l = 0; l < scene.counts.x + scene.counts.y; l++) {
+    vec3 axis;
+    vec3 flux;
+    float g[SH_ORDER];
+    if (l < scene.counts.x) {
+      float effective2;
+      float sin2 = sphere_light_cap(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w,
+                                    effective2, axis);
+      float cos_half = sqrt(max(1.0 - sin2, 0.0));
+      sh_cap_factors(sin2 / (1.0 + cos_half), g);
+      /* radiance I / (pi r^2) over the cap's solid angle 2 pi (1 - cos): 2 I / (d^2 (1 + cos)) */
+      flux = scene.point_intensity[l].rgb * (2.0 / (effective2 * (1.0 + cos_half)));
+      if (scene.spot_direction_size[l].w >= 0.0) {
+        float cos_angle = dot(-axis, safe_normalize(scene.spot_direction_size[l].xyz));
+        float cos_spot = cos(0.5 * scene.spot_direction_size[l].w);
+        float width = max((1.0 - cos_spot) * scene.spot_blend[l].x, 1.0e-12);
+        float s = clamp((cos_angle - cos_spot) / width, 0.0, 1.0);
+        flux *= s * s * (3.0 - 2.0 * s);
+      }
+    }
+    else {
+      int s = l - scene.counts.x;
+      axis = scene.sun_axis_sharpness[s].xyz;
+      float lambda = scene.sun_axis_sharpness[s].w;
+      sh_sg_factors(lambda, g);
+      /* the SG's integral over the sphere */
+      flux = scene.sun_amplitude[s].rgb * sg_sphere_integral(lambda, 1.0);
+    }
+    float ya[SH_COUNT];
+    sh_basis(axis, ya);
+    float glossy = 0.0;
+    float zonal[SH_ORDER];
+    for (int k = 0; k < SH_ORDER; k++) {
+      float w = SH_WINDOW[k] * g[k];
+      zonal[k] = w * SH_COSINE[k];
+      for (int i = k * k; i < (k + 1) * (k + 1); i++) {
+        glossy += w * c[i] * ya[i];
+      }
+    }
+    radiance += flux * glossy;
+    irradiance += flux * sh_zonal_sum(zonal, dot(n, axis));
+  }
+#endif
+  diffuse = diffuse_color * (1.0 / 3.14159265358979) * max(irradiance, vec3(0.0));
+  specular = specular_color * max(radiance, vec3(0.0));
+}

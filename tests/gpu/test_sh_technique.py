@@ -1,0 +1,96 @@
+"""The spherical-harmonics technique (techniques/spherical_harmonics.py, kautz2002) on the GPU against its
+numpy mirror (techniques/sh_shading.py), from the G-buffer: isotropic tables with a roughness texture, an
+anisotropic map, point, spot and sun lights, a world colour and an environment, orders and windows; and
+the material settings, saved and reopened."""
+import engine_fixtures as fx
+import numpy as np
+import pytest
+
+TOLERANCE = 1e-4         # max relative error of the shader against the mirror, per pass
+# An SH shading value is a signed sum of terms as large as the pass's brightest pixels (its ringing can
+# cancel to zero): float32 (and the GPU's atan, 3e-6 rad) leave up to 5e-6 of the pass's largest value on
+# any pixel, so the error is relative to max(|value|, 5% of that largest value); measured 7e-6 to 8.3e-5
+FLOOR_FRACTION = 0.05
+
+
+@pytest.fixture(scope="module")
+def engine(blender):
+    fx.ensure_registered()
+    return blender
+
+
+NO_TEXTURE = False
+ROUGHNESS = np.ones((8, 8, 4), np.float32)
+ROUGHNESS[..., 0] = np.linspace(0.3, 1.6, 8)[None, :]
+
+
+def _mirror_errors(result):
+    from sg_prt_addon.techniques import sh_shading, spherical_harmonics
+
+    passes, state = result["passes"], result["state"]
+    camera, uv = passes["camera"], passes["gbuffer_uv"]
+    covered = uv[..., 3] > 0.5
+    material_of_id = {i: name for name, i in passes["material_ids"].items()}
+    environment = spherical_harmonics.environment_coefficients(state.environment)
+    errors = {}
+    for material_id in np.unique(uv[covered][:, 2]).astype(int):
+        params = state.materials[material_of_id[material_id]]
+        mask = covered & (np.abs(uv[..., 2] - material_id) < 0.25)
+        view_origin = camera.position if camera.is_perspective else camera.forward
+        textures = {"roughness": ROUGHNESS} if "roughness" in params.textures else {}
+        diffuse, specular = sh_shading.shade_fragments(
+            params, textures, spherical_harmonics.table_for(params), environment,
+            passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
+            passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective, state.light_data())
+        for name, expected in (("Diffuse", diffuse), ("Specular", specular)):
+            actual = passes[name][mask][:, :3]
+            assert np.all(np.isfinite(actual)) and expected.max() > 0
+            errors[(params.name, name)] = float(fx.relative_error(actual, expected, FLOOR_FRACTION).max())
+    return errors, covered
+
+
+def _scene(name, world, order, window):
+    scene = fx.new_scene(name, 96, 96)
+    if world == "colour":
+        fx.world_colour(scene, (0.15, 0.17, 0.2))
+    else:
+        fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    fx.point_light(scene, name + "_point", (1.5, -2.0, 3.0), 800.0, radius=0.5)
+    fx.point_light(scene, name + "_sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
+    spot = fx.point_light(scene, name + "_spot", (-2.0, -2.0, 2.5), 600.0, radius=0.1, kind="SPOT")
+    spot.rotation_euler = (0.9, 0.0, -0.8)
+    glossy = fx.material(name + "_ggx", technique="SH", sh_order=order, sh_window=window, model="GGX",
+                         roughness=0.4, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6))
+    if not NO_TEXTURE: glossy.sgprt.roughness_texture = fx.image(name + "_rough", ROUGHNESS)
+    brushed = fx.material(name + "_as", technique="SH", sh_order=order, sh_window=window, model="ASHIKHMIN_SHIRLEY",
+                          nu=20.0, nv=200.0)
+    fx.uv_sphere(scene, name + "_a", (-1.1, 0.0, 1.0), radius=0.9).data.materials.append(glossy)
+    fx.uv_sphere(scene, name + "_b", (1.1, 0.0, 1.0), radius=0.9).data.materials.append(brushed)
+    return scene
+
+
+@pytest.mark.parametrize("world, order, window", [("colour", 5, "NONE"), ("environment", 5, "NONE"),
+                                                   ("environment", 3, "HANNING"), ("colour", 8, "LANCZOS")])
+def test_shader_matches_mirror(engine, world, order, window):
+    with fx.recorded_variant_keys() as keys:
+        result = fx.render(_scene(f"sh_{world}_{order}", world, order, window), gbuffer=True,
+                           environment_layer_size=32)
+    assert "error" not in result, result.get("error")
+    assert {key.technique for key in keys} == {"SH"} and {key.order for key in keys} == {order}
+    assert {key.isotropic for key in keys} == {True, False}
+    errors, covered = _mirror_errors(result)
+    assert covered.mean() > 0.2
+    print("max relative error", errors)
+    assert max(errors.values()) <= TOLERANCE
+
+
+def test_settings_survive_save_and_reopen(engine, tmp_path):
+    import bpy
+
+    material = fx.material("sh_saved", technique="SH", model="GGX", sh_order=7, sh_window="LANCZOS")
+    material.use_fake_user = True
+    path = tmp_path / "sh.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    settings = bpy.data.materials["sh_saved"].sgprt
+    assert (settings.technique, settings.sh_order, settings.sh_window) == ("SH", 7, "LANCZOS")
