@@ -66,7 +66,7 @@ class BrdfTable:
         the parabolic map's (anisotropic)."""
         view = np.asarray(view, np.float64)
         if self.layout == "theta":
-            theta = np.arctan2(np.linalg.norm(view[..., :2], axis=-1), np.maximum(view[..., 2], 0.0))
+            theta = np.arctan2(np.maximum(np.linalg.norm(view[..., :2], axis=-1), 1e-30), np.maximum(view[..., 2], 0.0))
             return np.stack([theta / (np.pi / 2), np.zeros_like(theta)], -1)
         return parabolic_coordinates(view)
 

@@ -16,7 +16,7 @@ def _table_coefficients(table, o, parameter):
     """The shader's sh_table_lookup: (N, N^2) at local views o (N, 3)."""
     layers = brdf_table.texture_layers(table)
     if table.layout == "theta":
-        theta = np.arctan2(np.linalg.norm(o[:, :2], axis=-1), np.maximum(o[:, 2], 0))
+        theta = np.arctan2(np.maximum(np.linalg.norm(o[:, :2], axis=-1), FLOAT(1e-30)), np.maximum(o[:, 2], 0))
         uv = np.stack([theta * FLOAT(2 / np.pi), table.parameter_coordinate(parameter)], -1).astype(FLOAT)
     else:
         uv = brdf_table.parabolic_coordinates(o).astype(FLOAT)

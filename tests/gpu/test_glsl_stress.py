@@ -548,6 +548,9 @@ RESOURCE_KERNELS = {
     "ggx_two_lobes.glsl": ["ggx_two_lobes"],
     "../common/surface_common.glsl": ["shading_frame", "apply_normal_map", "rotate_tangent"],
     "../factored/factored_shading.glsl": ["parabolic_uv", "factored_brdf"],
+    "../sh/sh_library.glsl": ["sh_basis", "sh_rotate_z", "sh_rotate", "sh_cap_factors", "sh_sg_factors",
+                              "sh_zonal_sum"],
+    "../sh/sh_shading.glsl": ["sh_parameter_coordinate", "sh_table_lookup"],
 }
 LIBRARY_ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl", "warp.glsl", "lights.glsl"]
 
@@ -609,6 +612,130 @@ def test_factored_brdf_stress(glsl, fuzz):
     assert finite.mean() > 0.15          # the stress vectors are mostly extreme by design
     expected = factored_shading.factored_brdf(maps, "pqpr", wo[finite], wi[finite])[:, :3]
     np.testing.assert_allclose(out[finite][:, :3], expected, rtol=1e-4)
+
+def _sh_weights(count, seed):
+    return np.random.default_rng(seed).uniform(-1, 1, count)
+
+
+def test_sh_library_stress(glsl, fuzz):
+    """The SH technique's library (shaders/techniques/sh/sh_library.glsl, order 8, with its generated x90
+    blocks): sh_basis at any direction the shader gives it (safe_normalize of zero, tiny, huge vectors),
+    sh_rotate (with sh_rotate_z) by random frames and the Euler angles' singular ones (beta 0 and pi, the
+    identity), sh_cap_factors for 1 - cos 0..2 and beyond, sh_sg_factors for sharpness 0..1e9 and
+    sh_zonal_sum at cosines beyond [-1, 1]: finite; the numpy mirrors within 2e-5 of the sums' scale."""
+    from scipy.spatial.transform import Rotation
+
+    from sg_prt_addon.harmonics import basis, projection, rotation
+    from sg_prt_addon.techniques import sh_glsl
+
+    order, count = 8, SMALL_ROWS // 8
+    d = fuzz.stress_vectors(count)
+    frames = Rotation.random(count, random_state=3).as_matrix()
+    frames[::7] = np.eye(3)
+    frames[1::7] = rotation.axis_rotation(2, 0.4)
+    frames[2::7] = rotation.axis_rotation(0, np.pi) @ rotation.axis_rotation(2, 1.3)
+    frames = _f32(frames)
+    epsilon = _f32(np.concatenate([fuzz.log_uniform(1e-9, 2.0, count - 4), [0.0, 1e-3, 2.0, 3.0]]))
+    sharpness = _f32(np.concatenate([fuzz.log_uniform(1e-6, 1e9, count - 3), [0.0, 10.0, 1e30]]))
+    cosine = _f32(fuzz.rng.uniform(-1.5, 1.5, count))
+    w1, w2, c = _sh_weights(order * order, 1), _sh_weights(order * order, 2), _sh_weights(order * order, 3)
+    g_weights = _sh_weights(order, 4)
+
+    def constants(name, values):
+        return f"const float {name}[{len(values)}] = float[](" + ", ".join(f"{v:.9e}" for v in values) + ");\n"
+
+    source = (sh_glsl.constants_source(order, None) + _resource("sh_library.glsl", "sh")
+              + constants("W1", w1) + constants("W2", w2) + constants("C", c) + constants("GW", g_weights))
+    body = """
+    float y[SH_COUNT];
+    sh_basis(safe_normalize(d.xyz, vec3(0.0, 0.0, 1.0)), y);
+    float turned[SH_COUNT];
+    for (int i = 0; i < SH_COUNT; i++) { turned[i] = C[i]; }
+    sh_rotate(turned, mat3(c0.xyz, c1.xyz, c2.xyz));
+    float g[SH_ORDER];
+    float s[SH_ORDER];
+    sh_cap_factors(e.x, g);
+    sh_sg_factors(e.y, s);
+    float zonal = sh_zonal_sum(GW, e.z);
+    float spun[SH_COUNT];
+    for (int i = 0; i < SH_COUNT; i++) { spun[i] = C[i]; }
+    sh_rotate_z(spun, 3.0 * e.z);
+    float z = 0.0;
+    for (int i = 0; i < SH_COUNT; i++) { z += W1[i] * spun[i]; }
+    float a = 0.0, b = 0.0, u = 0.0, v = 0.0, gc = 0.0, gs = 0.0;
+    for (int i = 0; i < SH_COUNT; i++) { a += W1[i] * y[i]; b += W2[i] * y[i]; u += W1[i] * turned[i]; v += W2[i] * turned[i]; }
+    for (int l = 0; l < SH_ORDER; l++) { gc += GW[l] * g[l]; gs += GW[l] * s[l]; }
+    result = row % 2 == 0 ? vec4(a, b, u, v) : vec4(gc, gs, zonal, z);
+    """
+    inputs = {"d": d, "c0": frames[:, :, 0], "c1": frames[:, :, 1], "c2": frames[:, :, 2],
+              "e": np.c_[epsilon, sharpness, cosine]}
+    out = glsl(["sg.glsl", source], body, inputs, 4)
+    _assert_finite(out, "SH library")
+    even, odd = slice(0, None, 2), slice(1, None, 2)
+    with np.errstate(all="ignore"):
+        length = np.linalg.norm(d, axis=1, keepdims=True)
+        unit = np.where((length > 0) & np.isfinite(length), d / length, [[0.0, 0.0, 1.0]])
+    y = basis.evaluate(unit[even], order)
+    turned = rotation.rotate_zyz_many(np.broadcast_to(c, (len(frames[even]), order * order)), frames[even])
+    expected = np.stack([y @ w1, y @ w2, turned @ w1, turned @ w2], -1)
+    scale = np.sum(np.abs(w1)) * 2.0
+    ordinary = (length[even, 0] > 1e-20) & (length[even, 0] < 1e20)
+    np.testing.assert_allclose(out[even][ordinary], expected[ordinary], atol=2e-5 * scale)
+    np.testing.assert_allclose(out[even][:, 2:], expected[:, 2:], atol=2e-5 * scale)
+    cap = projection.cap_factors(np.minimum(epsilon[odd], 2.0), order) @ g_weights
+    sg_expected = projection.sg_factors(np.minimum(sharpness[odd], 1e30), order) @ g_weights
+    bands = np.arange(order)
+    p = np.stack(projection.legendre_polynomials(cosine[odd], order - 1)[:order], -1)
+    zonal = p @ (g_weights * (2 * bands + 1) / (4 * np.pi))
+    inside = epsilon[odd] <= 2.0                     # beyond a hemisphere's 1 - cos = 2 no cap exists
+    np.testing.assert_allclose(out[odd][inside, 0], cap[inside], atol=2e-5 * np.sum(np.abs(g_weights)))
+    np.testing.assert_allclose(out[odd][:, 1], sg_expected, atol=2e-5 * np.sum(np.abs(g_weights)))
+    np.testing.assert_allclose(out[odd][:, 2], zonal, atol=2e-5 * np.max(np.abs(zonal)))
+    spun = rotation.rotate_z_many(np.broadcast_to(c, (len(cosine[odd]), order * order)), 3.0 * cosine[odd]) @ w1
+    np.testing.assert_allclose(out[odd][:, 3], spun, atol=2e-5 * scale)
+
+
+def test_sh_table_lookup_stress(glsl, fuzz):
+    """sh_table_lookup and sh_parameter_coordinate (sh_shading.glsl) on any view (zero, tiny, huge, below
+    the horizon) and parameter (0, negative, beyond the axis, NaN-free huge values), both layouts: finite,
+    and the mirror's lookup within 1e-5 of the table's scale on ordinary inputs."""
+    from sg_prt_addon.harmonics import brdf_table
+    from sg_prt_addon.techniques import sh_glsl, sh_shading, spherical_harmonics
+
+    count = SMALL_ROWS // 4
+    o = fuzz.stress_vectors(count)
+    parameter = _f32(np.concatenate([fuzz.rng.uniform(-0.5, 1.5, count - 4), [0.0, -1.0, 1e30, 1e-30]]))
+    shading = _resource("sh_shading.glsl", "sh")
+    weights = _sh_weights(25, 5)
+    for model, params in (("GGX", {}), ("ASHIKHMIN_SHIRLEY", {"nu": 20.0, "nv": 200.0})):
+        table = brdf_table.table_for(model, order=5, resolution=16 if model != "GGX" else None, **params)
+        isotropic = table.layout == "theta"
+        axis = spherical_harmonics.axis_constants(table)
+        source = ("#define SH_ISOTROPIC 1\n" if isotropic else "") + sh_glsl.constants_source(5, None) \
+            + f"const vec4 sh_axis = vec4({', '.join(f'{v:.9e}' for v in axis)});\n" \
+            + "const float W[25] = float[](" + ", ".join(f"{v:.9e}" for v in weights) + ");\n" \
+            + "".join(_glsl_function(shading, name) for name in ("sh_parameter_coordinate", "sh_table_lookup"))
+        body = """
+        float c[SH_COUNT];
+        float p = sh_parameter_coordinate(q.x);
+        sh_table_lookup(o.xyz, p, c);
+        float a = 0.0;
+        for (int i = 0; i < SH_COUNT; i++) { a += W[i] * c[i]; }
+        result = vec4(a, p, c[0], c[6]);
+        """
+        out = glsl(["sg.glsl", source], body, {"o": o, "q": parameter}, 4,
+                   textures={"sh_table": brdf_table.texture_layers(table)})
+        _assert_finite(out, f"sh_table_lookup {model}")
+        assert out[:, 1].min() >= 0 and out[:, 1].max() <= 1
+        with np.errstate(all="ignore"):
+            length = np.linalg.norm(o, axis=1)
+        ordinary = (length > 1e-3) & (length < 1e3)
+        expected = sh_shading._table_coefficients(table, (o[ordinary] / length[ordinary, None]).astype(np.float32),
+                                                  np.clip(parameter[ordinary], 0.0, 1e3))
+        scale = np.abs(table.coefficients).max()
+        np.testing.assert_allclose(out[ordinary, 0], expected @ weights, atol=1e-5 * scale * np.abs(weights).sum())
+        np.testing.assert_allclose(out[ordinary, 2], expected[:, 0], atol=1e-5 * scale)
+
 
 def test_shading_frame_stress(glsl, fuzz):
     """shading_frame, apply_normal_map and rotate_tangent with zero / parallel / huge tangents, zero
@@ -784,6 +911,9 @@ COVERED = {
     test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility"],
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
     test_factored_brdf_stress: ["parabolic_uv", "factored_brdf"],
+    test_sh_library_stress: ["sh_basis", "sh_rotate_z", "sh_rotate", "sh_cap_factors", "sh_sg_factors",
+                             "sh_zonal_sum"],
+    test_sh_table_lookup_stress: ["sh_parameter_coordinate", "sh_table_lookup"],
     test_model_lobes_stress: ["model_ndf_lobe", "model_m_factor"],
     test_table_lobes_stress: ["ggx_two_lobes", "anisotropic_lobes"],
     test_fitted_pieces_stress: ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",

@@ -22,8 +22,9 @@ float sh_parameter_coordinate(float value)
 void sh_table_lookup(vec3 o, float p, out float c[SH_COUNT])
 {
 #ifdef SH_ISOTROPIC
-  /* theta_v by atan: llvmpipe's acos is off by up to 1.6e-4 rad, its atan by 3e-6 */
-  vec2 uv = vec2(atan(length(o.xy), max(o.z, 0.0)) * (2.0 / 3.14159265358979), p);
+  /* theta_v by atan (llvmpipe's acos is off by up to 1.6e-4 rad, its atan by 3e-6); below the horizon pi / 2,
+   * also straight below, where atan(0, 0) would be undefined */
+  vec2 uv = vec2(atan(max(length(o.xy), 1.0e-30), max(o.z, 0.0)) * (2.0 / 3.14159265358979), p);
 #else
   vec3 d = safe_normalize(o);
   vec2 xy = d.z >= 0.0 ? d.xy : d.xy / max(length(d.xy), 1.0e-30);
