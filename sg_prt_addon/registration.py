@@ -1,7 +1,7 @@
 """Register and unregister everything the add-on adds to Blender, in dependency order."""
 import bpy
 
-from .blender import brdf_factorization, lobe_fit, panels, properties, visibility_bake
+from .blender import brdf_factorization, lobe_fit, panels, properties, transfer_bake, visibility_bake
 from .engine.render_engine import SGPRT_RenderEngine
 
 ENGINE_CLASSES = (SGPRT_RenderEngine,)
@@ -12,6 +12,7 @@ def register():
     properties.register()
     panels.register()
     visibility_bake.register()
+    transfer_bake.register()
     lobe_fit.register()           # after panels: its panel's parent is SGPRT_PT_material
     brdf_factorization.register()
     for cls in ENGINE_CLASSES:
@@ -24,6 +25,7 @@ def unregister():
         bpy.utils.unregister_class(_registered_engine_classes.pop())
     brdf_factorization.unregister()
     lobe_fit.unregister()
+    transfer_bake.unregister()
     visibility_bake.unregister()
     panels.unregister()
     properties.unregister()

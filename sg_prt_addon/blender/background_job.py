@@ -130,6 +130,28 @@ class ModalJobOperator:
         self._cleanup(context)
 
 
+class SceneJobOperator(ModalJobOperator):
+    """ModalJobOperator for a job on the scene (a bake): _prepare(context) -> the job or None after reporting
+    why not; execute runs it synchronously with printed progress (blender -b, scripts, tests), invoke in a
+    thread with the window manager's progress and Esc."""
+
+    def execute(self, context):
+        job = self._prepare(context)
+        if job is None:
+            return {"CANCELLED"}
+        job.verbose = True          # "[sg-prt] bake 40% ..." lines
+        job.run()
+        return self._finish(context, job)
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        job = self._prepare(context)
+        if job is None:
+            return {"CANCELLED"}
+        return self.start_modal(context, job)
+
+
 class FileJobOperator(ModalJobOperator):
     """ModalJobOperator for a job on a file: `filepath` (the file browser opens without one), _prepare(context)
     -> (target, job) or None after reporting why not; execute runs the job synchronously (blender -b,

@@ -69,7 +69,7 @@ from ..visibility import decode
 from ..visibility.per_vertex import MAX_ROWS, MAX_TERMS
 from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
 from . import export, per_vertex_store
-from .background_job import BackgroundJob, ModalJobOperator
+from .background_job import BackgroundJob, SceneJobOperator
 from .panels import RenderPanel
 from .per_vertex_store import mesh_topology_hash, mesh_triangles
 
@@ -232,7 +232,7 @@ def store_visibility_bake(mesh, result, options=None):
     })
 
 
-def _float_array(value):
+def float_array(value):
     try:
         return np.array(value, np.float64).ravel()          # IDPropertyArray: buffer protocol, no list
     except (TypeError, ValueError):
@@ -265,7 +265,7 @@ def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
             status=record.status, message=record.message, format_version=record.format_version,
             resolution=int(group["resolution"]), terms=int(group["terms"]), layers=record.layers,
             rms_error=float(group["rms_error"]), vertex_count=record.vertex_count,
-            topology_hash=record.topology_hash, frame_reference_axis=_float_array(group["frame_reference_axis"]),
+            topology_hash=record.topology_hash, frame_reference_axis=float_array(group["frame_reference_axis"]),
             date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)))
     except (KeyError, TypeError, ValueError) as error:
         return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
@@ -276,8 +276,8 @@ def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
     if not read_arrays:
         return stored
     resolution = stored.resolution
-    basis = _float_array(group["basis"]) if stored.terms else np.zeros(0)
-    mean = _float_array(group["mean"])
+    basis = float_array(group["basis"]) if stored.terms else np.zeros(0)
+    mean = float_array(group["mean"])
     if basis.size != stored.terms * resolution * resolution or mean.size != resolution * resolution:
         stored.status, stored.message = "INVALID", "stored basis has the wrong size: re-bake"
         return stored
@@ -400,7 +400,7 @@ def _bake_options(settings):
                        error_target=settings.error_target, max_terms=settings.max_terms)
 
 
-def _mesh_objects(context, target):
+def mesh_objects(context, target):
     if target == "ALL":
         hidden = export.render_roles(context.view_layer).hidden
         return [obj for obj in context.scene.objects if obj.type == "MESH" and obj.visible_get()
@@ -408,7 +408,63 @@ def _mesh_objects(context, target):
     return [obj for obj in context.selected_objects if obj.type == "MESH"]
 
 
-class SGPRT_OT_bake_visibility(ModalJobOperator, bpy.types.Operator):
+def bake_inputs(operator, context, objects, what):
+    """(receivers [(mesh key, object name, vertices, normals, triangles)], occluder vertices, occluder
+    triangles, {mesh key: topology hash}) of the objects a per-vertex bake writes to, world space; None
+    after the operator reported why not.  what: the bake's name in messages ("bake", "transfer bake")."""
+    if not objects:
+        operator.report({"ERROR"}, f"SG-PRT {what}: no mesh object selected" if operator.target == "SELECTED"
+                        else f"SG-PRT {what}: no visible mesh object")
+        return None
+    depsgraph = context.evaluated_depsgraph_get()
+    receivers, seen = [], set()
+    for obj in objects:
+        if obj.data.name in seen:
+            operator.report({"WARNING"}, f"'{obj.name}' shares its mesh with an object baked already; "
+                                         f"the {what} is stored once per mesh")
+            continue
+        try:
+            vertices, normals, triangles = receiver_arrays(obj, depsgraph)
+        except ValueError as error:
+            operator.report({"WARNING"}, f"SG-PRT {what} skips {error}")
+            continue
+        seen.add(obj.data.name)
+        receivers.append((obj.data.name, obj.name, vertices, normals, triangles))
+    if not receivers:
+        operator.report({"ERROR"}, f"SG-PRT {what}: none of the objects can be baked (see the warnings)")
+        return None
+    occluder_vertices, occluder_triangles = occluder_arrays(depsgraph)
+    topology = {key: mesh_topology_hash(bpy.data.meshes[key]) for key, *_ in receivers}
+    return receivers, occluder_vertices, occluder_triangles, topology
+
+
+def store_results(operator, job, topology, store, what, done):
+    """The operator's outcome of a finished per-vertex bake job: nothing written when it was cancelled or
+    failed; else store(mesh, result) -> a summary for every mesh whose topology is what was baked, reported
+    after `done`."""
+    if job.cancelled:
+        operator.report({"WARNING"}, f"SG-PRT {what} cancelled: nothing written, previous bakes kept")
+        return {"CANCELLED"}
+    if job.error is not None:
+        operator.report({"ERROR"}, f"SG-PRT {what} failed, nothing written: {job.error}")
+        return {"CANCELLED"}
+    written = []
+    for key, result in job.results.items():
+        mesh = bpy.data.meshes.get(key)
+        if mesh is None or mesh_topology_hash(mesh) != topology[key]:
+            operator.report({"WARNING"}, f"mesh '{key}' changed during the {what}: not stored")
+            continue
+        summary = store(mesh, result)
+        mesh.update()
+        label = next(label for k, label, *_ in job.receivers if k == key)
+        written.append(f"{label} ({summary})")
+    if not written:
+        return {"CANCELLED"}
+    operator.report({"INFO"}, f"{done} " + ", ".join(written))
+    return {"FINISHED"}
+
+
+class SGPRT_OT_bake_visibility(SceneJobOperator, bpy.types.Operator):
     """Bake all-frequency visibility (PCA-compressed SSDFs) at the vertices of mesh objects"""
     bl_idname = "sgprt.bake_visibility"
     bl_label = "Bake Visibility"
@@ -431,73 +487,38 @@ class SGPRT_OT_bake_visibility(ModalJobOperator, bpy.types.Operator):
     def _prepare(self, context):
         """The BakeJob, or None after reporting why not."""
         self._resolve_options(context)
-        objects = _mesh_objects(context, self.target)
-        if not objects:
-            self.report({"ERROR"}, "SG-PRT bake: no mesh object selected" if self.target == "SELECTED"
-                        else "SG-PRT bake: no visible mesh object")
+        inputs = bake_inputs(self, context, mesh_objects(context, self.target), "bake")
+        if inputs is None:
             return None
-        depsgraph = context.evaluated_depsgraph_get()
-        receivers, seen = [], set()
-        for obj in objects:
-            if obj.data.name in seen:
-                self.report({"WARNING"}, f"'{obj.name}' shares its mesh with an object baked already; "
-                                         "the bake is stored once per mesh")
-                continue
-            try:
-                vertices, normals, triangles = receiver_arrays(obj, depsgraph)
-            except ValueError as error:
-                self.report({"WARNING"}, f"SG-PRT bake skips {error}")
-                continue
-            seen.add(obj.data.name)
-            receivers.append((obj.data.name, obj.name, vertices, normals, triangles))
-        if not receivers:
-            self.report({"ERROR"}, "SG-PRT bake: none of the objects can be baked (see the warnings)")
-            return None
-        occluder_vertices, occluder_triangles = occluder_arrays(depsgraph)
-        self._topology = {key: mesh_topology_hash(bpy.data.meshes[key]) for key, *_ in receivers}
+        receivers, occluder_vertices, occluder_triangles, self._topology = inputs
         return BakeJob(receivers, occluder_vertices, occluder_triangles, _bake_options(self),
                        hook=progress_hook)
 
     def _finish(self, context, job):
-        if job.cancelled:
-            self.report({"WARNING"}, "SG-PRT bake cancelled: nothing written, previous bakes kept")
-            return {"CANCELLED"}
-        if job.error is not None:
-            self.report({"ERROR"}, f"SG-PRT bake failed, nothing written: {job.error}")
-            return {"CANCELLED"}
-        written = []
-        for key, result in job.results.items():
-            mesh = bpy.data.meshes.get(key)
-            if mesh is None or mesh_topology_hash(mesh) != self._topology[key]:
-                self.report({"WARNING"}, f"mesh '{key}' changed during the bake: not stored")
-                continue
+        def store(mesh, result):
             store_visibility_bake(mesh, result, job.options)
-            mesh.update()
-            label = next(label for k, label, *_ in job.receivers if k == key)
-            written.append(f"{label} ({result.terms} terms, {np.degrees(result.rms_error):.2f} deg, "
-                           f"{result.seconds:.1f} s)")
-        for name, message in unusable_bakes(context.scene, context.evaluated_depsgraph_get()):
-            self.report({"WARNING"}, f"SG-PRT: '{name}' renders unshadowed, its bake is {message}")
-        if not written:
-            return {"CANCELLED"}
-        self.report({"INFO"}, "SG-PRT baked " + ", ".join(written))
-        return {"FINISHED"}
+            return f"{result.terms} terms, {np.degrees(result.rms_error):.2f} deg, {result.seconds:.1f} s"
 
-    def execute(self, context):
-        job = self._prepare(context)
-        if job is None:
-            return {"CANCELLED"}
-        job.verbose = True          # the synchronous path prints "[sg-prt] bake 40% ..." lines
-        job.run()
-        return self._finish(context, job)
+        outcome = store_results(self, job, self._topology, store, "bake", "SG-PRT baked")
+        if not job.cancelled and job.error is None:
+            for name, message in unusable_bakes(context.scene, context.evaluated_depsgraph_get()):
+                self.report({"WARNING"}, f"SG-PRT: '{name}' renders unshadowed, its bake is {message}")
+        return outcome
 
-    def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
-        job = self._prepare(context)
-        if job is None:
-            return {"CANCELLED"}
-        return self.start_modal(context, job)
+
+def clear_bakes(operator, context, clear, what):
+    """A clear operator's execute: clear(mesh) -> bool on the target's meshes (else the active mesh object)."""
+    objects = mesh_objects(context, operator.target)
+    if not objects and context.active_object is not None and context.active_object.type == "MESH":
+        objects = [context.active_object]
+    if not objects:
+        operator.report({"ERROR"}, "SG-PRT: no mesh object selected")
+        return {"CANCELLED"}
+    cleared = [obj.data.name for obj in objects if clear(obj.data)]
+    for name in cleared:
+        bpy.data.meshes[name].update()
+    operator.report({"INFO"}, f"SG-PRT cleared {len(cleared)} {what}")
+    return {"FINISHED"}
 
 
 class SGPRT_OT_clear_visibility(bpy.types.Operator):
@@ -509,17 +530,7 @@ class SGPRT_OT_clear_visibility(bpy.types.Operator):
     target: EnumProperty(name="Target", items=TARGETS, default="SELECTED")
 
     def execute(self, context):
-        objects = _mesh_objects(context, self.target)
-        if not objects and context.active_object is not None and context.active_object.type == "MESH":
-            objects = [context.active_object]
-        if not objects:
-            self.report({"ERROR"}, "SG-PRT: no mesh object selected")
-            return {"CANCELLED"}
-        cleared = [obj.data.name for obj in objects if clear_visibility_bake(obj.data)]
-        for name in cleared:
-            bpy.data.meshes[name].update()
-        self.report({"INFO"}, f"SG-PRT cleared {len(cleared)} bake(s)")
-        return {"FINISHED"}
+        return clear_bakes(self, context, clear_visibility_bake, "bake(s)")
 
 
 class SGPRT_PT_visibility_bake(RenderPanel, bpy.types.Panel):

@@ -161,6 +161,7 @@ class PerVertexBuffers:
     vertex normal texture in the same rows (one texel a vertex) and the basis texture."""
 
     def __init__(self, mesh, data):
+        self.data = data                # the numpy PerVertexData (base.ObjectInputs.per_vertex_data)
         self.layers = data.layers
         self.vertices_per_row = vertices_per_row(data.layers)
         self.rows_texture = _texture_2d(per_vertex_texture(data.rows, data.layers, self.vertices_per_row))
@@ -211,6 +212,10 @@ class MeshBuffers:
     def per_vertex_layers(self):
         """kind -> vec4 rows a vertex of the uploaded per-vertex data (base.ObjectInputs.per_vertex)."""
         return {kind: buffers.layers for kind, buffers in self.per_vertex.items()}
+
+    def per_vertex_data(self):
+        """kind -> the uploaded visibility.per_vertex.PerVertexData (base.ObjectInputs.per_vertex_data)."""
+        return {kind: buffers.data for kind, buffers in self.per_vertex.items()}
 
 
 def _slot_material(state, entry, slot):
@@ -289,6 +294,13 @@ class _DrawContext(techniques.DrawContext):
             target = targets[name] = (texture, gpu.types.GPUFrameBuffer(color_slots=texture))
         return target
 
+    def object_table(self, name, sources, build):
+        tables = self.renderer.object_tables.setdefault(self.object_key, {})
+        entry = tables.get(name)
+        if entry is None or len(entry[0]) != len(sources) or any(a is not b for a, b in zip(entry[0], sources)):
+            entry = tables[name] = (tuple(sources), _texture(build()))
+        return entry[1]
+
     def object_texture(self, name):
         target = self.renderer.object_targets.get(self.object_key, {}).get(name)
         return None if target is None else target[0]
@@ -319,6 +331,7 @@ class Renderer:
         self.tables = {}                # a technique's tables (DrawContext.table): name -> GPUTexture
         self.material_tables = {}       # material name -> {name: GPUTexture} (DrawContext.material_table)
         self.object_targets = {}        # object key -> {name: (GPUTexture, GPUFrameBuffer)} of techniques' passes
+        self.object_tables = {}         # object key -> {name: (sources, GPUTexture)} (DrawContext.object_table)
         self.scene_buffer = None
         self.environment_texture = None
         self.equirect_texture = None
@@ -405,7 +418,8 @@ class Renderer:
             if buffers is None:
                 continue
             inputs = techniques.ObjectInputs(light_data, state.environment, self.gbuffer,
-                                             buffers.per_vertex_layers(), buffers.bounds, entry.matrix_world)
+                                             buffers.per_vertex_layers(), buffers.bounds, entry.matrix_world,
+                                             buffers.per_vertex_data())
             slots = []
             for slot, first_triangle, batch in buffers.batches:
                 name, params = _slot_material(state, entry, slot)
@@ -458,6 +472,8 @@ class Renderer:
         live = {object_key for _index, object_key, *_ in draws}
         for object_key in [key for key in self.object_targets if key not in live]:
             del self.object_targets[object_key]
+        for object_key in [key for key in self.object_tables if key not in live]:
+            del self.object_tables[object_key]
         for _index, _object_key, entry, context, slots in draws:
             if entry.holdout:
                 continue
@@ -530,6 +546,7 @@ class Renderer:
         self.tables.clear()
         self.material_tables.clear()
         self.object_targets.clear()
+        self.object_tables.clear()
         self.targets = []
         self.framebuffer = None
         self.size = None

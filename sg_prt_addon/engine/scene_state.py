@@ -66,9 +66,29 @@ def ssdf_data(bake, mesh):
                             mesh.vertex_count, mesh.corner_vertex)
 
 
+def transfer_for(object_eval):
+    """The stored transfer bake (blender.transfer_bake.StoredTransfer) of an evaluated object, or None."""
+    try:
+        from ..blender import transfer_bake
+    except ImportError:
+        return None
+    return transfer_bake.transfer_for_object(object_eval)
+
+
+def transfer_data(stored, mesh):
+    """(PerVertexData of kind "transfer", or None, message) of a stored transfer bake and the mesh it shades."""
+    if stored is None:
+        return None, "no transfer bake"
+    if not stored.usable:
+        return None, stored.message
+    return per_vertex.check(TRANSFER, stored.packed_coefficients, stored.basis_texture(), stored.terms,
+                            mesh.vertex_count, mesh.corner_vertex)
+
+
 # Per-vertex kinds the scene state looks up for each mesh: kind -> (source(object_eval), to data(record, mesh))
 SSDF = "ssdf"
-PER_VERTEX_KINDS = {SSDF: (visibility_for, ssdf_data)}
+TRANSFER = "transfer"
+PER_VERTEX_KINDS = {SSDF: (visibility_for, ssdf_data), TRANSFER: (transfer_for, transfer_data)}
 
 
 @dataclass
@@ -203,6 +223,13 @@ class SceneState:
         if unbaked and (self.visibility or lines):
             names = ", ".join(f"'{name}'" for name in unbaked[:5]) + (" ..." if len(unbaked) > 5 else "")
             lines.append(f"{len(unbaked)} object(s) without a visibility bake render unshadowed: {names}")
+        seen = set()
+        for entry in self.objects.values():      # a transfer bake that no longer fits: shaded without it
+            status = self.per_vertex_status.get(entry.mesh_key, {}).get(TRANSFER, "no transfer bake")
+            if entry.mesh_key not in seen and status != "no transfer bake" \
+                    and TRANSFER not in self.per_vertex.get(entry.mesh_key, {}):
+                lines.append(f"object '{entry.name}' renders without its transfer bake: {status}")
+            seen.add(entry.mesh_key)
         return lines
 
     @staticmethod

@@ -61,10 +61,10 @@ WINDOWS = ("hanning", "lanczos")
 
 
 def window_factors(name, order):
-    """sigma_l (order,) of a window over bands 0 .. order - 1: None -> ones; "hanning": (1 + cos(pi l / order))
-    / 2; "lanczos": sinc(l / order).  Both leave band 0 (the mean) alone."""
+    """sigma_l (order,) of a window over bands 0 .. order - 1: None or "none" -> ones; "hanning":
+    (1 + cos(pi l / order)) / 2; "lanczos": sinc(l / order).  Both leave band 0 (the mean) alone."""
     bands = np.arange(order, dtype=np.float64)
-    if name is None:
+    if name is None or name == "none":
         return np.ones(order)
     if name == "hanning":
         return 0.5 * (1.0 + np.cos(np.pi * bands / order))

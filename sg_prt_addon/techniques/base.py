@@ -25,15 +25,18 @@ class ObjectInputs:
     """What a variant may depend on besides its material: the scene and the object drawn.
 
     light_data: lighting.scene_lighting.LightData; environment: its EnvironmentData; gbuffer: the draw
-    writes the G-buffer outputs; per_vertex: per-vertex kind ("ssdf", ...) -> vec4 rows a vertex of the
-    object's usable precomputation (absent: none); bounds: (2, 3) local box or None; matrix_world (4, 4).
+    writes the G-buffer outputs; per_vertex: per-vertex kind ("ssdf", "transfer") -> vec4 rows a vertex of
+    the object's usable precomputation (absent: none), per_vertex_data: kind -> its
+    visibility.per_vertex.PerVertexData (numpy); bounds: (2, 3) local box or None; matrix_world (4, 4).
     Derived values a technique computes once per object go in ``memo``."""
 
-    def __init__(self, light_data, environment, gbuffer=False, per_vertex=None, bounds=None, matrix_world=None):
+    def __init__(self, light_data, environment, gbuffer=False, per_vertex=None, bounds=None, matrix_world=None,
+                 per_vertex_data=None):
         self.light_data = light_data
         self.environment = environment
         self.gbuffer = bool(gbuffer)
         self.per_vertex = dict(per_vertex or {})
+        self.per_vertex_data = dict(per_vertex_data or {})
         self.bounds = bounds
         self.matrix_world = np.eye(4) if matrix_world is None else np.asarray(matrix_world)
         self.memo = {}
@@ -57,6 +60,8 @@ class DrawContext:
     table(name, build): a GPU texture of build()'s float32 array ((H, W, 4) or (L, H, W, 4)), made once
       for the renderer; material_table(name, build): the same, remade when the material changes;
     image(slot): the material's image texture of a texture slot;
+    object_table(name, sources, build): a GPU texture of build()'s array for the object, remade when any of
+      the objects in the tuple `sources` is not the one it was made from, dropped with the object;
     object_target(name, size): a float RGBA (texture, framebuffer) of the object, kept while it lives;
     object_texture(name): the texture of object_target(name, ...), or None;
     fixed_shader(cache_key, create_info_calls): a compiled shader of a pass of the technique's own;

@@ -24,7 +24,7 @@ def _x90_function(name, order, transpose):
 
 def constants_source(order, window):
     """GLSL defines, constant arrays and sh_rotate_x90 / sh_rotate_x90_inverse of an order (2-8) and window
-    (None or harmonics.projection.WINDOWS)."""
+    ("none", None or one of harmonics.projection.WINDOWS)."""
     normalization = [basis.normalization(band, m) * (math.sqrt(2.0) if m else 1.0)
                      for band in range(order) for m in range(band + 1)]
     cosine = projection.clamped_cosine_zonal(order) / [basis.normalization(band, 0) for band in range(order)]

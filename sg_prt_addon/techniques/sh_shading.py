@@ -70,8 +70,10 @@ def _zonal_sum(weights, t):
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color, specular_color, parameter,
-          light_data, environment, table, window=None):
-    """Diffuse and specular radiance (N, 3) float32 of pixels."""
+          light_data, environment, table, window="none", transfer=None):
+    """Diffuse and specular radiance (N, 3) float32 of pixels; transfer: None or (rows (N, 4 L) the pixels'
+    interpolated [1, w_0, ...], radiance (4 L, N^2 + 1, >= 3) spherical_harmonics.transfer_radiance_texture,
+    terms (4 L, D) visibility.transfer.basis_terms of the bake), the HAS_TRANSFER variant's inputs."""
     order = table.order
     count = order * order
     position = np.asarray(position, FLOAT)
@@ -93,25 +95,37 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
     cosine = (projection.clamped_cosine_zonal(order)
               / [basis.normalization(band, 0) for band in range(order)]).astype(FLOAT)
     bands, _ = basis.band_of(count)
-    light = (window_factors[bands][:, None] * np.asarray(environment, FLOAT)[:count, :3]).astype(FLOAT)
-    radiance = c @ light
-    irradiance = (basis.evaluate(n, order).astype(FLOAT) * cosine[bands]) @ light
+    if transfer is None:
+        light = (window_factors[bands][:, None] * np.asarray(environment, FLOAT)[:count, :3]).astype(FLOAT)
+        radiance = c @ light
+        irradiance = (basis.evaluate(n, order).astype(FLOAT) * cosine[bands]) @ light
+    else:
+        rows, products, terms = (np.asarray(a, FLOAT) for a in transfer)
+        lit = np.einsum("nk,kic->nic", rows, products[:, :count + 1, :3])          # (N, N^2 + 1, 3)
+        radiance = np.einsum("ni,nic->nc", c, lit[:, :count])
+        irradiance = lit[:, count]
+        diffuse_transfer = rows @ terms[:, :count]                                 # (N, N^2): t(p)
     for axis, flux, g in _light_sets(position, light_data, order):
         weight = window_factors * g                                       # (N, P, order)
         y = basis.evaluate(axis, order).astype(FLOAT)                     # (N, P, N^2)
         glossy = np.sum(weight[..., bands] * c[:, None, :] * y, axis=-1)
+        unshadowed = _zonal_sum(weight * cosine, np.sum(n[:, None] * axis, axis=-1))
+        if transfer is not None:
+            shadowed = np.sum(weight[..., bands] * diffuse_transfer[:, None, :] * y, axis=-1)
+            visible = np.where(unshadowed > FLOAT(1e-12),
+                               np.clip(shadowed / np.where(unshadowed > 0, unshadowed, FLOAT(1)), 0, 1), FLOAT(1))
+            glossy, unshadowed = glossy * visible, shadowed
         radiance = radiance + np.sum(flux * glossy[..., None], axis=1)
-        diffuse_weight = _zonal_sum(weight * cosine, np.sum(n[:, None] * axis, axis=-1))
-        irradiance = irradiance + np.sum(flux * diffuse_weight[..., None], axis=1)
+        irradiance = irradiance + np.sum(flux * unshadowed[..., None], axis=1)
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / math.pi) * np.maximum(irradiance, 0)
     specular = np.asarray(specular_color, FLOAT) * np.maximum(radiance, 0)
     return diffuse.astype(FLOAT), specular.astype(FLOAT)
 
 
 def shade_fragments(material, textures, table, environment, position, normal, tangent, uv, view_origin,
-                    is_perspective, light_data):
+                    is_perspective, light_data, transfer=None):
     """Mirror of the technique's main(): per-fragment inputs as the G-buffer holds them, the material's
-    BrdfTable and the environment's coefficients."""
+    BrdfTable, the environment's coefficients and (HAS_TRANSFER) the transfer inputs of shade()."""
     count = len(position)
     diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
     specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
@@ -129,6 +143,5 @@ def shade_fragments(material, textures, table, environment, position, normal, ta
                                                      sg_shading.sample_texture(textures["normal_map"], uv)[:, :3],
                                                      FLOAT(material.normal_strength))
     shading_tangent = sg_shading.rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
-    window = None if getattr(material, "sh_window", "none") == "none" else material.sh_window
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
-                 specular_color, parameter, light_data, environment, table, window)
+                 specular_color, parameter, light_data, environment, table, material.sh_window, transfer)

@@ -10,6 +10,14 @@ not applied).  Lighting: the environment's equirect map projected once per map (
 bands, truncated to the material's order), or the world colour; point and spot lights as uniform caps,
 suns as their SG (both zonal about their direction).  The material's order (2-8) and window (none,
 Hanning, Lanczos: ringing against blur, docs/ACCURACY.md) pick the variant.
+
+Shadows: with a transfer bake of the object (blender/transfer_bake.py, visibility/transfer.py) the
+environment reaches the surface through the vertex's transfer: the glossy term dots the BRDF product with
+T L and the diffuse term is t . L (the paper's section 5 after Sloan 2002), the products of L with the
+compressed transfer's terms computed once per frame per object (visibility.transfer.transferred_radiance)
+and weighed per pixel by the interpolated PCA weights.  A light's diffuse term is t . (its SH) and its
+glossy term is scaled by the same visible fraction of the light (t . L_light over the unshadowed
+clamped-cosine integral); the shading order is at most the transfer's.
 """
 import collections
 import math
@@ -19,6 +27,7 @@ import numpy as np
 
 from ..harmonics import brdf_table, projection
 from ..reflectance import models
+from ..visibility import transfer
 from . import sh_glsl, sh_shading, shader_sources
 from .base import Technique
 
@@ -46,6 +55,7 @@ class SHKey:
     textures: tuple = ()
     has_lights: bool = False
     gbuffer: bool = False
+    transfer_layers: int = 0            # vec4 rows a vertex of the transfer bake (0: none)
 
     def describe(self):
         parts = [f"order {self.order}", f"window {self.window}",
@@ -55,13 +65,9 @@ class SHKey:
             parts.append("textures: " + ", ".join(self.textures))
         if self.gbuffer:
             parts.append("G-buffer")
+        if self.transfer_layers:
+            parts.append(f"transfer ({self.transfer_layers} weight vec4)")
         return ", ".join(parts)
-
-
-def window_name(params):
-    """The material's window as harmonics.projection names it (None: no window)."""
-    window = getattr(params, "sh_window", "none")
-    return None if window == "none" else window
 
 
 def texture_slots(params):
@@ -71,11 +77,12 @@ def texture_slots(params):
     return COLOUR_SLOTS + ((axis[0],) if axis else ())
 
 
-def table_for(params):
-    """The BrdfTable of a material (export.MaterialParams): its model at its order and fixed parameters."""
+def table_for(params, order=None):
+    """The BrdfTable of a material (export.MaterialParams): its model at its order (or `order`, the variant's:
+    a transfer bake of a lower order lowers it) and fixed parameters."""
     model = models.BY_NAME[params.model]
     values = {name: float(getattr(params, name)) for name in model.parameters}
-    return brdf_table.table_for(params.model, order=int(params.sh_order), **values)
+    return brdf_table.table_for(params.model, order=int(order or params.sh_order), **values)
 
 
 def axis_constants(table):
@@ -85,6 +92,28 @@ def axis_constants(table):
     _, spacing, low, high = brdf_table.PARAMETER_AXES[table.model]
     scale = 1.0 / math.log(high / low) if spacing == "log" else 1.0 / (high - low)
     return [scale, low, 1.0 if spacing == "log" else 0.0, float(len(table.parameter_nodes))]
+
+
+TRANSFER_KIND = "transfer"       # the per-vertex kind of a transfer bake (engine/scene_state.py)
+
+
+def transfer_order(data):
+    """The order of a transfer bake's PerVertexData (its basis texture holds D = vector_size(order) a term)."""
+    return transfer.order_of(data.basis_texture.shape[2])
+
+
+def transfer_radiance_texture(data, environment, order, window):
+    """(4 L, N^2 + 1, 4) float32: row k = term k of the transfer (the mean first) times the environment's
+    windowed SH lighting (visibility.transfer.transferred_radiance), for the shader's per-pixel weights."""
+    count = order * order
+    bands = np.floor(np.sqrt(np.arange(count))).astype(int)
+    factors = projection.window_factors(window, order)[bands]
+    lighting = environment_coefficients(environment)[:count].astype(np.float64) * factors[:, None]
+    products = transfer.transferred_radiance(transfer.basis_terms(data.basis_texture), lighting,
+                                             transfer_order(data), order)
+    out = np.zeros(products.shape[:2] + (4,), np.float32)
+    out[..., :3] = products
+    return out
 
 
 _environments = collections.OrderedDict()
@@ -123,9 +152,12 @@ class SphericalHarmonics(Technique):
         slots = texture_slots(params)
         textures = tuple(sorted(name for name in params.textures if name in slots))
         order = int(np.clip(int(getattr(params, "sh_order", DEFAULT_ORDER)), min(ORDERS), max(ORDERS)))
+        data = inputs.per_vertex_data.get(TRANSFER_KIND)
+        if data is not None:
+            order = min(order, transfer_order(data))
         return SHKey(order=order, window=getattr(params, "sh_window", "none"), isotropic=axis is not None,
                      parameter=axis[0] if axis else None, textures=textures, has_lights=inputs.has_lights,
-                     gbuffer=inputs.gbuffer)
+                     gbuffer=inputs.gbuffer, transfer_layers=data.layers if data is not None else 0)
 
     def defines(self, key):
         out = {"SH_PARAMETER": PARAMETER_FIELDS[key.parameter] if key.isotropic else "0.0"}
@@ -140,24 +172,40 @@ class SphericalHarmonics(Technique):
                 out["HAS_NORMAL_MAP" if name == "normal_map" else "HAS_TEXTURE_" + name.upper()] = 1
         if key.gbuffer:
             out["GBUFFER"] = 1
+        if key.transfer_layers:
+            out.update(HAS_TRANSFER=1, TRANSFER_LAYERS=key.transfer_layers)
         return out
 
     def samplers(self, key):
-        return ([("FLOAT_2D_ARRAY", "sh_table"), ("FLOAT_2D", "sh_environment")]
-                + [("FLOAT_2D", "texture_" + name) for name in key.textures])
+        samplers = [("FLOAT_2D_ARRAY", "sh_table"), ("FLOAT_2D", "sh_environment")]
+        if key.transfer_layers:
+            samplers += [("FLOAT_2D", "transfer_coefficients"), ("FLOAT_2D", "sh_transfer_radiance")]
+            if key.has_lights:
+                samplers.append(("FLOAT_2D_ARRAY", "transfer_basis"))
+        return samplers + [("FLOAT_2D", "texture_" + name) for name in key.textures]
+
+    def per_vertex_inputs(self, key):
+        if not key.transfer_layers:
+            return ()
+        return (shader_sources.PerVertexInput("transfer_coefficients", key.transfer_layers, "transfer_varying",
+                                              "transfer_rows"),)
 
     def create_info_calls(self, key):
         files = [name for name in LIBRARY_FILES if name != "lights.glsl" or key.has_lights]
         sources = [shader_sources.library_source(name) for name in files]
         sources += [shader_sources.technique_source("common", "surface_common.glsl"),
-                    sh_glsl.constants_source(key.order, None if key.window == "none" else key.window)]
+                    sh_glsl.constants_source(key.order, key.window)]
+        per_vertex = self.per_vertex_inputs(key)
+        if per_vertex:
+            sources.append(f"vec4 transfer_rows[{key.transfer_layers}];\n"
+                           + shader_sources.per_vertex_copy_source(per_vertex))
         sources += [shader_sources.technique_source(GLSL_DIR, name)
                     for name in ("sh_library.glsl", "sh_shading.glsl", "surface.frag.glsl")]
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
-                                            push_constants=(("VEC4", "sh_axis"),))
+                                            per_vertex, push_constants=(("VEC4", "sh_axis"),))
 
     def bind(self, shader, key, context):
-        table = table_for(context.params)
+        table = table_for(context.params, key.order)
         environment = context.inputs.environment
         shader.uniform_block("scene", context.scene_buffer)
         shader.uniform_block("material", context.material_buffer)
@@ -173,6 +221,15 @@ class SphericalHarmonics(Technique):
             return row
 
         shader.uniform_sampler("sh_environment", context.table(f"sh_environment_{id(environment)}", environment_row))
+        if key.transfer_layers:
+            buffers = context.per_vertex(TRANSFER_KIND)
+            data = buffers.data
+            shader.uniform_sampler("transfer_coefficients", buffers.rows_texture)
+            if key.has_lights:
+                shader.uniform_sampler("transfer_basis", buffers.basis_texture)
+            shader.uniform_sampler("sh_transfer_radiance", context.object_table(
+                f"sh_transfer_radiance_{key.order}_{key.window}", (data, environment),
+                lambda: transfer_radiance_texture(data, environment, key.order, key.window)))
         for name in key.textures:
             shader.uniform_sampler("texture_" + name, context.image(name))
 

@@ -132,7 +132,7 @@ def test_objects_disabled_in_renders_cast_no_shadow_in_bakes(scene):
     try:
         depsgraph = bpy.context.evaluated_depsgraph_get()
         assert len(vb.occluder_arrays(depsgraph)[1]) == both - len(suzanne.data.loop_triangles)
-        assert [obj.name for obj in vb._mesh_objects(bpy.context, "ALL")] == [floor.name]
+        assert [obj.name for obj in vb.mesh_objects(bpy.context, "ALL")] == [floor.name]
     finally:
         suzanne.hide_render = False
     hidden = bpy.data.collections.new("hidden_in_renders")

@@ -127,9 +127,9 @@ def test_techniques_table_puts_each_technique_beside_the_sg_lobes():
     scenes = {"a": {"kind": "diffuse", "roughness": None}, "b": {"kind": "glossy", "roughness": 0.3}}
     table = ts.techniques_table(_rows(), scenes).splitlines()
     assert table[0] == ("| scene | kind | SG lobes RMSE / HDR-FLIP / s | Factored BRDF RMSE / HDR-FLIP / s "
-                        "| noise floor |")
-    assert table[2] == "| a | diffuse | 0.040 / 0.050 / 0.200 | 0.070 / 0.060 / 0.100 | 0.010 |"
-    assert table[3] == "| b | glossy 0.3 | 0.120 / 0.200 / 0.300 | - / - / - | - |"
+                        "| Spherical harmonics RMSE / HDR-FLIP / s | noise floor |")
+    assert table[2] == "| a | diffuse | 0.040 / 0.050 / 0.200 | 0.070 / 0.060 / 0.100 | - / - / - | 0.010 |"
+    assert table[3] == "| b | glossy 0.3 | 0.120 / 0.200 / 0.300 | - / - / - | - / - / - | - |"
 
 
 def _data():

@@ -310,22 +310,16 @@ def clear_bakes():
     scene_state.visibility_provider = None
 
 
-def pixel_visibility(result, mask):
-    """techniques.sg_shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
-    as the GPU interpolates: the triangle (position.w - 1) of the object (normal.w - 1), barycentric
-    weights from the interpolated world position, the corners' vertex rows and SSDF normals, and the
-    broad diffuse lobes' visibility decoded at the corners' vertices.
-    None when the object has no usable bake."""
+def _pixel_corners(result, mask):
+    """(object entry, its world-space MeshExport, corner vertices (N, 3), barycentric weights (N, 3)) of the
+    G-buffer pixels `mask` (all of one object), as the GPU interpolates: the triangle (position.w - 1) of
+    the object (normal.w - 1), the weights from the interpolated world position."""
     from sg_prt_addon.blender import export
-    from sg_prt_addon.techniques import sg_shading
 
     passes, state = result["passes"], result["state"]
     object_index = np.unique(np.rint(passes["gbuffer_normal"][mask][:, 3]).astype(int) - 1)
     assert len(object_index) == 1, "pixels of one object"
     entry = list(state.objects.values())[object_index[0]]
-    data = state.visibility.get(entry.mesh_key)
-    if data is None:
-        return None
     mesh = export.to_world(state.meshes[entry.mesh_key], entry.matrix_world)
     triangle = np.rint(passes["gbuffer_position"][mask][:, 3]).astype(np.int64) - 1
     corners = mesh.triangles[triangle].astype(np.int64)                    # (N, 3)
@@ -338,7 +332,30 @@ def pixel_visibility(result, mask):
     b1 = (d22 * d1 - d12 * d2) / det
     b2 = (d11 * d2 - d12 * d1) / det
     weights = np.stack([1 - b1 - b2, b1, b2], axis=1)                       # (N, 3)
-    vertex = mesh.corner_vertex.astype(np.int64)[corners]                   # (N, 3) mesh vertices
+    return entry, mesh, mesh.corner_vertex.astype(np.int64)[corners], weights
+
+
+def pixel_per_vertex(result, mask, kind):
+    """(rows (N, 4 L) float32 interpolated to the G-buffer pixels `mask` (all of one object), the object's
+    visibility.per_vertex.PerVertexData of `kind`), or (None, None) without one."""
+    entry, _mesh, vertex, weights = _pixel_corners(result, mask)
+    data = result["state"].per_vertex.get(entry.mesh_key, {}).get(kind)
+    if data is None:
+        return None, None
+    return np.einsum("nk,nkc->nc", weights, data.rows[vertex].astype(np.float64)).astype(np.float32), data
+
+
+def pixel_visibility(result, mask):
+    """techniques.sg_shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
+    as the GPU interpolates (_pixel_corners): the corners' vertex rows and SSDF normals, and the broad
+    diffuse lobes' visibility decoded at the corners' vertices.  None when the object has no usable bake."""
+    from sg_prt_addon.techniques import sg_shading
+
+    state = result["state"]
+    entry, mesh, vertex, weights = _pixel_corners(result, mask)
+    data = state.visibility.get(entry.mesh_key)
+    if data is None:
+        return None
     rows = np.einsum("nk,nkc->nc", weights, data.packed[vertex].astype(np.float64))
     normal = np.einsum("nk,nkc->nc", weights, mesh.vertex_normals[vertex].astype(np.float64))
     # the broad diffuse lobes: decoded at the vertices, interpolated (renderer's per-vertex pass)

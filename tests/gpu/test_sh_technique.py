@@ -94,3 +94,75 @@ def test_settings_survive_save_and_reopen(engine, tmp_path):
     bpy.ops.wm.open_mainfile(filepath=str(path))
     settings = bpy.data.materials["sh_saved"].sgprt
     assert (settings.technique, settings.sh_order, settings.sh_window) == ("SH", 7, "LANCZOS")
+
+
+@pytest.fixture
+def transfer_scene(engine):
+    """A glossy sphere over a Cook-Torrance floor, both SH, under courtyard.exr and a point light."""
+    scene = fx.new_scene("sh_transfer", 96, 96)
+    scene.camera.location = (0.0, -5.0, 3.0)
+    scene.camera.rotation_euler = (1.05, 0.0, 0.0)
+    fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    fx.point_light(scene, "sh_transfer_light", (0.5, -0.5, 4.0), 800.0, radius=0.3)
+    sphere = fx.uv_sphere(scene, "sh_transfer_sphere", (0.0, 0.0, 1.0), radius=0.8, segments=24, rings=12)
+    sphere.data.materials.append(fx.material("sh_transfer_ggx", technique="SH", model="GGX", roughness=0.4,
+                                             diffuse_color=(0.6, 0.5, 0.4)))
+    floor = fx.grid(scene, "sh_transfer_floor", (0.0, 0.0, 0.0), size=5.0, segments=24)
+    floor.data.materials.append(fx.material("sh_transfer_floor_mat", technique="SH", model="COOK_TORRANCE",
+                                            roughness=0.3, diffuse_color=(0.7, 0.7, 0.7)))
+    yield scene, sphere, floor
+    from sg_prt_addon.blender import transfer_bake
+
+    for obj in (sphere, floor):
+        transfer_bake.clear_transfer_bake(obj.data)
+
+
+def _transfer_mirror_errors(result):
+    from sg_prt_addon.techniques import sh_shading, spherical_harmonics
+    from sg_prt_addon.visibility import transfer
+
+    passes, state = result["passes"], result["state"]
+    camera, uv = passes["camera"], passes["gbuffer_uv"]
+    covered = uv[..., 3] > 0.5
+    environment = spherical_harmonics.environment_coefficients(state.environment)
+    errors = {}
+    objects = np.rint(passes["gbuffer_normal"][..., 3]).astype(int) - 1
+    for object_index in np.unique(objects[covered]):
+        mask = covered & (objects == object_index)
+        material_id = int(np.rint(uv[mask][0, 2]))
+        params = state.materials[{i: n for n, i in passes["material_ids"].items()}[material_id]]
+        rows, data = fx.pixel_per_vertex(result, mask, "transfer")
+        assert data is not None
+        order = min(params.sh_order, spherical_harmonics.transfer_order(data))
+        products = spherical_harmonics.transfer_radiance_texture(data, state.environment, order, params.sh_window)
+        diffuse, specular = sh_shading.shade_fragments(
+            params, {}, spherical_harmonics.table_for(params, order), environment,
+            passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
+            passes["gbuffer_tangent"][mask], uv[mask][:, :2], camera.position, camera.is_perspective,
+            state.light_data(), transfer=(rows, products, transfer.basis_terms(data.basis_texture)))
+        for name, expected in (("Diffuse", diffuse), ("Specular", specular)):
+            actual = passes[name][mask][:, :3]
+            assert np.all(np.isfinite(actual)) and expected.max() > 0
+            errors[(params.name, name)] = float(fx.relative_error(actual, expected, FLOOR_FRACTION).max())
+    return errors
+
+
+def test_transfer_shadows_match_the_mirror(transfer_scene):
+    """Both objects' transfer baked by the operator at order 4 (the materials' order 5 shades at 4): the GPU
+    as the mirror, and the floor under the sphere darker than without the transfer."""
+    import bpy
+
+    scene, sphere, floor = transfer_scene
+    unshadowed = fx.render(scene, gbuffer=True, environment_layer_size=32)["passes"]["Diffuse"].copy()
+    with bpy.context.temp_override(scene=scene):
+        assert bpy.ops.sgprt.bake_transfer("EXEC_DEFAULT", target="ALL", order=4, directions=256,
+                                           term_mode="FIXED", terms=6) == {"FINISHED"}
+    with fx.recorded_variant_keys() as keys:
+        result = fx.render(scene, gbuffer=True, environment_layer_size=32)
+    assert "error" not in result, result.get("error")
+    assert {(key.order, key.transfer_layers) for key in keys} == {(4, 2)}
+    errors = _transfer_mirror_errors(result)
+    print("max relative error", errors)
+    assert max(errors.values()) <= TOLERANCE
+    darker = result["passes"]["Diffuse"][..., :3].sum() / unshadowed[..., :3].sum()
+    assert darker < 0.95, darker

@@ -7,6 +7,12 @@
  * the clamped cosine's bands A_l (Funk-Hecke), the lights' by the addition theorem.  Every band of the
  * lighting is scaled by the window's SH_WINDOW[l].  Mirrored by techniques/sh_shading.py.
  *
+ * HAS_TRANSFER (a transfer bake, techniques/spherical_harmonics.py): the environment through the vertex's
+ * transfer, T L and t . L weighed from sh_transfer_radiance (row k: term k of the transfer times the
+ * windowed lighting; columns 0 .. SH_COUNT - 1: T_k L, SH_COUNT: t_k . L) by transfer_rows; each light's
+ * diffuse term t . L_light with t rebuilt from transfer_basis, its glossy term times the same visible
+ * fraction of the light.
+ *
  * Needs sh_library.glsl and its generated constants, surface_common.glsl, (HAS_LIGHTS) lights.glsl, the
  * samplers sh_table (the BRDF product, ceil(SH_COUNT / 4) layers) and sh_environment (SH_COUNT x 1, rgb),
  * and the push constant sh_axis of the table's parameter axis (harmonics.brdf_table.BrdfTable.parameter_coordinate):
@@ -63,6 +69,26 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
   sh_basis(n, y);
   vec3 radiance = vec3(0.0);
   vec3 irradiance = vec3(0.0);
+#ifdef HAS_TRANSFER
+  for (int k = 0; k < 4 * TRANSFER_LAYERS; k++) {
+    float weight = transfer_rows[k / 4][k % 4];
+    for (int i = 0; i < SH_COUNT; i++) {
+      radiance += (weight * c[i]) * texelFetch(sh_transfer_radiance, ivec2(i, k), 0).rgb;
+    }
+    irradiance += weight * texelFetch(sh_transfer_radiance, ivec2(SH_COUNT, k), 0).rgb;
+  }
+#ifdef HAS_LIGHTS
+  float diffuse_transfer[SH_COUNT];             /* t(p): the mean and the terms, weighed */
+  for (int i = 0; i < SH_COUNT; i++) {
+    diffuse_transfer[i] = 0.0;
+  }
+  for (int layer = 0; layer < TRANSFER_LAYERS; layer++) {
+    for (int i = 0; i < SH_COUNT; i++) {
+      diffuse_transfer[i] += dot(transfer_rows[layer], texelFetch(transfer_basis, ivec3(i, 0, layer), 0));
+    }
+  }
+#endif
+#else
   for (int l = 0; l < SH_ORDER; l++) {
     for (int i = l * l; i < (l + 1) * (l + 1); i++) {
       vec3 light = SH_WINDOW[l] * texelFetch(sh_environment, ivec2(i, 0), 0).rgb;
@@ -70,6 +96,7 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
       irradiance += (SH_COSINE[l] * y[i]) * light;
     }
   }
+#endif
 #ifdef HAS_LIGHTS
   for (int l = 0; l < scene.counts.x + scene.counts.y; l++) {
     vec3 axis;
@@ -103,15 +130,28 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
     sh_basis(axis, ya);
     float glossy = 0.0;
     float zonal[SH_ORDER];
+#ifdef HAS_TRANSFER
+    float shadowed = 0.0;
+#endif
     for (int k = 0; k < SH_ORDER; k++) {
       float w = SH_WINDOW[k] * g[k];
       zonal[k] = w * SH_COSINE[k];
       for (int i = k * k; i < (k + 1) * (k + 1); i++) {
         glossy += w * c[i] * ya[i];
+#ifdef HAS_TRANSFER
+        shadowed += w * diffuse_transfer[i] * ya[i];
+#endif
       }
     }
+    float unshadowed = sh_zonal_sum(zonal, dot(n, axis));
+#ifdef HAS_TRANSFER
+    /* the visible fraction of the light's clamped-cosine integral shadows its glossy term too */
+    radiance += flux * (glossy * (unshadowed > 1.0e-12 ? clamp(shadowed / unshadowed, 0.0, 1.0) : 1.0));
+    irradiance += flux * shadowed;
+#else
     radiance += flux * glossy;
-    irradiance += flux * sh_zonal_sum(zonal, dot(n, axis));
+    irradiance += flux * unshadowed;
+#endif
   }
 #endif
   diffuse = diffuse_color * (1.0 / 3.14159265358979) * max(irradiance, vec3(0.0));

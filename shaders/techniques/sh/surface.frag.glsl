@@ -6,6 +6,9 @@ void main()
 {
   bool front = gl_FrontFacing != (determinant(mat3(model_matrix)) < 0.0);
   vec3 normal = front ? world_normal : -world_normal;
+#ifdef HAS_TRANSFER
+  load_per_vertex_rows();                        /* transfer_rows: the vertex's [1, w_0, ...], interpolated */
+#endif
   vec3 diffuse_color = material.diffuse_color.rgb;
   vec3 specular_color = material.specular_color.rgb;
 #ifdef HAS_TEXTURE_DIFFUSE_COLOR

@@ -1,0 +1,120 @@
+"""Transfer bake operator (sgprt.bake_transfer, blender/transfer_bake.py) and its storage: real bpy, real
+.blend files saved and reopened; a small Suzanne over a floor, 256 directions a vertex."""
+import bmesh
+import bpy
+import numpy as np
+import pytest
+
+from sg_prt_addon.blender import transfer_bake as tb
+from sg_prt_addon.engine import scene_state
+from sg_prt_addon.visibility import transfer
+
+SMALL = dict(order=4, directions=256, term_mode="FIXED", terms=6)
+
+
+@pytest.fixture
+def scene(addon):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "SG_PRT"
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=10, y_subdivisions=10, size=4.0)
+    floor = bpy.context.active_object
+    floor.name = "Floor"
+    bpy.ops.mesh.primitive_monkey_add(size=1.0, location=(0.0, 0.0, 1.0))
+    suzanne = bpy.context.active_object
+    suzanne.name = "Suzanne"
+    for key, value in SMALL.items():
+        setattr(scene.sgprt_transfer, key, value)
+    yield scene, floor, suzanne
+    tb.progress_hook = None
+
+
+def _snapshot(mesh):
+    stored = tb.load_transfer_bake(mesh)
+    return (stored.status, stored.order, stored.terms, np.asarray(stored.packed_coefficients).view(np.uint32).copy(),
+            stored.mean.view(np.uint32).copy(), stored.basis.view(np.uint32).copy())
+
+
+def _same(a, b):
+    return a[:3] == b[:3] and all(np.array_equal(x, y) for x, y in zip(a[3:], b[3:]))
+
+
+def test_bake_stores_and_survives_save_and_reopen(scene, tmp_path):
+    _, floor, suzanne = scene
+    assert bpy.ops.sgprt.bake_transfer(target="ALL") == {"FINISHED"}
+    stored = tb.load_transfer_bake(suzanne.data)
+    assert stored.usable and (stored.order, stored.terms, stored.layers) == (4, 6, 2)
+    assert stored.basis.shape == (6, transfer.vector_size(4)) and stored.packed_coefficients.shape == (507, 8)
+    assert 0 < stored.relative_error < 0.5
+    # the record reconstructs what the bake computed: the rows' weights times the basis, plus the mean
+    vectors = stored.mean + stored.packed_coefficients[:, 1:7] @ stored.basis
+    diffuse, _ = transfer.unpack(vectors, 4)
+    assert np.all(diffuse[:, 0] > -0.05)               # t_00: the visible cosine-weighted solid angle, >= 0
+    before = {mesh.name: _snapshot(mesh) for mesh in (floor.data, suzanne.data)}
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "transfer.blend"))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "transfer.blend"))
+    for name, snapshot in before.items():
+        assert _same(snapshot, _snapshot(bpy.data.meshes[name])), name
+
+
+def test_the_floor_under_suzanne_is_shadowed(scene):
+    """t_00 (the visible cosine-weighted solid angle) of the floor's centre vertex, under Suzanne, against a
+    far corner's, which sees the whole sky (pi / sqrt(4 pi) = 0.886)."""
+    _, floor, _ = scene
+    assert bpy.ops.sgprt.bake_transfer(target="ALL") == {"FINISHED"}
+    stored = tb.load_transfer_bake(floor.data)
+    vectors = stored.mean + stored.packed_coefficients[:, 1:7] @ stored.basis
+    positions = np.array([v.co for v in floor.data.vertices])
+    centre = np.argmin(np.linalg.norm(positions[:, :2], axis=1))
+    corner = np.argmax(np.linalg.norm(positions[:, :2], axis=1))
+    assert vectors[corner, 0] == pytest.approx(np.pi / np.sqrt(4 * np.pi), rel=0.05)
+    assert vectors[centre, 0] < 0.8 * vectors[corner, 0]
+
+
+def test_cancelled_and_failed_bakes_keep_the_previous_one(scene, monkeypatch):
+    _, floor, suzanne = scene
+    assert bpy.ops.sgprt.bake_transfer(target="ALL") == {"FINISHED"}
+    before = _snapshot(suzanne.data)
+    tb.progress_hook = lambda fraction, message: fraction > 0.3
+    assert bpy.ops.sgprt.bake_transfer(target="ALL", terms=3) == {"CANCELLED"}
+    assert _same(before, _snapshot(suzanne.data))
+    tb.progress_hook = None
+
+    def fails(*args, **kwargs):            # the second receiver's bake fails: nothing of the first is written
+        if fails.calls:
+            raise MemoryError("out of memory")
+        fails.calls += 1
+        return real(*args, **kwargs)
+    real, fails.calls = transfer.bake_transfer, 0
+    monkeypatch.setattr(transfer, "bake_transfer", fails)
+    with pytest.raises(RuntimeError, match="transfer bake failed, nothing written: out of memory"):
+        bpy.ops.sgprt.bake_transfer(target="ALL", terms=3)
+    assert _same(before, _snapshot(suzanne.data))
+
+
+def test_a_changed_mesh_makes_the_bake_stale_and_the_render_says_so(scene):
+    _, floor, suzanne = scene
+    assert bpy.ops.sgprt.bake_transfer(target="ALL") == {"FINISHED"}
+    mesh = bmesh.new()
+    mesh.from_mesh(suzanne.data)
+    bmesh.ops.subdivide_edges(mesh, edges=mesh.edges[:3], cuts=1)
+    mesh.to_mesh(suzanne.data)
+    mesh.free()
+    stored = tb.transfer_for_object(suzanne.evaluated_get(bpy.context.evaluated_depsgraph_get()))
+    assert stored.status == "STALE" and "re-bake" in stored.message
+    state = scene_state.SceneState()
+    state.sync(bpy.context.evaluated_depsgraph_get())
+    warnings = state.unshadowed_warnings()
+    assert any("'Suzanne' renders without its transfer bake: stale" in line for line in warnings), warnings
+    assert any(data.get("transfer") is not None for data in state.per_vertex.values())    # the floor's is kept
+
+
+def test_topology_changing_modifiers_are_refused(scene):
+    _, floor, suzanne = scene
+    suzanne.modifiers.new("subdivision", "SUBSURF")
+    bpy.ops.object.select_all(action="DESELECT")
+    suzanne.select_set(True)
+    with pytest.raises(RuntimeError, match="none of the objects can be baked"):
+        bpy.ops.sgprt.bake_transfer(target="SELECTED")
+    assert not tb.has_transfer_bake(suzanne.data)
