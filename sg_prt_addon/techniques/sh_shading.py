@@ -26,7 +26,8 @@ def _table_coefficients(table, o, parameter):
 
 
 def _cap_flux_and_factors(position, light_data, order):
-    """(axis (N, P, 3), flux (N, P, 3), g (N, P, order)) of the point and spot lights as uniform caps."""
+    """(axis (N, P, 3), flux (N, P, 3), g (N, P, order), sine of the angular radius (N, P)) of the point and
+    spot lights as uniform caps."""
     to_light = light_data.point_position[None] - position[:, None]
     distance2 = np.sum(to_light * to_light, axis=-1)
     radius2 = light_data.point_radius[None] ** 2
@@ -35,6 +36,7 @@ def _cap_flux_and_factors(position, light_data, order):
     sin2 = radius2 / effective2
     cos_half = np.sqrt(np.maximum(1 - sin2, 0)).astype(FLOAT)
     g = projection.cap_factors(sin2 / (1 + cos_half), order, FLOAT)
+    sine = np.sqrt(sin2).astype(FLOAT)
     flux = light_data.point_intensity[None] * (2 / (effective2 * (1 + cos_half)))[..., None]
     spot = light_data.spot_size >= 0
     if np.any(spot):
@@ -43,7 +45,7 @@ def _cap_flux_and_factors(position, light_data, order):
         width = np.maximum((1 - cos_spot) * light_data.spot_blend[None], FLOAT(1e-12))
         s = np.clip((cos_angle - cos_spot) / width, 0, 1)
         flux = flux * np.where(spot[None], s * s * (3 - 2 * s), FLOAT(1))[..., None]
-    return axis.astype(FLOAT), flux.astype(FLOAT), g
+    return axis.astype(FLOAT), flux.astype(FLOAT), g, sine
 
 
 def _light_sets(position, light_data, order):
@@ -54,9 +56,12 @@ def _light_sets(position, light_data, order):
         count = len(light_data.sun_sharpness)
         flux = light_data.sun_amplitude * sg.sphere_integral(light_data.sun_sharpness, FLOAT(1))[:, None]
         g = projection.sg_factors(light_data.sun_sharpness, order, FLOAT)
+        # the cap the SG stands for (lights.glsl light_cap_energy_lobe: sharpness ln(10) / sin^2)
+        sine = np.sqrt(np.minimum(FLOAT(np.log(10)) / np.maximum(light_data.sun_sharpness, FLOAT(1e-6)), 1))
         sets.append((np.broadcast_to(light_data.sun_axis[None], (len(position), count, 3)),
                      np.broadcast_to(flux[None], (len(position), count, 3)).astype(FLOAT),
-                     np.broadcast_to(g[None], (len(position), count, order))))
+                     np.broadcast_to(g[None], (len(position), count, order)),
+                     np.broadcast_to(sine[None].astype(FLOAT), (len(position), count))))
     return sets
 
 
@@ -105,16 +110,19 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
         radiance = np.einsum("ni,nic->nc", c, lit[:, :count])
         irradiance = lit[:, count]
         diffuse_transfer = rows @ terms[:, :count]                                 # (N, N^2): t(p)
-    for axis, flux, g in _light_sets(position, light_data, order):
+    for axis, flux, g, sine in _light_sets(position, light_data, order):
         weight = window_factors * g                                       # (N, P, order)
         y = basis.evaluate(axis, order).astype(FLOAT)                     # (N, P, N^2)
         glossy = np.sum(weight[..., bands] * c[:, None, :] * y, axis=-1)
-        unshadowed = _zonal_sum(weight * cosine, np.sum(n[:, None] * axis, axis=-1))
+        elevation = np.sum(n[:, None] * axis, axis=-1)
+        unshadowed = _zonal_sum(weight * cosine, elevation)
+        above = (elevation > -sine).astype(FLOAT)          # a light wholly below the horizon lights nothing
         if transfer is not None:
             shadowed = np.sum(weight[..., bands] * diffuse_transfer[:, None, :] * y, axis=-1)
             visible = np.where(unshadowed > FLOAT(1e-12),
-                               np.clip(shadowed / np.where(unshadowed > 0, unshadowed, FLOAT(1)), 0, 1), FLOAT(1))
+                               np.clip(shadowed / np.where(unshadowed > 0, unshadowed, FLOAT(1)), 0, 1), FLOAT(0))
             glossy, unshadowed = glossy * visible, shadowed
+        glossy, unshadowed = glossy * above, unshadowed * above
         radiance = radiance + np.sum(flux * glossy[..., None], axis=1)
         irradiance = irradiance + np.sum(flux * unshadowed[..., None], axis=1)
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / math.pi) * np.maximum(irradiance, 0)

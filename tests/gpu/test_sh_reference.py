@@ -12,8 +12,8 @@ WARD = dict(alpha_x=0.5, alpha_y=0.25, diffuse_color=(0.3, 0.3, 0.3), specular_c
 GGX = dict(roughness=0.4, diffuse_color=(0.5, 0.5, 0.5), specular_color=(0.3,) * 3)
 # (name, world, light radius (None: no light), model, settings, {SH order or "SG": bound}, SH 5 beats SG):
 # relative RMSE over interior pixels, 64 x 64.  Measured (SH 3 / SH 5 / SG, reference noise floor):
-# GGX courtyard + small light 0.367 / 0.207 / 0.045 (0.016): the small light's highlight rings at order 5;
-# Ward big light 0.320 / 0.063 / 0.091 (0.021) and Ward courtyard 0.290 / 0.104 / 0.126 (0.020): on a broad
+# GGX courtyard + small light 0.366 / 0.206 / 0.045 (0.016): the small light's highlight rings at order 5;
+# Ward big light 0.319 / 0.062 / 0.091 (0.021) and Ward courtyard 0.290 / 0.104 / 0.126 (0.020): on a broad
 # anisotropic lobe order 5 holds the whole product and beats the SG lobes
 CASES = [
     ("ggx_courtyard", "courtyard", 0.1, "GGX", GGX, {3: 0.45, 5: 0.26, "SG": 0.06}, False),

@@ -4,8 +4,9 @@
  * into the world frame, where the environment's coefficients live (the same dot product as rotating the
  * lighting into the local frame, one vector instead of three colours).  Lights are caps (point and spot
  * lights, by sphere_light_cap) and SGs (suns), zonal about their direction: Phi g_l Y_lm(axis).  Diffuse:
- * the clamped cosine's bands A_l (Funk-Hecke), the lights' by the addition theorem.  Every band of the
- * lighting is scaled by the window's SH_WINDOW[l].  Mirrored by techniques/sh_shading.py.
+ * the clamped cosine's bands A_l (Funk-Hecke), the lights' by the addition theorem; a light wholly below
+ * the horizon adds nothing (its expansion would add only ringing).  Every band of the lighting is scaled by
+ * the window's SH_WINDOW[l].  Mirrored by techniques/sh_shading.py.
  *
  * HAS_TRANSFER (a transfer bake, techniques/spherical_harmonics.py): the environment through the vertex's
  * transfer, T L and t . L weighed from sh_transfer_radiance (row k: term k of the transfer times the
@@ -102,10 +103,11 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
     vec3 axis;
     vec3 flux;
     float g[SH_ORDER];
+    float sin2;                                  /* of the light's angular radius */
     if (l < scene.counts.x) {
       float effective2;
-      float sin2 = sphere_light_cap(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w,
-                                    effective2, axis);
+      sin2 = sphere_light_cap(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w,
+                              effective2, axis);
       float cos_half = sqrt(max(1.0 - sin2, 0.0));
       sh_cap_factors(sin2 / (1.0 + cos_half), g);
       /* radiance I / (pi r^2) over the cap's solid angle 2 pi (1 - cos): 2 I / (d^2 (1 + cos)) */
@@ -123,6 +125,7 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
       axis = scene.sun_axis_sharpness[s].xyz;
       float lambda = scene.sun_axis_sharpness[s].w;
       sh_sg_factors(lambda, g);
+      sin2 = min(LIGHT_LN10 / max(lambda, 1.0e-6), 1.0);     /* the cap the SG stands for (lights.glsl) */
       /* the SG's integral over the sphere */
       flux = scene.sun_amplitude[s].rgb * sg_sphere_integral(lambda, 1.0);
     }
@@ -144,13 +147,15 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
       }
     }
     float unshadowed = sh_zonal_sum(zonal, dot(n, axis));
+    /* a light wholly below the horizon lights nothing: its expansion would only add the product's ringing */
+    float above = dot(n, axis) > -sqrt(sin2) ? 1.0 : 0.0;
 #ifdef HAS_TRANSFER
     /* the visible fraction of the light's clamped-cosine integral shadows its glossy term too */
-    radiance += flux * (glossy * (unshadowed > 1.0e-12 ? clamp(shadowed / unshadowed, 0.0, 1.0) : 1.0));
-    irradiance += flux * shadowed;
+    radiance += flux * (above * glossy * (unshadowed > 1.0e-12 ? clamp(shadowed / unshadowed, 0.0, 1.0) : 0.0));
+    irradiance += flux * (above * shadowed);
 #else
-    radiance += flux * glossy;
-    irradiance += flux * unshadowed;
+    radiance += flux * (above * glossy);
+    irradiance += flux * (above * unshadowed);
 #endif
   }
 #endif
