@@ -18,7 +18,9 @@ on one machine:
    layer size 64 / 256 (128 is the default); NDF lobe count 2 / 4 / 8 of the anisotropic
    material (6 is the scene's); every material's view warp with one or two lobes per NDF lobe
    (material.sgprt.view_warp PAPER and SPLIT2; SPLIT3, three, is the default); every material with the
-   factored-BRDF technique (mccool2001), unshadowed and baked.  Bake time is reported apart (a precomputation);
+   factored-BRDF technique (mccool2001), unshadowed and baked; every material with the spherical-harmonics
+   technique (kautz2002) at SH orders 3 / 5 / 6, unshadowed and with a transfer bake of order 6 (each lower
+   order reads its leading block).  Bake time is reported apart (a precomputation);
 3. baselines: the reference renderer at 1 / 4 / 16 samples per pixel (independent seeds), EEVEE
    at 1 / 16 / 64 samples and Cycles (CPU, direct light only) at 1 / 4 / 16 / 64 samples, both
    with node materials matched to ``material.sgprt`` (benchmarks/matched_materials.py says how
@@ -62,11 +64,11 @@ SCENES = ("suzanne_courtyard", "brushed_metal")
 FULL = dict(size=512, noise=0.015, max_reference_spp=256, reference_seconds=240, reference_curve=(1, 4, 16),
             bake_resolutions=(8, 16, 32),
             fixed_terms=(4, 8, 16, 47), layer_sizes=(64, 256), lobe_counts=(2, 4, 8), warp_modes=("PAPER", "SPLIT2"),
-            eevee_samples=(1, 16, 64), cycles_samples=(1, 4, 16, 64), redraws=3)
+            eevee_samples=(1, 16, 64), cycles_samples=(1, 4, 16, 64), redraws=3, sh_orders=(3, 5, 6))
 QUICK = dict(size=64, noise=0.06, max_reference_spp=32, reference_seconds=20, reference_curve=(1, 4),
              bake_resolutions=(8,),
              fixed_terms=(4, 47), layer_sizes=(64,), lobe_counts=(2,), warp_modes=("SPLIT2",), eevee_samples=(1, 16),
-             cycles_samples=(1, 4), redraws=2)
+             cycles_samples=(1, 4), redraws=2, sh_orders=(3,))
 
 
 # ----------------------------------------------------------------------------- pure logic (tested)
@@ -539,6 +541,7 @@ class SceneRun:
                 for material in materials:
                     material.sgprt.view_warp = defaults[material.name]
             self.factored_stage(materials, default_bakes, resolution)
+            self.harmonics_stage(materials)
         finally:
             scene_state.visibility_provider = None
             render_engine.debug["timed_redraws"] = 0
@@ -559,6 +562,42 @@ class SceneRun:
         finally:
             for material in materials:
                 material.sgprt.technique = defaults[material.name]
+
+    def harmonics_stage(self, materials):
+        """Every material with the SH technique (kautz2002) at each of config["sh_orders"]: unshadowed, then
+        with a transfer bake (the operator's defaults, of the highest order), removed afterwards."""
+        import bpy
+
+        from sg_prt_addon.blender import transfer_bake
+
+        orders = self.config["sh_orders"]
+        defaults = {material.name: (material.sgprt.technique, material.sgprt.sh_order) for material in materials}
+        try:
+            for material in materials:
+                material.sgprt.technique = "SH"
+            self.use_bakes(None)
+            for order in orders:
+                for material in materials:
+                    material.sgprt.sh_order = order
+                self.engine_render(f"SH order {order} (kautz2002), unshadowed", "Spherical harmonics",
+                                   {"technique": "SH", "sh_order": order, "transfer": None})
+            start = time.perf_counter()
+            result = bpy.ops.sgprt.bake_transfer("EXEC_DEFAULT", target="ALL", order=max(orders))
+            seconds = time.perf_counter() - start
+            if result != {"FINISHED"}:
+                raise RuntimeError(f"the transfer bake did not finish: {result}")
+            for order in orders:
+                for material in materials:
+                    material.sgprt.sh_order = order
+                self.engine_render(f"SH order {order}, transfer order {max(orders)}", "SH + transfer",
+                                   {"technique": "SH", "sh_order": order, "transfer": max(orders)},
+                                   bake_seconds=seconds if order == max(orders) else None)
+        finally:
+            for material in materials:
+                material.sgprt.technique, material.sgprt.sh_order = defaults[material.name]
+            for obj in self.scene.objects:
+                if obj.type == "MESH":
+                    transfer_bake.clear_transfer_bake(obj.data)
 
     def _materials(self):
         found = {}
@@ -607,6 +646,7 @@ def plot(data, path):
     styles = {"SG-PRT unshadowed": ("#9467bd", "v"), "SG-PRT bake R": ("#d62728", "o"),
               "SG-PRT terms": ("#ff7f0e", "s"), "SG-PRT layers": ("#e377c2", "D"), "SG-PRT lobes": ("#8c564b", "^"),
               "SG-PRT warp": ("#7f7f7f", "<"), "Factored BRDF": ("#bcbd22", ">"),
+              "Spherical harmonics": ("#aec7e8", "p"), "SH + transfer": ("#393b79", "*"),
               "reference": ("#2ca02c", "P"), "EEVEE": ("#1f77b4", "X"), "Cycles": ("#17becf", "h")}
     scenes = list(data["scenes"])
     figure, axes = plt.subplots(1, len(scenes), figsize=(6.0 * len(scenes), 4.6), squeeze=False)

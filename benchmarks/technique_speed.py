@@ -1,7 +1,8 @@
 """Frame time of each technique on the example scenes, beside EEVEE, in one process on one machine.
 
 Per scene (examples/build_scenes.py at --size): every material switched to each technique in turn
-(SG_PARAMETRIC unshadowed, SG_PARAMETRIC with the visibility bake, FACTORED, which has no shadows yet),
+(SG_PARAMETRIC unshadowed and with the visibility bake, FACTORED unshadowed and with the visibility bake,
+SH unshadowed and with the transfer bake, at the materials' SH order 5; the bakes' times printed apart),
 the steady frame (draw + read back 3 passes, median of --redraws) and render() (median of --renders,
 after a first render that factorizes, prefilters and compiles), then EEVEE at 1 sample with matched node
 materials.  Ratios against EEVEE measured in the same run.
@@ -18,7 +19,9 @@ REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if REPO_ROOT not in sys.path:
     sys.path.insert(0, REPO_ROOT)
 
-RUNS = (("SG_PARAMETRIC", False), ("SG_PARAMETRIC", True), ("FACTORED", False))
+RUNS = (("SG_PARAMETRIC", False), ("SG_PARAMETRIC", True), ("FACTORED", False), ("FACTORED", True),
+        ("SH", False), ("SH", True))
+BAKES = {"SG_PARAMETRIC": "visibility", "FACTORED": "visibility", "SH": "transfer"}
 
 
 def _set_technique(scene, technique):
@@ -37,9 +40,18 @@ def measure_scene(name, size, renders, redraws):
 
     scene = build_scenes.SCENES[name](size)
     figures = {}
+    operators = {"visibility": bpy.ops.sgprt.bake_visibility, "transfer": bpy.ops.sgprt.bake_transfer}
+    clears = {"visibility": bpy.ops.sgprt.clear_visibility, "transfer": bpy.ops.sgprt.clear_transfer}
     for technique, baked in RUNS:
-        if baked and bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
-            raise RuntimeError(f"{name}: the visibility bake did not finish")
+        kind = BAKES[technique]
+        for other in operators:          # only this run's bake present: "unshadowed" means no bake at all
+            if other != kind or not baked:
+                clears[other](target="ALL")
+        if baked:
+            start = time.perf_counter()
+            if operators[kind]("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
+                raise RuntimeError(f"{name}: the {kind} bake did not finish")
+            figures[(kind, "bake")] = time.perf_counter() - start
         _set_technique(scene, technique)
         label = technique + (" + bake" if baked else "")
         start = time.perf_counter()
@@ -74,6 +86,8 @@ def main(argv=None):
             label = technique + (" + bake" if baked else "")
             first, render, frame = (figures[(label, k)] for k in ("first", "render", "frame"))
             print(f"{label:28s} {first:14.3f} {render:9.3f} ({render / eevee:4.2f}) {frame:9.3f} ({frame / eevee:4.2f})")
+        print("bakes: " + ", ".join(f"{kind} {figures[(kind, 'bake')]:.1f} s" for kind in ("visibility", "transfer")
+                                    if (kind, "bake") in figures))
     return 0
 
 

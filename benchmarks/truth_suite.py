@@ -24,7 +24,8 @@ process, by:
    pixel centres, 0.36 box-filtered from 2x), a diagnostic row, not the engine's output.  SG-PRT
    reads only ``material.sgprt``; it renders before the node trees are rewritten for Cycles and
    EEVEE (step 2), in every scene; then the same bake rendered by each of the engine's other
-   techniques (TECHNIQUE_METHODS: every material switched to it, then back);
+   techniques (TECHNIQUE_METHODS: every material switched to it, then back; the SH technique after a
+   transfer bake of every mesh);
 2. the truth: Cycles on the CPU, direct light only (``max_bounces`` 0, 1-pixel box filter, no
    denoising), node materials matched to the SG-PRT settings (benchmarks/matched_materials.py),
    ``--cycles-samples`` per pixel, rendered twice with seeds 1 and 2; the truth is the mean of the
@@ -95,10 +96,11 @@ GLOSSY_MIN_ROUGHNESS = 0.1
 FULL = dict(size=256, cycles_samples=512, eevee_samples=(1, 16, 64))
 QUICK = dict(size=64, cycles_samples=32, eevee_samples=(1, 16))
 
-METHODS = ("SG-PRT", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Factored BRDF", "Cycles",
-           "Cycles 1 sample", "Cycles equal time", "EEVEE")
-# the engine's other techniques, each with the same bake: method -> the technique every material is switched to
-TECHNIQUE_METHODS = {"Factored BRDF": "FACTORED"}
+METHODS = ("SG-PRT", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Factored BRDF",
+           "Spherical harmonics", "Cycles", "Cycles 1 sample", "Cycles equal time", "EEVEE")
+# the engine's other techniques: method -> (the technique every material is switched to, the bake it reads
+# besides the visibility bake: None, or "transfer" (the transfer bake at the operator's defaults))
+TECHNIQUE_METHODS = {"Factored BRDF": ("FACTORED", None), "Spherical harmonics": ("SH", "transfer")}
 ANTI_ALIASING_SAMPLES = 16  # "SG-PRT 16 samples": the engine's Render Samples (scene.sgprt.render_samples), 4 x 4
 SUPERSAMPLING = 2          # "SG-PRT 2x2": the engine at twice the size, box-filtered down (Cycles' pixel filter)
 
@@ -328,7 +330,8 @@ def markdown_section(data, before=None):
         markdown_table(data["rows"], data["scenes"]), "",
         "The engine's techniques on the same scenes, each with the same bake (SG lobes: wang2009, the SG-PRT "
         "column above; Factored BRDF: mccool2001's p(o) q(h) p(i) r(o.h) of each material's model, 64 x 64 "
-        "parabolic maps, its environment term as techniques/factored.py says):", "",
+        "parabolic maps, its environment term as techniques/factored.py says; Spherical harmonics: kautz2002 "
+        "at order 5 with a transfer bake of order 5 at the operator's defaults):", "",
         techniques_table(data["rows"], data["scenes"]), "",
         f"Goals (relative RMSE < {GLOSSY_RMSE_GOAL:.2f} glossy of roughness >= {GLOSSY_MIN_ROUGHNESS:g}, "
         f"< {DIFFUSE_RMSE_GOAL:.2f} diffuse): {goal_summary(checks)}.", ""]
@@ -861,10 +864,17 @@ class SceneRun:
                 settings.render_samples = 1
             self.add("SG-PRT 16 samples", f"bake R={resolution}, Render Samples {ANTI_ALIASING_SAMPLES}", seconds,
                      image, warm_up_seconds=warm)
-        for method, technique in TECHNIQUE_METHODS.items():
+        for method, (technique, extra_bake) in TECHNIQUE_METHODS.items():
             if method in self.methods:
+                setting, extra = f"bake R={resolution}, technique {technique}", {}
+                if extra_bake == "transfer":
+                    start = time.perf_counter()
+                    if bpy.ops.sgprt.bake_transfer("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
+                        raise RuntimeError("the transfer bake did not finish")
+                    extra["transfer_bake_seconds"] = time.perf_counter() - start
+                    setting += f", transfer order {self.scene.sgprt_transfer.order}"
                 seconds, image, warm = self.technique_render(technique)
-                self.add(method, f"bake R={resolution}, technique {technique}", seconds, image, warm_up_seconds=warm)
+                self.add(method, setting, seconds, image, warm_up_seconds=warm, **extra)
 
     def technique_render(self, technique):
         """engine_render() with every material switched to ``technique``, then switched back."""

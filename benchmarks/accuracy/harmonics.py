@@ -1,8 +1,10 @@
 """Accuracy of the spherical-harmonic machinery (sg_prt_addon/harmonics, kautz2002): rotation by the
 recurrence and by the zyz method against projecting the rotated function (orders 2-8); projections of an
 equirect image, of caps, windows (ringing against blur); the BRDF product tables' quadrature against a
-dense one; and the shading error of the SH method itself (eq. 1, per order 3-6 and per model) against
-direct quadrature of the shading integral, under courtyard.exr and under sphere lights of three sizes."""
+dense one; the shading error of the SH method itself (eq. 1, per order 3-6 and per model) against
+direct quadrature of the shading integral, under courtyard.exr and under sphere lights of three sizes; and
+the transfer bake (visibility/transfer.py): its direction lattice against exact integrals where the
+visibility is known, and its PCA compression on a floor under a sphere."""
 import math
 import time
 
@@ -14,6 +16,8 @@ from sg_prt_addon.harmonics import basis, brdf_table, projection, rotation
 from sg_prt_addon.lighting import equirect
 from sg_prt_addon.measured.homomorphic import hemisphere_points
 from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.visibility import transfer
+from sg_prt_addon.visibility.raytrace import RayTracer
 
 SHADING_ORDERS = (3, 4, 5, 6)
 TABLE_MODELS = [
@@ -28,7 +32,7 @@ CAP_SIZES = (0.05, 0.2, 0.5)            # sphere lights' angular radii (rad)
 
 
 def measure():
-    return _rotation_rows() + _projection_rows() + _table_rows() + _shading_rows()
+    return _rotation_rows() + _projection_rows() + _table_rows() + _shading_rows() + _transfer_rows()
 
 
 def _rotation_rows():
@@ -190,4 +194,59 @@ def _shading_rows():
                              metric="relative RMS over 8 views x 6 light directions, order 5 (max: the worst order)",
                              max_error=max(errors), mean_error=errors[SHADING_ORDERS.index(5)],
                              note=f"orders {orders}: " + " / ".join(f"{e:.3f}" for e in errors)))
+    return rows
+
+
+def _gauss_rule(z_low, z_high, phi_low, phi_high, count=48):
+    t, w = np.polynomial.legendre.leggauss(count)
+    z, wz = z_low + (z_high - z_low) * 0.5 * (t + 1), (z_high - z_low) * 0.5 * w
+    phi, wphi = phi_low + (phi_high - phi_low) * 0.5 * (t + 1), (phi_high - phi_low) * 0.5 * w
+    r = np.sqrt(1 - z * z)
+    d = np.stack(np.broadcast_arrays(r[:, None] * np.cos(phi), r[:, None] * np.sin(phi), z[:, None]), -1)
+    return d.reshape(-1, 3), (wz[:, None] * wphi[None, :]).reshape(-1)
+
+
+def _transfer_rows():
+    rows = []
+    roof = (np.array([[0.0, -1e3, 1.0], [1e3, -1e3, 1.0], [1e3, 1e3, 1.0], [0.0, 1e3, 1.0]]),
+            np.array([[0, 1, 2], [0, 2, 3]]))
+    cases = {"nothing around (the hemisphere)": (None, (0.0, 1.0, 0.0, 2 * math.pi)),
+             "a roof over half the sky": (roof, (0.0, 1.0, math.pi / 2, 3 * math.pi / 2))}
+    for label, (occluders, bounds) in cases.items():
+        directions, weights = _gauss_rule(*bounds)
+        y = basis.evaluate(directions, 5)
+        exact_d, exact_g = (weights * directions[:, 2]) @ y, (y * weights[:, None]).T @ y
+        notes, worst = [], 0.0
+        for count in (256, 1024, 4096):
+            tracer = RayTracer(*(occluders or (np.zeros((0, 3)), np.zeros((0, 3), int))))
+            try:
+                samples = transfer.transfer_vectors(np.zeros((1, 3)), [[0.0, 0.0, 1.0]], tracer, 5,
+                                                    count)
+            finally:
+                tracer.close()
+            diffuse, glossy = transfer.unpack(samples.astype(np.float64), 5)
+            error = max(np.max(np.abs(diffuse[0] - exact_d)) / np.max(np.abs(exact_d)),
+                        np.max(np.abs(glossy[0] - exact_g)) / np.max(np.abs(exact_g)))
+            worst = max(worst, error) if count == 1024 else worst
+            notes.append(f"{count}: {error:.2e}")
+        rows.append(dict(name=f"transfer lattice, order 5: {label}", reference="Gauss-Legendre over the visible part",
+                         metric="max abs error / max entry of t and T, 1024 directions (the default)",
+                         max_error=worst, mean_error=None, note="directions " + ", ".join(notes)))
+    grid = np.stack(np.meshgrid(np.linspace(-2, 2, 32), np.linspace(-2, 2, 32)), -1).reshape(-1, 2)
+    vertices = np.c_[grid, np.zeros(len(grid))]
+    from scipy.spatial import ConvexHull
+    sphere = projection.sphere_quadrature(12, 24)[0] * 0.7 + [0.0, 0.0, 1.0]
+    tracer = RayTracer(sphere, ConvexHull(sphere).simplices)
+    try:
+        samples = transfer.transfer_vectors(vertices, np.tile([0.0, 0.0, 1.0], (len(grid), 1)), tracer, 5,
+                                            1024)
+    finally:
+        tracer.close()
+    model, errors = transfer.compress(samples, error_target=0.02)
+    rows.append(dict(name="transfer PCA, order 5: a floor of 1024 vertices under a sphere",
+                     reference="the uncompressed transfer vectors (D = 350)",
+                     metric="relative RMS of the vectors, at the default target 0.02 (max: 4 terms)",
+                     max_error=float(errors[4]), mean_error=float(errors[model.terms]),
+                     note=f"{model.terms} terms reach 0.02; " + ", ".join(f"{k} terms {errors[k]:.3f}"
+                                                                         for k in (1, 2, 4, 8, 16))))
     return rows
