@@ -193,7 +193,8 @@ class Factored(Technique):
                  and (name != "env_prefilter.glsl" or key.has_environment)
                  and (name != "ssdf.glsl" or key.visibility_layers)]
         sources = [shader_sources.library_source(name) for name in files]
-        sources.append(shader_sources.technique_source("common", "surface_common.glsl"))
+        sources += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl",
+                                                                                 "surface_io.glsl")]
         per_vertex = self.per_vertex_inputs(key)
         if per_vertex:
             sources += [shader_sources.technique_source("common", "lobe_visibility.glsl"),

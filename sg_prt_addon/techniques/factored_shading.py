@@ -77,18 +77,7 @@ def shade_fragments(material, textures, tables, position, normal, tangent, uv, v
     """Mirror of the technique's main(): per-fragment inputs as the G-buffer holds them (as
     sg_shading.shade_fragments takes them), and the material's FactoredTables."""
     count = len(position)
-    diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
-    specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
-    if "diffuse_color" in textures:
-        diffuse_color = diffuse_color * sg_shading.sample_texture(textures["diffuse_color"], uv)[:, :3]
-    if "specular_color" in textures:
-        specular_color = specular_color * sg_shading.sample_texture(textures["specular_color"], uv)[:, :3]
-    shading_normal = np.asarray(normal, FLOAT)
-    tangent = np.asarray(tangent, FLOAT)
-    if "normal_map" in textures:
-        shading_normal = sg_shading.apply_normal_map(shading_normal, tangent,
-                                                     sg_shading.sample_texture(textures["normal_map"], uv)[:, :3],
-                                                     FLOAT(material.normal_strength))
-    shading_tangent = sg_shading.rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+    diffuse_color, specular_color = sg_shading.surface_colours(material, textures, uv, count)
+    shading_normal, shading_tangent = sg_shading.surface_geometry(material, textures, normal, tangent, uv)
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
                  specular_color, light_data, environment, tables, visibility)

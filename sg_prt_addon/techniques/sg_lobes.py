@@ -232,7 +232,7 @@ class SGLobes(Technique):
     def fragment_source(self, key):
         parts = [_constants_source()]
         parts += [shader_sources.library_source(name) for name in self.library_files(key)]
-        parts.append(shader_sources.technique_source("common", "surface_common.glsl"))
+        parts += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl", "surface_io.glsl")]
         parts += [shader_sources.technique_source(folder, name) for folder, name in self.technique_files(key)]
         if key.visibility_layers:
             parts.append(shader_sources.per_vertex_copy_source(per_vertex_inputs(key)))

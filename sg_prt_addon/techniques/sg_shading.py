@@ -602,6 +602,29 @@ SCALAR_SLOTS = {"roughness": "roughness", "ior": "ior", "exponent": "exponent", 
                 "alpha_y": "alpha_y", "nu": "nu", "nv": "nv"}
 
 
+def surface_colours(material, textures, uv, count):
+    """(diffuse, specular) colours (N, 3) float32 of fragments, as common/surface_io.glsl gives them: the
+    material's, times their textures."""
+    diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
+    specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
+    if "diffuse_color" in textures:
+        diffuse_color = diffuse_color * sample_texture(textures["diffuse_color"], uv)[:, :3]
+    if "specular_color" in textures:
+        specular_color = specular_color * sample_texture(textures["specular_color"], uv)[:, :3]
+    return diffuse_color, specular_color
+
+
+def surface_geometry(material, textures, normal, tangent, uv):
+    """(shading normal, shading tangent) (N, 3) float32, as common/surface_io.glsl's surface_geometry: the
+    normal map, then the tangent turned about the shading normal."""
+    shading_normal = np.asarray(normal, FLOAT)
+    tangent = np.asarray(tangent, FLOAT)
+    if "normal_map" in textures:
+        shading_normal = apply_normal_map(shading_normal, tangent, sample_texture(textures["normal_map"], uv)[:, :3],
+                                          FLOAT(material.normal_strength))
+    return shading_normal, rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+
+
 def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,
                     is_perspective, light_data, environment, visibility=None):
     """Mirror of surface.frag.glsl's main(): per-fragment inputs as the G-buffer holds them.
@@ -617,34 +640,18 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     fitted = getattr(material, "fitted", None)
     if fitted is not None:         # the stored lobe fit (MODEL_FITTED): only a normal map applies
         model_params, diffuse_color = fitted_texel_values(fitted, uv)
-        shading_normal = np.asarray(normal, FLOAT)
-        tangent = np.asarray(tangent, FLOAT)
-        if "normal_map" in textures:
-            shading_normal = apply_normal_map(shading_normal, tangent,
-                                              sample_texture(textures["normal_map"], uv)[:, :3],
-                                              FLOAT(material.normal_strength))
-        shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+        shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
         return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
                      model_params, diffuse_color, np.ones((count, 3), FLOAT), light_data, environment,
                      visibility=visibility, warp_mode=getattr(material, "warp_mode", None))
-    diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
-    specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
-    if "diffuse_color" in textures:
-        diffuse_color = diffuse_color * sample_texture(textures["diffuse_color"], uv)[:, :3]
-    if "specular_color" in textures:
-        specular_color = specular_color * sample_texture(textures["specular_color"], uv)[:, :3]
+    diffuse_color, specular_color = surface_colours(material, textures, uv, count)
     params = {}
     for name in SCALAR_SLOTS:
         value = np.full(count, getattr(material, name), FLOAT)
         if name in textures:
             value = value * sample_texture(textures[name], uv)[:, 0]
         params[name] = value
-    shading_normal = np.asarray(normal, FLOAT)
-    tangent = np.asarray(tangent, FLOAT)
-    if "normal_map" in textures:
-        shading_normal = apply_normal_map(shading_normal, tangent, sample_texture(textures["normal_map"], uv)[:, :3],
-                                          FLOAT(material.normal_strength))
-    shading_tangent = rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+    shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
     model = material.model
     model_params = {key: params[key] for key in models.BY_NAME[model].parameters}
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,

@@ -135,21 +135,10 @@ def shade_fragments(material, textures, table, environment, position, normal, ta
     """Mirror of the technique's main(): per-fragment inputs as the G-buffer holds them, the material's
     BrdfTable, the environment's coefficients and (HAS_TRANSFER) the transfer inputs of shade()."""
     count = len(position)
-    diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
-    specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
-    if "diffuse_color" in textures:
-        diffuse_color = diffuse_color * sg_shading.sample_texture(textures["diffuse_color"], uv)[:, :3]
-    if "specular_color" in textures:
-        specular_color = specular_color * sg_shading.sample_texture(textures["specular_color"], uv)[:, :3]
+    diffuse_color, specular_color = sg_shading.surface_colours(material, textures, uv, count)
     parameter = np.full(count, FLOAT(getattr(material, table.parameter)) if table.parameter else 0, FLOAT)
     if table.parameter in textures:
         parameter = parameter * sg_shading.sample_texture(textures[table.parameter], uv)[:, 0]
-    shading_normal = np.asarray(normal, FLOAT)
-    tangent = np.asarray(tangent, FLOAT)
-    if "normal_map" in textures:
-        shading_normal = sg_shading.apply_normal_map(shading_normal, tangent,
-                                                     sg_shading.sample_texture(textures["normal_map"], uv)[:, :3],
-                                                     FLOAT(material.normal_strength))
-    shading_tangent = sg_shading.rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+    shading_normal, shading_tangent = sg_shading.surface_geometry(material, textures, normal, tangent, uv)
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
                  specular_color, parameter, light_data, environment, table, material.sh_window, transfer)

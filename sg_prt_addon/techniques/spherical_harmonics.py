@@ -193,8 +193,9 @@ class SphericalHarmonics(Technique):
     def create_info_calls(self, key):
         files = [name for name in LIBRARY_FILES if name != "lights.glsl" or key.has_lights]
         sources = [shader_sources.library_source(name) for name in files]
-        sources += [shader_sources.technique_source("common", "surface_common.glsl"),
-                    sh_glsl.constants_source(key.order, key.window)]
+        sources += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl",
+                                                                                 "surface_io.glsl")]
+        sources.append(sh_glsl.constants_source(key.order, key.window))
         per_vertex = self.per_vertex_inputs(key)
         if per_vertex:
             sources.append(f"vec4 transfer_rows[{key.transfer_layers}];\n"

@@ -1,12 +1,9 @@
 /* Material parameters (property x texture over the active UV map), normal map, tangent
- * frame, then shade_surface (sg_shading.glsl).  Writes Combined, Diffuse and
- * Specular; the GBUFFER variant writes Diffuse, Specular and the shading inputs for the
- * numpy mirror (framebuffers take 6 attachments: Combined is summed on the CPU). */
+ * frame (common/surface_io.glsl), then shade_surface (sg_shading.glsl).  Writes Combined, Diffuse and
+ * Specular; the GBUFFER variant writes Diffuse, Specular and the shading inputs for the numpy mirror. */
 void main()
 {
-  /* a mirroring transform (negative determinant) reverses the triangles' winding: its front faces face away */
-  bool front = gl_FrontFacing != (determinant(mat3(model_matrix)) < 0.0);
-  vec3 normal = front ? world_normal : -world_normal;
+  vec3 normal = surface_facing_normal();
 #ifdef HAS_VISIBILITY
   set_visibility_frame(world_vertex_normal);     /* the bake's frame: not flipped for back faces */
   load_per_vertex_rows();     /* the SSDF coefficients and the diffuse lobes' fractions (sg_lobes.py) */
@@ -23,12 +20,7 @@ void main()
   specular_color = vec3(1.0);
   p.y = fitted_base.w;
 #endif
-#ifdef HAS_TEXTURE_DIFFUSE_COLOR
-  diffuse_color *= texture(texture_diffuse_color, texcoord).rgb;
-#endif
-#ifdef HAS_TEXTURE_SPECULAR_COLOR
-  specular_color *= texture(texture_specular_color, texcoord).rgb;
-#endif
+  surface_colour_textures(diffuse_color, specular_color);
 #ifdef HAS_TEXTURE_ROUGHNESS
   p.x *= texture(texture_roughness, texcoord).r;
 #endif
@@ -50,30 +42,11 @@ void main()
 #ifdef HAS_TEXTURE_NV
   q.z *= texture(texture_nv, texcoord).r;
 #endif
-
-  /* tangent input: the UV map's, or the object axis in world space */
-  vec4 tangent = material.options.x > 0.5 ?
-                     vec4(mat3(model_matrix) * material.tangent_axis_rotation.xyz, 1.0) : world_tangent;
-  vec3 shading_normal = normal;
-#ifdef HAS_NORMAL_MAP
-  shading_normal = apply_normal_map(normal, tangent, texture(texture_normal_map, texcoord).rgb,
-                                    material.parameters1.w);
-#endif
-  vec3 shading_tangent = rotate_tangent(shading_normal, tangent.xyz, material.tangent_axis_rotation.w);
-
+  vec4 tangent;
+  vec3 shading_normal, shading_tangent;
+  surface_geometry(normal, tangent, shading_normal, shading_tangent);
   vec3 diffuse, specular;
   shade_surface(world_position, shading_normal, shading_tangent, p, q, diffuse_color, specular_color,
                 diffuse, specular);
-#ifndef GBUFFER
-  out_combined = vec4(diffuse + specular, 1.0);
-#endif
-  out_diffuse = vec4(diffuse, 1.0);
-  out_specular = vec4(specular, 1.0);
-#ifdef GBUFFER
-  /* w: the triangle (index into the mesh's triangle list) and object (draw order) + 1 */
-  out_position = vec4(world_position, float(gbuffer_triangle_offset + gl_PrimitiveID) + 1.0);
-  out_normal = vec4(normal, float(gbuffer_object_index) + 1.0);
-  out_tangent = tangent;
-  out_uv = vec4(texcoord, material.options.y, 1.0);
-#endif
+  surface_write(diffuse, specular, normal, tangent);
 }
