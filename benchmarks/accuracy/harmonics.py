@@ -14,8 +14,8 @@ from scipy.spatial.transform import Rotation
 from benchmarks.accuracy.lighting import load_world
 from sg_prt_addon.harmonics import basis, brdf_table, projection, rotation
 from sg_prt_addon.lighting import equirect
-from sg_prt_addon.measured.homomorphic import hemisphere_points
 from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.spherical.lattice import hemisphere_points
 from sg_prt_addon.visibility import transfer
 from sg_prt_addon.visibility.raytrace import RayTracer
 

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
+from ..spherical.lattice import hemisphere_points
 from . import merl
 
 EPSILON = 1e-5                  # eq. 6's bias, as the paper fixes it
@@ -112,15 +113,6 @@ def octahedral_coordinates(direction):
 
 
 MAPPINGS = {"parabolic": parabolic_coordinates, "octahedral": octahedral_coordinates}
-
-
-def hemisphere_points(count):
-    """(count, 3) directions on a Fibonacci lattice of the upper hemisphere, uniform in solid angle."""
-    k = np.arange(count) + 0.5
-    z = 1.0 - k / count
-    phi = k * np.pi * (3.0 - np.sqrt(5.0))
-    r = np.sqrt(np.maximum(1.0 - z * z, 0.0))
-    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
 
 
 def bilinear_weights(uv, width, height=None):

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..measured import homomorphic
 from ..reflectance import brdf, models
+from ..spherical import lattice
 from . import factored_shading, shader_sources
 from .base import Technique
 
@@ -97,7 +98,7 @@ def tables_of(factorization, albedo_samples=1024):
     1 / E[1 - i.n] of f(n, i) cos(i) (the glossy environment lookup's; a Gaussian lobe of sharpness
     lambda has E[1 - cos] = 1 / lambda)."""
     maps = {name: _rgba(log_map) for name, log_map in factorization.log_factors.items()}
-    lights = homomorphic.hemisphere_points(albedo_samples)
+    lights = lattice.hemisphere_points(albedo_samples)
     views = _parabolic_directions(factorization.resolution).reshape(-1, 3)
 
     def unscaled(wo, wi):

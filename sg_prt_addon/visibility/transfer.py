@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..harmonics import basis, projection, rotation
+from ..spherical import lattice
 from . import decode, hemisphere_map, pca
 from .per_vertex import MAX_TERMS
 from .pipeline import BakeCancelled, topology_hash
@@ -81,15 +82,6 @@ def unpack(vector, order):
     return vector[..., :count], glossy
 
 
-def hemisphere_directions(count):
-    """(count, 3) points of a Fibonacci lattice of the upper hemisphere (z > 0), equal solid angles 2 pi / count."""
-    k = np.arange(count) + 0.5
-    z = 1.0 - k / count
-    phi = k * np.pi * (3.0 - np.sqrt(5.0))
-    r = np.sqrt(np.maximum(1.0 - z * z, 0.0))
-    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
-
-
 def open_sky(order):
     """(t, T) of an unoccluded vertex in its own frame (z along the normal), exactly: the clamped cosine's
     zonal coefficients, and the hemisphere's Gram matrix by a Gauss-Legendre x azimuth rule exact for it."""
@@ -115,7 +107,7 @@ def transfer_vectors(vertices, normals, tracer, order, directions, progress=None
     world frame: t by M(R), T by M(R) T M(R)^T (harmonics.rotation, R local -> world)."""
     vertices = np.asarray(vertices, np.float64)
     frames = hemisphere_map.local_frame(np.asarray(normals, np.float64))           # rows: world -> local
-    local = hemisphere_directions(max(int(directions) // 2, 1))
+    local = lattice.hemisphere_points(max(int(directions) // 2, 1))
     weight = 2.0 * np.pi / len(local)
     y = basis.evaluate(local, order)                                                # (S, N^2)
     sky_diffuse, sky_glossy = open_sky(order)

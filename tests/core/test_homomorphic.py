@@ -5,6 +5,7 @@ import pytest
 
 from sg_prt_addon.measured import homomorphic as hf
 from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.spherical import lattice
 from validation.brdf_generators import AnalyticMaterial
 
 
@@ -62,10 +63,10 @@ def test_octahedral_map_covers_the_square_with_the_horizon_on_its_border():
     border = np.min(np.minimum(horizon, 1.0 - horizon), axis=-1)
     np.testing.assert_allclose(border, 0.0, atol=1e-12)
     # uniform directions fill the square evenly to within the map's area distortion (parabolic: a disk)
-    uv = hf.octahedral_coordinates(hf.hemisphere_points(20000))
+    uv = hf.octahedral_coordinates(lattice.hemisphere_points(20000))
     counts = np.histogram2d(uv[:, 0], uv[:, 1], bins=4, range=[[0, 1], [0, 1]])[0]
     assert counts.min() > 0.4 * counts.mean()
-    disk = hf.parabolic_coordinates(hf.hemisphere_points(20000))
+    disk = hf.parabolic_coordinates(lattice.hemisphere_points(20000))
     assert np.max(np.linalg.norm(disk - 0.5, axis=-1)) <= 0.5 + 1e-12
 
 
@@ -126,7 +127,7 @@ def test_fresnel_factor_halves_the_error_of_fresnel_brdfs():
 
 
 def test_parabolic_map_covers_the_hemisphere():
-    directions = hf.hemisphere_points(2000)
+    directions = lattice.hemisphere_points(2000)
     uv = hf.parabolic_coordinates(directions)
     assert np.all((uv >= 0) & (uv <= 1))
     assert np.all(np.linalg.norm(uv - 0.5, axis=-1) <= 0.5 + 1e-12)       # inside the inscribed disk

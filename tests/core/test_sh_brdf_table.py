@@ -6,8 +6,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from sg_prt_addon.harmonics import basis, brdf_table, rotation
-from sg_prt_addon.measured.homomorphic import hemisphere_points
 from sg_prt_addon.reflectance import brdf
+from sg_prt_addon.spherical.lattice import hemisphere_points
 
 DENSE = hemisphere_points(300000)
 MODELS = [("GGX 0.5", brdf.GGX(roughness=0.5)), ("GGX 0.2", brdf.GGX(roughness=0.2)),
