@@ -3,7 +3,7 @@ steps, per pixel, in float32 where the shader is.  tables: techniques.factored.F
 import numpy as np
 
 from ..measured import homomorphic
-from ..spherical import clamped_cosine, sg, texture_fetch
+from ..spherical import clamped_cosine, texture_fetch
 from . import sg_shading
 
 FLOAT = np.float32
@@ -27,10 +27,7 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
     an sg_shading.Visibility (the HAS_VISIBILITY variant's SSDF inputs) or None."""
     position = np.asarray(position, FLOAT)
     n, t, b = sg_shading.shading_frame(normal, tangent)
-    if is_perspective:
-        view = sg.normalize(np.asarray(view_origin, FLOAT)[None] - position)
-    else:
-        view = np.broadcast_to(-sg.normalize(np.asarray(view_origin, FLOAT)), position.shape)
+    view = sg_shading.view_directions(position, view_origin, is_perspective)
     frame = np.stack([t, b, n], axis=-1)
     o = np.einsum("nji,nj->ni", frame, view)
     maps, form = tables.factorization.log_factors, tables.factorization.form

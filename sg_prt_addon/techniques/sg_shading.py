@@ -261,6 +261,14 @@ def shares_light_visibility(light_data, bounds):
     return bool(np.all(sin2 <= limit) and np.all(suns_narrow))
 
 
+def view_directions(position, view_origin, is_perspective):
+    """Unit directions (N, 3) float32 from pixels at position (N, 3) to the camera: towards its position
+    (perspective), or against its forward axis (orthographic), as the shaders take them."""
+    if is_perspective:
+        return sg.normalize(np.asarray(view_origin, FLOAT)[None] - position)
+    return np.broadcast_to(-sg.normalize(np.asarray(view_origin, FLOAT)), np.shape(position))
+
+
 def shading_frame(normal, tangent):
     """Unit normal, tangent (Gram-Schmidt; fallback if parallel), bitangent = n x t."""
     n = sg.normalize(np.asarray(normal, FLOAT))
@@ -458,10 +466,7 @@ def _pixels(position, normal, tangent, view_origin, is_perspective, model, param
             warp_mode):
     position = np.asarray(position, FLOAT)
     n, t, b = shading_frame(normal, tangent)
-    if is_perspective:
-        view = sg.normalize(np.asarray(view_origin, FLOAT)[None] - position)
-    else:
-        view = np.broadcast_to(-sg.normalize(np.asarray(view_origin, FLOAT)), position.shape)
+    view = view_directions(position, view_origin, is_perspective)
     frame = np.stack([t, b, n], axis=-1)                          # local -> world: columns t, b, n
     view_local = np.einsum("nji,nj->ni", frame, view).astype(FLOAT)
 

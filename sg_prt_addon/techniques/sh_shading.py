@@ -83,10 +83,7 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
     count = order * order
     position = np.asarray(position, FLOAT)
     n, t, b = sg_shading.shading_frame(normal, tangent)
-    if is_perspective:
-        view = sg.normalize(np.asarray(view_origin, FLOAT)[None] - position)
-    else:
-        view = np.broadcast_to(-sg.normalize(np.asarray(view_origin, FLOAT)), position.shape)
+    view = sg_shading.view_directions(position, view_origin, is_perspective)
     if table.layout == "theta":
         along = view - n * np.sum(n * view, axis=-1, keepdims=True)
         turn = np.sum(along * along, axis=-1, keepdims=True) > FLOAT(1e-12)
@@ -101,7 +98,7 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
               / [basis.normalization(band, 0) for band in range(order)]).astype(FLOAT)
     bands, _ = basis.band_of(count)
     if transfer is None:
-        light = (window_factors[bands][:, None] * np.asarray(environment, FLOAT)[:count, :3]).astype(FLOAT)
+        light = projection.apply_window(np.asarray(environment, FLOAT)[:count, :3], window_factors).astype(FLOAT)
         radiance = c @ light
         irradiance = (basis.evaluate(n, order).astype(FLOAT) * cosine[bands]) @ light
     else:

@@ -105,10 +105,8 @@ def transfer_order(data):
 def transfer_radiance_texture(data, environment, order, window):
     """(4 L, N^2 + 1, 4) float32: row k = term k of the transfer (the mean first) times the environment's
     windowed SH lighting (visibility.transfer.transferred_radiance), for the shader's per-pixel weights."""
-    count = order * order
-    bands = np.floor(np.sqrt(np.arange(count))).astype(int)
-    factors = projection.window_factors(window, order)[bands]
-    lighting = environment_coefficients(environment)[:count].astype(np.float64) * factors[:, None]
+    lighting = projection.apply_window(environment_coefficients(environment)[:order * order].astype(np.float64),
+                                       projection.window_factors(window, order))
     products = transfer.transferred_radiance(transfer.basis_terms(data.basis_texture), lighting,
                                              transfer_order(data), order)
     out = np.zeros(products.shape[:2] + (4,), np.float32)
