@@ -86,6 +86,12 @@ class ModalJobOperator:
         self._status(context, f"{self.job_label}: starting (Esc cancels)")
         return {"RUNNING_MODAL"}
 
+    def run_now(self, context, job):
+        """The job in this thread, printing its progress ("[sg-prt] bake 40% ..."), then _finish."""
+        job.verbose = True
+        job.run()
+        return self._finish(context, job)
+
     def _status(self, context, text):
         if context.workspace is not None:
             context.workspace.status_text_set(text)
@@ -137,11 +143,7 @@ class SceneJobOperator(ModalJobOperator):
 
     def execute(self, context):
         job = self._prepare(context)
-        if job is None:
-            return {"CANCELLED"}
-        job.verbose = True          # "[sg-prt] bake 40% ..." lines
-        job.run()
-        return self._finish(context, job)
+        return {"CANCELLED"} if job is None else self.run_now(context, job)
 
     def invoke(self, context, event):
         if bpy.app.background or context.window is None:
@@ -166,10 +168,7 @@ class FileJobOperator(ModalJobOperator):
         prepared = self._prepare(context)
         if prepared is None:
             return {"CANCELLED"}
-        _, job = prepared
-        job.verbose = True          # "[sg-prt] fit 30% ..." lines
-        job.run()
-        return self._finish(context, job)
+        return self.run_now(context, prepared[1])
 
     def invoke(self, context, event):
         if bpy.app.background or context.window is None:

@@ -29,7 +29,17 @@ from ..visibility.pipeline import BakeCancelled
 from . import per_vertex_store
 from .background_job import BackgroundJob, SceneJobOperator
 from .panels import RenderPanel
-from .visibility_bake import TARGETS, TERM_MODES, bake_inputs, clear_bakes, float_array, mesh_objects, store_results
+from .visibility_bake import (
+    TARGETS,
+    TERM_MODES,
+    active_mesh_record,
+    bake_inputs,
+    clear_bakes,
+    draw_bake_controls,
+    float_array,
+    mesh_objects,
+    store_results,
+)
 
 FORMAT_VERSION = 1
 KIND = "transfer"
@@ -269,23 +279,10 @@ class SGPRT_PT_transfer_bake(RenderPanel, bpy.types.Panel):
 
     def draw(self, context):
         layout = self.layout
-        layout.use_property_split = True
-        settings = context.scene.sgprt_transfer
-        for name in ("target", "order", "directions", "term_mode"):
-            layout.prop(settings, name)
-        layout.prop(settings, "terms" if settings.term_mode == "FIXED" else "error_target")
-        layout.prop(settings, "max_terms")
-        row = layout.row(align=True)
-        row.operator(SGPRT_OT_bake_transfer.bl_idname, icon="RENDER_STILL")
-        row.operator(SGPRT_OT_clear_transfer.bl_idname, text="", icon="X")
-        obj = context.active_object
-        if obj is None or obj.type != "MESH":
-            layout.label(text="Active object: not a mesh", icon="INFO")
-            return
-        try:
-            stored = transfer_for_object(obj.evaluated_get(context.view_layer.depsgraph), read_arrays=False)
-        except Exception as error:      # a panel must draw whatever the data
-            layout.label(text=f"{obj.name}: cannot read the transfer ({error})", icon="ERROR")
+        draw_bake_controls(layout, context.scene.sgprt_transfer, ("target", "order", "directions"),
+                           SGPRT_OT_bake_transfer.bl_idname, SGPRT_OT_clear_transfer.bl_idname)
+        obj, stored = active_mesh_record(layout, context, transfer_for_object, "the transfer")
+        if obj is None:
             return
         column = layout.column(align=True)
         if stored is None:

@@ -533,34 +533,43 @@ class SGPRT_OT_clear_visibility(bpy.types.Operator):
         return clear_bakes(self, context, clear_visibility_bake, "bake(s)")
 
 
+def draw_bake_controls(layout, settings, option_names, bake_idname, clear_idname):
+    """A bake panel's settings (option_names, then its PCA terms: fixed, or by an error target, at most
+    max_terms) and its Bake and Clear buttons."""
+    layout.use_property_split = True
+    for name in option_names + ("term_mode",):
+        layout.prop(settings, name)
+    layout.prop(settings, "terms" if settings.term_mode == "FIXED" else "error_target")
+    layout.prop(settings, "max_terms")
+    row = layout.row(align=True)
+    row.operator(bake_idname, icon="RENDER_STILL")
+    row.operator(clear_idname, text="", icon="X")
+
+
+def active_mesh_record(layout, context, load, what):
+    """(the active object, load(its evaluated object, read_arrays=False)) for a bake panel's status line, or
+    (None, None) after drawing why there is none: no active mesh, or `what` could not be read."""
+    obj = context.active_object
+    if obj is None or obj.type != "MESH":
+        layout.label(text="Active object: not a mesh", icon="INFO")
+        return None, None
+    try:
+        # the view layer's depsgraph as last evaluated: drawing must not trigger an evaluation
+        return obj, load(obj.evaluated_get(context.view_layer.depsgraph), read_arrays=False)
+    except Exception as error:      # a panel must draw whatever the data
+        layout.label(text=f"{obj.name}: cannot read {what} ({error})", icon="ERROR")
+        return None, None
+
+
 class SGPRT_PT_visibility_bake(RenderPanel, bpy.types.Panel):
     bl_label = "SG-PRT Visibility Bake"
 
     def draw(self, context):
         layout = self.layout
-        layout.use_property_split = True
-        settings = context.scene.sgprt_bake
-        layout.prop(settings, "target")
-        layout.prop(settings, "resolution")
-        layout.prop(settings, "refinement")
-        layout.prop(settings, "term_mode")
-        if settings.term_mode == "FIXED":
-            layout.prop(settings, "terms")
-        else:
-            layout.prop(settings, "error_target")
-        layout.prop(settings, "max_terms")
-        row = layout.row(align=True)
-        row.operator(SGPRT_OT_bake_visibility.bl_idname, icon="RENDER_STILL")
-        row.operator(SGPRT_OT_clear_visibility.bl_idname, text="", icon="X")
-        obj = context.active_object
-        if obj is None or obj.type != "MESH":
-            layout.label(text="Active object: not a mesh", icon="INFO")
-            return
-        try:
-            # the view layer's depsgraph as last evaluated: drawing must not trigger an evaluation
-            stored = visibility_for_object(obj.evaluated_get(context.view_layer.depsgraph), read_arrays=False)
-        except Exception as error:      # a panel must draw whatever the data
-            layout.label(text=f"{obj.name}: cannot read the bake ({error})", icon="ERROR")
+        draw_bake_controls(layout, context.scene.sgprt_bake, ("target", "resolution", "refinement"),
+                           SGPRT_OT_bake_visibility.bl_idname, SGPRT_OT_clear_visibility.bl_idname)
+        obj, stored = active_mesh_record(layout, context, visibility_for_object, "the bake")
+        if obj is None:
             return
         column = layout.column(align=True)
         if stored is None:
