@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import techniques
-from ..reflectance import models
+from ..reflectance import layering, models, principled
 from ..techniques import factored, sg_fitted, spherical_harmonics
 
 # Mesh exports since import; tests read it to check what an update re-exported.
@@ -114,6 +114,14 @@ class MaterialParams:
     warp_mode: str = "split3"      # spherical.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.view_warp)
     sh_order: int = 5              # the SH technique's order and window (harmonics.projection's names, or "none")
     sh_window: str = "none"
+    # the glossy layer (reflectance.layering): Schlick Fresnel on the specular colour, Multiscatter GGX's gain,
+    # the F0 of a dielectric layer over the diffuse (below 0: none); emitted radiance (Combined only)
+    fresnel: str = "NONE"
+    multiscatter: bool = False
+    layered_f0: float = -1.0
+    emission: tuple = (0.0, 0.0, 0.0)
+    source: str = "SETTINGS"       # what the look was read from: material.sgprt.source (NODE_TREE, SETTINGS)
+    decoded_slots: tuple = ()      # data slots whose sRGB images are decoded to linear (node trees: as Blender)
     normal_strength: float = 1.0
     tangent_source: str = "UV_MAP"
     tangent_axis: tuple = (1.0, 0.0, 0.0)
@@ -449,7 +457,10 @@ def _usable_technique(material, params):
 
 
 def export_material(material):
-    """MaterialParams of a bpy Material (None, or without `sgprt`: the defaults)."""
+    """MaterialParams of a bpy Material (None, or without `sgprt`: the defaults): its SG-PRT settings, or its
+    node tree's reading when its Source is the node tree."""
+    from . import properties
+
     params = MaterialParams()
     if material is None:
         return params
@@ -470,21 +481,45 @@ def export_material(material):
     params.tangent_source = settings.tangent_source
     params.tangent_axis = tuple(settings.tangent_axis)
     params.tangent_rotation = float(settings.tangent_rotation)
+    params.fresnel = settings.fresnel
+    params.multiscatter = bool(settings.multiscatter)
+    params.layered_f0 = principled.dielectric_f0(settings.ior) if settings.layered_diffuse else layering.NO_LAYER
+    params.emission = tuple(float(c) * float(settings.emission_strength) for c in settings.emission_color)
     for name in TEXTURED_PARAMETERS:
         image = getattr(settings, name + "_texture", None)
         if image is not None:
             params.textures[name] = image.name
     if settings.normal_map is not None:
         params.textures["normal_map"] = settings.normal_map.name
+    if properties.resolved_source(settings) == "NODE_TREE":
+        _read_node_tree(material, params)
     params.technique = _usable_technique(material, params)
     _finite_settings(params)
     return params
 
 
+def _read_node_tree(material, params):
+    """The node tree's reading (blender/node_reader.py) in place of the appearance settings; its notes in one
+    warning."""
+    from . import node_reader
+
+    reading = node_reader.read_material(material)
+    params.source = "NODE_TREE"
+    params.tangent_rotation = 0.0
+    params.normal_strength = 1.0
+    for name, value in reading.fields.items():
+        setattr(params, name, value)
+    params.textures = dict(reading.textures)
+    params.decoded_slots = reading.decoded_slots
+    if reading.notes:
+        warn(f"material '{material.name}' (node tree): " + "; ".join(reading.notes))
+
+
 def _finite_settings(params):
     """Non-finite scalar or colour settings (scripts can store them) -> the defaults, warned."""
     defaults = MaterialParams()
-    for name in COLOUR_PARAMETERS + SCALAR_PARAMETERS + ("normal_strength", "tangent_rotation", "tangent_axis"):
+    for name in COLOUR_PARAMETERS + SCALAR_PARAMETERS + ("normal_strength", "tangent_rotation", "tangent_axis",
+                                                         "layered_f0", "emission"):
         value = getattr(params, name)
         if not np.all(np.isfinite(value)):
             setattr(params, name, getattr(defaults, name))
@@ -533,18 +568,21 @@ def srgb_to_linear(values):
     return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4).astype(np.float32)
 
 
-def texture_pixels(image, slot):
+def texture_pixels(image, slot, decode=None):
     """What the shader samples for `slot`: image_pixels, with the RGB of colour slots made
     scene-linear when the image holds sRGB-encoded bytes (float images are linear already;
-    data slots such as roughness or the normal map are used as stored, like Non-Color).  NaN/Inf
-    texels become 0, with a warning (finite_texels): the upload reads each image once."""
+    data slots such as roughness or the normal map are used as stored, like Non-Color, unless
+    `decode`: a node tree's data slot, decoded as Blender decodes it).  NaN/Inf texels become 0,
+    with a warning (finite_texels): the upload reads each image once."""
     if not image_has_pixels(image):
         texel, what = MISSING_TEXEL["colour" if slot in COLOUR_SLOTS else "normal_map" if slot == "normal_map"
                                     else "scalar"]
         warn(f"image '{image.name}': {_no_pixels_reason(image)}: {what} used for {slot}")
         return np.array(texel, np.float32).reshape(1, 1, 4)
     pixels = finite_texels(image_pixels(image), f"image '{image.name}'")
-    if slot in COLOUR_SLOTS and not image.is_float and image.colorspace_settings.name == "sRGB":
+    if decode is None:
+        decode = slot in COLOUR_SLOTS
+    if decode and not image.is_float and image.colorspace_settings.name == "sRGB":
         pixels = pixels.copy()
         pixels[..., :3] = srgb_to_linear(pixels[..., :3])
     return pixels

@@ -32,6 +32,18 @@ VIEW_WARPS = (
                         "(0.08 at 75 degrees, 0.2 at 85)"),
 )
 
+FRESNEL_MODES = (("NONE", "None", "The specular colour at every angle (Blender's Glossy BSDF)"),
+                 ("SCHLICK", "Schlick", "The specular colour at normal incidence, white at grazing angles "
+                                        "(Blender's Principled BSDF: metals and dielectrics)"))
+SOURCES = (("NODE_TREE", "Node Tree", "Render the material's shader nodes (Principled, Diffuse, Glossy, Emission, "
+                                      "Mix and Add, image textures, normal maps; blender/node_reader.py)"),
+           ("SETTINGS", "SG-PRT Settings", "Render the settings below, whatever the node tree holds"))
+# What a material's look is made of in its SG-PRT settings: one of them set (or a stored fit or factors) means
+# the settings were given, so a material without an explicit Source renders them (files older than Source)
+APPEARANCE_PROPERTIES = ("model", "diffuse_color", "specular_color", "roughness", "ior", "exponent", "alpha_x",
+                         "alpha_y", "nu", "nv", "lobe_count", "normal_strength", "fresnel",
+                         "multiscatter", "layered_diffuse", "emission_color", "emission_strength")
+
 # Parameters that may be driven by an image texture: `<name>_texture`.
 TEXTURED_PARAMETERS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
                        "alpha_x", "alpha_y", "nu", "nv")
@@ -45,6 +57,42 @@ _technique_items = []
 def technique_items(self, context):
     _technique_items[:] = techniques.enum_items()
     return _technique_items
+
+
+def settings_given(settings):
+    """Whether a material's SG-PRT appearance settings were ever set (an image, a stored lobe fit or factors
+    count; image pointers are tested by value: reading one marks it set)."""
+    images = tuple(name + "_texture" for name in TEXTURED_PARAMETERS) + ("normal_map",)
+    return (any(settings.is_property_set(name) for name in APPEARANCE_PROPERTIES)
+            or any(getattr(settings, name) is not None for name in images)
+            or settings.lobe_fit.format_version > 0 or settings.factorization.format_version > 0)
+
+
+def has_node_tree(material):
+    """A material whose shader nodes Blender renders (Blender 5 always uses them; use_nodes before)."""
+    import bpy
+
+    tree = material.node_tree
+    return tree is not None and (bpy.app.version >= (5, 0, 0) or material.use_nodes)
+
+
+def resolved_source(settings):
+    """NODE_TREE or SETTINGS: the choice stored, else the node tree for a material that has one and was never
+    given SG-PRT settings."""
+    stored = settings.get("source_choice")
+    if stored is not None:
+        return SOURCES[int(stored)][0] if 0 <= int(stored) < len(SOURCES) else "SETTINGS"
+    material = settings.id_data
+    return "NODE_TREE" if has_node_tree(material) and not settings_given(settings) else "SETTINGS"
+
+
+def _get_source(self):
+    return [item[0] for item in SOURCES].index(resolved_source(self))
+
+
+def _set_source(self, value):
+    self["source_choice"] = int(value)
+    self.id_data.update_tag()
 
 
 def _tag_material_changed(self, context):
@@ -108,6 +156,9 @@ class SGPRT_PG_factorization(bpy.types.PropertyGroup):
 
 
 class SGPRT_PG_material(bpy.types.PropertyGroup):
+    source: EnumProperty(name="Source", items=SOURCES, get=_get_source, set=_set_source,
+                         description="What the material's look is read from: its shader nodes, or the SG-PRT "
+                                     "settings (default: the node tree, unless the material has SG-PRT settings)")
     # default 0: the number of techniques.DEFAULT; a file without the setting: techniques.of_settings
     technique: EnumProperty(update=_tag_material_changed, name="Technique", items=technique_items, default=0,
                             description="The rendering method of this material (techniques/: the reference each "
@@ -153,6 +204,20 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                                       "Kautz 2002 used 5): higher follows sharper lights and glossier lobes")
     sh_window: EnumProperty(update=_tag_material_changed, name="SH Window", items=SH_WINDOWS, default="NONE",
                             description="Smoothing of the lighting's bands against ringing (it blurs)")
+    fresnel: EnumProperty(update=_tag_material_changed, name="Fresnel", items=FRESNEL_MODES, default="NONE",
+                          description="How the specular colour changes with angle (reflectance/layering.py)")
+    multiscatter: BoolProperty(update=_tag_material_changed, name="Multiscatter", default=False,
+                               description="Add the energy of light scattered between microfacets, as Blender's "
+                                           "Multiscatter GGX does (brighter and more saturated rough metals)")
+    layered_diffuse: BoolProperty(update=_tag_material_changed, name="Layered Diffuse", default=False,
+                                  description="The diffuse lies under a dielectric coat of the IOR and loses what "
+                                              "the coat reflects at each view (Blender's Principled BSDF)")
+    emission_color: FloatVectorProperty(update=_tag_material_changed, name="Emission", subtype="COLOR", size=3,
+                                        default=(1.0, 1.0, 1.0), min=0.0, soft_max=1.0,
+                                        description="Colour of the light the surface emits")
+    emission_strength: FloatProperty(update=_tag_material_changed, name="Emission Strength", default=0.0, min=0.0,
+                                     soft_max=10.0, description="Emitted radiance, times the colour (it lights "
+                                                                "nothing else)")
     normal_map: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Normal Map",
                                 description="Tangent-space normal map (OpenGL convention, +Y up)")
     normal_strength: FloatProperty(update=_tag_material_changed, name="Strength", default=1.0, min=0.0, max=10.0,

@@ -13,7 +13,7 @@ import numpy as np
 from .. import techniques
 from ..blender.export import COLOUR_SLOTS, texture_pixels
 from ..spherical import clamped_cosine
-from ..techniques import shader_sources
+from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 from . import shader_cache
 
@@ -44,8 +44,9 @@ def _texture_2d_array(layers):
                                 data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
 
 
-def _texture_key(image_name, slot):
-    return image_name, slot in COLOUR_SLOTS
+def _texture_key(image_name, slot, params):
+    """(image, decoded from sRGB): a colour slot, or a data slot a node tree reads decoded (as Blender does)."""
+    return image_name, slot in COLOUR_SLOTS or slot in params.decoded_slots
 
 
 def _uniform_buffer(data):
@@ -109,14 +110,16 @@ def scene_block(camera, light_data, environment):
 
 
 def material_block(params, material_id=0):
-    """MaterialData of an export.MaterialParams as (6, 4) float32; material_id goes to the G-buffer."""
+    """MaterialData of an export.MaterialParams as (7, 4) float32; material_id goes to the G-buffer."""
     return np.array([
-        list(params.diffuse_color) + [1.0],
+        list(params.diffuse_color) + [params.layered_f0],
         list(params.specular_color) + [1.0],
         [params.roughness, params.ior, params.exponent, params.alpha_x],
         [params.alpha_y, params.nu, params.nv, params.normal_strength],
         list(params.tangent_axis) + [params.tangent_rotation],
-        [1.0 if params.tangent_source == "OBJECT_AXIS" else 0.0, float(material_id), 0.0, 0.0],
+        [1.0 if params.tangent_source == "OBJECT_AXIS" else 0.0, float(material_id),
+         surface_layering.layer_roughness(params), 0.0],
+        list(params.emission) + [0.0],
     ], np.float32)
 
 
@@ -282,7 +285,7 @@ class _DrawContext(techniques.DrawContext):
         return tables[name]
 
     def image(self, slot):
-        return self.renderer.textures[_texture_key(self.params.textures[slot], slot)]
+        return self.renderer.textures[_texture_key(self.params.textures[slot], slot, self.params)]
 
     def object_target(self, name, size):
         import gpu
@@ -368,9 +371,10 @@ class Renderer:
             self.uploads["materials"] += 1
             self.material_tables.pop(params.name or name, None)
             for slot, image_name in params.textures.items():
-                key = _texture_key(image_name, slot)
+                key = _texture_key(image_name, slot, params)
                 if key not in self.textures and image_name in bpy.data.images:
-                    self.textures[key] = _texture_2d(texture_pixels(bpy.data.images[image_name], slot))
+                    self.textures[key] = _texture_2d(texture_pixels(bpy.data.images[image_name], slot,
+                                                                    decode=key[1]))
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)

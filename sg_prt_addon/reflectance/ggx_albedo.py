@@ -21,8 +21,9 @@ QUADRATURE_U = 64
 QUADRATURE_PHI = 32
 
 
-def directional_albedo(cos_o, roughness, nodes_u=QUADRATURE_U, nodes_phi=QUADRATURE_PHI):
-    """E(o) of brdf.GGX for arrays cos_o, roughness (broadcast) -> float64 array."""
+def directional_albedo(cos_o, roughness, nodes_u=QUADRATURE_U, nodes_phi=QUADRATURE_PHI, schlick_weight=False):
+    """E(o) of brdf.GGX for arrays cos_o, roughness (broadcast) -> float64 array.  schlick_weight: the
+    integrand times Schlick's (1 - o.h)^5 (reflectance.layering's second table)."""
     cos_o, roughness = np.broadcast_arrays(np.asarray(cos_o, np.float64), np.asarray(roughness, np.float64))
     shape = cos_o.shape
     cos_o = np.clip(cos_o.ravel(), 1e-4, 1.0)[:, None, None]
@@ -43,6 +44,8 @@ def directional_albedo(cos_o, roughness, nodes_u=QUADRATURE_U, nodes_phi=QUADRAT
     lambda_o = brdf.GGX.smith_lambda(np.broadcast_to(o, i.shape), alpha)
     lambda_i = brdf.GGX.smith_lambda(i, alpha)
     integrand = np.where(above, o_dot_h / ((1.0 + lambda_o + lambda_i) * cos_o * cos_h), 0.0)
+    if schlick_weight:
+        integrand = integrand * (1.0 - np.clip(o_dot_h, 0.0, 1.0)) ** 5
     albedo = np.sum(integrand * weight_u, axis=(1, 2)) / nodes_phi
     return albedo.reshape(shape)
 

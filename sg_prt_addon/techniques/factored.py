@@ -20,7 +20,7 @@ import numpy as np
 from ..measured import homomorphic
 from ..reflectance import brdf, models
 from ..spherical import lattice
-from . import factored_shading, shader_sources
+from . import factored_shading, shader_sources, surface_layering
 from .base import Technique
 
 NAME = "FACTORED"
@@ -43,6 +43,7 @@ class FactoredKey:
     has_environment: bool = False
     gbuffer: bool = False
     visibility_layers: int = 0      # vec4 of SSDF coefficients per vertex (0: no visibility bake)
+    layering: tuple = ()            # surface_layering.flags of the material
 
     def describe(self):
         parts = [homomorphic.FORM_LABELS[self.form], "lights" if self.has_lights else "no lights",
@@ -53,6 +54,8 @@ class FactoredKey:
             parts.append("G-buffer")
         if self.visibility_layers:
             parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
+        if self.layering:
+            parts.append("layering: " + ", ".join(self.layering))
         return ", ".join(parts)
 
 
@@ -153,7 +156,8 @@ class Factored(Technique):
     def variant_key(self, params, inputs):
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS))
         return FactoredKey(textures=textures, has_lights=inputs.has_lights, has_environment=inputs.has_environment,
-                           gbuffer=inputs.gbuffer, visibility_layers=int(inputs.per_vertex.get(VISIBILITY_KIND, 0)))
+                           gbuffer=inputs.gbuffer, visibility_layers=int(inputs.per_vertex.get(VISIBILITY_KIND, 0)),
+                           layering=surface_layering.flags(params))
 
     def defines(self, key):
         out = {"FACTOR_P_LIGHT": 1} if homomorphic.FORMS[key.form][2] == "p" else {}
@@ -169,6 +173,7 @@ class Factored(Technique):
             out["GBUFFER"] = 1
         if key.visibility_layers:
             out.update(HAS_VISIBILITY=1, SSDF_MAX_LAYERS=key.visibility_layers)
+        out.update(surface_layering.layering_defines(key.layering, False))     # its parameters are uniform
         return out
 
     def samplers(self, key):
@@ -179,6 +184,8 @@ class Factored(Technique):
         if key.has_environment:
             samplers += [("FLOAT_2D_ARRAY", "environment_texture"), ("FLOAT_2D", "equirect_texture")]
         samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        if key.layering:
+            samplers.append(surface_layering.SAMPLER)
         if key.visibility_layers:
             samplers += [("FLOAT_2D", "visibility_coefficients"), ("FLOAT_2D_ARRAY", "visibility_basis")]
         return samplers
@@ -196,6 +203,8 @@ class Factored(Technique):
         sources = [shader_sources.library_source(name) for name in files]
         sources += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl",
                                                                                  "surface_io.glsl")]
+        if key.layering:
+            sources.append(surface_layering.source())
         per_vertex = self.per_vertex_inputs(key)
         if per_vertex:
             sources += [shader_sources.technique_source("common", "lobe_visibility.glsl"),
@@ -221,6 +230,8 @@ class Factored(Technique):
             shader.uniform_sampler("equirect_texture", equirect)
         for name in key.textures:
             shader.uniform_sampler("texture_" + name, context.image(name))
+        if key.layering:
+            surface_layering.bind(shader, context)
         if key.visibility_layers:
             buffers = context.per_vertex(VISIBILITY_KIND)
             shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)

@@ -76,5 +76,7 @@ def shade_fragments(material, textures, tables, position, normal, tangent, uv, v
     count = len(position)
     diffuse_color, specular_color = sg_shading.surface_colours(material, textures, uv, count)
     shading_normal, shading_tangent = sg_shading.surface_geometry(material, textures, normal, tangent, uv)
+    diffuse_color, specular_color = sg_shading.surface_layers(material, None, uv, diffuse_color, specular_color,
+                                                              shading_normal, position, view_origin, is_perspective)
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
                  specular_color, light_data, environment, tables, visibility)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 from ..reflectance import brdf
 from ..spherical import clamped_cosine_table, warp
-from . import sg_shading, shader_sources
+from . import sg_shading, shader_sources, surface_layering
 from .base import Technique
 from .shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
 
@@ -58,6 +58,7 @@ class VariantKey:
     # lights and a specular term)
     shared_light_visibility: bool = False
     warp_mode: str = warp.DEFAULT_MODE      # of the view slice (MaterialParams.warp_mode); with a specular term
+    layering: tuple = ()            # surface_layering.flags of the material
 
     @property
     def has_visibility(self):
@@ -80,6 +81,8 @@ class VariantKey:
             parts.append("light visibility shared by its products")
         if self.has_specular and self.warp_mode != warp.DEFAULT_MODE:
             parts.append(f"warp {self.warp_mode}")
+        if self.layering:
+            parts.append("layering: " + ", ".join(self.layering))
         if not self.has_diffuse:
             parts.append("no diffuse")
         if not self.has_specular:
@@ -205,6 +208,8 @@ class SGLobes(Technique):
             out["DIFFUSE_VISIBILITY_ROWS"] = key.diffuse_visibility_rows
         if key.shared_light_visibility:
             out["SHARED_LIGHT_VISIBILITY"] = 1
+        out.update(surface_layering.layering_defines(key.layering, surface_layering.textured_roughness(key.model,
+                                                                                                key.textures)))
         out.update(self.model_defines(key))
         return out
 
@@ -233,6 +238,8 @@ class SGLobes(Technique):
         parts = [_constants_source()]
         parts += [shader_sources.library_source(name) for name in self.library_files(key)]
         parts += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl", "surface_io.glsl")]
+        if key.layering:
+            parts.append(surface_layering.source())
         parts += [shader_sources.technique_source(folder, name) for folder, name in self.technique_files(key)]
         if key.visibility_layers:
             parts.append(shader_sources.per_vertex_copy_source(per_vertex_inputs(key)))
@@ -249,6 +256,8 @@ class SGLobes(Technique):
         if uses_clamped_cosine_table(key):
             samplers.append(("FLOAT_2D", "clamped_cosine_table"))
         samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        if key.layering:
+            samplers.append(surface_layering.SAMPLER)
         if key.visibility_layers:
             samplers.append(("FLOAT_2D", "visibility_coefficients"))       # read in the vertex shader
             samplers.append(("FLOAT_2D_ARRAY", "visibility_basis"))
@@ -282,6 +291,8 @@ class SGLobes(Technique):
                                    context.table("clamped_cosine", clamped_cosine_table.clamped_cosine_table))
         for name in key.textures:
             shader.uniform_sampler("texture_" + name, context.image(name))
+        if key.layering:
+            surface_layering.bind(shader, context)
 
     def prepare_object(self, keys, context):
         """The broad diffuse lobes' visibility at the vertices of an object whose variants read it (a bake

@@ -4,7 +4,7 @@ import numpy as np
 
 from ..reflectance import ggx_albedo, models, ndf_fit
 from ..spherical import warp
-from . import sg_shading
+from . import sg_shading, surface_layering
 from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_PARAMETRIC"
@@ -64,7 +64,8 @@ class SGParametric(SGLobes):
                                 and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
         return VariantKey(self.name, model, lobes, textures=textures, has_diffuse=has_diffuse,
                           has_specular=has_specular, warp_mode=warp_mode_of(params) if has_specular else
-                          warp.DEFAULT_MODE, **scene_fields(inputs, has_diffuse, has_specular))
+                          warp.DEFAULT_MODE, layering=surface_layering.flags(params),
+                          **scene_fields(inputs, has_diffuse, has_specular))
 
     def model_defines(self, key):
         if not uses_ggx_table(key):

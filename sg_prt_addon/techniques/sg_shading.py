@@ -49,8 +49,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..lighting import env_prefilter, equirect, lights
-from ..reflectance import brdf, ggx_albedo, models
+from ..reflectance import brdf, ggx_albedo, layering, models
 from ..spherical import clamped_cosine, sg, texture_fetch, warp
+from . import surface_layering
 
 FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
@@ -630,6 +631,25 @@ def surface_geometry(material, textures, normal, tangent, uv):
     return shading_normal, rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
 
 
+def surface_layers(material, roughness_texture, uv, diffuse_color, specular_color, shading_normal, position,
+                   view_origin, is_perspective):
+    """(diffuse, specular) colours (N, 3) after the material's layering, as common/surface_layering.glsl's
+    surface_layering() gives them (unchanged without layering: techniques.surface_layering.flags);
+    roughness_texture: the image scaling the layer's roughness where the variant applies it, or None."""
+    layering_flags = surface_layering.flags(material)
+    if not layering_flags:
+        return diffuse_color, specular_color
+    roughness = np.full(len(position), surface_layering.layer_roughness(material), FLOAT)
+    if roughness_texture is not None:
+        roughness = roughness * sample_texture(roughness_texture, uv)[:, 0]
+    view = view_directions(np.asarray(position, FLOAT), view_origin, is_perspective)
+    cos_o = np.sum(np.asarray(shading_normal, FLOAT) * view, axis=-1)
+    specular_factor, diffuse_factor = layering.factors(
+        np.asarray(specular_color, FLOAT), FLOAT(getattr(material, "layered_f0", layering.NO_LAYER)), cos_o,
+        roughness, "fresnel" in layering_flags, "multiscatter" in layering_flags)
+    return diffuse_color * diffuse_factor[:, None], specular_color * specular_factor
+
+
 def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,
                     is_perspective, light_data, environment, visibility=None):
     """Mirror of surface.frag.glsl's main(): per-fragment inputs as the G-buffer holds them.
@@ -657,6 +677,9 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
             value = value * sample_texture(textures[name], uv)[:, 0]
         params[name] = value
     shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
+    roughness_texture = textures["roughness"] if surface_layering.textured_roughness(material.model, textures) else None
+    diffuse_color, specular_color = surface_layers(material, roughness_texture, uv, diffuse_color, specular_color,
+                                                   shading_normal, position, view_origin, is_perspective)
     model = material.model
     model_params = {key: params[key] for key in models.BY_NAME[model].parameters}
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,

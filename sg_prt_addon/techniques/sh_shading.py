@@ -137,5 +137,9 @@ def shade_fragments(material, textures, table, environment, position, normal, ta
     if table.parameter in textures:
         parameter = parameter * sg_shading.sample_texture(textures[table.parameter], uv)[:, 0]
     shading_normal, shading_tangent = sg_shading.surface_geometry(material, textures, normal, tangent, uv)
+    roughness_texture = textures["roughness"] if table.parameter == "roughness" and "roughness" in textures else None
+    diffuse_color, specular_color = sg_shading.surface_layers(material, roughness_texture, uv, diffuse_color,
+                                                              specular_color, shading_normal, position, view_origin,
+                                                              is_perspective)
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, diffuse_color,
                  specular_color, parameter, light_data, environment, table, material.sh_window, transfer)

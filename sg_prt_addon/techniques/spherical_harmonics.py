@@ -28,7 +28,7 @@ import numpy as np
 from ..harmonics import brdf_table, projection
 from ..reflectance import models
 from ..visibility import transfer
-from . import sh_glsl, sh_shading, shader_sources
+from . import sh_glsl, sh_shading, shader_sources, surface_layering
 from .base import Technique
 
 NAME = "SH"
@@ -56,6 +56,7 @@ class SHKey:
     has_lights: bool = False
     gbuffer: bool = False
     transfer_layers: int = 0            # vec4 rows a vertex of the transfer bake (0: none)
+    layering: tuple = ()            # surface_layering.flags of the material
 
     def describe(self):
         parts = [f"order {self.order}", f"window {self.window}",
@@ -67,6 +68,8 @@ class SHKey:
             parts.append("G-buffer")
         if self.transfer_layers:
             parts.append(f"transfer ({self.transfer_layers} weight vec4)")
+        if self.layering:
+            parts.append("layering: " + ", ".join(self.layering))
         return ", ".join(parts)
 
 
@@ -155,7 +158,8 @@ class SphericalHarmonics(Technique):
             order = min(order, transfer_order(data))
         return SHKey(order=order, window=getattr(params, "sh_window", "none"), isotropic=axis is not None,
                      parameter=axis[0] if axis else None, textures=textures, has_lights=inputs.has_lights,
-                     gbuffer=inputs.gbuffer, transfer_layers=data.layers if data is not None else 0)
+                     gbuffer=inputs.gbuffer, transfer_layers=data.layers if data is not None else 0,
+                     layering=surface_layering.flags(params))
 
     def defines(self, key):
         out = {"SH_PARAMETER": PARAMETER_FIELDS[key.parameter] if key.isotropic else "0.0"}
@@ -172,6 +176,8 @@ class SphericalHarmonics(Technique):
             out["GBUFFER"] = 1
         if key.transfer_layers:
             out.update(HAS_TRANSFER=1, TRANSFER_LAYERS=key.transfer_layers)
+        out.update(surface_layering.layering_defines(key.layering, key.parameter == "roughness"
+                                                     and "roughness" in key.textures))
         return out
 
     def samplers(self, key):
@@ -180,7 +186,8 @@ class SphericalHarmonics(Technique):
             samplers += [("FLOAT_2D", "transfer_coefficients"), ("FLOAT_2D", "sh_transfer_radiance")]
             if key.has_lights:
                 samplers.append(("FLOAT_2D_ARRAY", "transfer_basis"))
-        return samplers + [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        return samplers + ([surface_layering.SAMPLER] if key.layering else [])
 
     def per_vertex_inputs(self, key):
         if not key.transfer_layers:
@@ -193,6 +200,8 @@ class SphericalHarmonics(Technique):
         sources = [shader_sources.library_source(name) for name in files]
         sources += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl",
                                                                                  "surface_io.glsl")]
+        if key.layering:
+            sources.append(surface_layering.source())
         sources.append(sh_glsl.constants_source(key.order, key.window))
         per_vertex = self.per_vertex_inputs(key)
         if per_vertex:
@@ -231,6 +240,8 @@ class SphericalHarmonics(Technique):
                 lambda: transfer_radiance_texture(data, environment, key.order, key.window)))
         for name in key.textures:
             shader.uniform_sampler("texture_" + name, context.image(name))
+        if key.layering:
+            surface_layering.bind(shader, context)
 
 
 TECHNIQUE = SphericalHarmonics()

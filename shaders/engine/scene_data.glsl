@@ -35,6 +35,7 @@ struct SceneData {
 };
 
 struct MaterialData {
+  /* rgb kd; w the F0 of the dielectric layer over the diffuse (negative: none; common/surface_layering.glsl) */
   vec4 diffuse_color;
   vec4 specular_color;
   /* roughness, ior, exponent, alpha_x */
@@ -43,6 +44,8 @@ struct MaterialData {
   vec4 parameters1;
   /* xyz object-space tangent axis, w tangent rotation (radians) */
   vec4 tangent_axis_rotation;
-  /* x tangent source: 0 UV map, 1 object axis */
+  /* x tangent source: 0 UV map, 1 object axis; y the material's G-buffer id; z the layer's GGX roughness */
   vec4 options;
+  /* rgb emitted radiance (Combined only) */
+  vec4 emission;
 };

@@ -13,7 +13,7 @@ void main()
 {
   bool front = gl_FrontFacing != (determinant(mat3(model_matrix)) < 0.0);
   vec3 n = normalize(front ? world_normal : -world_normal);
-  vec3 colour = (0.5 * n + 0.5) * material.diffuse_color.a;    /* a = 1: the block is read */
+  vec3 colour = (0.5 * n + 0.5) * material.specular_color.a;    /* a = 1: the block is read */
 #ifndef GBUFFER
   out_combined = vec4(colour, 1.0);
 #endif

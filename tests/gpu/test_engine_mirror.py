@@ -69,10 +69,11 @@ def _check(result, textures_by_material=None, minimum_coverage=0.2):
 
 
 def test_isotropic_models_lights_and_world_colour(engine):
-    """GGX, Cook-Torrance, Blinn-Phong and Ward on four spheres, point + spot + sun + area lights."""
+    """GGX (with Fresnel, multiscatter and a layered diffuse: reflectance.layering), Cook-Torrance, Blinn-Phong
+    and Ward on four spheres, point + spot + sun + area lights."""
     scene = fx.new_scene("mirror_isotropic", 256, 256)
     fx.world_colour(scene, (0.05, 0.07, 0.1))
-    models = [("GGX", dict(roughness=0.35)), ("COOK_TORRANCE", dict(roughness=0.25, ior=1.6)),
+    models = [("GGX", dict(roughness=0.35, fresnel="SCHLICK", multiscatter=True, layered_diffuse=True)), ("COOK_TORRANCE", dict(roughness=0.25, ior=1.6)),
               ("BLINN_PHONG", dict(exponent=60.0)), ("WARD_ISO", dict(alpha_x=0.15))]
     for index, (model, settings) in enumerate(models):
         x = -2.25 + 1.5 * index

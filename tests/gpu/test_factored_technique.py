@@ -49,7 +49,7 @@ def _scene(name, world):
     fx.point_light(scene, name + "_point", (1.5, -2.0, 3.0), 800.0, radius=0.2)
     fx.point_light(scene, name + "_sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
     glossy = fx.material(name + "_ggx", technique="FACTORED", model="GGX", roughness=0.4,
-                         diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6))
+                         diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6), fresnel="SCHLICK", multiscatter=True, layered_diffuse=True)
     brushed = fx.material(name + "_ward", technique="FACTORED", model="WARD_ANISO", alpha_x=0.3, alpha_y=0.1)
     fx.uv_sphere(scene, name + "_a", (-1.1, 0.0, 1.0), radius=0.9).data.materials.append(glossy)
     fx.uv_sphere(scene, name + "_b", (1.1, 0.0, 1.0), radius=0.9).data.materials.append(brushed)

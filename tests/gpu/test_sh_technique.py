@@ -60,7 +60,8 @@ def _scene(name, world, order, window):
     spot = fx.point_light(scene, name + "_spot", (-2.0, -2.0, 2.5), 600.0, radius=0.1, kind="SPOT")
     spot.rotation_euler = (0.9, 0.0, -0.8)
     glossy = fx.material(name + "_ggx", technique="SH", sh_order=order, sh_window=window, model="GGX",
-                         roughness=0.4, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6))
+                         roughness=0.4, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6),
+                         fresnel="SCHLICK", multiscatter=True, layered_diffuse=True)     # the layer's roughness follows the texture
     if not NO_TEXTURE: glossy.sgprt.roughness_texture = fx.image(name + "_rough", ROUGHNESS)
     brushed = fx.material(name + "_as", technique="SH", sh_order=order, sh_window=window, model="ASHIKHMIN_SHIRLEY",
                           nu=20.0, nv=200.0)

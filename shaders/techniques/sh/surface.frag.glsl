@@ -18,6 +18,9 @@ void main()
   vec4 tangent;
   vec3 shading_normal, shading_tangent;
   surface_geometry(normal, tangent, shading_normal, shading_tangent);
+#ifdef LAYERING
+  surface_layering(shading_normal, diffuse_color, specular_color);
+#endif
   vec3 diffuse, specular;
   shade_sh(world_position, shading_normal, shading_tangent, diffuse_color, specular_color, parameter, diffuse,
            specular);

@@ -1,0 +1,86 @@
+"""Blender's shader nodes in the engine's terms: the Principled, Diffuse and Glossy BSDFs mapped to a model,
+colours and reflectance.layering's settings (pure: plain numbers in, a dict of export.MaterialParams fields
+out; blender/node_reader.py reads the nodes).
+
+What Cycles does (intern/cycles/kernel/svm/closure.h, read for Blender 4.2-5.x): alpha = roughness^2; with
+Anisotropic a > 0, aspect = sqrt(1 - 0.9 a), alpha_x = alpha / aspect, alpha_y = alpha aspect, the tangent
+turned by Anisotropic Rotation x 2 pi; the metal (weight Metallic) has Schlick-like Fresnel from F0 = the base
+colour (F82 tint, white tint: Schlick); what remains is a dielectric of F0 = ((ior - 1)/(ior + 1))^2 x
+2 Specular IOR Level, tinted by Specular Tint, over the diffuse base (weighted by 1 - Transmission), which
+loses the dielectric's directional albedo.  Both glossy lobes share one GGX, so their Fresnel terms add to one
+Schlick term with F0 = Metallic base + (1 - Metallic) F0_dielectric tint (Schlick is linear in F0).
+"""
+import numpy as np
+
+# Glossy BSDF distributions -> (model, multiscatter); Beckmann's NDF is Ward's but for a cosine
+GLOSSY_DISTRIBUTIONS = {"GGX": ("GGX", False), "MULTI_GGX": ("GGX", True), "BECKMANN": ("WARD_ISO", False),
+                        "ASHIKHMIN_SHIRLEY": ("ASHIKHMIN_SHIRLEY", False), "SHARP": ("GGX", False)}
+MIN_ROUGHNESS = 0.001       # material.sgprt.roughness's lower end: a mirror renders as the sharpest lobe
+
+
+def dielectric_f0(ior, specular_ior_level=0.5):
+    """F0 of Cycles' dielectric layer: ((ior - 1)/(ior + 1))^2 times 2 x Specular IOR Level, in [0, 1]."""
+    ior = max(float(ior), 1e-5)
+    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+    return float(np.clip(f0 * 2.0 * max(float(specular_ior_level), 0.0), 0.0, 1.0))
+
+
+def ior_of_f0(f0):
+    """The IOR whose normal-incidence reflectance is f0 (the inverse of dielectric_f0 at level 0.5)."""
+    root = np.sqrt(np.clip(float(f0), 0.0, 0.999999))
+    return float((1.0 + root) / (1.0 - root))
+
+
+def anisotropic_alphas(roughness, anisotropic):
+    """(alpha_x, alpha_y) of Cycles' anisotropic GGX."""
+    alpha = float(np.clip(roughness, 0.0, 1.0)) ** 2
+    aspect = np.sqrt(1.0 - 0.9 * float(np.clip(anisotropic, 0.0, 1.0)))
+    return alpha / aspect, alpha * aspect
+
+
+def _roughness_fields(roughness, anisotropic, distribution_model):
+    """The model and its width fields for a GGX-family roughness (Ward for anisotropy: its alphas are GGX's)."""
+    roughness = float(np.clip(roughness, 0.0, 1.0))
+    if anisotropic > 0.0 and distribution_model == "GGX":
+        alpha_x, alpha_y = anisotropic_alphas(roughness, anisotropic)
+        return {"model": "WARD_ANISO", "alpha_x": float(np.clip(alpha_x, MIN_ROUGHNESS, 1.0)),
+                "alpha_y": float(np.clip(alpha_y, MIN_ROUGHNESS, 1.0))}
+    if distribution_model == "WARD_ISO":
+        return {"model": "WARD_ISO", "alpha_x": float(np.clip(roughness ** 2, MIN_ROUGHNESS, 1.0))}
+    if distribution_model == "ASHIKHMIN_SHIRLEY":
+        alpha = max(roughness ** 2, 1e-3)
+        exponent = float(np.clip(2.0 / (alpha * alpha) - 2.0, 1.0, 1e5))
+        return {"model": "ASHIKHMIN_SHIRLEY", "nu": exponent, "nv": exponent}
+    return {"model": "GGX", "roughness": max(roughness, MIN_ROUGHNESS)}
+
+
+def principled(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, ior=1.5, specular_ior_level=0.5,
+               specular_tint=(1.0, 1.0, 1.0), anisotropic=0.0, anisotropic_rotation=0.0, transmission=0.0,
+               emission_color=(1.0, 1.0, 1.0), emission_strength=0.0, multiscatter=True):
+    """MaterialParams fields of a Principled BSDF with these input values (colours linear RGB)."""
+    base = np.clip(np.asarray(base_color, np.float64)[:3], 0.0, None)
+    metallic = float(np.clip(metallic, 0.0, 1.0))
+    transmission = float(np.clip(transmission, 0.0, 1.0))
+    tint = np.clip(np.asarray(specular_tint, np.float64)[:3], 0.0, None)
+    f0 = dielectric_f0(ior, specular_ior_level)
+    specular = metallic * np.minimum(base, 1.0) + (1.0 - metallic) * f0 * tint
+    out = {"diffuse_color": tuple(float(c) for c in base * (1.0 - metallic) * (1.0 - transmission)),
+           "specular_color": tuple(float(c) for c in specular),
+           "fresnel": "SCHLICK", "multiscatter": bool(multiscatter),
+           "layered_f0": float(f0 * float(np.max(tint))) if metallic < 1.0 else -1.0,
+           "ior": ior_of_f0(f0) if f0 > 0 else 1.0,
+           "tangent_rotation": float(anisotropic_rotation) * 2.0 * np.pi,
+           "emission": tuple(float(c) * float(emission_strength) for c in np.asarray(emission_color)[:3])}
+    out.update(_roughness_fields(roughness, float(anisotropic), "GGX"))
+    return out
+
+
+def glossy(color=(0.8, 0.8, 0.8), roughness=0.5, distribution="GGX", anisotropy=0.0, rotation=0.0):
+    """MaterialParams fields of a Glossy BSDF: the colour at every angle (no Fresnel), Multiscatter GGX's gain."""
+    model, multiscatter = GLOSSY_DISTRIBUTIONS.get(distribution, ("GGX", False))
+    if distribution == "SHARP":
+        roughness = 0.0
+    out = {"specular_color": tuple(float(c) for c in np.asarray(color)[:3]), "fresnel": "NONE",
+           "multiscatter": multiscatter, "tangent_rotation": float(rotation) * 2.0 * np.pi}
+    out.update(_roughness_fields(roughness, float(anisotropy), model))
+    return out

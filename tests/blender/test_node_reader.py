@@ -1,0 +1,156 @@
+"""Blender's node materials read by blender/node_reader.py and chosen by material.sgprt.source: the reading
+of hand-built trees per node and socket, the default source, one warning per material, saved and reopened."""
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+
+def _material(name):
+    material = bpy.data.materials.new(name)
+    material.use_fake_user = True              # kept when saved without a user
+    if bpy.app.version < (5, 0, 0):
+        material.use_nodes = True
+    tree = material.node_tree
+    for node in list(tree.nodes):
+        tree.nodes.remove(node)
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    return material, tree, output
+
+
+def _principled(tree, output, **inputs):
+    node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    for name, value in inputs.items():
+        node.inputs[name.replace("_", " ")].default_value = value
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    return node
+
+
+def _image(name, pixels, colorspace="sRGB"):
+    height, width = pixels.shape[:2]
+    image = bpy.data.images.new(name, width, height, alpha=True)
+    image.colorspace_settings.name = colorspace
+    image.pixels.foreach_set(np.ascontiguousarray(pixels, np.float32).ravel())
+    image.pack()
+    return image
+
+
+def _read(material):
+    from sg_prt_addon.blender import export
+    messages = export.collect_warnings([])
+    try:
+        params = export.export_material(material)
+    finally:
+        export.collect_warnings(None)
+    return params, messages
+
+
+def test_principled_dielectric(empty_file):
+    material, tree, output = _material("dielectric")
+    _principled(tree, output, Base_Color=(0.8, 0.1, 0.05, 1.0), Roughness=0.35, IOR=1.5, Metallic=0.0)
+    params, warnings = _read(material)
+    assert material.sgprt.source == "NODE_TREE" and params.source == "NODE_TREE"
+    assert params.model == "GGX" and params.roughness == pytest.approx(0.35)
+    assert params.diffuse_color == pytest.approx((0.8, 0.1, 0.05))
+    assert params.specular_color == pytest.approx((0.04,) * 3, abs=1e-6)
+    assert params.fresnel == "SCHLICK" and params.multiscatter and params.layered_f0 == pytest.approx(0.04)
+    assert warnings == []
+
+
+def test_principled_metal_textures_and_normal_map(empty_file):
+    material, tree, output = _material("gold")
+    node = _principled(tree, output, Base_Color=(1.0, 0.77, 0.34, 1.0), Metallic=1.0, Specular_IOR_Level=0.5)
+    node.distribution = "GGX"
+    colour = _image("base", np.full((4, 4, 4), 0.5))
+    rough = _image("rough", np.full((4, 4, 4), 0.4), colorspace="Non-Color")
+    bumps = _image("bumps", np.full((4, 4, 4), (0.5, 0.5, 1.0, 1.0)), colorspace="Non-Color")
+    for image, socket in ((colour, "Base Color"), (rough, "Roughness")):
+        texture = tree.nodes.new("ShaderNodeTexImage")
+        texture.image = image
+        tree.links.new(texture.outputs["Color"], node.inputs[socket])
+    normal_map = tree.nodes.new("ShaderNodeNormalMap")
+    normal_map.inputs["Strength"].default_value = 0.7
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = bumps
+    tree.links.new(texture.outputs["Color"], normal_map.inputs["Color"])
+    tree.links.new(normal_map.outputs["Normal"], node.inputs["Normal"])
+    params, warnings = _read(material)
+    assert params.textures == {"diffuse_color": "base", "specular_color": "base", "roughness": "rough",
+                               "normal_map": "bumps"}
+    assert params.roughness == pytest.approx(1.0)        # the factor: the texture holds the value
+    assert params.diffuse_color == pytest.approx((0.0, 0.0, 0.0)) and params.layered_f0 < 0
+    assert params.specular_color == pytest.approx((1.0, 1.0, 1.0)) and not params.multiscatter
+    assert params.normal_strength == pytest.approx(0.7)
+    assert params.decoded_slots == () and warnings == []
+    rough.colorspace_settings.name = "sRGB"              # Blender decodes it: so does the engine
+    assert _read(material)[0].decoded_slots == ("roughness",)
+
+
+def test_mix_add_emission_and_math(empty_file):
+    material, tree, output = _material("mix")
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.2, 0.4, 0.6, 1.0)
+    glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.distribution = "GGX"
+    glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+    value = tree.nodes.new("ShaderNodeValue")
+    value.outputs[0].default_value = 0.25
+    math = tree.nodes.new("ShaderNodeMath")
+    math.operation = "MULTIPLY"
+    math.inputs[1].default_value = 2.0
+    tree.links.new(value.outputs[0], math.inputs[0])
+    tree.links.new(math.outputs[0], glossy.inputs["Roughness"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = 0.3
+    tree.links.new(diffuse.outputs[0], mix.inputs[1])
+    tree.links.new(glossy.outputs[0], mix.inputs[2])
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (1.0, 0.5, 0.0, 1.0)
+    emission.inputs["Strength"].default_value = 2.0
+    add = tree.nodes.new("ShaderNodeAddShader")
+    tree.links.new(mix.outputs[0], add.inputs[0])
+    tree.links.new(emission.outputs[0], add.inputs[1])
+    tree.links.new(add.outputs[0], output.inputs["Surface"])
+    params, warnings = _read(material)
+    assert params.diffuse_color == pytest.approx((0.14, 0.28, 0.42))
+    assert params.specular_color == pytest.approx((0.27, 0.27, 0.27))
+    assert params.roughness == pytest.approx(0.5) and params.fresnel == "NONE" and not params.multiscatter
+    assert params.layered_f0 < 0 and params.emission == pytest.approx((2.0, 1.0, 0.0))
+    assert warnings == []
+
+
+def test_unsupported_nodes_give_one_warning_naming_them(empty_file):
+    material, tree, output = _material("odd")
+    node = _principled(tree, output, Coat_Weight=0.5, Alpha=0.5)
+    ramp = tree.nodes.new("ShaderNodeValToRGB")
+    tree.links.new(ramp.outputs["Color"], node.inputs["Base Color"])
+    node.inputs["Base Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+    params, warnings = _read(material)
+    assert len(warnings) == 1, warnings
+    text = warnings[0]
+    assert "'odd' (node tree)" in text and "Color Ramp" in text and "(0.3, 0.3, 0.3)" in text
+    assert "the coat" in text and "Alpha 0.5" in text
+    assert params.diffuse_color == pytest.approx((0.3, 0.3, 0.3))
+
+
+def test_source_defaults_and_survives_reopening(empty_file, tmp_path):
+    node_material, tree, output = _material("nodes")
+    _principled(tree, output, Base_Color=(0.1, 0.2, 0.3, 1.0))
+    tuned, tree, output = _material("tuned")
+    _principled(tree, output)
+    tuned.sgprt.model = "WARD_ISO"                     # given SG-PRT settings: they render
+    chosen, tree, output = _material("chosen")
+    _principled(tree, output)
+    chosen.sgprt.diffuse_color = (1.0, 0.0, 0.0)
+    chosen.sgprt.source = "NODE_TREE"                  # an explicit choice wins
+    assert (node_material.sgprt.source, tuned.sgprt.source, chosen.sgprt.source) == ("NODE_TREE", "SETTINGS",
+                                                                                     "NODE_TREE")
+    assert _read(tuned)[0].model == "WARD_ISO" and _read(tuned)[0].source == "SETTINGS"
+    path = tmp_path / "sources.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    materials = bpy.data.materials
+    assert [materials[name].sgprt.source for name in ("nodes", "tuned", "chosen")] == ["NODE_TREE", "SETTINGS",
+                                                                                       "NODE_TREE"]
+    assert _read(materials["nodes"])[0].diffuse_color == pytest.approx((0.1, 0.2, 0.3))
+    assert _read(materials["chosen"])[0].diffuse_color == pytest.approx((0.8, 0.8, 0.8))
