@@ -1,7 +1,7 @@
 """Register and unregister everything the add-on adds to Blender, in dependency order."""
 import bpy
 
-from .blender import brdf_factorization, lobe_fit, panels, properties, transfer_bake, visibility_bake
+from .blender import brdf_factorization, lobe_fit, node_copy, panels, properties, transfer_bake, visibility_bake
 from .engine.render_engine import SGPRT_RenderEngine
 
 ENGINE_CLASSES = (SGPRT_RenderEngine,)
@@ -15,6 +15,7 @@ def register():
     transfer_bake.register()
     lobe_fit.register()           # after panels: its panel's parent is SGPRT_PT_material
     brdf_factorization.register()
+    node_copy.register()
     for cls in ENGINE_CLASSES:
         bpy.utils.register_class(cls)
         _registered_engine_classes.append(cls)
@@ -23,6 +24,7 @@ def register():
 def unregister():
     while _registered_engine_classes:
         bpy.utils.unregister_class(_registered_engine_classes.pop())
+    node_copy.unregister()
     brdf_factorization.unregister()
     lobe_fit.unregister()
     transfer_bake.unregister()

@@ -20,6 +20,15 @@ class MaterialPanel:
         return context.engine in cls.COMPAT_ENGINES and context.material is not None
 
 
+def _draw_technique_settings(layout, settings):
+    """The chosen technique's own settings (whatever the material's source)."""
+    if techniques.of_settings(settings) == spherical_harmonics.NAME:
+        layout.prop(settings, "sh_order")
+        layout.prop(settings, "sh_window")
+    else:
+        layout.prop(settings, "view_warp")
+
+
 class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
     bl_label = "SG-PRT Surface"
 
@@ -27,7 +36,13 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
         settings = context.material.sgprt
         layout = self.layout
         layout.use_property_split = True
+        layout.prop(settings, "source")
         layout.prop(settings, "technique")
+        if settings.source == "NODE_TREE":
+            layout.label(text="Shading nodes: Principled, Diffuse, Glossy, Emission, Mix, Add", icon="NODETREE")
+            layout.operator("sgprt.copy_from_node_tree")
+            _draw_technique_settings(layout, settings)
+            return
         layout.prop(settings, "model")
         textured = settings.show_textures
         for name in ("diffuse_color", "specular_color") + models.BY_NAME[settings.model].panel_parameters:
@@ -35,12 +50,11 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
             row.prop(settings, name)
             if textured and hasattr(settings, f"{name}_texture"):
                 row.template_ID(settings, f"{name}_texture", open="image.open")
-        if techniques.of_settings(settings) == spherical_harmonics.NAME:
-            layout.prop(settings, "sh_order")
-            layout.prop(settings, "sh_window")
-        else:
-            layout.prop(settings, "view_warp")
+        for name in ("fresnel", "multiscatter", "layered_diffuse", "emission_color", "emission_strength"):
+            layout.prop(settings, name)
+        _draw_technique_settings(layout, settings)
         layout.prop(settings, "show_textures")
+
 
 
 class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
@@ -89,6 +103,7 @@ COMPATIBLE_BUILTIN_PANELS = (
     "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_output", "RENDER_PT_color_management",
     "DATA_PT_context_light", "DATA_PT_light", "DATA_PT_lens", "DATA_PT_camera", "DATA_PT_camera_display",
     "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface", "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_context_material",
+    "EEVEE_MATERIAL_PT_surface",
 )
 
 

@@ -12,7 +12,7 @@ Blender's glossy lobes differ from the engine's GGX (brdf.GGX, no Fresnel) in th
 The techniques shade the engine's GGX, so Fresnel leaves the integral: it is replaced by its average over
 the lobe at this view, F_E(o) = (F0 (E - E_w) + E_w) / E, with E(o) the GGX albedo and E_w(o) the albedo
 weighted by (1 - o.h)^5.  Exact in the white furnace; under a light the error is the spread of F(o.h) over
-the lobe (docs/ACCURACY.md, layering).  The factors multiply the specular colour (F0) and the diffuse colour;
+the lobe (docs/ACCURACY.md, layering).  F_E replaces the specular colour (F0), a factor the diffuse colour;
 shaders/techniques/common/surface_layering.glsl computes the same, and `factors` is its mirror.
 
 Table: (TABLE_SIZE, TABLE_SIZE, 4) float32 over (roughness rows, cos theta_o columns) at texel centres, as
@@ -74,15 +74,16 @@ def table_values(cos_o, roughness):
     return values[..., 0], values[..., 1], values[..., 2]
 
 
-def _specular_factor(f0, albedo, weighted, average, fresnel, multiscatter):
-    """Per channel: the Fresnel average over the lobe (or 1), times the multiscatter gain (or 1)."""
+def _specular_colour(f0, albedo, weighted, average, fresnel, multiscatter):
+    """Per channel: the colour on the engine's GGX lobe: Schlick's average over the lobe from f0 (or f0 itself,
+    a constant colour), times the multiscatter gain (or 1)."""
     one = FLOAT(1.0)
     albedo = np.maximum(albedo, FLOAT(1e-4))
     if fresnel:
         single = (f0 * (albedo - weighted) + weighted) / albedo
         fresnel_average = f0 + (one - f0) * FLOAT(SCHLICK_AVERAGE_WEIGHT)
     else:
-        single = np.ones_like(f0)
+        single = f0
         fresnel_average = f0
     if not multiscatter:
         return single
@@ -92,7 +93,8 @@ def _specular_factor(f0, albedo, weighted, average, fresnel, multiscatter):
 
 
 def factors(f0, layered_f0, cos_o, roughness, fresnel, multiscatter):
-    """(specular factor (N, 3), diffuse factor (N,)) float32 at views cos_o (N,) and roughness (N,).
+    """(specular colour (N, 3), diffuse factor (N,)) float32 at views cos_o (N,) and roughness (N,): the colour
+    that replaces the specular colour on the engine's GGX lobe, and what multiplies the diffuse colour.
 
     f0 (N, 3): the specular colour at normal incidence; layered_f0 (N,) or scalar: the dielectric layer's F0
     over the diffuse (below 0: the diffuse is not layered, factor 1); fresnel: Schlick on (else a constant
@@ -101,9 +103,9 @@ def factors(f0, layered_f0, cos_o, roughness, fresnel, multiscatter):
     roughness = np.clip(np.asarray(roughness, FLOAT), FLOAT(0.0), FLOAT(1.0))
     albedo, weighted, average = table_values(cos_o, roughness)
     f0 = np.asarray(f0, FLOAT)
-    specular = _specular_factor(f0, albedo[:, None], weighted[:, None], average[:, None], fresnel, multiscatter)
+    specular = _specular_colour(f0, albedo[:, None], weighted[:, None], average[:, None], fresnel, multiscatter)
     layered_f0 = np.broadcast_to(np.asarray(layered_f0, FLOAT), cos_o.shape)
-    layer = _specular_factor(np.maximum(layered_f0, FLOAT(0.0)), albedo, weighted, average, True, multiscatter)
+    layer = _specular_colour(np.maximum(layered_f0, FLOAT(0.0)), albedo, weighted, average, True, multiscatter)
     reflected = np.clip(layer * albedo, FLOAT(0.0), FLOAT(1.0))
     diffuse = np.where(layered_f0 < FLOAT(0.0), FLOAT(1.0), FLOAT(1.0) - reflected)
     return specular.astype(FLOAT), diffuse.astype(FLOAT)

@@ -644,10 +644,10 @@ def surface_layers(material, roughness_texture, uv, diffuse_color, specular_colo
         roughness = roughness * sample_texture(roughness_texture, uv)[:, 0]
     view = view_directions(np.asarray(position, FLOAT), view_origin, is_perspective)
     cos_o = np.sum(np.asarray(shading_normal, FLOAT) * view, axis=-1)
-    specular_factor, diffuse_factor = layering.factors(
+    specular, diffuse_factor = layering.factors(
         np.asarray(specular_color, FLOAT), FLOAT(getattr(material, "layered_f0", layering.NO_LAYER)), cos_o,
         roughness, "fresnel" in layering_flags, "multiscatter" in layering_flags)
-    return diffuse_color * diffuse_factor[:, None], specular_color * specular_factor
+    return diffuse_color * diffuse_factor[:, None], specular
 
 
 def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,

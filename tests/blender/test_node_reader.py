@@ -154,3 +154,50 @@ def test_source_defaults_and_survives_reopening(empty_file, tmp_path):
                                                                                        "NODE_TREE"]
     assert _read(materials["nodes"])[0].diffuse_color == pytest.approx((0.1, 0.2, 0.3))
     assert _read(materials["chosen"])[0].diffuse_color == pytest.approx((0.8, 0.8, 0.8))
+
+
+def test_panel_and_copy_from_node_tree(empty_file):
+    """The material panel shows the source and the copy button for a node material, the settings after the
+    copy; the copy writes the reading into the settings, which then render the same parameters."""
+    from sg_prt_addon.blender import panels
+
+    material, tree, output = _material("copied")
+    _principled(tree, output, Base_Color=(0.6, 0.3, 0.1, 1.0), Roughness=0.45, Metallic=0.0)
+    before = _read(material)[0]
+
+    class Layout:
+        def __init__(self):
+            self.calls, self.use_property_split = [], False
+
+        def prop(self, data, name, **kwargs):
+            getattr(data, name)
+            self.calls.append(("prop", name))
+
+        def operator(self, idname, **kwargs):
+            self.calls.append(("operator", idname))
+
+        def label(self, text="", **kwargs):
+            self.calls.append(("label", text))
+
+        def row(self, **kwargs):
+            return self
+
+        def template_ID(self, *args, **kwargs):
+            self.calls.append(("template_ID", args[1]))
+
+    def drawn():
+        layout = Layout()
+        context = type("Context", (), {"material": material})()
+        panels.SGPRT_PT_material.draw(type("Panel", (), {"layout": layout})(), context)
+        return layout.calls
+
+    calls = drawn()
+    assert ("prop", "source") in calls and ("operator", "sgprt.copy_from_node_tree") in calls
+    assert ("prop", "model") not in calls
+    with bpy.context.temp_override(material=material):
+        assert bpy.ops.sgprt.copy_from_node_tree() == {"FINISHED"}
+    assert material.sgprt.source == "SETTINGS" and ("prop", "model") in drawn()
+    after = _read(material)[0]
+    for name in ("model", "diffuse_color", "specular_color", "roughness", "fresnel", "multiscatter"):
+        assert getattr(after, name) == pytest.approx(getattr(before, name)), name
+    assert after.layered_f0 == pytest.approx(before.layered_f0, abs=1e-6)

@@ -130,3 +130,29 @@ def test_equivalent_roughness():
     assert layering.equivalent_roughness("GGX", {"roughness": 0.4}) == pytest.approx(0.4)
     assert layering.equivalent_roughness("WARD_ANISO", {"alpha_x": 0.25, "alpha_y": 0.04}) == pytest.approx(0.316, 1e-2)
     assert layering.equivalent_roughness("WARD_ISO", {"alpha_x": 0.16}) == pytest.approx(0.4)
+
+
+def test_the_mirror_replaces_the_specular_colour():
+    """sg_shading.surface_layers (the shaders' order of operations): a constant colour stays itself, Schlick from
+    F0 gives F_E (about F0 face-on, not F0 times it), the diffuse is scaled."""
+    from types import SimpleNamespace
+
+    from sg_prt_addon.techniques import sg_shading
+
+    position = np.array([[0.0, 0.0, 0.0]] * 2, np.float32)
+    normal = np.array([[0.0, 0.0, 1.0], [0.0, 0.8, 0.6]], np.float32)
+    colour = np.array([[0.9, 0.5, 0.2]] * 2, np.float32)
+    diffuse = np.full((2, 3), 0.5, np.float32)
+
+    def layered(**settings):
+        material = SimpleNamespace(model="GGX", roughness=0.3, layered_f0=-1.0, fresnel="NONE", multiscatter=False)
+        material.__dict__.update(settings)
+        return sg_shading.surface_layers(material, None, None, diffuse, colour, normal, position, (0.0, 0.0, 5.0),
+                                         True)
+
+    assert layered()[1] is colour and layered(fresnel="NONE")[0] is diffuse
+    kd, ks = layered(fresnel="SCHLICK")
+    np.testing.assert_allclose(ks[0], colour[0], rtol=0.02)              # face-on: F_E(o) ~ F0
+    assert np.all(ks[1] > colour[1])                                      # towards grazing: whiter
+    kd, ks = layered(fresnel="SCHLICK", layered_f0=0.04)
+    assert np.all(kd < diffuse) and np.all(kd > 0.9 * diffuse)

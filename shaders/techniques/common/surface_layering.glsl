@@ -4,10 +4,12 @@
  * LAYERING_FRESNEL: Schlick on the specular colour; LAYERING_MULTISCATTER: the multiscatter gain; the
  * diffuse is layered when material.diffuse_color.w (the layer's F0) is not negative. */
 
-vec3 layering_specular_factor(vec3 f0, vec3 table, bool fresnel)
+/* The colour on the engine's GGX lobe: Schlick's average over the lobe from f0 (or f0 itself), times the
+ * multiscatter gain */
+vec3 layering_specular_colour(vec3 f0, vec3 table, bool fresnel)
 {
   float albedo = max(table.x, 1.0e-4);
-  vec3 single = vec3(1.0);
+  vec3 single = f0;
   vec3 fresnel_average = f0;
   if (fresnel) {
     single = (f0 * (albedo - table.y) + table.y) / albedo;
@@ -34,13 +36,13 @@ void surface_layering(vec3 shading_normal, inout vec3 diffuse_color, inout vec3 
                 float(LAYERING_TABLE_SIZE);
   vec3 table = texture(layering_table, coords).rgb;
 #ifdef LAYERING_FRESNEL
-  specular_color *= layering_specular_factor(specular_color, table, true);
+  specular_color = layering_specular_colour(specular_color, table, true);
 #else
-  specular_color *= layering_specular_factor(specular_color, table, false);
+  specular_color = layering_specular_colour(specular_color, table, false);
 #endif
   float layer_f0 = material.diffuse_color.w;
   if (layer_f0 >= 0.0) {
-    float reflected = clamp(layering_specular_factor(vec3(layer_f0), table, true).x * table.x, 0.0, 1.0);
+    float reflected = clamp(layering_specular_colour(vec3(layer_f0), table, true).x * table.x, 0.0, 1.0);
     diffuse_color *= 1.0 - reflected;
   }
 }

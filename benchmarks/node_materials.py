@@ -1,0 +1,221 @@
+"""Blender's own node materials rendered by SG-PRT (material source: Node Tree) against Cycles.
+
+Each scene is a sphere whose material is built only from Blender's nodes (no SG-PRT settings), under the
+courtyard HDRI and a point light; SG-PRT reads the node tree (blender/node_reader.py), Cycles renders the same
+tree with direct light only (benchmarks.matched_materials.configure_cycles), two seeds: the truth is their
+mean, the noise floor rmse(seed 1 - seed 2) / 2.  A lone sphere has no occluder, so no bake is needed.
+Scores over the sphere's pixels (one pixel in from its silhouette): relative RMSE and mean bias.
+
+    .venv/bin/python -m benchmarks.node_materials [--size 128] [--cycles-samples 256] [--update-doc]
+"""
+import argparse
+import json
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+JSON_PATH = ROOT / "docs" / "node_materials.json"
+DOC_PATH = ROOT / "docs" / "ACCURACY.md"
+SECTION_TITLE = "## Blender node materials against Cycles"
+SEEDS = (1, 2)
+GOLD = (1.0, 0.766, 0.336, 1.0)
+
+
+def _nodes(name):
+    import bpy
+
+    material = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        material.use_nodes = True
+    tree = material.node_tree
+    for node in list(tree.nodes):
+        tree.nodes.remove(node)
+    return material, tree, tree.nodes.new("ShaderNodeOutputMaterial")
+
+
+def _principled(name, **inputs):
+    material, tree, output = _nodes(name)
+    node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    for socket, value in inputs.items():
+        node.inputs[socket.replace("_", " ")].default_value = value
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    return material, tree, node
+
+
+def _image(name, pixels, colorspace):
+    import bpy
+    import numpy as np
+
+    height, width = pixels.shape[:2]
+    image = bpy.data.images.new(name, width, height, alpha=True)
+    image.colorspace_settings.name = colorspace
+    image.pixels.foreach_set(np.ascontiguousarray(pixels, np.float32).ravel())
+    image.pack()
+    return image
+
+
+def _textured(tree, node, socket, image):
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    tree.links.new(texture.outputs["Color"], node.inputs[socket])
+    return texture
+
+
+def dielectric(roughness):
+    def build():
+        return _principled(f"dielectric_{roughness}", Base_Color=(0.8, 0.25, 0.1, 1.0), Roughness=roughness)[0]
+    return build
+
+
+def gold():
+    return _principled("gold", Base_Color=GOLD, Metallic=1.0, Roughness=0.3)[0]
+
+
+def textured():
+    """A checker Base Color, a striped roughness map (Non-Color) and a bumpy normal map."""
+    import numpy as np
+
+    material, tree, node = _principled("textured", Roughness=1.0)
+    u, v = np.meshgrid((np.arange(64) + 0.5) / 64, (np.arange(64) + 0.5) / 64)
+    checker = ((np.floor(u * 8) + np.floor(v * 4)) % 2)[..., None]
+    colour = np.ones((64, 64, 4))
+    colour[..., :3] = checker * (0.8, 0.7, 0.2) + (1 - checker) * (0.1, 0.3, 0.6)
+    rough = np.ones((64, 64, 4))
+    rough[..., :3] = (0.25 + 0.45 * (np.floor(v * 6) % 2))[..., None]
+    bumps = np.ones((64, 64, 4))
+    bumps[..., 0] = 0.5 + 0.25 * np.sin(2 * np.pi * 8 * u)
+    bumps[..., 1] = 0.5
+    bumps[..., 2] = np.sqrt(1 - (2 * bumps[..., 0] - 1) ** 2) * 0.5 + 0.5
+    _textured(tree, node, "Base Color", _image("checker", colour, "sRGB"))
+    _textured(tree, node, "Roughness", _image("stripes", rough, "Non-Color"))
+    normal_map = tree.nodes.new("ShaderNodeNormalMap")
+    _textured(tree, normal_map, "Color", _image("bumps", bumps, "Non-Color"))
+    tree.links.new(normal_map.outputs["Normal"], node.inputs["Normal"])
+    return material
+
+
+def mix_diffuse_glossy():
+    material, tree, output = _nodes("mix_diffuse_glossy")
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.2, 0.5, 0.8, 1.0)
+    glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.distribution = "GGX"
+    glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+    glossy.inputs["Roughness"].default_value = 0.3
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = 0.4
+    tree.links.new(diffuse.outputs[0], mix.inputs[1])
+    tree.links.new(glossy.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def anisotropic():
+    return _principled("anisotropic", Base_Color=(0.9, 0.9, 0.9, 1.0), Metallic=1.0, Roughness=0.4,
+                       Anisotropic=0.8)[0]
+
+
+SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),
+          "principled_gold_r030": gold, "principled_textured": textured, "mix_diffuse_glossy": mix_diffuse_glossy,
+          "principled_anisotropic": anisotropic}
+
+
+def build(name, size):
+    from benchmarks import truth_suite
+
+    scene = truth_suite._start(size)
+    truth_suite._hdri(scene)
+    truth_suite._light(scene, "POINT", **truth_suite.POINT_LIGHT)
+    truth_suite._sphere(SCENES[name]())
+    truth_suite._sphere_camera(scene)
+    scene.render.film_transparent = True
+    return scene
+
+
+def render_engine_image(scene):
+    """(seconds of the second render, RGB (H, W, 3) row 0 at the top, alpha, warnings)."""
+    import bpy
+
+    from sg_prt_addon.engine import render_engine
+
+    scene.render.engine = "SG_PRT"
+    seconds = 0.0
+    for _ in range(2):
+        render_engine.last_render.clear()
+        start = time.perf_counter()
+        bpy.ops.render.render()
+        seconds = time.perf_counter() - start
+        if "error" in render_engine.last_render:
+            raise RuntimeError(render_engine.last_render["error"])
+    combined = render_engine.last_render["passes"]["Combined"][::-1].astype("float64")
+    warnings = list(render_engine.last_render["state"].warnings)
+    return seconds, combined[..., :3], combined[..., 3], warnings
+
+
+def score(name, size, samples, log=print):
+    """One scene's row: SG-PRT against the two-seed Cycles truth."""
+    from scipy import ndimage
+
+    from benchmarks import error_vs_time, matched_materials
+    from validation import image_error
+
+    scene = build(name, size)
+    seconds, image, alpha, warnings = render_engine_image(scene)
+    mask = ndimage.binary_erosion(alpha > 0.999, iterations=1)
+    seeds = []
+    with tempfile.TemporaryDirectory() as folder:
+        import bpy
+        for seed in SEEDS:
+            matched_materials.configure_cycles(scene, samples, seed)
+            start = time.perf_counter()
+            bpy.ops.render.render()
+            seeds.append((time.perf_counter() - start, error_vs_time._read_render_result(scene, folder)))
+    truth = 0.5 * (seeds[0][1] + seeds[1][1])
+    row = {"scene": name, "size": size, "cycles_samples": samples, "engine_seconds": seconds,
+           "cycles_seconds": seeds[0][0], "pixels": int(mask.sum()),
+           "relative_rmse": image_error.relative_rmse(image, truth, mask),
+           "relative_bias": image_error.relative_mean_bias(image, truth, mask),
+           "noise_floor": image_error.relative_rmse(seeds[0][1], seeds[1][1], mask) / 2,
+           "warnings": warnings}
+    log(f"{name:24s} rmse {row['relative_rmse']:.3f}  bias {row['relative_bias']:+.3f}  noise floor "
+        f"{row['noise_floor']:.3f}  SG-PRT {seconds:.2f} s  Cycles {seeds[0][0]:.1f} s")
+    return row
+
+
+def markdown_section(data):
+    lines = [f"Blender materials built only from nodes (`benchmarks/node_materials.py`): a sphere under "
+             f"courtyard.exr and a point light, {data['size']} x {data['size']}, Cycles direct light only, "
+             f"{data['cycles_samples']} spp x 2 seeds.  SG-PRT reads the node tree (no SG-PRT settings); a lone "
+             "sphere needs no bake.  Relative RMSE and bias over the sphere's pixels.", "",
+             "| scene | relative RMSE | bias | noise floor |", "|---|---|---|---|"]
+    for row in data["rows"]:
+        lines.append(f"| {row['scene']} | {row['relative_rmse']:.3f} | {row['relative_bias']:+.3f} | "
+                     f"{row['noise_floor']:.3f} |")
+    lines += ["", f"Rerun: `.venv/bin/python -m benchmarks.node_materials --size {data['size']} "
+              f"--cycles-samples {data['cycles_samples']}` ({data['seconds']:.0f} s), then `--update-doc`."]
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=int, default=128)
+    parser.add_argument("--cycles-samples", type=int, default=256)
+    parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--update-doc", action="store_true", help="write the section from the JSON (no run)")
+    args = parser.parse_args(argv)
+    if args.update_doc:
+        from benchmarks import markdown_sections
+        markdown_sections.update_file(str(DOC_PATH), SECTION_TITLE, markdown_section(json.loads(JSON_PATH.read_text())))
+        print(f"updated {DOC_PATH}")
+        return
+    started = time.perf_counter()
+    rows = [score(name, args.size, args.cycles_samples) for name in args.scenes.split(",")]
+    data = {"size": args.size, "cycles_samples": args.cycles_samples, "rows": rows,
+            "seconds": time.perf_counter() - started}
+    JSON_PATH.write_text(json.dumps(data, indent=1))
+    print(markdown_section(data))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,27 @@
+"""Blender node materials (no SG-PRT settings) rendered by SG-PRT against Cycles (benchmarks/node_materials.py)
+at 64 x 64 with 2 x 32 spp: relative RMSE and mean bias over the sphere, with bounds from the figures measured
+at this size (in comments: RMSE / bias / the truth's noise floor; docs/ACCURACY.md has the 128 px run)."""
+import pytest
+
+
+@pytest.fixture(scope="module")
+def node_materials(blender):
+    from benchmarks import node_materials
+    return node_materials
+
+
+@pytest.mark.parametrize("name, rmse_bound, bias_bound", [
+    ("principled_r020", 0.16, 0.03),          # measured 0.110 / -0.001 / 0.089
+    ("principled_r050", 0.14, 0.03),          # 0.091 / -0.003 / 0.081
+    ("principled_r080", 0.13, 0.03),          # 0.081 / -0.002 / 0.076
+    ("principled_gold_r030", 0.27, 0.04),     # 0.214 / +0.007 / 0.136
+    ("principled_textured", 0.27, 0.12),      # 0.214 / +0.084 / 0.106
+    ("mix_diffuse_glossy", 0.17, 0.03),       # 0.125 / +0.001 / 0.103
+    ("principled_anisotropic", 0.56, 0.27),   # 0.507 / -0.223 / 0.119: Ward's lobes for Cycles' anisotropic GGX
+])
+def test_node_material_against_cycles(node_materials, name, rmse_bound, bias_bound):
+    row = node_materials.score(name, 64, 32)
+    assert row["pixels"] > 800
+    assert row["relative_rmse"] < rmse_bound
+    assert abs(row["relative_bias"]) < bias_bound
+    assert not [w for w in row["warnings"] if "node tree" in w], row["warnings"]    # every node read as Blender
