@@ -26,15 +26,19 @@ def flags(params):
 
 
 def layer_roughness(params):
-    """The GGX roughness the layer's tables are read at (MaterialData options.z): the model's equivalent."""
-    model = models.BY_NAME[params.model]
+    """The GGX roughness the layer's tables are read at (MaterialData options.z): the model's equivalent (0
+    without layering, or for a material rendered by its stored fit, model FITTED)."""
+    model = models.BY_NAME.get(params.model)
+    if model is None or not flags(params):
+        return 0.0
     return layering.equivalent_roughness(params.model, {name: getattr(params, name) for name in model.parameters})
 
 
 def textured_roughness(model, textures):
     """Whether the roughness texture also scales the layer's roughness: where the technique applies it to a
     model with a roughness (GGX, Cook-Torrance)."""
-    return "roughness" in models.BY_NAME[model].parameters and "roughness" in textures
+    entry = models.BY_NAME.get(model)            # None: a stored fit (model FITTED)
+    return entry is not None and "roughness" in entry.parameters and "roughness" in textures
 
 
 def layering_defines(layering_flags, roughness_textured):
