@@ -660,40 +660,40 @@ def export_light(object_eval):
 # --------------------------------------------------------------------------- world
 
 def export_world(world):
-    """WorldExport of a bpy World: the first Environment Texture node's image, else its colour."""
+    """WorldExport of a bpy World from its node tree (blender/world_reader.py: a Background's colour or
+    Environment Texture, turned by a Mapping node, and its strength), else its colour."""
     if world is None:
         return WorldExport(colour=(0.0, 0.0, 0.0))
     import bpy
 
+    from . import world_reader
+
     colour = tuple(world.color)
-    strength = 1.0
     # Blender 5 always renders worlds with nodes (use_nodes is deprecated there)
     uses_nodes = world.node_tree is not None and (bpy.app.version >= (5, 0, 0) or world.use_nodes)
-    if uses_nodes:
-        for node in world.node_tree.nodes:
-            if node.type == "BACKGROUND":
-                if not node.inputs["Color"].is_linked:
-                    colour = tuple(node.inputs["Color"].default_value)[:3]
-                strength = _finite_setting(node.inputs["Strength"].default_value, 0.0,
-                                           f"world '{world.name}': strength")
+    reading = world_reader.read_world(world) if uses_nodes else world_reader.WorldReading()
+    if reading.notes:
+        warn(f"world '{world.name}' (node tree): " + "; ".join(reading.notes))
+    strength = _finite_setting(reading.strength, 0.0, f"world '{world.name}': strength")
+    if reading.colour is not None:
+        colour = tuple(reading.colour)[:3]
     if not np.all(np.isfinite(colour[:3])):
         warn(f"world '{world.name}': colour {tuple(colour[:3])} not finite, 0 used there")
         colour = tuple(float(c) if np.isfinite(c) else 0.0 for c in colour[:3])
-    if uses_nodes:
-        for node in world.node_tree.nodes:
-            if node.type == "TEX_ENVIRONMENT" and node.image is not None:
-                if not image_has_pixels(node.image):
-                    warn(f"world '{world.name}': image '{node.image.name}': {_no_pixels_reason(node.image)}: the "
-                         f"world colour {tuple(round(float(c), 4) for c in colour[:3])} used")
-                    break
-                pixels = image_pixels(node.image)[::-1, :, :3]      # numpy orientation, row 0 at the top
-                with np.errstate(over="ignore", invalid="ignore"):      # huge x strength: Inf, repaired below
-                    pixels = pixels * np.float32(strength)
-                pixels = finite_texels(pixels,
-                                       f"world '{world.name}': image '{node.image.name}'")
-                return WorldExport(colour=colour, image_name=node.image.name,
-                                   equirect=np.ascontiguousarray(pixels, np.float32),
-                                   strength=strength)
+    image = reading.image
+    if image is not None and not image_has_pixels(image):
+        warn(f"world '{world.name}': image '{image.name}': {_no_pixels_reason(image)}: the "
+             f"world colour {tuple(round(float(c), 4) for c in colour[:3])} used")
+    elif image is not None:
+        pixels = image_pixels(image)[::-1, :, :3]      # numpy orientation, row 0 at the top
+        with np.errstate(over="ignore", invalid="ignore"):      # huge x strength: Inf, repaired below
+            pixels = pixels * np.float32(strength)
+        pixels = finite_texels(pixels, f"world '{world.name}': image '{image.name}'")
+        if reading.matrix is not None and not np.allclose(reading.matrix, np.eye(3)):
+            from ..lighting import equirect
+            pixels = equirect.rotated(pixels, reading.matrix)
+        return WorldExport(colour=colour, image_name=image.name, equirect=np.ascontiguousarray(pixels, np.float32),
+                           strength=strength)
     return WorldExport(colour=tuple(float(c) * strength for c in colour[:3]), strength=strength)
 
 

@@ -45,7 +45,7 @@ class _Closure:
     inputs: dict
 
 
-def _follow(socket):
+def follow(socket):
     """The output socket feeding an input (through reroutes), or None."""
     if not socket.is_linked or not socket.links:
         return None
@@ -78,8 +78,11 @@ def _as_scalar(value):
     return float(np.dot(value[:3], (0.2126, 0.7152, 0.0722))) if isinstance(value, tuple) else float(value)
 
 
-class _Reader:
-    def __init__(self, material):
+class SocketReader:
+    """Reads sockets as Inputs and shader trees as closures, collecting notes (material: the one read, whose
+    meshes' UV maps an Image Texture's UV Map node is checked against; None for a world)."""
+
+    def __init__(self, material=None):
         self.material = material
         self.notes = []
 
@@ -92,7 +95,7 @@ class _Reader:
 
     def value(self, socket, colour):
         """Input of a socket: a constant, or a constant times one image."""
-        out = _follow(socket)
+        out = follow(socket)
         if out is None:
             value = _default(socket)
             return Input(_as_colour(value) if colour else _as_scalar(value))
@@ -127,7 +130,7 @@ class _Reader:
             return Input(_as_colour(value) if colour else _as_scalar(value))
         if out.name != "Color":
             self.note(node, f"its {out.name} output is read as its Color")
-        vector = _follow(node.inputs["Vector"])
+        vector = follow(node.inputs["Vector"])
         if vector is not None:
             source = vector.node
             if source.type == "UVMAP" and source.uv_map and self._other_uv_map(source.uv_map):
@@ -142,6 +145,8 @@ class _Reader:
         """Whether a mesh with this material has an active UV map other than `name` (export reads the active)."""
         import bpy
 
+        if self.material is None:
+            return False
         for mesh in bpy.data.meshes:
             if self.material.name in mesh.materials and mesh.uv_layers.active is not None \
                     and mesh.uv_layers.active.name != name:
@@ -151,7 +156,7 @@ class _Reader:
     # ------------------------------------------------------------------ shaders
 
     def closures(self, socket, weight):
-        out = _follow(socket)
+        out = follow(socket)
         if out is None or weight <= 0.0:
             return []
         node = out.node
@@ -198,7 +203,7 @@ def output_node(tree):
 
 def read_material(material):
     """Reading of a bpy Material's node tree."""
-    reader = _Reader(material)
+    reader = SocketReader(material)
     reading = Reading(notes=reader.notes)
     tree = material.node_tree
     output = output_node(tree) if tree is not None else None
@@ -267,7 +272,7 @@ def _is_srgb(image):
 
 def _normal_input(reader, node, values, images):
     """A Normal input fed by a Normal Map node (tangent space) over an image: the normal map and strength."""
-    out = _follow(node.inputs["Normal"])
+    out = follow(node.inputs["Normal"])
     if out is None:
         return
     source = out.node

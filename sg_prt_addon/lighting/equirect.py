@@ -45,3 +45,25 @@ def lookup_nearest(image, direction):
     col = np.clip((u * width).astype(np.int64), 0, width - 1)
     row = np.clip(((1.0 - v) * height).astype(np.int64), 0, height - 1)
     return image[row, col]
+
+
+def rotated(image, matrix):
+    """The map of the world L'(d) = L(normalize(M d)) (a Mapping node's rotation and scale in front of an
+    Environment Texture): (H, W, C) float32, each texel centre's direction mapped and the map read bilinearly
+    (wrapping in u, clamped in v).  A turn about z alone is a shift of the rows: read along u only."""
+    image = np.asarray(image, np.float32)
+    matrix = np.asarray(matrix, np.float64)
+    height, width = image.shape[:2]
+    directions = texel_directions(height, width) @ matrix.T
+    u, v = direction_to_uv(directions)
+    x = u * width - 0.5
+    y = (1.0 - v) * height - 0.5
+    if np.allclose(matrix[2], [0.0, 0.0, matrix[2, 2]]) and np.allclose(matrix[:2, 2], 0.0):
+        y = np.broadcast_to((np.arange(height) + 0.0)[:, None], x.shape)         # the rows stay (no blur in v)
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    xa, xb = x0.astype(np.int64) % width, (x0.astype(np.int64) + 1) % width
+    ya, yb = np.clip(y0.astype(np.int64), 0, height - 1), np.clip(y0.astype(np.int64) + 1, 0, height - 1)
+    low = image[ya, xa] * (1 - fx) + image[ya, xb] * fx
+    high = image[yb, xa] * (1 - fx) + image[yb, xb] * fx
+    return (low * (1 - fy) + high * fy).astype(np.float32)
