@@ -95,6 +95,25 @@ def textured():
     return material
 
 
+def pbr_metallic_map():
+    """A PBR texture set: Base Color, a Metallic map (metal stripes, Non-Color) and a roughness map."""
+    import numpy as np
+
+    material, tree, node = _principled("pbr_metallic_map", Roughness=1.0)
+    u, v = np.meshgrid((np.arange(64) + 0.5) / 64, (np.arange(64) + 0.5) / 64)
+    metal = (np.floor(u * 6) % 2)[..., None]
+    colour = np.ones((64, 64, 4))
+    colour[..., :3] = metal * GOLD[:3] + (1 - metal) * (0.6, 0.1, 0.1)
+    metallic = np.ones((64, 64, 4))
+    metallic[..., :3] = metal
+    rough = np.ones((64, 64, 4))
+    rough[..., :3] = (0.3 + 0.3 * v)[..., None]
+    _textured(tree, node, "Base Color", _image("pbr_colour", colour, "sRGB"))
+    _textured(tree, node, "Metallic", _image("pbr_metallic", metallic, "Non-Color"))
+    _textured(tree, node, "Roughness", _image("pbr_roughness", rough, "Non-Color"))
+    return material
+
+
 def mix_diffuse_glossy():
     material, tree, output = _nodes("mix_diffuse_glossy")
     diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
@@ -117,7 +136,8 @@ def anisotropic():
 
 
 SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),
-          "principled_gold_r030": gold, "principled_textured": textured, "mix_diffuse_glossy": mix_diffuse_glossy,
+          "principled_gold_r030": gold, "principled_textured": textured, "principled_pbr_metallic_map": pbr_metallic_map,
+          "mix_diffuse_glossy": mix_diffuse_glossy,
           "principled_anisotropic": anisotropic}
 
 

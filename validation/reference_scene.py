@@ -36,12 +36,14 @@ def _texture_lookup(params, images):
 
 
 def reference_material(params, texture_pixels):
-    """validation.reference.Material of an export.MaterialParams; texture_pixels(image name, slot) gives
-    what the shader samples for that slot (export.texture_pixels), or None for a missing image."""
+    """validation.reference.Material of an export.MaterialParams; texture_pixels(texture, slot, decode) gives
+    what the shader samples for that slot (export.slot_pixels of an image name or Expression), or None for a
+    missing image."""
     constant = {name: float(getattr(params, name)) for name in models.BY_NAME[params.model].parameters}
     material = reference.Material(np.asarray(params.diffuse_color, float), np.asarray(params.specular_color, float),
                                   brdf.model_from_name(params.model, **constant))
-    images = {slot: texture_pixels(image, slot) for slot, image in params.textures.items() if slot != "normal_map"}
+    images = {slot: texture_pixels(value, slot, True if slot in params.decoded_slots else None)
+              for slot, value in params.textures.items() if slot != "normal_map"}
     images = {slot: pixels for slot, pixels in images.items() if pixels is not None}
     if images:
         material.textures = _texture_lookup(params, images)
@@ -123,9 +125,10 @@ def reference_inputs(depsgraph, width, height):
     state = SceneState()
     state.sync(depsgraph)
 
-    def texture_pixels(name, slot):
-        image = bpy.data.images.get(name)
-        return None if image is None else export.texture_pixels(image, slot)
+    def texture_pixels(value, slot, decode=None):
+        if not all(name in bpy.data.images for name in export.texture_sources(value)):
+            return None
+        return export.slot_pixels(value, slot, decode)
 
     scene = depsgraph.scene
     camera = export.export_camera(scene.camera.evaluated_get(depsgraph), depsgraph, width, height)

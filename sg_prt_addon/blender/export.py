@@ -126,7 +126,9 @@ class MaterialParams:
     tangent_source: str = "UV_MAP"
     tangent_axis: tuple = (1.0, 0.0, 0.0)
     tangent_rotation: float = 0.0
-    textures: dict = field(default_factory=dict)     # parameter name or "normal_map" -> image name
+    # parameter name or "normal_map" -> image name, or (node trees) a reflectance.texture_expression.Expression of
+    # images that export.slot_pixels evaluates
+    textures: dict = field(default_factory=dict)
     technique: str = techniques.DEFAULT    # the registered technique that renders it (techniques/)
     fitted: object = None          # FittedLobes with the fitted-lobes technique and a VALID stored fit
     factorization: object = None   # techniques.factored.FactoredTables of VALID stored factors (factored technique)
@@ -586,6 +588,22 @@ def texture_pixels(image, slot, decode=None):
         pixels = pixels.copy()
         pixels[..., :3] = srgb_to_linear(pixels[..., :3])
     return pixels
+
+
+def texture_sources(value):
+    """The image names a slot's texture reads: its image, or an Expression's (reflectance.texture_expression)."""
+    return (value,) if isinstance(value, str) else value.images
+
+
+def slot_pixels(value, slot, decode=None):
+    """What the shader samples for a slot's texture (MaterialParams.textures[slot]): an image's texture_pixels,
+    or an Expression evaluated from its images, each decoded as Blender decodes it (a node tree's value)."""
+    import bpy
+
+    if isinstance(value, str):
+        return texture_pixels(bpy.data.images[value], slot, decode)
+    images = {name: texture_pixels(bpy.data.images[name], "computed", decode=True) for name in value.images}
+    return value.evaluate(images)
 
 
 # --------------------------------------------------------------------------- lights

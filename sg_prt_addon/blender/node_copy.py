@@ -10,8 +10,12 @@ COPIED_FIELDS = ("model", "diffuse_color", "specular_color", "roughness", "alpha
 
 
 def copy_reading(material):
-    """Write the reading into material.sgprt; returns the reading's notes."""
+    """Write the reading into material.sgprt; returns the reading's notes (with the slots whose texture the
+    nodes compute from several images, or an affine function of one: the settings hold one image a slot)."""
     reading = node_reader.read_material(material)
+    computed = sorted(slot for slot, value in reading.textures.items() if not isinstance(value, str))
+    if computed:
+        reading.notes.append(f"computed textures not copied (the factor alone): {', '.join(computed)}")
     settings = material.sgprt
     for name in COPIED_FIELDS:
         if name in reading.fields:
@@ -27,7 +31,8 @@ def copy_reading(material):
         settings.emission_color = tuple(c / strength for c in emission)
     for slot in properties.TEXTURED_PARAMETERS:
         image_name = reading.textures.get(slot)
-        setattr(settings, slot + "_texture", bpy.data.images.get(image_name) if image_name else None)
+        image = bpy.data.images.get(image_name) if isinstance(image_name, str) else None
+        setattr(settings, slot + "_texture", image)
     image_name = reading.textures.get("normal_map")
     settings.normal_map = bpy.data.images.get(image_name) if image_name else None
     settings.source = "SETTINGS"

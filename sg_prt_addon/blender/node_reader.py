@@ -1,36 +1,33 @@
 """A material's shader nodes read as the engine's parameters (material.sgprt.source = Node Tree).
 
 From the active Material Output's Surface, the shader tree is walked into weighted closures: Principled,
-Diffuse and Glossy BSDFs, Emission, through Mix Shader (a constant factor, or a texture's mean) and Add
-Shader.  Their inputs are read as a constant times at most one image (the engine's factor x texture): an
-unlinked socket, RGB, Value, constant Math, an Image Texture over the UV map (Color output), a Normal Map
-in tangent space.  What cannot be read as Blender renders it takes the nearest reading (a socket's default
-value, a texture's mean) and is named in one warning per material.  reflectance/principled.py maps the
-BSDFs' values to the model, colours and layering; this module is the bpy side.
+Diffuse and Glossy BSDFs, Emission, through Mix Shader (its factor a constant or a texture) and Add Shader.
+Their inputs are read as texture_expression.Expressions: unlinked sockets, RGB, Value, Image Texture (its
+Color, over the UV map), Math (add, subtract, multiply; divide by a constant), Invert and Mix / MixRGB
+(mix, multiply, add) of them, a Normal Map in tangent space.  reflectance/principled.py maps the BSDFs'
+values to the model, colours and layering; an expression that is a constant or a factor times one image
+takes the engine's factor x texture path, any other one (a metallic map, a texture factor) becomes a texture
+computed from its images (export.slot_pixels).  What cannot be read as Blender renders it takes the nearest
+reading (a socket's default value) and is named in one warning per material.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..reflectance import principled
+from ..reflectance.texture_expression import Expression
 
-MATH_OPERATIONS = {"ADD": np.add, "SUBTRACT": np.subtract, "MULTIPLY": np.multiply,
-                   "DIVIDE": lambda a, b: a / b if b != 0 else 0.0, "POWER": np.power, "MINIMUM": min,
-                   "MAXIMUM": max}
 PASS_THROUGH = ("REROUTE",)
-
-
-@dataclass
-class Input:
-    """A socket's reading: value (float or RGB tuple) times the image `image` (a bpy Image) when set."""
-    value: object
-    image: object = None
+# Blender's implicit colour -> float conversion (Rec. 709 luminance)
+LUMINANCE = (0.2126, 0.7152, 0.0722)
+COLOUR_SLOTS = ("diffuse_color", "specular_color")
 
 
 @dataclass
 class Reading:
-    """What read_material found: MaterialParams fields, textures (slot -> image name), the data slots whose
-    images Blender decodes from sRGB (decoded_slots), and the notes on what was read otherwise."""
+    """What read_material found: MaterialParams fields, textures (slot -> image name, or an Expression
+    computed into a texture), the data slots whose images Blender decodes from sRGB (decoded_slots), and the
+    notes on what was read otherwise."""
     fields: dict = field(default_factory=dict)
     textures: dict = field(default_factory=dict)
     decoded_slots: tuple = ()
@@ -40,9 +37,8 @@ class Reading:
 @dataclass
 class _Closure:
     kind: str            # "principled", "diffuse", "glossy", "emission"
-    weight: float
+    weight: object       # float or Expression
     node: object
-    inputs: dict
 
 
 def follow(socket):
@@ -69,22 +65,41 @@ def _default(socket):
         return float(value)
 
 
-def _as_colour(value):
-    return value if isinstance(value, tuple) else (float(value),) * 3
+def _constant(value, colour):
+    """A socket's plain value as an Expression: colours RGB, scalars (a colour read as a scalar: luminance)."""
+    if isinstance(value, tuple):
+        return Expression.constant(value if colour else float(np.dot(value[:3], LUMINANCE)))
+    return Expression.constant(value)
 
 
-def _as_scalar(value):
-    # Blender's implicit colour -> float: the luminance (Rec. 709 weights)
-    return float(np.dot(value[:3], (0.2126, 0.7152, 0.0722))) if isinstance(value, tuple) else float(value)
+def _rounded(value):
+    return tuple(round(v, 4) for v in value) if isinstance(value, tuple) else round(value, 4)
+
+
+def scalar_of(expression):
+    """A scalar Expression's value when constant (its red channel), else None."""
+    value = expression.as_constant()
+    return None if value is None else value[0]
+
+
+def _sockets(node, *names):
+    """Inputs of a node by identifier or name, for nodes whose sockets changed names across versions."""
+    found = []
+    for name in names:
+        socket = next((s for s in node.inputs if s.identifier == name and s.enabled), None) \
+            or next((s for s in node.inputs if s.name == name and s.enabled), None)
+        found.append(socket)
+    return found
 
 
 class SocketReader:
-    """Reads sockets as Inputs and shader trees as closures, collecting notes (material: the one read, whose
-    meshes' UV maps an Image Texture's UV Map node is checked against; None for a world)."""
+    """Reads sockets as Expressions and shader trees as closures, collecting notes (material: the one read,
+    whose meshes' UV maps an Image Texture's UV Map node is checked against; None for a world)."""
 
     def __init__(self, material=None):
         self.material = material
         self.notes = []
+        self.images = {}            # name -> bpy Image of every image an Expression names
 
     def note(self, node, what):
         text = f"'{node.name}' ({node.bl_label}): {what}"
@@ -94,40 +109,80 @@ class SocketReader:
     # ------------------------------------------------------------------ values
 
     def value(self, socket, colour):
-        """Input of a socket: a constant, or a constant times one image."""
+        """The Expression a socket receives."""
         out = follow(socket)
         if out is None:
-            value = _default(socket)
-            return Input(_as_colour(value) if colour else _as_scalar(value))
+            return _constant(_default(socket), colour)
         node = out.node
         if node.type in ("RGB", "VALUE"):
-            value = _default(out)
-            return Input(_as_colour(value) if colour else _as_scalar(value))
+            return _constant(_default(out), colour)
         if node.type == "TEX_IMAGE":
-            return self.image_input(node, out, colour, socket)
-        if node.type == "MATH" and node.operation in MATH_OPERATIONS:
-            return self.math(node, colour, socket)
-        self.note(node, f"not read: {socket.name} uses its value {_rounded(_default(socket))}")
-        value = _default(socket)
-        return Input(_as_colour(value) if colour else _as_scalar(value))
+            return self.image_value(node, out, socket, colour)
+        reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix}.get(node.type)
+        if reader is not None:
+            result = reader(node, colour)
+            if result is not None:
+                return result
+        else:
+            self.note(node, f"not read: {socket.name} uses its value {_rounded(_default(socket))}")
+        return _constant(_default(socket), colour)
 
-    def math(self, node, colour, socket):
+    def math(self, node, colour):
         a, b = (self.value(node.inputs[k], False) for k in range(2))
-        if a.image is not None and b.image is not None or node.operation != "MULTIPLY" and (a.image or b.image):
-            self.note(node, f"{node.operation.lower()} of a texture: {socket.name} uses its value")
-            value = _default(socket)
-            return Input(_as_colour(value) if colour else _as_scalar(value))
-        result = float(MATH_OPERATIONS[node.operation](a.value, b.value))
+        operation = node.operation
+        if operation in ("ADD", "SUBTRACT", "MULTIPLY"):
+            result = a + b if operation == "ADD" else a - b if operation == "SUBTRACT" else a * b
+        elif operation == "DIVIDE" and scalar_of(b) not in (None, 0.0):
+            result = a * (1.0 / scalar_of(b))
+        elif scalar_of(a) is not None and scalar_of(b) is not None:
+            functions = {"POWER": np.power, "MINIMUM": min, "MAXIMUM": max, "DIVIDE": lambda x, y: 0.0}
+            if operation not in functions:
+                self.note(node, f"{operation.lower()}: its output is the first input")
+                return a
+            result = Expression.constant(float(functions[operation](scalar_of(a), scalar_of(b))))
+        else:
+            self.note(node, f"{operation.lower()} of a texture: its output is the first input")
+            return a
         if node.use_clamp:
-            result = float(np.clip(result, 0.0, 1.0))
-        return Input(_as_colour(result) if colour else result, a.image or b.image)
+            value = scalar_of(result)
+            if value is None:
+                self.note(node, "clamp of a texture: not clamped")
+            else:
+                result = Expression.constant(float(np.clip(value, 0.0, 1.0)))
+        return result
 
-    def image_input(self, node, out, colour, socket):
+    def invert(self, node, colour):
+        factor = self.value(node.inputs["Fac"], False)
+        value = self.value(node.inputs["Color"], True)
+        return factor * (1.0 - value) + (1.0 - factor) * value
+
+    def mix(self, node, colour):
+        """Mix (colour or float) and the legacy MixRGB: mix, multiply, add, with their factor."""
+        if node.type == "MIX":
+            if node.data_type not in ("RGBA", "FLOAT"):
+                self.note(node, f"a {node.data_type.lower()} mix: its first input is used")
+                return None
+            suffix = "Color" if node.data_type == "RGBA" else "Float"
+            factor_socket, a_socket, b_socket = _sockets(node, "Factor_Float", f"A_{suffix}", f"B_{suffix}")
+            blend = node.blend_type if node.data_type == "RGBA" else "MIX"
+        else:
+            factor_socket, a_socket, b_socket = _sockets(node, "Fac", "Color1", "Color2")
+            blend = node.blend_type
+        if None in (factor_socket, a_socket, b_socket):
+            return None
+        factor = self.value(factor_socket, False)
+        a, b = self.value(a_socket, True), self.value(b_socket, True)
+        blended = {"MIX": lambda: b, "MULTIPLY": lambda: a * b, "ADD": lambda: a + b}.get(blend)
+        if blended is None:
+            self.note(node, f"blend {blend.lower()}: read as mix")
+            blended = lambda: b  # noqa: E731
+        return (1.0 - factor) * a + factor * blended()
+
+    def image_value(self, node, out, socket, colour):
         image = node.image
         if image is None:
             self.note(node, f"no image: {socket.name} uses its value")
-            value = _default(socket)
-            return Input(_as_colour(value) if colour else _as_scalar(value))
+            return _constant(_default(socket), colour)
         if out.name != "Color":
             self.note(node, f"its {out.name} output is read as its Color")
         vector = follow(node.inputs["Vector"])
@@ -139,7 +194,8 @@ class SocketReader:
                 self.note(source, "texture coordinates other than the UV map: the active UV map is used")
         if node.projection != "FLAT":
             self.note(node, f"{node.projection.lower()} projection: read flat over the UV map")
-        return Input((1.0, 1.0, 1.0) if colour else 1.0, image)
+        self.images[image.name] = image
+        return Expression.image(image.name)
 
     def _other_uv_map(self, name):
         """Whether a mesh with this material has an active UV map other than `name` (export reads the active)."""
@@ -157,48 +213,32 @@ class SocketReader:
 
     def closures(self, socket, weight):
         out = follow(socket)
-        if out is None or weight <= 0.0:
+        if out is None or (not isinstance(weight, Expression) and weight <= 0.0):
             return []
         node = out.node
         kind = {"BSDF_PRINCIPLED": "principled", "BSDF_DIFFUSE": "diffuse", "BSDF_GLOSSY": "glossy",
                 "BSDF_ANISOTROPIC": "glossy", "EMISSION": "emission"}.get(node.type)
         if kind is not None:
-            return [_Closure(kind, weight, node, {})]
+            return [_Closure(kind, weight, node)]
         if node.type == "ADD_SHADER":
             return self.closures(node.inputs[0], weight) + self.closures(node.inputs[1], weight)
         if node.type == "MIX_SHADER":
             factor = self.value(node.inputs["Fac"], False)
-            fac = float(np.clip(factor.value, 0.0, 1.0))
-            if factor.image is not None:
-                mean = _image_mean(factor.image)
-                self.note(node, f"a texture factor: its mean {mean:.3g} is used")
-                fac = float(np.clip(fac * mean, 0.0, 1.0))
-            return self.closures(node.inputs[1], weight * (1.0 - fac)) + self.closures(node.inputs[2], weight * fac)
+            constant = scalar_of(factor)
+            if constant is not None:
+                fac = float(np.clip(constant, 0.0, 1.0))
+                first, second = weight * (1.0 - fac), weight * fac
+            else:
+                first, second = weight * (1.0 - factor), weight * factor
+            return self.closures(node.inputs[1], first) + self.closures(node.inputs[2], second)
         self.note(node, "shader not supported: rendered as nothing")
         return []
 
 
-def _rounded(value):
-    return tuple(round(v, 4) for v in value) if isinstance(value, tuple) else round(value, 4)
-
-
-def _image_mean(image):
-    """The mean of an image's first channel as stored (1 for an image without pixels)."""
-    if image.size[0] == 0 or image.size[1] == 0 or image.channels == 0:
-        return 1.0
-    pixels = np.empty(len(image.pixels), np.float32)
-    image.pixels.foreach_get(pixels)
-    return float(np.nanmean(pixels[::image.channels]))
-
-
 def output_node(tree):
     """The material's active output node (the one every engine renders), or None."""
-    node = None
-    if hasattr(tree, "get_output_node"):
-        node = tree.get_output_node("ALL")
-    if node is None:
-        node = next((n for n in tree.nodes if n.type == "OUTPUT_MATERIAL"), None)
-    return node
+    node = tree.get_output_node("ALL") if hasattr(tree, "get_output_node") else None
+    return node or next((n for n in tree.nodes if n.type == "OUTPUT_MATERIAL"), None)
 
 
 def read_material(material):
@@ -211,8 +251,7 @@ def read_material(material):
         reader.notes.append("no Material Output node: renders black")
         reading.fields.update(diffuse_color=(0.0, 0.0, 0.0), specular_color=(0.0, 0.0, 0.0))
         return reading
-    closures = reader.closures(output.inputs["Surface"], 1.0)
-    _combine(reader, closures, reading)
+    _combine(reader, reader.closures(output.inputs["Surface"], 1.0), reading)
     return reading
 
 
@@ -220,57 +259,87 @@ def _combine(reader, closures, reading):
     """The closures' weighted sum as one parameter set: diffuse colours add, the heaviest glossy lobe gives the
     model (others are named), emissions add."""
     fields = reading.fields
-    fields.update(diffuse_color=(0.0, 0.0, 0.0), specular_color=(0.0, 0.0, 0.0), emission=(0.0, 0.0, 0.0))
-    diffuse_total = np.zeros(3)
-    diffuse_image = None
-    specular = None
+    diffuse = Expression.constant(0.0)
     emission = np.zeros(3)
+    specular = None
     for closure in closures:
-        values, images = _closure_values(reader, closure)
+        values = _closure_values(reader, closure)
         weight = closure.weight
-        if "normal_map" in images and "normal_map" not in reading.textures:
-            reading.textures["normal_map"] = images.pop("normal_map")
+        if "normal_map" in values and "normal_map" not in reading.textures:
+            reading.textures["normal_map"] = values.pop("normal_map")
             fields["normal_strength"] = values.pop("normal_strength")
-        if "diffuse_color" in values and closure.kind != "glossy":
-            colour = np.asarray(values["diffuse_color"]) * weight
-            if images.get("diffuse_color") is not None:
-                if diffuse_image is not None and diffuse_image is not images["diffuse_color"]:
-                    reader.note(closure.node, "a second textured diffuse colour: its texture is not applied")
-                else:
-                    diffuse_image = images["diffuse_color"]
-            diffuse_total += colour
+        if "diffuse_color" in values:
+            diffuse = diffuse + weight * Expression.of(values["diffuse_color"])
         if "specular_color" in values:
-            if specular is None or weight > specular[0]:
+            rank = _mean_weight(reader, weight)
+            if specular is None or rank > specular[0]:
                 if specular is not None:
                     reader.note(specular[1].node, "a second glossy lobe: not rendered")
-                specular = (weight, closure, values, images)
+                specular = (rank, closure, values)
             else:
                 reader.note(closure.node, "a second glossy lobe: not rendered")
-        emission += np.asarray(values.get("emission", (0.0, 0.0, 0.0))) * weight
-    fields["diffuse_color"] = tuple(float(c) for c in diffuse_total)
-    if diffuse_image is not None:
-        reading.textures["diffuse_color"] = diffuse_image
+        if "emission" in values:
+            if not isinstance(weight, (int, float)):
+                reader.note(closure.node, "emission under a texture factor: its mean is used")
+            emission += np.asarray(values["emission"]) * _mean_weight(reader, weight)
+    _to_slot(reader, reading, "diffuse_color", diffuse)
     if specular is not None:
-        weight, closure, values, images = specular
-        fields.update({k: v for k, v in values.items() if k not in ("diffuse_color", "emission", "normal_strength")})
-        fields["specular_color"] = tuple(float(c) * weight for c in values["specular_color"])
-        for slot, image in images.items():
-            if slot not in ("diffuse_color", "normal_map"):
-                reading.textures[slot] = image
+        _, closure, values = specular
+        for name, value in values.items():
+            if name == "specular_color":
+                _to_slot(reader, reading, name, closure.weight * Expression.of(value))
+            elif name == "roughness":
+                _to_slot(reader, reading, name, value)
+            elif name not in ("diffuse_color", "emission", "normal_strength"):
+                fields[name] = value
     else:
+        fields["specular_color"] = (0.0, 0.0, 0.0)
         fields["layered_f0"] = -1.0
     fields["emission"] = tuple(float(c) for c in emission)
-    reading.decoded_slots = tuple(sorted(slot for slot, image in reading.textures.items()
-                                         if slot not in ("diffuse_color", "specular_color", "normal_map")
-                                         and _is_srgb(image)))
-    reading.textures = {slot: image.name for slot, image in reading.textures.items()}
+    reading.decoded_slots = tuple(sorted(slot for slot, value in reading.textures.items()
+                                         if isinstance(value, str) and slot not in COLOUR_SLOTS + ("normal_map",)
+                                         and _is_srgb(reader.images[value])))
+
+
+def _mean_weight(reader, weight):
+    if not isinstance(weight, Expression):
+        return float(weight)
+    return weight.mean_value({name: _image_mean(reader.images[name]) for name in weight.images})[0]
+
+
+def _to_slot(reader, reading, slot, value):
+    """A parameter's Expression into the reading: a number or colour, a factor x image, or a computed texture."""
+    value = Expression.of(value)
+    colour = slot in COLOUR_SLOTS
+    constant = value.as_constant()
+    if constant is not None:
+        reading.fields[slot] = constant if colour else constant[0]
+        return
+    plain = value.as_factor_times_image()
+    if plain is not None and (colour or len(set(plain[0])) == 1):
+        factor, image = plain
+        reading.fields[slot] = factor if colour else factor[0]
+        reading.textures[slot] = image
+        return
+    reading.fields[slot] = (1.0, 1.0, 1.0) if colour else 1.0
+    reading.textures[slot] = value
 
 
 def _is_srgb(image):
     return not image.is_float and image.colorspace_settings.name == "sRGB"
 
 
-def _normal_input(reader, node, values, images):
+def _image_mean(image):
+    """The mean RGB of an image as stored (1 for an image without pixels)."""
+    if image.size[0] == 0 or image.size[1] == 0 or image.channels == 0:
+        return (1.0, 1.0, 1.0)
+    pixels = np.empty(len(image.pixels), np.float32)
+    image.pixels.foreach_get(pixels)
+    pixels = pixels.reshape(-1, image.channels)
+    return tuple(float(np.nanmean(pixels[:, min(k, image.channels - 1)])) for k in range(3))
+
+
+def _normal_input(reader, node, values):
     """A Normal input fed by a Normal Map node (tangent space) over an image: the normal map and strength."""
     out = follow(node.inputs["Normal"])
     if out is None:
@@ -282,87 +351,93 @@ def _normal_input(reader, node, values, images):
     if source.space != "TANGENT":
         reader.note(source, f"{source.space.lower()} space: the mesh normal is used")
         return
-    colour = reader.value(source.inputs["Color"], True)
-    if colour.image is None:
-        reader.note(source, "no image: the mesh normal is used")
+    colour = reader.value(source.inputs["Color"], True).as_factor_times_image()
+    if colour is None:
+        reader.note(source, "not an image: the mesh normal is used")
         return
-    strength = reader.value(source.inputs["Strength"], False)
-    images["normal_map"] = colour.image
-    values["normal_strength"] = float(strength.value)
+    strength = scalar_of(reader.value(source.inputs["Strength"], False))
+    if strength is None:
+        reader.note(source, "a texture on Strength: 1 is used")
+    values["normal_map"] = colour[1]
+    values["normal_strength"] = 1.0 if strength is None else float(strength)
+
+
+def _constant_input(reader, node, name, default=0.0):
+    """A socket that must be a constant: its value, or (a texture on it) its default with a note."""
+    if name not in node.inputs:
+        return default
+    value = reader.value(node.inputs[name], False)
+    constant = scalar_of(value)
+    if constant is None:
+        reader.note(node, f"a texture on {name}: its value {_rounded(_default(node.inputs[name]))} is used")
+        return float(_default(node.inputs[name]))
+    return constant
+
+
+def _constant_colour(reader, node, name, default):
+    if name not in node.inputs:
+        return default
+    value = reader.value(node.inputs[name], True)
+    constant = value.as_constant()
+    if constant is None:
+        reader.note(node, f"a texture on {name}: its value {_rounded(_default(node.inputs[name]))} is used")
+        return _default(node.inputs[name])
+    return constant
 
 
 def _closure_values(reader, closure):
-    """(MaterialParams fields, slot -> bpy Image) of one closure."""
+    """MaterialParams fields of one closure: colours and roughness as Expressions, the rest numbers, and the
+    normal map's image name."""
     node, kind = closure.node, closure.kind
-    images = {}
-
-    def read(name, colour, slot=None):
-        item = reader.value(node.inputs[name], colour)
-        if item.image is not None:
-            if slot is None:
-                reader.note(node, f"a texture on {name}: its value {_rounded(item.value)} is used")
-            else:
-                images[slot] = item.image
-        return item
-
+    values = {}
     if kind == "emission":
-        colour = read("Color", True)
-        strength = read("Strength", False)
-        return {"emission": tuple(c * strength.value for c in colour.value)}, {}
+        colour = _constant_colour(reader, node, "Color", (1.0, 1.0, 1.0))
+        return {"emission": tuple(c * _constant_input(reader, node, "Strength") for c in colour)}
     if kind == "diffuse":
-        colour = read("Color", True, "diffuse_color")
-        if reader.value(node.inputs["Roughness"], False).value > 0:
+        if _constant_input(reader, node, "Roughness") > 0:
             reader.note(node, "Oren-Nayar roughness: rendered as Lambert")
-        values = {"diffuse_color": colour.value}
-        _normal_input(reader, node, values, images)
-        return values, images
-    if kind == "glossy":
-        colour = read("Color", True, "specular_color")
-        roughness = read("Roughness", False, "roughness")
-        anisotropy = read("Anisotropy", False) if "Anisotropy" in node.inputs else Input(0.0)
-        rotation = read("Rotation", False) if "Rotation" in node.inputs else Input(0.0)
-        values = principled.glossy(colour.value, roughness.value, node.distribution, anisotropy.value, rotation.value)
-        _texture_on_width(reader, node, values, images)
-        _normal_input(reader, node, values, images)
-        return values, images
-    return _principled_values(reader, node, read, images)
+        values["diffuse_color"] = reader.value(node.inputs["Color"], True)
+    elif kind == "glossy":
+        anisotropy = _constant_input(reader, node, "Anisotropy")
+        plain_ggx = node.distribution in ("GGX", "MULTI_GGX") and anisotropy == 0.0
+        values.update(principled.glossy(reader.value(node.inputs["Color"], True),
+                                        _width(reader, node, plain_ggx), node.distribution, anisotropy,
+                                        _constant_input(reader, node, "Rotation")))
+    else:
+        values.update(_principled_values(reader, node))
+    _normal_input(reader, node, values)
+    return values
 
 
-def _principled_values(reader, node, read, images):
-    base = read("Base Color", True, "diffuse_color")
-    metallic = read("Metallic", False)
-    roughness = read("Roughness", False, "roughness")
+def _principled_values(reader, node):
     inputs = node.inputs
-    optional = {name: read(name, False).value for name in ("Specular IOR Level", "Anisotropic", "Anisotropic Rotation",
-                                                           "Transmission Weight", "Emission Strength", "Alpha",
-                                                           "Coat Weight", "Sheen Weight", "Subsurface Weight")
-                if name in inputs}
-    tint = read("Specular Tint", True).value if "Specular Tint" in inputs else (1.0, 1.0, 1.0)
-    emission = read("Emission Color", True).value if "Emission Color" in inputs else (0.0, 0.0, 0.0)
+    optional = {name: _constant_input(reader, node, name, default)
+                for name, default in (("Specular IOR Level", 0.5), ("Anisotropic", 0.0), ("Anisotropic Rotation", 0.0),
+                                      ("Transmission Weight", 0.0), ("Emission Strength", 0.0), ("Alpha", 1.0),
+                                      ("Coat Weight", 0.0), ("Sheen Weight", 0.0), ("Subsurface Weight", 0.0))}
     values = principled.principled(
-        base.value, metallic.value, roughness.value, read("IOR", False).value, optional.get("Specular IOR Level", 0.5),
-        tint, optional.get("Anisotropic", 0.0), optional.get("Anisotropic Rotation", 0.0),
-        optional.get("Transmission Weight", 0.0), emission, optional.get("Emission Strength", 0.0),
+        reader.value(inputs["Base Color"], True), reader.value(inputs["Metallic"], False),
+        _width(reader, node, optional["Anisotropic"] == 0.0), _constant_input(reader, node, "IOR", 1.5),
+        optional["Specular IOR Level"], _constant_colour(reader, node, "Specular Tint", (1.0, 1.0, 1.0)),
+        optional["Anisotropic"], optional["Anisotropic Rotation"], optional["Transmission Weight"],
+        _constant_colour(reader, node, "Emission Color", (1.0, 1.0, 1.0)), optional["Emission Strength"],
         multiscatter=node.distribution == "MULTI_GGX")
-    if base.image is not None and metallic.value > 0.0:
-        if metallic.value >= 1.0:
-            images["specular_color"] = base.image
-        else:
-            reader.note(node, "a textured Base Color under Metallic between 0 and 1: the metal's colour is the "
-                              "Base Color's factor alone")
     for name, what in (("Transmission Weight", "transmission"), ("Coat Weight", "the coat"),
                        ("Sheen Weight", "sheen"), ("Subsurface Weight", "subsurface scattering")):
-        if optional.get(name, 0.0) > 0.0:
+        if optional[name] > 0.0:
             reader.note(node, f"{what} ({name} {optional[name]:.3g}) is not rendered")
-    if optional.get("Alpha", 1.0) < 1.0:
+    if optional["Alpha"] < 1.0:
         reader.note(node, f"Alpha {optional['Alpha']:.3g}: rendered opaque")
-    _texture_on_width(reader, node, values, images)
-    _normal_input(reader, node, values, images)
-    return values, images
+    return values
 
 
-def _texture_on_width(reader, node, values, images):
-    """A roughness texture drives the GGX roughness itself; the other models' widths are not linear in it."""
-    if "roughness" in images and values["model"] != "GGX":
-        reader.note(node, f"a texture on Roughness with the {values['model']} model: its value is used")
-        del images["roughness"]
+def _width(reader, node, plain_ggx):
+    """The Roughness input: an Expression where it drives an isotropic GGX's roughness itself, else a number
+    (the other models' widths are not linear in it: a texture's mean, named)."""
+    roughness = reader.value(node.inputs["Roughness"], False)
+    constant = scalar_of(roughness)
+    if constant is not None or plain_ggx:
+        return roughness if constant is None else constant
+    mean = _mean_weight(reader, roughness)
+    reader.note(node, f"a texture on Roughness of an anisotropic or non-GGX lobe: its mean {mean:.3g} is used")
+    return mean

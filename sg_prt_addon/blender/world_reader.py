@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .node_reader import SocketReader, follow
+from .node_reader import SocketReader, follow, scalar_of
 
 
 @dataclass
@@ -49,10 +49,14 @@ def read_world(world):
             reader.note(surface.node, "world shader not supported: the world colour is used")
         return reading
     shader = surface.node
-    reading.strength = float(reader.value(shader.inputs["Strength"], False).value)
+    strength = scalar_of(reader.value(shader.inputs["Strength"], False))
+    if strength is None:
+        reader.note(shader, "a texture on Strength: its value is used")
+        strength = float(shader.inputs["Strength"].default_value)
+    reading.strength = float(strength)
     source = follow(shader.inputs["Color"])
     if source is None or source.node.type == "RGB":
-        reading.colour = reader.value(shader.inputs["Color"], True).value
+        reading.colour = reader.value(shader.inputs["Color"], True).as_constant()
         return reading
     node = source.node
     if node.type != "TEX_ENVIRONMENT":

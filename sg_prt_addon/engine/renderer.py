@@ -11,7 +11,7 @@ import collections
 import numpy as np
 
 from .. import techniques
-from ..blender.export import COLOUR_SLOTS, texture_pixels
+from ..blender.export import COLOUR_SLOTS, slot_pixels, texture_sources
 from ..spherical import clamped_cosine
 from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
@@ -44,9 +44,10 @@ def _texture_2d_array(layers):
                                 data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
 
 
-def _texture_key(image_name, slot, params):
-    """(image, decoded from sRGB): a colour slot, or a data slot a node tree reads decoded (as Blender does)."""
-    return image_name, slot in COLOUR_SLOTS or slot in params.decoded_slots
+def _texture_key(value, slot, params):
+    """(image name or Expression, decoded from sRGB): a colour slot, or a data slot a node tree reads decoded
+    (as Blender does; an Expression decodes each of its images so)."""
+    return value, slot in COLOUR_SLOTS or slot in params.decoded_slots
 
 
 def _uniform_buffer(data):
@@ -357,10 +358,11 @@ class Renderer:
         for key in list(self.mesh_buffers):
             if key not in state.meshes:
                 del self.mesh_buffers[key]
-        for key in [key for key in self.textures if key[0] in dirty.images]:
+        for key in [key for key in self.textures if any(name in dirty.images for name in texture_sources(key[0]))]:
             del self.textures[key]
         for name, params in state.materials.items():      # materials whose image changed reload it
-            if name not in dirty.materials and any(image in dirty.images for image in params.textures.values()):
+            if name not in dirty.materials and any(image in dirty.images for value in params.textures.values()
+                                                   for image in texture_sources(value)):
                 dirty.materials.add(name)
         for name in dirty.materials:
             params = state.materials.get(name)
@@ -370,11 +372,10 @@ class Renderer:
             self.material_buffers[name] = _uniform_buffer(material_block(params, material_id))
             self.uploads["materials"] += 1
             self.material_tables.pop(params.name or name, None)
-            for slot, image_name in params.textures.items():
-                key = _texture_key(image_name, slot, params)
-                if key not in self.textures and image_name in bpy.data.images:
-                    self.textures[key] = _texture_2d(texture_pixels(bpy.data.images[image_name], slot,
-                                                                    decode=key[1]))
+            for slot, value in params.textures.items():
+                key = _texture_key(value, slot, params)
+                if key not in self.textures and all(name in bpy.data.images for name in texture_sources(value)):
+                    self.textures[key] = _texture_2d(slot_pixels(value, slot, decode=key[1]))
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)

@@ -12,6 +12,8 @@ Schlick term with F0 = Metallic base + (1 - Metallic) F0_dielectric tint (Schlic
 """
 import numpy as np
 
+from .texture_expression import Expression
+
 # Glossy BSDF distributions -> (model, multiscatter); Beckmann's NDF is Ward's but for a cosine
 GLOSSY_DISTRIBUTIONS = {"GGX": ("GGX", False), "MULTI_GGX": ("GGX", True), "BECKMANN": ("WARD_ISO", False),
                         "ASHIKHMIN_SHIRLEY": ("ASHIKHMIN_SHIRLEY", False), "SHARP": ("GGX", False)}
@@ -38,8 +40,30 @@ def anisotropic_alphas(roughness, anisotropic):
     return alpha / aspect, alpha * aspect
 
 
+def _plain(value):
+    """A constant Expression as its number (scalar: the red channel) or colour; anything else as it is."""
+    if not isinstance(value, Expression) or value.as_constant() is None:
+        return value
+    constant = value.as_constant()
+    return constant[0] if len(set(constant)) == 1 else constant
+
+
+def _rgb(value):
+    """(3,) float64 of a colour given as 3 or 4 components or one number."""
+    values = np.asarray(value, np.float64)
+    return np.broadcast_to(values[:3] if values.ndim else values, (3,))
+
+
+def _colour(value):
+    """A colour field: an RGB tuple, or the Expression of a textured one."""
+    return value if isinstance(value, Expression) else tuple(float(c) for c in _rgb(value))
+
+
 def _roughness_fields(roughness, anisotropic, distribution_model):
-    """The model and its width fields for a GGX-family roughness (Ward for anisotropy: its alphas are GGX's)."""
+    """The model and its width fields for a GGX-family roughness (Ward for anisotropy: its alphas are GGX's).
+    A textured roughness (an Expression) is GGX's own: the caller gives the others a number."""
+    if isinstance(roughness, Expression):
+        return {"model": "GGX", "roughness": roughness}
     roughness = float(np.clip(roughness, 0.0, 1.0))
     if anisotropic > 0.0 and distribution_model == "GGX":
         alpha_x, alpha_y = anisotropic_alphas(roughness, anisotropic)
@@ -57,20 +81,29 @@ def _roughness_fields(roughness, anisotropic, distribution_model):
 def principled(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, ior=1.5, specular_ior_level=0.5,
                specular_tint=(1.0, 1.0, 1.0), anisotropic=0.0, anisotropic_rotation=0.0, transmission=0.0,
                emission_color=(1.0, 1.0, 1.0), emission_strength=0.0, multiscatter=True):
-    """MaterialParams fields of a Principled BSDF with these input values (colours linear RGB)."""
-    base = np.clip(np.asarray(base_color, np.float64)[:3], 0.0, None)
-    metallic = float(np.clip(metallic, 0.0, 1.0))
+    """MaterialParams fields of a Principled BSDF with these input values (colours linear RGB).  Base Color,
+    Metallic and Roughness may be texture_expression.Expressions (textured): the colours then come out as
+    Expressions of the same formulas."""
+    base_color, metallic, roughness = (_plain(value) for value in (base_color, metallic, roughness))
+    textured_metallic = isinstance(metallic, Expression)
+    if isinstance(base_color, Expression):
+        base = clamped = base_color
+    else:
+        base = np.clip(_rgb(base_color), 0.0, None)
+        clamped = np.minimum(base, 1.0)
+    if not textured_metallic:
+        metallic = float(np.clip(metallic, 0.0, 1.0))
     transmission = float(np.clip(transmission, 0.0, 1.0))
-    tint = np.clip(np.asarray(specular_tint, np.float64)[:3], 0.0, None)
+    tint = np.clip(_rgb(specular_tint), 0.0, None)
     f0 = dielectric_f0(ior, specular_ior_level)
-    specular = metallic * np.minimum(base, 1.0) + (1.0 - metallic) * f0 * tint
-    out = {"diffuse_color": tuple(float(c) for c in base * (1.0 - metallic) * (1.0 - transmission)),
-           "specular_color": tuple(float(c) for c in specular),
+    specular = metallic * clamped + (1.0 - metallic) * (f0 * tint)
+    out = {"diffuse_color": _colour(base * (1.0 - metallic) * (1.0 - transmission)),
+           "specular_color": _colour(specular),
            "fresnel": "SCHLICK", "multiscatter": bool(multiscatter),
-           "layered_f0": float(f0 * float(np.max(tint))) if metallic < 1.0 else -1.0,
+           "layered_f0": float(f0 * float(np.max(tint))) if textured_metallic or metallic < 1.0 else -1.0,
            "ior": ior_of_f0(f0) if f0 > 0 else 1.0,
            "tangent_rotation": float(anisotropic_rotation) * 2.0 * np.pi,
-           "emission": tuple(float(c) * float(emission_strength) for c in np.asarray(emission_color)[:3])}
+           "emission": tuple(float(c) * float(emission_strength) for c in _rgb(emission_color))}
     out.update(_roughness_fields(roughness, float(anisotropic), "GGX"))
     return out
 
@@ -78,9 +111,11 @@ def principled(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, ior=1.5,
 def glossy(color=(0.8, 0.8, 0.8), roughness=0.5, distribution="GGX", anisotropy=0.0, rotation=0.0):
     """MaterialParams fields of a Glossy BSDF: the colour at every angle (no Fresnel), Multiscatter GGX's gain."""
     model, multiscatter = GLOSSY_DISTRIBUTIONS.get(distribution, ("GGX", False))
+    color, roughness = _plain(color), _plain(roughness)
     if distribution == "SHARP":
         roughness = 0.0
-    out = {"specular_color": tuple(float(c) for c in np.asarray(color)[:3]), "fresnel": "NONE",
+    out = {"specular_color": _colour(color),
+           "fresnel": "NONE",
            "multiscatter": multiscatter, "tangent_rotation": float(rotation) * 2.0 * np.pi}
     out.update(_roughness_fields(roughness, float(anisotropy), model))
     return out

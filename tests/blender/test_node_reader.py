@@ -75,8 +75,7 @@ def test_principled_metal_textures_and_normal_map(empty_file):
     tree.links.new(texture.outputs["Color"], normal_map.inputs["Color"])
     tree.links.new(normal_map.outputs["Normal"], node.inputs["Normal"])
     params, warnings = _read(material)
-    assert params.textures == {"diffuse_color": "base", "specular_color": "base", "roughness": "rough",
-                               "normal_map": "bumps"}
+    assert params.textures == {"specular_color": "base", "roughness": "rough", "normal_map": "bumps"}
     assert params.roughness == pytest.approx(1.0)        # the factor: the texture holds the value
     assert params.diffuse_color == pytest.approx((0.0, 0.0, 0.0)) and params.layered_f0 < 0
     assert params.specular_color == pytest.approx((1.0, 1.0, 1.0)) and not params.multiscatter
@@ -201,3 +200,53 @@ def test_panel_and_copy_from_node_tree(empty_file):
     for name in ("model", "diffuse_color", "specular_color", "roughness", "fresnel", "multiscatter"):
         assert getattr(after, name) == pytest.approx(getattr(before, name)), name
     assert after.layered_f0 == pytest.approx(before.layered_f0, abs=1e-6)
+
+
+def test_metallic_map_and_texture_factors_compute_textures(empty_file):
+    """A metallic map and a Mix Shader's texture factor: the slots get textures computed from the images
+    (export.slot_pixels), equal to the formulas on the decoded pixels."""
+    from sg_prt_addon.blender import export
+    from sg_prt_addon.reflectance.texture_expression import Expression
+
+    rng = np.random.default_rng(2)
+    base_pixels = np.ones((4, 4, 4), np.float32)
+    base_pixels[..., :3] = rng.uniform(0.1, 0.9, (4, 4, 3))
+    metal_pixels = np.ones((4, 4, 4), np.float32)
+    metal_pixels[..., :3] = rng.integers(0, 2, (4, 4, 1))
+    material, tree, output = _material("metal_map")
+    node = _principled(tree, output, Roughness=0.3)
+    _link_image(tree, _image("pbr_base", base_pixels), node.inputs["Base Color"])
+    _link_image(tree, _image("pbr_metal", metal_pixels, "Non-Color"), node.inputs["Metallic"])
+    params, warnings = _read(material)
+    assert warnings == []
+    assert isinstance(params.textures["diffuse_color"], Expression)
+    assert params.diffuse_color == (1.0, 1.0, 1.0) and params.specular_color == (1.0, 1.0, 1.0)
+    base = export.srgb_to_linear(export.image_pixels(bpy.data.images["pbr_base"])[..., :3])    # as stored: bytes
+    metal = export.image_pixels(bpy.data.images["pbr_metal"])[..., :3]
+    np.testing.assert_allclose(export.slot_pixels(params.textures["diffuse_color"], "diffuse_color")[..., :3],
+                               base * (1 - metal), atol=1e-6)
+    np.testing.assert_allclose(export.slot_pixels(params.textures["specular_color"], "specular_color")[..., :3],
+                               metal * base + (1 - metal) * 0.04, atol=1e-6)
+
+    material, tree, output = _material("mix_map")
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.2, 0.4, 0.6, 1.0)
+    glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    _link_image(tree, bpy.data.images["pbr_metal"], mix.inputs["Fac"])
+    tree.links.new(diffuse.outputs[0], mix.inputs[1])
+    tree.links.new(glossy.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    params, warnings = _read(material)
+    assert warnings == []
+    np.testing.assert_allclose(export.slot_pixels(params.textures["diffuse_color"], "diffuse_color")[..., :3],
+                               (1 - metal) * (0.2, 0.4, 0.6), atol=1e-6)
+    assert params.textures["specular_color"] == "pbr_metal" and params.specular_color == (1.0, 1.0, 1.0)
+
+
+def _link_image(tree, image, socket):
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    tree.links.new(texture.outputs["Color"], socket)
+    return texture

@@ -263,3 +263,27 @@ def test_visibility_environment(engine, bakes):
     assert len(result["state"].visibility) == 2
     _check(result)
     _assert_shadows(result)
+
+
+def test_node_material_with_computed_textures(engine):
+    """A Principled BSDF over a PBR texture set with a metallic map (its colours are textures computed from
+    two images: export.slot_pixels) and a roughness map, read from its node tree: shader against mirror."""
+    import bpy
+
+    from benchmarks import node_materials
+    from sg_prt_addon.blender import export
+    from sg_prt_addon.reflectance.texture_expression import Expression
+
+    scene = fx.new_scene("mirror_nodes", 160, 160)
+    fx.world_colour(scene, (0.2, 0.22, 0.25))
+    material = node_materials.pbr_metallic_map()
+    fx.uv_sphere(scene, "pbr_sphere", (0.0, 0.0, 1.0), radius=1.2).data.materials.append(material)
+    fx.point_light(scene, "point", (1.5, -3.0, 3.0), 900.0, radius=0.1)
+    result = fx.render(scene, gbuffer=True)
+    assert "error" not in result, result.get("error")
+    params = result["state"].materials[material.name]
+    assert params.source == "NODE_TREE" and isinstance(params.textures["diffuse_color"], Expression)
+    textures = {slot: export.slot_pixels(value, slot, True if slot in params.decoded_slots else None)
+                for slot, value in params.textures.items()}
+    assert set(textures) == {"diffuse_color", "specular_color", "roughness"} and bpy.data.images["pbr_metallic"]
+    _check(result, {material.name: textures})

@@ -1,0 +1,133 @@
+"""Values a node tree computes from images: sums of products of constants and images (or an affine function
+of one, such as 1 - metallic), with the arithmetic of the formulas that use them (reflectance/principled.py
+writes kd = base (1 - metallic) once for numbers and for textures).  A value with no image is a constant;
+with one plain image it is the engine's factor x texture; anything else is evaluated into a texture of its
+own (`evaluate`, pure numpy: the images resampled to the largest one's size).
+
+Colours are RGB triples throughout: a scalar constant c is (c, c, c), and a scalar slot reads the red channel.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Factor:
+    """offset + scale x an image's RGB (linear, as Blender decodes it)."""
+    image: str
+    scale: float = 1.0
+    offset: float = 0.0
+
+
+def _rgb(value):
+    values = np.broadcast_to(np.asarray(value, np.float64), (3,))
+    return tuple(float(v) for v in values)
+
+
+@dataclass(frozen=True)
+class Expression:
+    """sum over terms of coefficient (RGB) x the product of the term's factors; hashable."""
+    terms: tuple = ()
+    __array_ufunc__ = None          # numpy arrays defer to its arithmetic (array * Expression is an Expression)
+
+    @staticmethod
+    def constant(value):
+        return Expression(((_rgb(value), ()),))
+
+    @staticmethod
+    def image(name, scale=1.0, offset=0.0):
+        return Expression((((1.0, 1.0, 1.0), (Factor(name, float(scale), float(offset)),)),))
+
+    @staticmethod
+    def of(value):
+        return value if isinstance(value, Expression) else Expression.constant(value)
+
+    # -- arithmetic
+    def __add__(self, other):
+        return Expression(self.terms + Expression.of(other).terms).simplified()
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return self * -1.0
+
+    def __sub__(self, other):
+        return self + (-Expression.of(other))
+
+    def __rsub__(self, other):
+        return Expression.of(other) + (-self)
+
+    def __mul__(self, other):
+        other = Expression.of(other)
+        terms = tuple((tuple(a * b for a, b in zip(ca, cb)), fa + fb) for ca, fa in self.terms for cb, fb in other.terms)
+        return Expression(terms).simplified()
+
+    __rmul__ = __mul__
+
+    def simplified(self):
+        """Like terms (the same factors) summed, zero terms dropped, a single factor with no offset folded into
+        the coefficient."""
+        merged = {}
+        for coefficient, factors in self.terms:
+            key = tuple(sorted(factors, key=lambda f: (f.image, f.scale, f.offset)))
+            if len(key) == 1 and key[0].offset == 0.0 and key[0].scale != 1.0:
+                coefficient = tuple(c * key[0].scale for c in coefficient)
+                key = (Factor(key[0].image),)
+            previous = merged.get(key, (0.0, 0.0, 0.0))
+            merged[key] = tuple(a + b for a, b in zip(previous, coefficient))
+        terms = tuple((c, f) for f, c in merged.items() if any(v != 0.0 for v in c))
+        return Expression(terms or (((0.0, 0.0, 0.0), ()),))
+
+    # -- what it is
+    @property
+    def images(self):
+        return tuple(sorted({factor.image for _, factors in self.terms for factor in factors}))
+
+    def as_constant(self):
+        """Its RGB value when it holds no image, else None."""
+        if self.images:
+            return None
+        return tuple(float(sum(c[k] for c, _ in self.terms)) for k in range(3))
+
+    def as_factor_times_image(self):
+        """(RGB factor, image name) when it is a constant times one plain image, else None."""
+        if len(self.terms) != 1:
+            return None
+        coefficient, factors = self.terms[0]
+        if len(factors) == 1 and factors[0].scale == 1.0 and factors[0].offset == 0.0:
+            return coefficient, factors[0].image
+        return None
+
+    def mean_value(self, means):
+        """Its value with every image replaced by its mean RGB (means: name -> RGB)."""
+        total = np.zeros(3)
+        for coefficient, factors in self.terms:
+            product = np.asarray(coefficient, np.float64)
+            for factor in factors:
+                product = product * (factor.offset + factor.scale * np.asarray(means[factor.image], np.float64))
+            total += product
+        return tuple(float(v) for v in total)
+
+    def evaluate(self, images):
+        """(H, W, 4) float32: the value at every texel of the largest image (images: name -> (H, W, >=3)
+        linear pixels, Blender's row order), the others read bilinearly at its texel centres; alpha 1."""
+        from ..spherical.texture_fetch import bilinear
+
+        height, width = max((images[name].shape[:2] for name in self.images), key=lambda s: s[0] * s[1])
+        u = (np.arange(width) + 0.5) / width
+        v = (np.arange(height) + 0.5) / height
+        uv = np.stack(np.broadcast_arrays(u[None, :], v[:, None]), axis=-1)
+
+        def sample(name):
+            pixels = np.asarray(images[name], np.float32)[..., :3]
+            return pixels if pixels.shape[:2] == (height, width) else bilinear(pixels, uv.astype(np.float32))
+
+        samples = {name: sample(name) for name in self.images}
+        out = np.zeros((height, width, 4), np.float32)
+        out[..., 3] = 1.0
+        for coefficient, factors in self.terms:
+            product = np.broadcast_to(np.asarray(coefficient, np.float32), (height, width, 3))
+            for factor in factors:
+                product = product * (np.float32(factor.offset) + np.float32(factor.scale) * samples[factor.image])
+            out[..., :3] += product
+        return out

@@ -1,0 +1,38 @@
+"""reflectance.texture_expression: the arithmetic of textured node values and their evaluation, against the
+same formula applied to the pixels."""
+import numpy as np
+
+from sg_prt_addon.reflectance import principled
+from sg_prt_addon.reflectance.texture_expression import Expression
+
+RNG = np.random.default_rng(4)
+BASE = RNG.uniform(0, 1, (8, 8, 4)).astype(np.float32)
+METAL = np.repeat(RNG.uniform(0, 1, (4, 4, 1)), 4, axis=-1).astype(np.float32)
+
+
+def test_constants_fold_and_plain_images_stay_plain():
+    assert (Expression.constant(0.25) * 2 + 0.5).as_constant() == (1.0, 1.0, 1.0)
+    scaled = Expression.image("base") * (0.5, 0.25, 1.0)
+    assert scaled.as_factor_times_image() == ((0.5, 0.25, 1.0), "base")
+    assert (Expression.image("base") * 0.0).as_constant() == (0.0, 0.0, 0.0)
+    assert (1.0 - Expression.image("metal")).as_factor_times_image() is None
+
+
+def test_principled_textured_metallic_evaluates_to_its_formula():
+    base, metal = Expression.image("base"), Expression.image("metal")
+    values = principled.principled(base_color=base, metallic=metal, roughness=0.4, ior=1.5)
+    images = {"base": BASE, "metal": METAL}
+    diffuse, specular = values["diffuse_color"].evaluate(images), values["specular_color"].evaluate(images)
+    assert diffuse.shape == (8, 8, 4) and np.all(diffuse[..., 3] == 1)
+    from sg_prt_addon.spherical.texture_fetch import bilinear
+    centres = (np.arange(8) + 0.5) / 8
+    uv = np.stack(np.broadcast_arrays(centres[None, :], centres[:, None]), -1).astype(np.float32)
+    metal_up = bilinear(METAL, uv)[..., :3]                      # the smaller image read at the larger's texels
+    np.testing.assert_allclose(diffuse[..., :3], BASE[..., :3] * (1 - metal_up), atol=1e-6)
+    np.testing.assert_allclose(specular[..., :3], metal_up * BASE[..., :3] + (1 - metal_up) * 0.04, atol=1e-6)
+    assert values["layered_f0"] == np.float32(0.04) or abs(values["layered_f0"] - 0.04) < 1e-9
+
+
+def test_mean_value():
+    expression = 0.5 * Expression.image("a") + Expression.image("a") * Expression.image("b")
+    assert np.allclose(expression.mean_value({"a": (0.2, 0.4, 0.6), "b": (1.0, 0.5, 0.0)}), (0.3, 0.4, 0.3))
