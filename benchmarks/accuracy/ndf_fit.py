@@ -85,6 +85,21 @@ def _anisotropic_rows():
     return rows
 
 
+def _ggx_anisotropic_rows():
+    """Anisotropic GGX (the Principled BSDF's anisotropy) from the same table as Ward's: its tails are what the
+    lobes miss (the SG technique's light and environment tails return them)."""
+    rows = []
+    for alpha_x, alpha_y in ((0.35, 0.06), (0.5, 0.2), (0.16, 0.16)):
+        model = brdf.GGXAnisotropic(alpha_x=alpha_x, alpha_y=alpha_y)
+        for lobe_count in (2, 4, 8):
+            lobes = model.ndf_lobes(lobe_count)
+            rows.append(_row(f"GGX aniso ax={alpha_x} ay={alpha_y}, {lobe_count} lobes", QUADRATURE, L2,
+                             ndf_fit.ndf_l2_error(model, lobes), "the anisotropy table at the alphas"))
+            rows.append(_row(f"GGX aniso ax={alpha_x} ay={alpha_y}, {lobe_count} lobes", MONTE_CARLO, RMSE,
+                             ndf_fit.brdf_relative_rmse(model, lobes, 100_000), "table"))
+    return rows
+
+
 def _broad_lobe_rows():
     rows = []
     cases = (("Ward aniso 0.5/0.5", brdf.WardAnisotropic(alpha_x=0.5, alpha_y=0.5)),
@@ -104,7 +119,7 @@ def _broad_lobe_rows():
 
 
 def measure():
-    return _isotropic_rows() + _anisotropic_rows() + _broad_lobe_rows()
+    return _isotropic_rows() + _anisotropic_rows() + _ggx_anisotropic_rows() + _broad_lobe_rows()
 
 
 if __name__ == "__main__":

@@ -60,6 +60,7 @@ def equivalent_roughness(model, params):
         "BLINN_PHONG": lambda: from_exponent(params["exponent"]),
         "WARD_ISO": lambda: float(params["alpha_x"]),
         "WARD_ANISO": lambda: np.sqrt(float(params["alpha_x"]) * float(params["alpha_y"])),
+        "GGX_ANISO": lambda: np.sqrt(float(params["alpha_x"]) * float(params["alpha_y"])),
         "ASHIKHMIN_SHIRLEY": lambda: np.sqrt(from_exponent(params["nu"]) * from_exponent(params["nv"])),
     }[model]()
     return float(np.sqrt(np.clip(alpha, 0.0, 1.0)))

@@ -30,6 +30,10 @@ MODELS = (
           anisotropic=True),
     Model("ASHIKHMIN_SHIRLEY", "Ashikhmin-Shirley", "Anisotropic Ashikhmin-Shirley, fitted with several SG lobes",
           ("nu", "nv"), anisotropic=True),
+    # appended: a .blend stores the enum by position
+    Model("GGX_ANISO", "GGX Anisotropic", "Anisotropic GGX as Blender's Principled BSDF with Anisotropic > 0 "
+                                          "(alpha x along the tangent, alpha y across it), fitted with several SG "
+                                          "lobes", ("alpha_x", "alpha_y"), anisotropic=True),
 )
 BY_NAME = {model.name: model for model in MODELS}
 NAMES = tuple(BY_NAME)

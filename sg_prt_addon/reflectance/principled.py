@@ -60,14 +60,14 @@ def _colour(value):
 
 
 def _roughness_fields(roughness, anisotropic, distribution_model):
-    """The model and its width fields for a GGX-family roughness (Ward for anisotropy: its alphas are GGX's).
+    """The model and its width fields for a GGX-family roughness (anisotropic GGX for anisotropy).
     A textured roughness (an Expression) is GGX's own: the caller gives the others a number."""
     if isinstance(roughness, Expression):
         return {"model": "GGX", "roughness": roughness}
     roughness = float(np.clip(roughness, 0.0, 1.0))
     if anisotropic > 0.0 and distribution_model == "GGX":
         alpha_x, alpha_y = anisotropic_alphas(roughness, anisotropic)
-        return {"model": "WARD_ANISO", "alpha_x": float(np.clip(alpha_x, MIN_ROUGHNESS, 1.0)),
+        return {"model": "GGX_ANISO", "alpha_x": float(np.clip(alpha_x, MIN_ROUGHNESS, 1.0)),
                 "alpha_y": float(np.clip(alpha_y, MIN_ROUGHNESS, 1.0))}
     if distribution_model == "WARD_ISO":
         return {"model": "WARD_ISO", "alpha_x": float(np.clip(roughness ** 2, MIN_ROUGHNESS, 1.0))}

@@ -27,6 +27,12 @@ def uses_ggx_table(key):
     return key.model == "GGX" and key.ndf_lobes == 2 and key.has_specular
 
 
+def uses_albedo_table(key):
+    """The environment tail and energy cap from GGX's albedo: GGX's two lobes, and anisotropic GGX's lobes at
+    its equivalent roughness (reflectance.layering.equivalent_roughness)."""
+    return uses_ggx_table(key) or (key.model == "GGX_ANISO" and key.has_specular)
+
+
 def ggx_table():
     """ndf_fit's two-lobe GGX table as an (A, 2, 4) float32 texture: texel (k, row) =
     (log alpha, sharpness * alpha^2, amplitude / D(n), 0)."""
@@ -68,7 +74,7 @@ class SGParametric(SGLobes):
                           **scene_fields(inputs, has_diffuse, has_specular))
 
     def model_defines(self, key):
-        if not uses_ggx_table(key):
+        if not uses_albedo_table(key):
             return {}
         # GGX's energy beyond its two lobes, from its albedo table (reflectance.ggx_albedo)
         return {"ENVIRONMENT_TAIL": 1, "GGX_ALBEDO_SIZE": ggx_albedo.TABLE_SIZE,
@@ -81,7 +87,8 @@ class SGParametric(SGLobes):
 
     def model_samplers(self, key):
         if key.model in models.ANISOTROPIC:
-            return [("FLOAT_2D", "anisotropy_table")]
+            return [("FLOAT_2D", "anisotropy_table")] + ([("FLOAT_2D", "ggx_albedo_table")]
+                                                         if uses_albedo_table(key) else [])
         if uses_ggx_table(key):
             return [("FLOAT_2D", "ggx_table"), ("FLOAT_2D", "ggx_albedo_table")]      # ENVIRONMENT_TAIL
         return []
@@ -92,6 +99,7 @@ class SGParametric(SGLobes):
                                                                      lambda: anisotropy_table(key.ndf_lobes)))
         if uses_ggx_table(key):
             shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", ggx_table))
+        if uses_albedo_table(key):
             shader.uniform_sampler("ggx_albedo_table", context.table("ggx_albedo", ggx_albedo_texture))
 
 

@@ -176,12 +176,18 @@ def visible_part_axes(slice_axis, slice_sharpness, slice_visible, view, centre, 
 
 
 def model_albedo(model, params, view_local):
-    """The model's exact directional albedo E(o) per pixel (N,) where the engine tabulates it (GGX:
-    reflectance.ggx_albedo's table, one bilinear fetch, as sg_shading.glsl's ENVIRONMENT_TAIL), else None."""
-    if model != "GGX":
+    """The model's directional albedo E(o) per pixel (N,) where the engine tabulates it (GGX:
+    reflectance.ggx_albedo's table, one bilinear fetch, as sg_shading.glsl's ENVIRONMENT_TAIL; anisotropic GGX:
+    the same table at its equivalent roughness (alpha_x alpha_y)^(1/4), as Cycles reads its own), else None."""
+    if model == "GGX":
+        roughness = np.asarray(params["roughness"], FLOAT)
+    elif model == "GGX_ANISO":         # Cycles' equivalent roughness (sg_shading.glsl)
+        roughness = np.sqrt(np.sqrt(np.maximum(np.asarray(params["alpha_x"], FLOAT), FLOAT(1e-6))
+                                    * np.maximum(np.asarray(params["alpha_y"], FLOAT), FLOAT(1e-6))))
+    else:
         return None
     table = ggx_albedo.albedo_table()[..., None]
-    s, t = ggx_albedo.table_coordinates(np.asarray(view_local, FLOAT)[:, 2], np.asarray(params["roughness"], FLOAT))
+    s, t = ggx_albedo.table_coordinates(np.asarray(view_local, FLOAT)[:, 2], roughness)
     return sample_texture(table, np.stack([s, t], axis=-1))[:, 0]
 
 

@@ -20,6 +20,7 @@
  *   cook_torrance_beckmann_*  <- CookTorranceBeckmann
  *   blinn_phong_*             <- BlinnPhong
  *   ward_anisotropic_*        <- WardAnisotropic (ndf, m_factor; its lobes come from a table)
+ *   ggx_anisotropic_*         <- GGXAnisotropic (ndf, smith_lambda, m_factor; lobes from the same table)
  *   ward_isotropic_*          <- WardIsotropic
  *   ashikhmin_shirley_*       <- AshikhminShirley (ndf, m_factor; lobes from a table)
  *   ggx_*                     <- GGX (Blender conventions: alpha = roughness^2,
@@ -336,6 +337,39 @@ float ggx_m_factor(vec3 wo, vec3 wi, float roughness)
   }
   float alpha = ggx_alpha(roughness);
   float shadowing = 1.0 / (1.0 + ggx_smith_lambda(wo, alpha) + ggx_smith_lambda(wi, alpha));
+  return shadowing / (4.0 * max(wi.z, BRDF_COSINE_EPSILON) * max(wo.z, BRDF_COSINE_EPSILON));
+}
+
+/* ---- anisotropic GGX (GGXAnisotropic): alpha_x along the tangent, alpha_y along the bitangent ---- */
+
+float ggx_anisotropic_ndf(vec3 h, float alpha_x, float alpha_y)
+{
+  float ax = max(alpha_x, 1.0e-6);
+  float ay = max(alpha_y, 1.0e-6);
+  h = safe_normalize(h, vec3(0.0));
+  float u = h.x / ax;
+  float v = h.y / ay;
+  float scaled = u * u + v * v + h.z * h.z;
+  return h.z > 0.0 ? 1.0 / (SG_PI * ax * ay * scaled * scaled) : 0.0;
+}
+
+float ggx_anisotropic_smith_lambda(vec3 w, float alpha_x, float alpha_y)
+{
+  float z = max(w.z, BRDF_COSINE_EPSILON);
+  float a = ((alpha_x * w.x) * (alpha_x * w.x) + (alpha_y * w.y) * (alpha_y * w.y)) / (z * z);
+  return a / (2.0 * (1.0 + sqrt(1.0 + a)));
+}
+
+float ggx_anisotropic_m_factor(vec3 wo, vec3 wi, float alpha_x, float alpha_y)
+{
+  wo = safe_normalize(wo);
+  wi = safe_normalize(wi);
+  if (!(wo.z > 0.0 && wi.z > 0.0)) {
+    return 0.0;
+  }
+  float ax = max(alpha_x, 1.0e-6);
+  float ay = max(alpha_y, 1.0e-6);
+  float shadowing = 1.0 / (1.0 + ggx_anisotropic_smith_lambda(wo, ax, ay) + ggx_anisotropic_smith_lambda(wi, ax, ay));
   return shadowing / (4.0 * max(wi.z, BRDF_COSINE_EPSILON) * max(wo.z, BRDF_COSINE_EPSILON));
 }
 

@@ -111,7 +111,7 @@ def test_principled_mapping():
     assert half["specular_color"] == pytest.approx((0.52, 0.26, 0.01))
     aniso = principled.principled(roughness=0.5, anisotropic=0.8, anisotropic_rotation=0.25)
     aspect = np.sqrt(1 - 0.72)
-    assert aniso["model"] == "WARD_ANISO"
+    assert aniso["model"] == "GGX_ANISO"
     assert (aniso["alpha_x"], aniso["alpha_y"]) == pytest.approx((0.25 / aspect, 0.25 * aspect))
     assert aniso["tangent_rotation"] == pytest.approx(np.pi / 2)
     assert principled.principled(emission_color=(1, 0.5, 0), emission_strength=2)["emission"] == (2, 1, 0)

@@ -287,3 +287,20 @@ def test_node_material_with_computed_textures(engine):
                 for slot, value in params.textures.items()}
     assert set(textures) == {"diffuse_color", "specular_color", "roughness"} and bpy.data.images["pbr_metallic"]
     _check(result, {material.name: textures})
+
+
+def test_anisotropic_ggx_with_its_tails(engine):
+    """Anisotropic GGX (the Principled BSDF's anisotropy) under courtyard.exr and a point light: its table
+    lobes, the light tail, the environment tail from GGX's albedo at the equivalent roughness, and the layer."""
+    scene = fx.new_scene("mirror_ggx_aniso", 128, 128)
+    fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
+    brushed = fx.material("mat_ggx_aniso", model="GGX_ANISO", alpha_x=0.35, alpha_y=0.06, lobe_count=4,
+                          diffuse_color=(0.1, 0.1, 0.1), specular_color=(0.9, 0.8, 0.6), tangent_rotation=0.3,
+                          fresnel="SCHLICK", multiscatter=True)
+    fx.uv_sphere(scene, "ggx_aniso", (0.0, 0.0, 1.0), radius=1.2).data.materials.append(brushed)
+    fx.point_light(scene, "point", (1.0, -3.0, 3.0), 900.0, radius=0.05)
+    with fx.recorded_variant_keys() as keys:
+        result = fx.render(scene, gbuffer=True, environment_layer_size=32)
+    assert {key.model for key in keys} == {"GGX_ANISO"}
+    assert "ENVIRONMENT_TAIL" in fx.variant_defines(next(iter(keys)))
+    _check(result)

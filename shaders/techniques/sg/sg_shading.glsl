@@ -48,7 +48,7 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
 #endif
   sharpness = lobe.x;
   amplitude = lobe.y;
-#if defined(MODEL_WARD_ANISO)
+#if defined(MODEL_WARD_ANISO) || defined(MODEL_GGX_ANISO)
   float ax = max(p.w, 1.0e-6);
   float ay = max(q.x, 1.0e-6);
   anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
@@ -168,6 +168,8 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
   return ward_isotropic_m_factor(wo, wi);
 #elif defined(MODEL_WARD_ANISO)
   return ward_anisotropic_m_factor(wo, wi);
+#elif defined(MODEL_GGX_ANISO)
+  return ggx_anisotropic_m_factor(wo, wi, p.w, q.x);
 #elif defined(MODEL_ASHIKHMIN_SHIRLEY)
   return ashikhmin_shirley_m_factor(wo, wi, q.y, q.z, q.w);
 #elif defined(MODEL_FITTED)
@@ -196,6 +198,8 @@ float model_specular(vec3 wo, vec3 wi, vec4 p, vec4 q)
   ndf = ward_isotropic_ndf(h, p.w);
 #elif defined(MODEL_WARD_ANISO)
   ndf = ward_anisotropic_ndf(h, p.w, q.x);
+#elif defined(MODEL_GGX_ANISO)
+  ndf = ggx_anisotropic_ndf(h, p.w, q.x);
 #elif defined(MODEL_ASHIKHMIN_SHIRLEY)
   ndf = ashikhmin_shirley_ndf(h, q.y, q.z);
 #endif
@@ -299,7 +303,12 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef ENVIRONMENT_TAIL
   /* GGX's exact albedo (reflectance.ggx_albedo): the lobes keep at most it (at grazing views they overshoot it
    * several times over), and the environment tail returns what they miss of it (techniques.sg_shading.model_albedo) */
-  vec2 albedo_coords = (clamp(vec2(view_local.z, p.x), 0.0, 1.0) * float(GGX_ALBEDO_SIZE - 1) + 0.5) /
+#ifdef MODEL_GGX_ANISO
+  float albedo_roughness = sqrt(sqrt(max(p.w, 1.0e-6) * max(q.x, 1.0e-6)));   /* Cycles' equivalent roughness */
+#else
+  float albedo_roughness = p.x;
+#endif
+  vec2 albedo_coords = (clamp(vec2(view_local.z, albedo_roughness), 0.0, 1.0) * float(GGX_ALBEDO_SIZE - 1) + 0.5) /
                        float(GGX_ALBEDO_SIZE);
   float model_albedo = texture(ggx_albedo_table, albedo_coords).r;
   float energy_scale = min(1.0, model_albedo / max(slice_albedo, 1.0e-30));
