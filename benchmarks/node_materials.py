@@ -131,8 +131,14 @@ def mix_diffuse_glossy():
 
 
 def anisotropic():
-    return _principled("anisotropic", Base_Color=(0.9, 0.9, 0.9, 1.0), Metallic=1.0, Roughness=0.4,
-                       Anisotropic=0.8)[0]
+    """A brushed metal: anisotropy along the UV map's tangent (a Tangent node; unlinked, Cycles would turn it
+    radially about the object's Z, which the engine reads as the UV tangent with a warning)."""
+    material, tree, node = _principled("anisotropic", Base_Color=(0.9, 0.9, 0.9, 1.0), Metallic=1.0, Roughness=0.4,
+                                       Anisotropic=0.8)
+    tangent = tree.nodes.new("ShaderNodeTangent")
+    tangent.direction_type = "UV_MAP"
+    tree.links.new(tangent.outputs["Tangent"], node.inputs["Tangent"])
+    return material
 
 
 SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),

@@ -428,7 +428,19 @@ def _principled_values(reader, node):
             reader.note(node, f"{what} ({name} {optional[name]:.3g}) is not rendered")
     if optional["Alpha"] < 1.0:
         reader.note(node, f"Alpha {optional['Alpha']:.3g}: rendered opaque")
+    if optional["Anisotropic"] > 0.0:
+        _tangent_input(reader, node)
     return values
+
+
+def _tangent_input(reader, node):
+    """An anisotropic lobe's Tangent input: a Tangent node over the UV map is the engine's UV tangent; Cycles'
+    default (unlinked: radial about the object's Z) and other tangents are named."""
+    out = follow(node.inputs["Tangent"]) if "Tangent" in node.inputs else None
+    if out is None:
+        reader.note(node, "Tangent unlinked (Cycles: radial about the object's Z): the UV map's tangent is used")
+    elif out.node.type != "TANGENT" or out.node.direction_type != "UV_MAP":
+        reader.note(out.node, "not read as the tangent: the UV map's tangent is used")
 
 
 def _width(reader, node, plain_ggx):
