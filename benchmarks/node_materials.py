@@ -114,6 +114,27 @@ def pbr_metallic_map():
     return material
 
 
+def tiled():
+    """A checker Base Color tiled and turned by a Mapping node on the UVs (Scale 3 x 2, Rotation 0.4 about z,
+    Location 0.1, 0.2): texture coordinates beyond [0, 1] repeat."""
+    import numpy as np
+
+    material, tree, node = _principled("tiled", Roughness=0.5)
+    u, v = np.meshgrid((np.arange(32) + 0.5) / 32, (np.arange(32) + 0.5) / 32)
+    checker = ((np.floor(u * 2) + np.floor(v * 2)) % 2)[..., None]
+    colour = np.ones((32, 32, 4))
+    colour[..., :3] = checker * (0.9, 0.8, 0.3) + (1 - checker) * (0.1, 0.2, 0.5)
+    texture = _textured(tree, node, "Base Color", _image("tiles", colour, "sRGB"))
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Scale"].default_value = (3.0, 2.0, 1.0)
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, 0.4)
+    mapping.inputs["Location"].default_value = (0.1, 0.2, 0.0)
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coordinates.outputs["UV"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    return material
+
+
 def mix_diffuse_glossy():
     material, tree, output = _nodes("mix_diffuse_glossy")
     diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
@@ -143,7 +164,7 @@ def anisotropic():
 
 SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),
           "principled_gold_r030": gold, "principled_textured": textured, "principled_pbr_metallic_map": pbr_metallic_map,
-          "mix_diffuse_glossy": mix_diffuse_glossy,
+          "principled_tiled": tiled, "mix_diffuse_glossy": mix_diffuse_glossy,
           "principled_anisotropic": anisotropic}
 
 

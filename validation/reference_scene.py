@@ -17,18 +17,19 @@ from validation.camera import Camera
 def _texture_lookup(params, images):
     """uv -> per-point colours and model for a material with textures (the engine's sampling)."""
     def lookup(uv):
+        uv = sg_shading.material_uv(params, uv)
         count = len(uv)
         values = {}
         for name in ("diffuse_color", "specular_color"):
             colour = np.broadcast_to(np.asarray(getattr(params, name), np.float64), (count, 3))
             if name in images:
-                colour = colour * sg_shading.sample_texture(images[name], uv)[:, :3]
+                colour = colour * sg_shading.sample_material_texture(images[name], uv)[:, :3]
             values[name] = colour
         model_parameters = {}
         for name in models.BY_NAME[params.model].parameters:
             value = np.full(count, float(getattr(params, name)))
             if name in images:
-                value = value * sg_shading.sample_texture(images[name], uv)[:, 0]
+                value = value * sg_shading.sample_material_texture(images[name], uv)[:, 0]
             model_parameters[name] = value
         values["specular_model"] = brdf.model_from_name(params.model, **model_parameters)
         return values

@@ -121,6 +121,8 @@ class MaterialParams:
     layered_f0: float = -1.0
     emission: tuple = (0.0, 0.0, 0.0)
     source: str = "SETTINGS"       # what the look was read from: material.sgprt.source (NODE_TREE, SETTINGS)
+    # texture coordinates from the UV map: u' = a u + b v + c, v' = d u + e v + f (a node tree's Mapping node)
+    uv_transform: tuple = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
     decoded_slots: tuple = ()      # data slots whose sRGB images are decoded to linear (node trees: as Blender)
     normal_strength: float = 1.0
     tangent_source: str = "UV_MAP"

@@ -18,6 +18,7 @@ from ..reflectance import principled
 from ..reflectance.texture_expression import Expression
 
 PASS_THROUGH = ("REROUTE",)
+IDENTITY_UV_TRANSFORM = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
 # Blender's implicit colour -> float conversion (Rec. 709 luminance)
 LUMINANCE = (0.2126, 0.7152, 0.0722)
 COLOUR_SLOTS = ("diffuse_color", "specular_color")
@@ -100,6 +101,7 @@ class SocketReader:
         self.material = material
         self.notes = []
         self.images = {}            # name -> bpy Image of every image an Expression names
+        self.uv_transforms = []     # the UV transform of every Image Texture read (uv_transform_of)
 
     def note(self, node, what):
         text = f"'{node.name}' ({node.bl_label}): {what}"
@@ -186,6 +188,11 @@ class SocketReader:
         if out.name != "Color":
             self.note(node, f"its {out.name} output is read as its Color")
         vector = follow(node.inputs["Vector"])
+        transform = IDENTITY_UV_TRANSFORM
+        if vector is not None and vector.node.type == "MAPPING":
+            transform = self.uv_transform_of(vector.node)
+            vector = follow(vector.node.inputs["Vector"])
+        self.uv_transforms.append(transform)
         if vector is not None:
             source = vector.node
             if source.type == "UVMAP" and source.uv_map and self._other_uv_map(source.uv_map):
@@ -194,8 +201,35 @@ class SocketReader:
                 self.note(source, "texture coordinates other than the UV map: the active UV map is used")
         if node.projection != "FLAT":
             self.note(node, f"{node.projection.lower()} projection: read flat over the UV map")
+        if node.extension != "REPEAT":
+            self.note(node, f"extension {node.extension.lower()}: read repeating")
         self.images[image.name] = image
         return Expression.image(image.name)
+
+    def uv_transform_of(self, mapping):
+        """A Mapping node on UV coordinates as the affine (a, b, c, d, e, f): u' = a u + b v + c, v' = d u + e v +
+        f (POINT: R S uv + L; TEXTURE: its inverse; VECTOR: R S uv; about z only, in the UV plane)."""
+        inputs = mapping.inputs
+        for name in ("Location", "Rotation", "Scale"):
+            if name in inputs and inputs[name].is_linked:
+                self.note(mapping, f"a linked {name}: its value is used")
+        rotation = inputs["Rotation"].default_value
+        if abs(rotation[0]) > 1e-9 or abs(rotation[1]) > 1e-9:
+            self.note(mapping, "a rotation about x or y: only the turn about z applies to UVs")
+        if mapping.vector_type == "NORMAL":
+            self.note(mapping, "normal mapping type: the UVs are used as they are")
+            return IDENTITY_UV_TRANSFORM
+        cos, sin = np.cos(rotation[2]), np.sin(rotation[2])
+        scale = inputs["Scale"].default_value
+        matrix = np.array([[cos, -sin], [sin, cos]]) @ np.diag([scale[0], scale[1]])
+        offset = np.zeros(2)
+        if mapping.vector_type in ("POINT", "TEXTURE"):
+            offset = np.array(inputs["Location"].default_value[:2], np.float64)
+        if mapping.vector_type == "TEXTURE":
+            matrix = np.linalg.inv(matrix) if abs(np.linalg.det(matrix)) > 1e-12 else np.eye(2)
+            offset = -matrix @ offset
+        return (float(matrix[0, 0]), float(matrix[0, 1]), float(offset[0]),
+                float(matrix[1, 0]), float(matrix[1, 1]), float(offset[1]))
 
     def _other_uv_map(self, name):
         """Whether a mesh with this material has an active UV map other than `name` (export reads the active)."""
@@ -296,9 +330,19 @@ def _combine(reader, closures, reading):
         fields["specular_color"] = (0.0, 0.0, 0.0)
         fields["layered_f0"] = -1.0
     fields["emission"] = tuple(float(c) for c in emission)
+    _uv_transform(reader, fields)
     reading.decoded_slots = tuple(sorted(slot for slot, value in reading.textures.items()
                                          if isinstance(value, str) and slot not in COLOUR_SLOTS + ("normal_map",)
                                          and _is_srgb(reader.images[value])))
+
+
+def _uv_transform(reader, fields):
+    """The one UV transform of the material's textures (the engine maps every texture of a material alike)."""
+    transforms = list(dict.fromkeys(reader.uv_transforms))
+    if transforms:
+        fields["uv_transform"] = transforms[0]
+        if len(transforms) > 1:
+            reader.notes.append("textures under different Mapping nodes: the first one's mapping is used for all")
 
 
 def _mean_weight(reader, weight):

@@ -111,7 +111,7 @@ def scene_block(camera, light_data, environment):
 
 
 def material_block(params, material_id=0):
-    """MaterialData of an export.MaterialParams as (7, 4) float32; material_id goes to the G-buffer."""
+    """MaterialData of an export.MaterialParams as (9, 4) float32; material_id goes to the G-buffer."""
     return np.array([
         list(params.diffuse_color) + [params.layered_f0],
         list(params.specular_color) + [1.0],
@@ -121,6 +121,8 @@ def material_block(params, material_id=0):
         [1.0 if params.tangent_source == "OBJECT_AXIS" else 0.0, float(material_id),
          surface_layering.layer_roughness(params), 0.0],
         list(params.emission) + [0.0],
+        list(params.uv_transform[:3]) + [0.0],
+        list(params.uv_transform[3:]) + [0.0],
     ], np.float32)
 
 

@@ -7,13 +7,14 @@ the prefiltered environment's layers, the SSDF basis and the material textures a
 import numpy as np
 
 
-def bilinear(image, uv, layer=None):
+def bilinear(image, uv, layer=None, wrap=False):
     """Samples of `image` at texture coordinates uv (..., 2) in [0, 1]^2 (u along a row, v across rows).
 
     image: (H, W, ...) indexed [row, column], row 0 at v = 0 (the GPU's and Blender's order); with `layer`,
     (L, H, W, ...) and layer (...) integer indices, as a texture array.  Returns (...) + image's trailing
     dimensions.  The arithmetic is in uv's precision (float32 coordinates: the shader's, float64: a
-    reference's)."""
+    reference's).  wrap: the texel indices repeat (GL_REPEAT: the material textures' manual fetch in
+    shaders/techniques/common/surface_io.glsl), else they clamp to the edge."""
     uv = np.asarray(uv)
     dtype = np.result_type(uv.dtype, np.float32).type
     first = 0 if layer is None else 1
@@ -24,8 +25,11 @@ def bilinear(image, uv, layer=None):
     trailing = (Ellipsis,) + (None,) * (image.ndim - 2 - first)
     fx, fy = (x - x0)[trailing], (y - y0)[trailing]
     x0, y0 = x0.astype(np.int64), y0.astype(np.int64)
-    xa, xb = np.clip(x0, 0, width - 1), np.clip(x0 + 1, 0, width - 1)
-    ya, yb = np.clip(y0, 0, height - 1), np.clip(y0 + 1, 0, height - 1)
+    if wrap:
+        xa, xb, ya, yb = x0 % width, (x0 + 1) % width, y0 % height, (y0 + 1) % height
+    else:
+        xa, xb = np.clip(x0, 0, width - 1), np.clip(x0 + 1, 0, width - 1)
+        ya, yb = np.clip(y0, 0, height - 1), np.clip(y0 + 1, 0, height - 1)
     index = () if layer is None else (layer,)
     low = image[index + (ya, xa)] * (1 - fx) + image[index + (ya, xb)] * fx
     high = image[index + (yb, xa)] * (1 - fx) + image[index + (yb, xb)] * fx

@@ -606,8 +606,25 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
 
 
 def sample_texture(image, uv):
-    """A material texture or table (H, W, C) read as the GPU reads it, as float32 (N, C)."""
+    """A table or map (H, W, C) read as the GPU's sampler reads it (bilinear, clamped to the edge), float32."""
     return texture_fetch.bilinear(image, np.asarray(uv, FLOAT)).astype(FLOAT)
+
+
+def sample_material_texture(image, uv):
+    """A material texture (H, W, C) at the surface's texture coordinates, as common/surface_io.glsl's
+    material_texture reads it (bilinear, repeating as Blender's Image Texture does): float32 (N, C)."""
+    return texture_fetch.bilinear(image, np.asarray(uv, FLOAT), wrap=True).astype(FLOAT)
+
+
+def material_uv(material, uv):
+    """The surface's texture coordinates (N, 2) float32: the UV map through the material's affine
+    uv_transform (u' = a u + b v + c, v' = d u + e v + f), as mesh.vert.glsl computes texcoord."""
+    a, b, c, d, e, f = (FLOAT(value) for value in getattr(material, "uv_transform", IDENTITY_UV_TRANSFORM))
+    uv = np.asarray(uv, FLOAT)
+    return np.stack([a * uv[:, 0] + b * uv[:, 1] + c, d * uv[:, 0] + e * uv[:, 1] + f], axis=-1)
+
+
+IDENTITY_UV_TRANSFORM = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
 
 
 SCALAR_SLOTS = {"roughness": "roughness", "ior": "ior", "exponent": "exponent", "alpha_x": "alpha_x",
@@ -620,9 +637,9 @@ def surface_colours(material, textures, uv, count):
     diffuse_color = np.broadcast_to(np.asarray(material.diffuse_color, FLOAT), (count, 3))
     specular_color = np.broadcast_to(np.asarray(material.specular_color, FLOAT), (count, 3))
     if "diffuse_color" in textures:
-        diffuse_color = diffuse_color * sample_texture(textures["diffuse_color"], uv)[:, :3]
+        diffuse_color = diffuse_color * sample_material_texture(textures["diffuse_color"], uv)[:, :3]
     if "specular_color" in textures:
-        specular_color = specular_color * sample_texture(textures["specular_color"], uv)[:, :3]
+        specular_color = specular_color * sample_material_texture(textures["specular_color"], uv)[:, :3]
     return diffuse_color, specular_color
 
 
@@ -632,7 +649,7 @@ def surface_geometry(material, textures, normal, tangent, uv):
     shading_normal = np.asarray(normal, FLOAT)
     tangent = np.asarray(tangent, FLOAT)
     if "normal_map" in textures:
-        shading_normal = apply_normal_map(shading_normal, tangent, sample_texture(textures["normal_map"], uv)[:, :3],
+        shading_normal = apply_normal_map(shading_normal, tangent, sample_material_texture(textures["normal_map"], uv)[:, :3],
                                           FLOAT(material.normal_strength))
     return shading_normal, rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
 
@@ -647,7 +664,7 @@ def surface_layers(material, roughness_texture, uv, diffuse_color, specular_colo
         return diffuse_color, specular_color
     roughness = np.full(len(position), surface_layering.layer_roughness(material), FLOAT)
     if roughness_texture is not None:
-        roughness = roughness * sample_texture(roughness_texture, uv)[:, 0]
+        roughness = roughness * sample_material_texture(roughness_texture, uv)[:, 0]
     view = view_directions(np.asarray(position, FLOAT), view_origin, is_perspective)
     cos_o = np.sum(np.asarray(shading_normal, FLOAT) * view, axis=-1)
     specular, diffuse_factor = layering.factors(
@@ -680,7 +697,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     for name in SCALAR_SLOTS:
         value = np.full(count, getattr(material, name), FLOAT)
         if name in textures:
-            value = value * sample_texture(textures[name], uv)[:, 0]
+            value = value * sample_material_texture(textures[name], uv)[:, 0]
         params[name] = value
     shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
     roughness_texture = textures["roughness"] if surface_layering.textured_roughness(material.model, textures) else None

@@ -135,7 +135,7 @@ def shade_fragments(material, textures, table, environment, position, normal, ta
     diffuse_color, specular_color = sg_shading.surface_colours(material, textures, uv, count)
     parameter = np.full(count, FLOAT(getattr(material, table.parameter)) if table.parameter else 0, FLOAT)
     if table.parameter in textures:
-        parameter = parameter * sg_shading.sample_texture(textures[table.parameter], uv)[:, 0]
+        parameter = parameter * sg_shading.sample_material_texture(textures[table.parameter], uv)[:, 0]
     shading_normal, shading_tangent = sg_shading.surface_geometry(material, textures, normal, tangent, uv)
     roughness_texture = textures["roughness"] if table.parameter == "roughness" and "roughness" in textures else None
     diffuse_color, specular_color = sg_shading.surface_layers(material, roughness_texture, uv, diffuse_color,

@@ -48,4 +48,7 @@ struct MaterialData {
   vec4 options;
   /* rgb emitted radiance (Combined only) */
   vec4 emission;
+  /* the texture coordinates from the UV map (a node tree's Mapping): u' = dot(xyz, (u, v, 1)), v' likewise */
+  vec4 uv_transform_u;
+  vec4 uv_transform_v;
 };

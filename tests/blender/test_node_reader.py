@@ -250,3 +250,26 @@ def _link_image(tree, image, socket):
     texture.image = image
     tree.links.new(texture.outputs["Color"], socket)
     return texture
+
+
+def test_mapping_node_on_uvs(empty_file):
+    """A Mapping node between the UVs and the Image Textures: the material's UV transform (POINT: R S uv + L;
+    TEXTURE: its inverse); textures under different mappings are named."""
+    material, tree, output = _material("mapped")
+    node = _principled(tree, output)
+    texture = _link_image(tree, _image("mapped_base", np.full((4, 4, 4), 0.5)), node.inputs["Base Color"])
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Scale"].default_value = (4.0, 2.0, 1.0)
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, np.pi / 2)
+    mapping.inputs["Location"].default_value = (0.25, 0.5, 0.0)
+    tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    params, warnings = _read(material)
+    assert warnings == []
+    np.testing.assert_allclose(params.uv_transform, (0.0, -2.0, 0.25, 4.0, 0.0, 0.5), atol=1e-6)
+    mapping.vector_type = "TEXTURE"
+    a, b, c, d, e, f = _read(material)[0].uv_transform
+    forward = np.array([[0.0, -2.0, 0.25], [4.0, 0.0, 0.5], [0.0, 0.0, 1.0]])
+    np.testing.assert_allclose(np.array([[a, b, c], [d, e, f], [0, 0, 1]]) @ forward, np.eye(3), atol=1e-6)
+    _link_image(tree, _image("unmapped_rough", np.full((4, 4, 4), 0.5), "Non-Color"), node.inputs["Roughness"])
+    params, warnings = _read(material)
+    assert len(warnings) == 1 and "different Mapping" in warnings[0]

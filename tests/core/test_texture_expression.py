@@ -36,3 +36,21 @@ def test_principled_textured_metallic_evaluates_to_its_formula():
 def test_mean_value():
     expression = 0.5 * Expression.image("a") + Expression.image("a") * Expression.image("b")
     assert np.allclose(expression.mean_value({"a": (0.2, 0.4, 0.6), "b": (1.0, 0.5, 0.0)}), (0.3, 0.4, 0.3))
+
+
+def test_material_textures_repeat_and_the_uv_transform():
+    """sg_shading.sample_material_texture wraps (GL_REPEAT) where the tables' fetch clamps; material_uv applies
+    the material's affine UV transform."""
+    from types import SimpleNamespace
+
+    from sg_prt_addon.techniques import sg_shading
+
+    image = RNG.uniform(0, 1, (4, 8, 3)).astype(np.float32)
+    uv = np.array([[0.3, 0.6], [1.3, -0.4], [0.01, 0.99]], np.float32)
+    wrapped = sg_shading.sample_material_texture(image, uv)
+    np.testing.assert_allclose(wrapped[0], wrapped[1], atol=1e-5)           # one period apart
+    corner = 0.25 * (image[3, 0] + image[3, 7] + image[0, 0] + image[0, 7])   # between the four corner texels
+    np.testing.assert_allclose(sg_shading.sample_material_texture(image, [[0.0, 0.0]])[0], corner, atol=1e-6)
+    assert not np.allclose(sg_shading.sample_texture(image, [[0.0, 0.0]])[0], corner)     # clamped: texel (0, 0)
+    material = SimpleNamespace(uv_transform=(2.0, 0.0, 0.5, 0.0, 3.0, -1.0))
+    np.testing.assert_allclose(sg_shading.material_uv(material, uv[:1]), [[1.1, 0.8]], atol=1e-6)

@@ -304,3 +304,25 @@ def test_anisotropic_ggx_with_its_tails(engine):
     assert {key.model for key in keys} == {"GGX_ANISO"}
     assert "ENVIRONMENT_TAIL" in fx.variant_defines(next(iter(keys)))
     _check(result)
+
+
+def test_node_material_with_tiled_uvs(engine):
+    """An Image Texture behind a Mapping node (scale 3 x 2, a turn, an offset): texture coordinates beyond
+    [0, 1] repeat through the manual bilinear fetch (material_texture), against the mirror's wrapped fetch."""
+    from benchmarks import node_materials
+    from sg_prt_addon.blender import export
+
+    scene = fx.new_scene("mirror_tiled", 128, 128)
+    fx.world_colour(scene, (0.3, 0.3, 0.35))
+    material = node_materials.tiled()
+    fx.uv_sphere(scene, "tiled_sphere", (0.0, 0.0, 1.0), radius=1.2).data.materials.append(material)
+    fx.point_light(scene, "point", (1.5, -3.0, 3.0), 600.0, radius=0.1)
+    result = fx.render(scene, gbuffer=True)
+    assert "error" not in result, result.get("error")
+    params = result["state"].materials[material.name]
+    assert params.uv_transform != (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    uv = result["passes"]["gbuffer_uv"]
+    covered = uv[..., 3] > 0.5
+    assert uv[covered][:, :2].max() > 2.0 and uv[covered][:, :2].min() < 0.0       # tiled beyond [0, 1]
+    _check(result, {material.name: {"diffuse_color": export.slot_pixels(params.textures["diffuse_color"],
+                                                                        "diffuse_color")}})

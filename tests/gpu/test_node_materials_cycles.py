@@ -18,6 +18,8 @@ def node_materials(blender):
     ("principled_textured", 0.27, 0.12),      # 0.214 / +0.084 / 0.106 (the normal map: light below the mesh's
                                               # horizon reaches bumps facing it; Cycles cuts it)
     ("principled_pbr_metallic_map", 0.30, 0.04),  # 0.243 / +0.008 / 0.163: colours computed from two images
+    ("principled_tiled", 0.20, 0.05),         # 0.155 / +0.022 / 0.097: a Mapping node tiling and turning the UVs
+                                              # (its turn read the other way round: 1.16)
     ("mix_diffuse_glossy", 0.17, 0.03),       # 0.125 / +0.001 / 0.103
     ("principled_anisotropic", 0.31, 0.08),   # 0.258 / +0.047 / 0.119 (Ward's lobes in its place: 0.507 / -0.223)
 ])

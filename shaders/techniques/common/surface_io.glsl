@@ -11,15 +11,31 @@ vec3 surface_facing_normal()
   return front ? world_normal : -world_normal;
 }
 
+/* A material texture at the surface's texture coordinates, bilinear and repeating as Blender's Image Texture
+ * (the gpu module binds samplers clamped to the edge, so the four texels are fetched here; numpy mirror:
+ * techniques.sg_shading.sample_material_texture). */
+vec4 material_texture(sampler2D image)
+{
+  ivec2 size = textureSize(image, 0);
+  vec2 position = texcoord * vec2(size) - 0.5;
+  vec2 low = floor(position);
+  vec2 fraction = position - low;
+  ivec2 a = ivec2(low) - size * ivec2(floor(low / vec2(size)));     /* low modulo size, for negative low too */
+  ivec2 b = ivec2(a.x + 1 == size.x ? 0 : a.x + 1, a.y + 1 == size.y ? 0 : a.y + 1);
+  vec4 bottom = mix(texelFetch(image, a, 0), texelFetch(image, ivec2(b.x, a.y), 0), fraction.x);
+  vec4 top = mix(texelFetch(image, ivec2(a.x, b.y), 0), texelFetch(image, b, 0), fraction.x);
+  return mix(bottom, top, fraction.y);
+}
+
 /* The colours' textures over the active UV map, multiplied onto their base values (the material's, or a
  * stored fit's). */
 void surface_colour_textures(inout vec3 diffuse_color, inout vec3 specular_color)
 {
 #ifdef HAS_TEXTURE_DIFFUSE_COLOR
-  diffuse_color *= texture(texture_diffuse_color, texcoord).rgb;
+  diffuse_color *= material_texture(texture_diffuse_color).rgb;
 #endif
 #ifdef HAS_TEXTURE_SPECULAR_COLOR
-  specular_color *= texture(texture_specular_color, texcoord).rgb;
+  specular_color *= material_texture(texture_specular_color).rgb;
 #endif
 }
 
@@ -31,7 +47,7 @@ void surface_geometry(vec3 normal, out vec4 tangent, out vec3 shading_normal, ou
                                      : world_tangent;
   shading_normal = normal;
 #ifdef HAS_NORMAL_MAP
-  shading_normal = apply_normal_map(normal, tangent, texture(texture_normal_map, texcoord).rgb,
+  shading_normal = apply_normal_map(normal, tangent, material_texture(texture_normal_map).rgb,
                                     material.parameters1.w);
 #endif
   shading_tangent = rotate_tangent(shading_normal, tangent.xyz, material.tangent_axis_rotation.w);

@@ -22,25 +22,25 @@ void main()
 #endif
   surface_colour_textures(diffuse_color, specular_color);
 #ifdef HAS_TEXTURE_ROUGHNESS
-  p.x *= texture(texture_roughness, texcoord).r;
+  p.x *= material_texture(texture_roughness).r;
 #endif
 #ifdef HAS_TEXTURE_IOR
-  p.y *= texture(texture_ior, texcoord).r;
+  p.y *= material_texture(texture_ior).r;
 #endif
 #ifdef HAS_TEXTURE_EXPONENT
-  p.z *= texture(texture_exponent, texcoord).r;
+  p.z *= material_texture(texture_exponent).r;
 #endif
 #ifdef HAS_TEXTURE_ALPHA_X
-  p.w *= texture(texture_alpha_x, texcoord).r;
+  p.w *= material_texture(texture_alpha_x).r;
 #endif
 #ifdef HAS_TEXTURE_ALPHA_Y
-  q.x *= texture(texture_alpha_y, texcoord).r;
+  q.x *= material_texture(texture_alpha_y).r;
 #endif
 #ifdef HAS_TEXTURE_NU
-  q.y *= texture(texture_nu, texcoord).r;
+  q.y *= material_texture(texture_nu).r;
 #endif
 #ifdef HAS_TEXTURE_NV
-  q.z *= texture(texture_nv, texcoord).r;
+  q.z *= material_texture(texture_nv).r;
 #endif
   vec4 tangent;
   vec3 shading_normal, shading_tangent;
