@@ -15,8 +15,9 @@ def node_materials(blender):
     ("principled_r050", 0.14, 0.03),          # 0.091 / -0.003 / 0.081
     ("principled_r080", 0.13, 0.03),          # 0.081 / -0.002 / 0.076
     ("principled_gold_r030", 0.27, 0.04),     # 0.214 / +0.007 / 0.136
-    ("principled_textured", 0.27, 0.12),      # 0.214 / +0.084 / 0.106 (the normal map: light below the mesh's
-                                              # horizon reaches bumps facing it; Cycles cuts it)
+    ("principled_textured", 0.30, 0.15),      # 0.214 / +0.084 / 0.106; Blender 4.2's Cycles: 0.259 / +0.125 (the
+                                              # normal map: light below the mesh's horizon reaches bumps facing
+                                              # it; Cycles cuts it)
     ("principled_pbr_metallic_map", 0.30, 0.04),  # 0.243 / +0.008 / 0.163: colours computed from two images
     ("principled_tiled", 0.20, 0.05),         # 0.155 / +0.022 / 0.097: a Mapping node tiling and turning the UVs
                                               # (its turn read the other way round: 1.16)
