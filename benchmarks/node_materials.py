@@ -231,7 +231,7 @@ def score(name, size, samples, log=print):
 
 
 def markdown_section(data):
-    lines = [f"Blender materials built only from nodes (`benchmarks/node_materials.py`): a sphere under "
+    lines = [SECTION_TITLE, "", f"Blender materials built only from nodes (`benchmarks/node_materials.py`): a sphere under "
              f"courtyard.exr and a point light, {data['size']} x {data['size']}, Cycles direct light only, "
              f"{data['cycles_samples']} spp x 2 seeds.  SG-PRT reads the node tree (no SG-PRT settings); a lone "
              "sphere needs no bake.  Relative RMSE and bias over the sphere's pixels.", "",
