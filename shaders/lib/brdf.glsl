@@ -356,7 +356,8 @@ float ggx_anisotropic_ndf(vec3 h, float alpha_x, float alpha_y)
 float ggx_anisotropic_smith_lambda(vec3 w, float alpha_x, float alpha_y)
 {
   float z = max(w.z, BRDF_COSINE_EPSILON);
-  float a = ((alpha_x * w.x) * (alpha_x * w.x) + (alpha_y * w.y) * (alpha_y * w.y)) / (z * z);
+  /* capped: a non-unit or grazing w overflows a to Inf, and Inf / Inf is NaN (found by test_glsl_stress) */
+  float a = min(((alpha_x * w.x) * (alpha_x * w.x) + (alpha_y * w.y) * (alpha_y * w.y)) / (z * z), 1.0e30);
   return a / (2.0 * (1.0 + sqrt(1.0 + a)));
 }
 

@@ -97,7 +97,8 @@ def test_brdf_stress(glsl, fuzz):
     ndfs = """
     float r = wo.w, n = h.w;
     result = vec4(cook_torrance_ndf(h.xyz, r) + cook_torrance_beckmann_ndf(h.xyz, r) + ggx_ndf(h.xyz, r),
-                  blinn_phong_ndf(h.xyz, n) + ashikhmin_shirley_ndf(h.xyz, n, n * 7.0 + 1.0),
+                  blinn_phong_ndf(h.xyz, n) + ashikhmin_shirley_ndf(h.xyz, n, n * 7.0 + 1.0)
+                  + ggx_anisotropic_ndf(h.xyz, r, 1.0 - r) + ggx_anisotropic_smith_lambda(wo.xyz, r, 1.0 - r),
                   ward_isotropic_ndf(h.xyz, r) + ward_anisotropic_ndf(h.xyz, r, 1.0 - r),
                   fresnel_dielectric(h.z, wi.w) + fresnel_schlick(h.z, e.x));
     """
@@ -108,7 +109,8 @@ def test_brdf_stress(glsl, fuzz):
     float r = wo.w, n = h.w;
     result = vec4(cook_torrance_m_factor(wo.xyz, wi.xyz, r, wi.w) + cook_torrance_beckmann_m_factor(wo.xyz, wi.xyz, r, wi.w),
                   blinn_phong_m_factor(wo.xyz, wi.xyz, n) + ward_anisotropic_m_factor(wo.xyz, wi.xyz),
-                  ashikhmin_shirley_m_factor(wo.xyz, wi.xyz, n, 1.0, e.x) + ggx_m_factor(wo.xyz, wi.xyz, r),
+                  ashikhmin_shirley_m_factor(wo.xyz, wi.xyz, n, 1.0, e.x) + ggx_m_factor(wo.xyz, wi.xyz, r)
+                  + ggx_anisotropic_m_factor(wo.xyz, wi.xyz, r, 1.0 - r),
                   lambert_m_factor(wo.xyz, wi.xyz, e.x));
     """
     out = glsl(["sg.glsl", "brdf.glsl"], m_factors, inputs, 4)
@@ -886,7 +888,8 @@ COVERED = {
                        "blinn_phong_m_factor", "ward_anisotropic_m_factor", "ashikhmin_shirley_m_factor",
                        "ggx_m_factor", "lambert_m_factor", "cook_torrance_ndf_lobe",
                        "cook_torrance_beckmann_ndf_lobe", "blinn_phong_ndf_lobe", "ward_isotropic_ndf_lobe",
-                       "ggx_ndf_lobe"],
+                       "ggx_ndf_lobe", "ggx_anisotropic_ndf", "ggx_anisotropic_smith_lambda",
+                       "ggx_anisotropic_m_factor"],
     test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "spot_light_sg", "directional_light_sg"],
     test_clamped_cosine_stress: ["sg_clamped_cosine_integral", "sg_clamped_cosine_integral_paper",
                                  "clamped_cosine_from_cosine", "clamped_cosine_lobe_evaluate"],
