@@ -502,15 +502,23 @@ def export_material(material):
     return params
 
 
+# What a node tree's reading replaces of the SG-PRT settings: the look (the technique's own controls, the
+# lobe count and the view warp stay the material's)
+NODE_TREE_FIELDS = COLOUR_PARAMETERS + SCALAR_PARAMETERS + (
+    "model", "fresnel", "multiscatter", "layered_f0", "emission", "normal_strength", "tangent_source",
+    "tangent_axis", "tangent_rotation", "uv_transform")
+
+
 def _read_node_tree(material, params):
-    """The node tree's reading (blender/node_reader.py) in place of the appearance settings; its notes in one
-    warning."""
+    """The node tree's reading (blender/node_reader.py) in place of the appearance settings (what it does not
+    set takes the defaults, not the settings it replaces); its notes in one warning."""
     from . import node_reader
 
     reading = node_reader.read_material(material)
     params.source = "NODE_TREE"
-    params.tangent_rotation = 0.0
-    params.normal_strength = 1.0
+    defaults = MaterialParams()
+    for name in NODE_TREE_FIELDS:
+        setattr(params, name, getattr(defaults, name))
     for name, value in reading.fields.items():
         setattr(params, name, value)
     params.textures = dict(reading.textures)
@@ -604,7 +612,7 @@ def slot_pixels(value, slot, decode=None):
 
     if isinstance(value, str):
         return texture_pixels(bpy.data.images[value], slot, decode)
-    images = {name: texture_pixels(bpy.data.images[name], "computed", decode=True) for name in value.images}
+    images = {name: texture_pixels(bpy.data.images[name], slot, decode=True) for name in value.images}
     return value.evaluate(images)
 
 

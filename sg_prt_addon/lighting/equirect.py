@@ -50,7 +50,8 @@ def lookup_nearest(image, direction):
 def rotated(image, matrix):
     """The map of the world L'(d) = L(normalize(M d)) (a Mapping node's rotation and scale in front of an
     Environment Texture): (H, W, C) float32, each texel centre's direction mapped and the map read bilinearly
-    (wrapping in u, clamped in v).  A turn about z alone is a shift of the rows: read along u only."""
+    (wrapping in u, clamped in v).  A turn (or mirror) about z that scales x, y and z alike keeps every
+    elevation: the rows shift, read along u only."""
     image = np.asarray(image, np.float32)
     matrix = np.asarray(matrix, np.float64)
     height, width = image.shape[:2]
@@ -58,7 +59,9 @@ def rotated(image, matrix):
     u, v = direction_to_uv(directions)
     x = u * width - 0.5
     y = (1.0 - v) * height - 0.5
-    if np.allclose(matrix[2], [0.0, 0.0, matrix[2, 2]]) and np.allclose(matrix[:2, 2], 0.0):
+    planar = matrix[:2, :2]
+    if (np.allclose(matrix[2, :2], 0.0) and np.allclose(matrix[:2, 2], 0.0)
+            and np.allclose(planar.T @ planar, matrix[2, 2] ** 2 * np.eye(2))):
         y = np.broadcast_to((np.arange(height) + 0.0)[:, None], x.shape)         # the rows stay (no blur in v)
     x0, y0 = np.floor(x), np.floor(y)
     fx, fy = (x - x0)[..., None], (y - y0)[..., None]

@@ -2,6 +2,7 @@
 of hand-built trees per node and socket, the default source, one warning per material, saved and reopened."""
 import numpy as np
 import pytest
+import recording_layout
 
 bpy = pytest.importorskip("bpy")
 
@@ -164,31 +165,8 @@ def test_panel_and_copy_from_node_tree(empty_file):
     _principled(tree, output, Base_Color=(0.6, 0.3, 0.1, 1.0), Roughness=0.45, Metallic=0.0)
     before = _read(material)[0]
 
-    class Layout:
-        def __init__(self):
-            self.calls, self.use_property_split = [], False
-
-        def prop(self, data, name, **kwargs):
-            getattr(data, name)
-            self.calls.append(("prop", name))
-
-        def operator(self, idname, **kwargs):
-            self.calls.append(("operator", idname))
-
-        def label(self, text="", **kwargs):
-            self.calls.append(("label", text))
-
-        def row(self, **kwargs):
-            return self
-
-        def template_ID(self, *args, **kwargs):
-            self.calls.append(("template_ID", args[1]))
-
     def drawn():
-        layout = Layout()
-        context = type("Context", (), {"material": material})()
-        panels.SGPRT_PT_material.draw(type("Panel", (), {"layout": layout})(), context)
-        return layout.calls
+        return recording_layout.draw(panels.SGPRT_PT_material, type("Context", (), {"material": material})())
 
     calls = drawn()
     assert ("prop", "source") in calls and ("operator", "sgprt.copy_from_node_tree") in calls
@@ -273,3 +251,21 @@ def test_mapping_node_on_uvs(empty_file):
     _link_image(tree, _image("unmapped_rough", np.full((4, 4, 4), 0.5), "Non-Color"), node.inputs["Roughness"])
     params, warnings = _read(material)
     assert len(warnings) == 1 and "different Mapping" in warnings[0]
+
+
+def test_node_tree_chosen_over_tuned_settings_reads_nothing_from_them(empty_file):
+    """A material whose settings were tuned, then switched to its node tree: what the nodes do not set takes
+    the defaults (a Glossy BSDF has no layered diffuse, no object-axis tangent), not the tuned settings."""
+    material, tree, output = _material("switched")
+    glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.distribution = "GGX"
+    tree.links.new(glossy.outputs[0], output.inputs["Surface"])
+    settings = material.sgprt
+    settings.model, settings.layered_diffuse, settings.ior = "WARD_ANISO", True, 2.0
+    settings.tangent_source, settings.tangent_rotation, settings.normal_strength = "OBJECT_AXIS", 0.7, 3.0
+    assert _read(material)[0].layered_f0 > 0                      # the settings render them
+    settings.source = "NODE_TREE"
+    params, warnings = _read(material)
+    assert warnings == [] and params.model == "GGX" and params.fresnel == "NONE"
+    assert params.layered_f0 < 0 and params.ior == 1.5
+    assert (params.tangent_source, params.tangent_rotation, params.normal_strength) == ("UV_MAP", 0.0, 1.0)

@@ -4,6 +4,7 @@ import bmesh
 import bpy
 import numpy as np
 import pytest
+import recording_layout
 
 from sg_prt_addon.blender import transfer_bake as tb
 from sg_prt_addon.engine import scene_state
@@ -136,30 +137,6 @@ def test_topology_changing_modifiers_are_refused(scene):
     assert not tb.has_transfer_bake(suzanne.data)
 
 
-class _RecordingLayout:
-    """Stands in for a panel's UILayout (pip bpy draws no UI): records what a draw() asks for."""
-
-    def __init__(self):
-        self.calls = []
-        self.use_property_split = False
-        self.alert = False
-
-    def prop(self, data, name, **kwargs):
-        getattr(data, name)                      # a real property of the real settings, or AttributeError
-        self.calls.append(("prop", name))
-
-    def operator(self, idname, **kwargs):
-        self.calls.append(("operator", idname))
-
-    def label(self, text="", **kwargs):
-        self.calls.append(("label", text))
-
-    def row(self, **kwargs):
-        return self
-
-    column = row
-
-
 def test_both_bake_panels_draw_their_settings_buttons_and_status(scene):
     """The visibility and transfer panels' draw() (shared controls and status reader) against the real scene
     settings and the real active object: before and after a transfer bake."""
@@ -169,14 +146,11 @@ def test_both_bake_panels_draw_their_settings_buttons_and_status(scene):
     bpy.context.view_layer.objects.active = suzanne
     drawn = {}
     for name, panel in (("visibility", visibility_bake.SGPRT_PT_visibility_bake), ("transfer", tb.SGPRT_PT_transfer_bake)):
-        layout = _RecordingLayout()
-        panel.draw(type("Panel", (), {"layout": layout})(), bpy.context)
-        drawn[name] = layout.calls
+        drawn[name] = recording_layout.draw(panel, bpy.context)
     assert ("prop", "resolution") in drawn["visibility"] and ("prop", "order") in drawn["transfer"]
     assert ("operator", "sgprt.bake_transfer") in drawn["transfer"]
     assert ("label", "Suzanne: not baked (renders unshadowed)") in drawn["visibility"]
     assert ("label", "Suzanne: no transfer (SH renders unshadowed)") in drawn["transfer"]
     assert bpy.ops.sgprt.bake_transfer(target="ALL") == {"FINISHED"}
-    layout = _RecordingLayout()
-    tb.SGPRT_PT_transfer_bake.draw(type("Panel", (), {"layout": layout})(), bpy.context)
-    assert any(call[0] == "label" and call[1].startswith("Suzanne: order 4, 6 terms") for call in layout.calls)
+    calls = recording_layout.draw(tb.SGPRT_PT_transfer_bake, bpy.context)
+    assert any(call[0] == "label" and call[1].startswith("Suzanne: order 4, 6 terms") for call in calls)

@@ -21,12 +21,15 @@ def _turn(axis, angle):
     (_turn((0, 0, 1), 0.7), 3e-4),                       # measured 1.6e-4: along u only
     (_turn((1, 0, 0), 0.7) @ _turn((0, 0, 1), 0.7), 3e-3),  # measured 2.2e-3: bilinear in u and v
     (np.diag([1.0, -1.0, 1.0]), 1e-6),                   # a mirror in y: texel centres land on texel centres
+    (np.diag([2.0, 2.0, 1.0]), 1e-3),                    # measured 2.4e-4: x and y scaled, not z, move the
+                                                         # elevations (read along u only: 0.19)
 ])
 def test_turned_map_reads_the_turned_function(matrix, bound):
     directions = equirect.texel_directions(64, 128)
     image = _smooth(directions).astype(np.float32)
     turned = equirect.rotated(image, matrix)
-    exact = _smooth(directions @ matrix.T)
+    mapped = directions @ matrix.T
+    exact = _smooth(mapped / np.linalg.norm(mapped, axis=-1, keepdims=True))      # the map reads normalize(M d)
     assert np.abs(turned - exact).max() / np.abs(exact).max() < bound
 
 
