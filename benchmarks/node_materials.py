@@ -182,19 +182,12 @@ def build(name, size):
 
 def render_engine_image(scene):
     """(seconds of the second render, RGB (H, W, 3) row 0 at the top, alpha, warnings)."""
-    import bpy
-
+    from benchmarks import engine_vs_eevee
     from sg_prt_addon.engine import render_engine
 
     scene.render.engine = "SG_PRT"
-    seconds = 0.0
-    for _ in range(2):
-        render_engine.last_render.clear()
-        start = time.perf_counter()
-        bpy.ops.render.render()
-        seconds = time.perf_counter() - start
-        if "error" in render_engine.last_render:
-            raise RuntimeError(render_engine.last_render["error"])
+    engine_vs_eevee.render_seconds()                # warm-up: compile, prefilter, upload
+    seconds = engine_vs_eevee.render_seconds()
     combined = render_engine.last_render["passes"]["Combined"][::-1].astype("float64")
     warnings = list(render_engine.last_render["state"].warnings)
     return seconds, combined[..., :3], combined[..., 3], warnings

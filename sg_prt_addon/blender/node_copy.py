@@ -2,6 +2,7 @@
 settings, which then render (Source: SG-PRT Settings), for users who tune the SG-specific controls."""
 import bpy
 
+from ..reflectance import principled
 from . import node_reader, properties
 
 # MaterialParams fields that are settings of the same name
@@ -23,7 +24,7 @@ def copy_reading(material):
     layered_f0 = reading.fields.get("layered_f0", -1.0)
     settings.layered_diffuse = layered_f0 >= 0
     if layered_f0 > 0:
-        settings.ior = node_reader.principled.ior_of_f0(layered_f0)
+        settings.ior = principled.ior_of_f0(layered_f0)
     emission = reading.fields.get("emission", (0.0, 0.0, 0.0))
     strength = max(emission)
     settings.emission_strength = strength

@@ -269,10 +269,11 @@ class SocketReader:
         return []
 
 
-def output_node(tree):
-    """The material's active output node (the one every engine renders), or None."""
+def output_node(tree, node_type="OUTPUT_MATERIAL"):
+    """A node tree's active output node (the one every engine renders; else its first of `node_type`), or
+    None."""
     node = tree.get_output_node("ALL") if hasattr(tree, "get_output_node") else None
-    return node or next((n for n in tree.nodes if n.type == "OUTPUT_MATERIAL"), None)
+    return node or next((n for n in tree.nodes if n.type == node_type), None)
 
 
 def read_material(material):

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .node_reader import SocketReader, follow, scalar_of
+from .node_reader import SocketReader, follow, output_node, scalar_of
 
 
 @dataclass
@@ -34,15 +34,10 @@ def mapping_matrix(vector_type, rotation, scale):
     return np.linalg.inv(matrix) if vector_type == "TEXTURE" else matrix
 
 
-def output_node(tree):
-    node = tree.get_output_node("ALL") if hasattr(tree, "get_output_node") else None
-    return node or next((n for n in tree.nodes if n.type == "OUTPUT_WORLD"), None)
-
-
 def read_world(world):
     reader = SocketReader()
     reading = WorldReading(notes=reader.notes)
-    output = output_node(world.node_tree)
+    output = output_node(world.node_tree, "OUTPUT_WORLD")
     surface = follow(output.inputs["Surface"]) if output is not None else None
     if surface is None or surface.node.type not in ("BACKGROUND", "EMISSION"):
         if surface is not None:
