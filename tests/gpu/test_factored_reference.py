@@ -6,6 +6,8 @@ import engine_fixtures as fx
 import pytest
 from test_reference_score import _score, _sphere_scene
 
+pytestmark = pytest.mark.reference      # against the Monte Carlo reference: the two full tiers run it
+
 # (name, world, model, settings, bound for FACTORED, bound for SG): relative RMSE over interior pixels,
 # 64 x 64.  Measured (factored / SG, reference noise floor): GGX point light 0.037 / 0.038 (0.012);
 # Cook-Torrance point light 0.0046 / 0.0041 (0.0028); GGX courtyard + light 0.120 / 0.045 (0.016): under

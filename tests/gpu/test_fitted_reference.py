@@ -14,6 +14,8 @@ from scipy.ndimage import binary_erosion
 from validation import image_error
 from validation.reference import render_to_noise
 
+pytestmark = pytest.mark.reference      # against the Monte Carlo reference: the two full tiers run it
+
 SIZE = 64
 ANALYTIC = dict(diffuse=(0.35, 0.25, 0.15), oren_nayar_sigma=0.0, specular=(1.0, 1.0, 1.0), roughness=0.3,
                 eta=1.5, retro=(0.0, 0.0, 0.0))

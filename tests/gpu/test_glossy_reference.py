@@ -12,6 +12,8 @@ from scipy.ndimage import binary_erosion
 from validation import image_error
 from validation.reference import render_reference
 
+pytestmark = pytest.mark.reference      # against the Monte Carlo reference: the two full tiers run it
+
 SIZE = 96
 
 

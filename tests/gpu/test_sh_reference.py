@@ -7,6 +7,8 @@ import engine_fixtures as fx
 import pytest
 from test_reference_score import SIZE, _sphere_scene
 
+pytestmark = pytest.mark.reference      # against the Monte Carlo reference: the two full tiers run it
+
 WARD = dict(alpha_x=0.5, alpha_y=0.25, diffuse_color=(0.3, 0.3, 0.3), specular_color=(0.6,) * 3,
             tangent_source="OBJECT_AXIS", tangent_axis=(0.0, 0.0, 1.0))
 GGX = dict(roughness=0.4, diffuse_color=(0.5, 0.5, 0.5), specular_color=(0.3,) * 3)

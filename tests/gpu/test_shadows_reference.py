@@ -15,6 +15,8 @@ from scipy.ndimage import binary_erosion
 from validation import image_error
 from validation.reference import render_to_noise
 
+pytestmark = pytest.mark.reference      # against the Monte Carlo reference: the two full tiers run it
+
 SIZE = 64
 BAKE_RESOLUTION = 16
 
