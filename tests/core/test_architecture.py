@@ -10,7 +10,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = "sg_prt_addon"
 # Lowest first: a package may import those before it, never those after (the maths packages among
 # themselves: no cycle, checked below)
-MATHS = ("spherical", "reflectance", "lighting", "harmonics", "measured", "visibility")
+MATHS = ("spherical", "reflectance", "lighting", "harmonics", "measured", "visibility", "biscale")
 LAYERS = MATHS + ("techniques", "blender", "engine", "registration", "render")
 NO_BLENDER = MATHS + ("techniques",)        # importable without Blender: no bpy; gpu only inside functions
 

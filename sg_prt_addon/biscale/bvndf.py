@@ -1,0 +1,158 @@
+"""The BVNDF of a tile as SGs (iwasaki2012 section 4): the NDF's lobes fitted once (eq. 6, spherical EM),
+their amplitudes re-solved for every pair of directions (eq. 7-8) from the tile's masking and shadowing.
+
+gamma~(n, i, o) = gamma(n, i, o) (n.i)(n.o) / a_v(o) (eq. 5) is, for the tile's sample points s (area dA each),
+the sum of deltas at their normals with weights w_s(i, o) = dA V_s(i) V_s(o) max(0, n_s.i) max(0, n_s.o) / a_v(o),
+a_v(o) = sum_s dA V_s(o) max(0, n_s.o).  The least-squares amplitudes solve A mu = b with A_jk = <G_j, G_k> and
+b_j = sum_s w_s G_j(n_s) (eq. 8's normal equations; iwasaki2012 bins the normals first, the sum is the limit),
+kept non-negative.  That fit is not mass-preserving: a cluster of normals sharper than its lobe (a flat facet,
+whose lobe's sharpness is capped) gets up to twice its weight.  The default therefore shares each point's
+weight among the lobes by the NDF mixture's responsibilities, mu_j = c(eta_j) sum_s w_s r_sj: the integral of
+the lobes is that of gamma~ exactly, the amplitudes are non-negative by construction, and where the data has
+the lobes' shape the two agree (AMPLITUDE_SOLVES; their errors in docs/ACCURACY.md).
+
+Directions i and o run over the hemisphere map's sample lattice (visibility.hemisphere_map.sample_directions,
+R x R each, R = 12 the paper's 144): the tables are indexed [i, o] by lattice index b R + a, and read between
+nodes by multilinear interpolation (effective_brdf.interpolate).  The lattice's outer ring lies on the
+horizon, where every cosine is 0: its rays leave at HORIZON_LIFT above it, so the stored values there are
+the limits the interpolation needs (a value per unit cos(theta_i), below).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..spherical import sg
+from ..visibility import hemisphere_map
+from . import microgeometry, spherical_em
+
+DEFAULT_RESOLUTION = 12
+DEFAULT_LOBES = 16           # iwasaki2012 figures 3-4 use 4 to 8; sharp small-scale BRDFs need more (docs/ACCURACY.md)
+HORIZON_LIFT = np.radians(3.0)
+_SOLVER_ITERATIONS = 200
+AMPLITUDE_SOLVES = ("responsibility", "least_squares")
+
+
+def lattice_directions(resolution):
+    """(R^2, 3) unit directions of the table's nodes, index b R + a; the horizon ring lifted by HORIZON_LIFT."""
+    directions = hemisphere_map.sample_directions(resolution).reshape(-1, 3)
+    floor = np.sin(HORIZON_LIFT)
+    low = directions[:, 2] < floor
+    horizontal = np.linalg.norm(directions[:, :2], axis=1, keepdims=True)
+    lifted = np.concatenate([directions[:, :2] / np.maximum(horizontal, 1e-12) * np.cos(HORIZON_LIFT),
+                             np.full((len(directions), 1), floor)], axis=1)
+    return np.where(low[:, None], lifted, directions)
+
+
+@dataclass(frozen=True)
+class BVNDF:
+    """axes (J, 3), sharpness (J,) and mixture weights (J,) of the NDF lobes (tile frame); amplitudes (J, K, K)
+    mu_j(i, o) per unit cos(theta_i); integral (K, K) the exact integral of gamma~ over n per unit cos(theta_i)
+    (the diffuse term's, eq. 9 without its SG approximation); directions (K, 3) the lattice, K = R^2."""
+    axes: np.ndarray
+    sharpness: np.ndarray
+    mixture: np.ndarray
+    amplitudes: np.ndarray
+    integral: np.ndarray
+    directions: np.ndarray
+    resolution: int
+
+    @property
+    def lobe_count(self):
+        return len(self.sharpness)
+
+
+@dataclass(frozen=True)
+class TileSamples:
+    """What every later step reads of the tile: its sample points, their cosines times visibility towards
+    each lattice direction (N, K), and the visible projected area a_v of each direction (K,)."""
+    points: microgeometry.SamplePoints
+    cosines: np.ndarray
+    projected_area: np.ndarray
+    directions: np.ndarray
+
+    def weights(self, i_index, o_index):
+        """(N,) w_s(i, o) of the pair of lattice nodes (the delta weights of gamma~)."""
+        return self.points.area * self.cosines[:, i_index] * self.cosines[:, o_index] / \
+            self.projected_area[o_index]
+
+
+def trace_tile(geometry, resolution=DEFAULT_RESOLUTION, samples=microgeometry.DEFAULT_SAMPLES, seed=0,
+               tracer=None):
+    """Sample the tile and trace its points' visibility towards every lattice direction."""
+    directions = lattice_directions(resolution)
+    points = microgeometry.sample_points(geometry, samples, seed)
+    own = tracer is None
+    tracer = tracer or microgeometry.TiledTracer(geometry)
+    try:
+        count, nodes = len(points.positions), len(directions)
+        repeated = np.repeat(directions[None], count, axis=0).reshape(-1, 3)
+        visible = tracer.visible(np.repeat(points.positions, nodes, axis=0),
+                                 np.repeat(points.normals, nodes, axis=0), repeated).reshape(count, nodes)
+    finally:
+        if own:
+            tracer.close()
+    cosines = np.maximum(points.normals @ directions.T, 0.0) * visible
+    projected = points.area * cosines.sum(axis=0)
+    if np.any(projected <= 0):
+        raise ValueError("the tile shows nothing towards some directions of the lattice "
+                         "(no point faces them unoccluded): is it a surface seen from above?")
+    return TileSamples(points, cosines.astype(np.float32), projected, directions)
+
+
+def lobe_gram(axes, sharpness):
+    """A_jk = integral of G_j G_k (unit amplitudes), eq. 8's matrix."""
+    return sg.inner_product(axes[:, None], sharpness[:, None], 1.0, axes[None], sharpness[None], 1.0)
+
+
+def solve_nonnegative(gram, right, iterations=_SOLVER_ITERATIONS):
+    """min |A mu - b| with mu >= 0 for many right-hand sides (J, M) at once: the unconstrained solution
+    clipped, then projected gradient steps (A is J x J, small; the same for every column)."""
+    mu = np.maximum(np.linalg.lstsq(gram, right, rcond=1e-10)[0], 0.0)
+    step = 1.0 / max(float(np.linalg.eigvalsh(gram).max()), 1e-30)
+    for _ in range(iterations):
+        mu = np.maximum(mu - step * (gram @ mu - right), 0.0)
+    return mu
+
+
+def fit_ndf(geometry, lobes=DEFAULT_LOBES):
+    """The NDF's lobes: spherical EM over the triangles' normals weighted by their areas (eq. 6)."""
+    normals, areas = geometry.facets()
+    return spherical_em.fit(normals, areas, lobes)
+
+
+def compute(geometry, lobes=DEFAULT_LOBES, resolution=DEFAULT_RESOLUTION, samples=microgeometry.DEFAULT_SAMPLES,
+            seed=0, tile=None, solve="responsibility"):
+    """The tile's BVNDF as SGs.  tile: a TileSamples of the same geometry and resolution (trace_tile), reused;
+    solve: one of AMPLITUDE_SOLVES."""
+    tile = tile or trace_tile(geometry, resolution, samples, seed)
+    axes, sharpness, mixture = fit_ndf(geometry, lobes)
+    return from_samples(tile, axes, sharpness, mixture, resolution, solve)
+
+
+def _lobe_weighted_sums(tile, weights):
+    """sum_s w_s(i, o) weights[s, j] for every pair of nodes: (J, K, K), per unit cos(theta_i)."""
+    cosines = tile.cosines.astype(np.float64)
+    # per unit cos(theta_i): the lattice's lifted horizon ring keeps a finite, continuous value
+    scale = tile.points.area / (tile.projected_area[None, :] * tile.directions[:, 2][:, None])     # (K_i, K_o)
+    return np.stack([(cosines * weights[:, j:j + 1]).T @ cosines for j in range(weights.shape[1])]) * scale[None]
+
+
+def from_samples(tile, axes, sharpness, mixture, resolution, solve="responsibility"):
+    """Amplitudes and integrals of gamma~ over the traced tile for given NDF lobes."""
+    if solve not in AMPLITUDE_SOLVES:
+        raise ValueError(f"unknown amplitude solve {solve!r}: {AMPLITUDE_SOLVES}")
+    lobes = len(sharpness)
+    normals = tile.points.normals[:, None, :]
+    nodes = len(tile.directions)
+    if solve == "least_squares":
+        right = _lobe_weighted_sums(tile, sg.evaluate(normals, axes[None], sharpness[None], 1.0))
+        amplitudes = solve_nonnegative(lobe_gram(axes, sharpness), right.reshape(lobes, -1))
+    else:
+        density = sg.evaluate(normals, axes[None], sharpness[None], 1.0) * \
+            (mixture * spherical_em.normalization(sharpness))[None]
+        responsibility = density / np.maximum(density.sum(axis=1, keepdims=True), 1e-300)
+        amplitudes = _lobe_weighted_sums(tile, responsibility).reshape(lobes, -1) / \
+            sg.sphere_integral(sharpness)[:, None]
+    integral = _lobe_weighted_sums(tile, np.ones((len(tile.points.normals), 1)))[0]
+    return BVNDF(axes, sharpness, mixture, amplitudes.reshape(len(sharpness), nodes, nodes).astype(np.float32),
+                 integral.astype(np.float32), tile.directions, int(resolution))

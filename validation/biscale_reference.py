@@ -1,0 +1,122 @@
+"""Ground truth for the bi-scale maths (sg_prt_addon.biscale): the effective BRDF of eq. 1 by brute force.
+
+Rays fall on the periodic tile along -o from points spread uniformly over it (uniform in projected area
+along o, so the first hits sample the visible surface weighted by n.o / a_v(o)); each hit is shaded with the
+exact small-scale BRDF in its facet's frame and shadowed towards i by the tile: the mean over the rays is
+f(i, o) = integral over the visible area of f_s V(i) (n.i)(n.o) dA / a_v(o), eq. 1 with nothing binned,
+fitted or convolved.  Its noise is the rays' standard error, returned with it.
+"""
+import numpy as np
+
+from sg_prt_addon.biscale import microgeometry
+from sg_prt_addon.visibility import hemisphere_map
+
+
+def facet_brdf(small, model, normals, wi, wo):
+    """(N, 3) small-scale BRDF kd / pi + ks rho_s on facets with normals (N, 3), directions in the tile frame."""
+    frames = hemisphere_map.local_frame(normals)
+    local_i = np.einsum("nij,nj->ni", frames, np.broadcast_to(wi, normals.shape))
+    local_o = np.einsum("nij,nj->ni", frames, np.broadcast_to(wo, normals.shape))
+    specular = model.specular(local_o, local_i)
+    lit = (local_i[:, 2] > 0) & (local_o[:, 2] > 0)
+    return np.where(lit[:, None], np.asarray(small.diffuse_color) / np.pi +
+                    specular[:, None] * np.asarray(small.specular_color), 0.0)
+
+
+def effective_brdf_traced(geometry, small, wi, wo, rays=20000, seed=1, tracer=None):
+    """(rho (P, 3), standard error (P, 3)): the effective BRDF without the large-scale cosine (f / cos(theta_i))
+    at pairs of unit directions wi, wo (P, 3) in the tile frame, by ray tracing the tile."""
+    wi = np.atleast_2d(np.asarray(wi, np.float64))
+    wo = np.atleast_2d(np.asarray(wo, np.float64))
+    model = small.brdf()
+    normals, _ = geometry.facets()
+    own = tracer is None
+    tracer = tracer or microgeometry.TiledTracer(geometry)
+    rng = np.random.default_rng(seed)
+    start = np.column_stack([rng.random(rays) * geometry.size[0], rng.random(rays) * geometry.size[1],
+                             np.full(rays, tracer.top + 1e-3 * max(geometry.size))])
+    values, errors = [], []
+    try:
+        for i, o in zip(wi, wo):
+            hit, positions, triangle = tracer.first_hit(start, np.broadcast_to(-o, start.shape))
+            facet = normals[np.maximum(triangle, 0)]
+            lit = hit & (facet @ i > 0) & (facet @ o > 0)
+            shade = np.zeros((rays, 3))
+            if np.any(lit):
+                visible = tracer.visible(positions[lit], facet[lit], np.broadcast_to(i, (int(lit.sum()), 3)))
+                f = facet_brdf(small, model, facet[lit], i, o) * (facet[lit] @ i)[:, None]
+                shade[lit] = f * visible[:, None]
+            cos_i = max(i[2], 1e-6)
+            values.append(shade.mean(axis=0) / cos_i)
+            errors.append(shade.std(axis=0) / np.sqrt(rays) / cos_i)
+    finally:
+        if own:
+            tracer.close()
+    return np.array(values), np.array(errors)
+
+
+def effective_brdf_of_samples(tile, small, i_index, o_index):
+    """rho (3,) at a pair of lattice nodes from the BVNDF's own samples with the exact small-scale BRDF: eq. 1
+    as the tables discretize it, before any SG (bvndf.TileSamples)."""
+    model = small.brdf()
+    weights = tile.weights(i_index, o_index).astype(np.float64)
+    keep = weights > 0
+    i, o = tile.directions[i_index], tile.directions[o_index]
+    f = facet_brdf(small, model, tile.points.normals[keep], i, o)
+    return (weights[keep] @ f) / i[2]
+
+
+def relative_rms(estimate, reference, wi):
+    """Relative RMS of the effective BRDF with its cosine (f = rho cos(theta_i)): the grazing pairs, where rho
+    is large and the light it meets small, weigh what they deliver."""
+    cosine = np.asarray(wi)[..., 2:3]
+    difference = (np.asarray(estimate) - np.asarray(reference)) * cosine
+    return float(np.sqrt(np.sum(difference ** 2) / max(np.sum((np.asarray(reference) * cosine) ** 2), 1e-300)))
+
+
+def direction_pairs(count, seed=0, max_zenith=np.radians(80.0)):
+    """(wi, wo) (count, 3) each: random pairs over the hemisphere up to max_zenith, half of them near the
+    mirror configuration (where a glossy effective BRDF peaks)."""
+    rng = np.random.default_rng(seed)
+
+    def directions(n):
+        cos = rng.uniform(np.cos(max_zenith), 1.0, n)
+        phi = rng.uniform(0, 2 * np.pi, n)
+        sin = np.sqrt(1 - cos * cos)
+        return np.column_stack([sin * np.cos(phi), sin * np.sin(phi), cos])
+
+    wo = directions(count)
+    wi = directions(count)
+    mirror = count // 2
+    jitter = rng.normal(scale=0.08, size=(mirror, 3))
+    reflected = np.column_stack([-wo[:mirror, :2], wo[:mirror, 2:]]) + jitter
+    reflected[:, 2] = np.maximum(reflected[:, 2], np.cos(max_zenith))
+    wi[:mirror] = reflected / np.linalg.norm(reflected, axis=1, keepdims=True)
+    return wi, wo
+
+
+
+def egg_crate(resolution=64, amplitude=0.05, periods=1):
+    """Height field sin(2 pi k x) sin(2 pi k y) (heights in tile widths): bumps and dents in a checkerboard."""
+    y, x = np.mgrid[0:resolution, 0:resolution] / resolution
+    return amplitude * np.sin(2 * np.pi * periods * x) * np.sin(2 * np.pi * periods * y)
+
+
+def grooves(resolution=64, amplitude=0.06, periods=2):
+    """Parallel rounded grooves along y (heights vary along x only): an anisotropic tile."""
+    x = np.arange(resolution) / resolution
+    profile = amplitude * np.abs(np.sin(np.pi * periods * x))
+    return np.broadcast_to(profile[None, :], (resolution, resolution)).copy()
+
+
+def random_bumps(resolution=64, amplitude=0.04, cutoff=4, seed=7):
+    """A smooth periodic random surface: white noise kept below `cutoff` cycles per tile, scaled to amplitude."""
+    rng = np.random.default_rng(seed)
+    spectrum = np.fft.fft2(rng.normal(size=(resolution, resolution)))
+    frequency = np.fft.fftfreq(resolution) * resolution
+    radius = np.hypot(frequency[:, None], frequency[None, :])
+    heights = np.real(np.fft.ifft2(spectrum * (radius <= cutoff)))
+    return amplitude * heights / np.abs(heights).max()
+
+
+TILES = {"egg crate": egg_crate, "grooves": grooves, "random bumps": random_bumps}
