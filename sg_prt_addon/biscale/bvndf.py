@@ -13,15 +13,17 @@ the lobes' shape the two agree (AMPLITUDE_SOLVES; their errors in docs/ACCURACY.
 
 Directions i and o run over the hemisphere map's sample lattice (visibility.hemisphere_map.sample_directions,
 R x R each, R = 12 the paper's 144): the tables are indexed [i, o] by lattice index b R + a, and read between
-nodes by multilinear interpolation (effective_brdf.interpolate).  The lattice's outer ring lies on the
+nodes by multilinear interpolation (interpolate, below).  The lattice's outer ring lies on the
 horizon, where every cosine is 0: its rays leave at HORIZON_LIFT above it, so the stored values there are
 the limits the interpolation needs (a value per unit cos(theta_i), below).
 """
+import functools
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..spherical import sg
+from ..spherical import lattice, sg
 from ..visibility import hemisphere_map
 from . import microgeometry, spherical_em
 
@@ -30,6 +32,7 @@ DEFAULT_LOBES = 16           # iwasaki2012 figures 3-4 use 4 to 8; sharp small-s
 HORIZON_LIFT = np.radians(3.0)
 _SOLVER_ITERATIONS = 200
 AMPLITUDE_SOLVES = ("responsibility", "least_squares")
+ALBEDO_POINTS = 2048
 
 
 def lattice_directions(resolution):
@@ -47,18 +50,29 @@ def lattice_directions(resolution):
 class BVNDF:
     """axes (J, 3), sharpness (J,) and mixture weights (J,) of the NDF lobes (tile frame); amplitudes (J, K, K)
     mu_j(i, o) per unit cos(theta_i); integral (K, K) the exact integral of gamma~ over n per unit cos(theta_i)
-    (the diffuse term's, eq. 9 without its SG approximation); directions (K, 3) the lattice, K = R^2."""
+    (the diffuse term's, eq. 9 without its SG approximation), albedo (K,) its cosine-weighted mean over i
+    (1 / pi integral of D(i, o) cos(theta_i) di: a constant world's diffuse factor); directions (K, 3) the
+    lattice, K = R^2."""
     axes: np.ndarray
     sharpness: np.ndarray
     mixture: np.ndarray
     amplitudes: np.ndarray
     integral: np.ndarray
+    albedo: np.ndarray
     directions: np.ndarray
     resolution: int
 
     @property
     def lobe_count(self):
         return len(self.sharpness)
+
+    @functools.cached_property
+    def signature(self):
+        """A content hash: what the engine keys its GPU tables by."""
+        digest = hashlib.sha1()
+        for array in (self.axes, self.sharpness, self.amplitudes, self.integral):
+            digest.update(np.ascontiguousarray(array).tobytes())
+        return digest.hexdigest()
 
 
 @dataclass(frozen=True)
@@ -153,6 +167,49 @@ def from_samples(tile, axes, sharpness, mixture, resolution, solve="responsibili
         responsibility = density / np.maximum(density.sum(axis=1, keepdims=True), 1e-300)
         amplitudes = _lobe_weighted_sums(tile, responsibility).reshape(lobes, -1) / \
             sg.sphere_integral(sharpness)[:, None]
-    integral = _lobe_weighted_sums(tile, np.ones((len(tile.points.normals), 1)))[0]
+    integral = _lobe_weighted_sums(tile, np.ones((len(tile.points.normals), 1)))[0].astype(np.float32)
     return BVNDF(axes, sharpness, mixture, amplitudes.reshape(len(sharpness), nodes, nodes).astype(np.float32),
-                 integral.astype(np.float32), tile.directions, int(resolution))
+                 integral, diffuse_albedo(integral, resolution), tile.directions, int(resolution))
+
+
+def diffuse_albedo(integral, resolution, points=ALBEDO_POINTS):
+    """(K,) 1 / pi integral of D(i, o) cos(theta_i) over i for each lattice o, on an equal-area point set."""
+    incoming = lattice.hemisphere_points(points)
+    outgoing = lattice_directions(resolution)
+    values = interpolate(np.asarray(integral)[None], incoming[:, None, :], outgoing[None], resolution)[0]
+    return (2.0 / points * np.sum(values * incoming[:, 2:3], axis=0)).astype(np.float32)
+
+
+def lattice_coordinates(directions, resolution):
+    """Continuous lattice coordinates (..., 2) in [0, R - 1] (a, b) of directions (clamped to the hemisphere)."""
+    directions = np.asarray(directions, np.float64)
+    clamped = np.concatenate([directions[..., :2], np.maximum(directions[..., 2:], 0.0)], axis=-1)
+    square = hemisphere_map.hemisphere_to_square(sg.normalize(clamped))
+    return np.clip((square + 1.0) * (0.5 * (resolution - 1)), 0.0, resolution - 1)
+
+
+def interpolate(tables, wi, wo, resolution):
+    """Multilinear reading of tables (M, K, K) [i node, o node] at directions wi, wo (..., 3): (M, ...)."""
+    tables = np.asarray(tables)
+    shape = np.broadcast_shapes(np.shape(wi)[:-1], np.shape(wo)[:-1])
+    ci = np.broadcast_to(lattice_coordinates(wi, resolution), shape + (2,)).reshape(-1, 2)
+    co = np.broadcast_to(lattice_coordinates(wo, resolution), shape + (2,)).reshape(-1, 2)
+    top = resolution - 2
+
+    def corners(c):
+        low = np.minimum(np.floor(c).astype(np.int64), top)
+        return low, c - low
+
+    (ia, ib), (fa_i, fb_i) = zip(*(corners(ci[:, k]) for k in range(2)))
+    (oa, ob), (fa_o, fb_o) = zip(*(corners(co[:, k]) for k in range(2)))
+    result = np.zeros((tables.shape[0], len(ci)))
+    for di in (0, 1):
+        for dj in (0, 1):
+            i_node = (ib + dj) * resolution + ia + di
+            w_i = (fa_i if di else 1 - fa_i) * (fb_i if dj else 1 - fb_i)
+            for do in (0, 1):
+                for dk in (0, 1):
+                    o_node = (ob + dk) * resolution + oa + do
+                    w_o = (fa_o if do else 1 - fa_o) * (fb_o if dk else 1 - fb_o)
+                    result += tables[:, i_node, o_node] * (w_i * w_o)
+    return result.reshape((tables.shape[0],) + shape)

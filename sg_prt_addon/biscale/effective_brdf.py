@@ -26,6 +26,7 @@ from ..reflectance import brdf as brdf_models
 from ..reflectance import models
 from ..spherical import sg
 from ..visibility import hemisphere_map
+from . import bvndf
 
 CONVOLUTIONS = ("sg_form", "exact")
 
@@ -93,7 +94,7 @@ class EffectiveBRDF:
         wi, wo = np.asarray(wi, np.float64), np.asarray(wo, np.float64)
         h = sg.normalize(wi + wo)
         shape = (-1,) + (1,) * (h.ndim - 1)
-        factors = interpolate(self.tables, wi, wo, self.resolution)              # (L, ...)
+        factors = bvndf.interpolate(self.tables, wi, wo, self.resolution)              # (L, ...)
         if convolution == "exact":
             eta_j, eta_s = self.ndf_sharpness.reshape(shape), self.small_sharpness.reshape(shape)
             lobes = sg.inner_product(self.axes.reshape(shape + (3,)), eta_j, 1.0, h[None], eta_s, 1.0) * \
@@ -108,7 +109,7 @@ class EffectiveBRDF:
     def diffuse_factor(self, wi, wo):
         """D(i, o): the Lambertian term kd / pi is scaled by it (1 on a flat tile)."""
         wi, wo = np.asarray(wi, np.float64), np.asarray(wo, np.float64)
-        return interpolate(self.diffuse[None], wi, wo, self.resolution)[0] * ((wi[..., 2] > 0) & (wo[..., 2] > 0))
+        return bvndf.interpolate(self.diffuse[None], wi, wo, self.resolution)[0] * ((wi[..., 2] > 0) & (wo[..., 2] > 0))
 
     def evaluate(self, wi, wo, convolution="sg_form"):
         """rho(i, o) RGB (..., 3): the effective BRDF without the large-scale cosine."""
@@ -124,55 +125,20 @@ def facet_m_factor(model, normals, wi, wo):
     return model.m_factor(local_o, local_i)
 
 
-def compute(bvndf, small):
+def compute(model, small):
     """The effective BRDF of a BVNDF (bvndf.compute) and a SmallScaleMaterial (eq. 15's lobes)."""
     small.brdf()                                     # refuses an unknown or anisotropic model now, not at shading
     small_sharpness, small_amplitude = small.ndf_lobes()
-    eta_j = bvndf.sharpness[:, None]
+    eta_j = model.sharpness[:, None]
     eta_s = small_sharpness[None, :]
     scale = 2.0 * np.pi * small_amplitude[None, :] / (eta_j + eta_s)              # (J, S)
-    tables = bvndf.amplitudes[:, None].astype(np.float64) * scale[..., None, None]
-    count, nodes = tables.shape[0] * tables.shape[1], len(bvndf.directions)
+    tables = model.amplitudes[:, None].astype(np.float64) * scale[..., None, None]
+    count, nodes = tables.shape[0] * tables.shape[1], len(model.directions)
     return EffectiveBRDF(
-        axes=np.repeat(bvndf.axes, len(small_sharpness), axis=0),
-        ndf_sharpness=np.repeat(bvndf.sharpness, len(small_sharpness)),
-        small_sharpness=np.tile(small_sharpness, bvndf.lobe_count),
+        axes=np.repeat(model.axes, len(small_sharpness), axis=0),
+        ndf_sharpness=np.repeat(model.sharpness, len(small_sharpness)),
+        small_sharpness=np.tile(small_sharpness, model.lobe_count),
         tables=tables.reshape(count, nodes, nodes).astype(np.float32),
-        diffuse=bvndf.integral,
-        resolution=bvndf.resolution,
+        diffuse=model.integral,
+        resolution=model.resolution,
         small=small)
-
-
-def lattice_coordinates(directions, resolution):
-    """Continuous lattice coordinates (..., 2) in [0, R - 1] (a, b) of directions (clamped to the hemisphere)."""
-    directions = np.asarray(directions, np.float64)
-    clamped = np.concatenate([directions[..., :2], np.maximum(directions[..., 2:], 0.0)], axis=-1)
-    square = hemisphere_map.hemisphere_to_square(sg.normalize(clamped))
-    return np.clip((square + 1.0) * (0.5 * (resolution - 1)), 0.0, resolution - 1)
-
-
-def interpolate(tables, wi, wo, resolution):
-    """Multilinear reading of tables (M, K, K) [i node, o node] at directions wi, wo (..., 3): (M, ...)."""
-    tables = np.asarray(tables)
-    shape = np.broadcast_shapes(np.shape(wi)[:-1], np.shape(wo)[:-1])
-    ci = np.broadcast_to(lattice_coordinates(wi, resolution), shape + (2,)).reshape(-1, 2)
-    co = np.broadcast_to(lattice_coordinates(wo, resolution), shape + (2,)).reshape(-1, 2)
-    top = resolution - 2
-
-    def corners(c):
-        low = np.minimum(np.floor(c).astype(np.int64), top)
-        return low, c - low
-
-    (ia, ib), (fa_i, fb_i) = zip(*(corners(ci[:, k]) for k in range(2)))
-    (oa, ob), (fa_o, fb_o) = zip(*(corners(co[:, k]) for k in range(2)))
-    result = np.zeros((tables.shape[0], len(ci)))
-    for di in (0, 1):
-        for dj in (0, 1):
-            i_node = (ib + dj) * resolution + ia + di
-            w_i = (fa_i if di else 1 - fa_i) * (fb_i if dj else 1 - fb_i)
-            for do in (0, 1):
-                for dk in (0, 1):
-                    o_node = (ob + dk) * resolution + oa + do
-                    w_o = (fa_o if do else 1 - fa_o) * (fb_o if dk else 1 - fb_o)
-                    result += tables[:, i_node, o_node] * (w_i * w_o)
-    return result.reshape((tables.shape[0],) + shape)

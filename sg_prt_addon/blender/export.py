@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import techniques
 from ..reflectance import layering, models, principled
-from ..techniques import factored, sg_fitted, spherical_harmonics
+from ..techniques import biscale_shading, factored, sg_biscale, sg_fitted, spherical_harmonics, surface_layering
 
 # Mesh exports since import; tests read it to check what an update re-exported.
 export_counter = {"meshes": 0}
@@ -134,10 +134,11 @@ class MaterialParams:
     technique: str = techniques.DEFAULT    # the registered technique that renders it (techniques/)
     fitted: object = None          # FittedLobes with the fitted-lobes technique and a VALID stored fit
     factorization: object = None   # techniques.factored.FactoredTables of VALID stored factors (factored technique)
+    biscale: object = None         # biscale.bvndf.BVNDF of the material's small-scale tile (bi-scale technique)
 
     def values_key(self):
         """Everything but textures, hashable: the material UBO is rebuilt when this changes."""
-        return tuple((k, v.signature if k in ("fitted", "factorization") and v is not None else v)
+        return tuple((k, v.signature if k in ("fitted", "factorization", "biscale") and v is not None else v)
                      for k, v in self.__dict__.items() if k != "textures")
 
 
@@ -450,6 +451,8 @@ def _usable_technique(material, params):
         if ignored:
             warn(f"material '{material.name}': {spherical_harmonics.TECHNIQUE.label} tabulates the model with "
                  f"uniform {', '.join(ignored)}: those textures are not applied")
+    if name == sg_biscale.NAME:
+        return _usable_biscale(material, params)
     if name == sg_fitted.NAME:
         params.fitted = export_fitted_lobes(material)
         if params.fitted is None:
@@ -458,6 +461,28 @@ def _usable_technique(material, params):
                  "its model")
             return techniques.DEFAULT
     return name
+
+
+def _usable_biscale(material, params):
+    """The bi-scale technique with the material's tile (params.biscale), or the default with the reason."""
+    from . import biscale_source
+
+    if params.model not in biscale_shading.SMALL_SCALE_MODELS:
+        warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} needs an isotropic small-scale model "
+             f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}: rendered as a single scale")
+        return techniques.DEFAULT
+    params.biscale, reason = biscale_source.tables(material)
+    if params.biscale is None:
+        warn(f"material '{material.name}': no usable small-scale geometry ({reason}): rendered as a single scale")
+        return techniques.DEFAULT
+    layers = surface_layering.flags(params)
+    if layers:
+        warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} does not apply {', '.join(layers)}")
+    ignored = sorted(slot for slot in params.textures if slot not in sg_biscale.TEXTURES)
+    if ignored:
+        warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} does not apply the textures on "
+             f"{', '.join(ignored)}")
+    return sg_biscale.NAME
 
 
 def export_material(material):

@@ -3,7 +3,7 @@ import bpy
 
 from .. import techniques
 from ..reflectance import models
-from ..techniques import spherical_harmonics
+from ..techniques import sg_biscale, spherical_harmonics
 
 ENGINE_ID = "SG_PRT"
 
@@ -57,6 +57,34 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
 
 
 
+class SGPRT_PT_material_biscale(MaterialPanel, bpy.types.Panel):
+    bl_label = "Small-Scale Geometry"
+    bl_parent_id = "SGPRT_PT_material"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and techniques.of_settings(context.material.sgprt) == sg_biscale.NAME
+
+    def draw(self, context):
+        from . import biscale_source
+
+        settings = context.material.sgprt.biscale
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(settings, "source")
+        if settings.source == "IMAGE":
+            layout.template_ID(settings, "height_image", open="image.open")
+            layout.prop(settings, "height_scale")
+        else:
+            layout.prop(settings, "tile_object")
+        for name in ("lobes", "resolution", "samples"):
+            layout.prop(settings, name)
+        status = biscale_source.last_status(context.material)
+        if status:
+            layout.label(text=status, icon="INFO")
+        layout.label(text="Small-scale BRDF: the model above (isotropic)", icon="MATERIAL")
+
+
 class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
     bl_label = "Normal and Tangent"
     bl_parent_id = "SGPRT_PT_material"
@@ -96,7 +124,7 @@ class SGPRT_PT_sampling(RenderPanel, bpy.types.Panel):
         layout.prop(context.scene.sgprt, "render_samples")
 
 
-classes = (SGPRT_PT_material, SGPRT_PT_material_geometry, SGPRT_PT_sampling)
+classes = (SGPRT_PT_material, SGPRT_PT_material_biscale, SGPRT_PT_material_geometry, SGPRT_PT_sampling)
 
 # Built-in panels that work unchanged with this engine.
 COMPATIBLE_BUILTIN_PANELS = (

@@ -155,6 +155,34 @@ class SGPRT_PG_factorization(bpy.types.PropertyGroup):
     images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
 
 
+def _is_mesh(self, obj):
+    return obj.type == "MESH"
+
+
+class SGPRT_PG_biscale(bpy.types.PropertyGroup):
+    """A bi-scale material's small-scale geometry (technique SG_BISCALE; blender/biscale_source.py): a tileable
+    height field or a mesh tile, seen under the material's own model."""
+    source: EnumProperty(update=_tag_material_changed, name="Geometry", default="IMAGE",
+                         items=(("IMAGE", "Height Field", "A tileable height image (its mean of RGB) over one tile"),
+                                ("OBJECT", "Mesh Tile", "A mesh object's faces, one period of the surface across "
+                                                        "its X and Y extent, facing +Z")),
+                         description="What the surface is made of at the small scale")
+    height_image: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Height",
+                                  description="Tileable height field: heights are its values times Height Scale, "
+                                              "in tile widths")
+    height_scale: FloatProperty(update=_tag_material_changed, name="Height Scale", default=0.05, min=0.0,
+                                soft_max=0.5, description="Height of an image value of 1, in tile widths")
+    tile_object: PointerProperty(update=_tag_material_changed, type=bpy.types.Object, name="Tile", poll=_is_mesh,
+                                 description="Mesh whose faces are one tile of the surface (object space)")
+    lobes: IntProperty(update=_tag_material_changed, name="Lobes", default=16, min=1, max=32,
+                       description="SG lobes of the tile's normal distribution (more follow sharp small-scale "
+                                   "BRDFs better; docs/ACCURACY.md, bi-scale)")
+    resolution: IntProperty(update=_tag_material_changed, name="Directions", default=12, min=4, max=20,
+                            description="Lattice of view and light directions per side (12: 144 each, the paper's)")
+    samples: IntProperty(update=_tag_material_changed, name="Samples", default=8192, min=256, max=65536,
+                         description="Points on the tile whose shadowing and masking are traced")
+
+
 class SGPRT_PG_material(bpy.types.PropertyGroup):
     source: EnumProperty(name="Source", items=SOURCES, get=_get_source, set=_set_source,
                          description="What the material's look is read from: its shader nodes, or the SG-PRT "
@@ -237,6 +265,8 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                                    description="A measured BRDF factorized by sgprt.factor_brdf")
     lobe_fit: PointerProperty(type=SGPRT_PG_lobe_fit, name="Lobe Fit",
                               description="SG lobes fitted to a measured BRDF (sgprt.fit_lobes)")
+    biscale: PointerProperty(type=SGPRT_PG_biscale, name="Bi-Scale",
+                             description="Small-scale geometry of the bi-scale technique")
 
 
 class SGPRT_PG_scene(bpy.types.PropertyGroup):
@@ -248,7 +278,8 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
                                             "viewport draws one")
 
 
-classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_factorization, SGPRT_PG_material, SGPRT_PG_scene)
+classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_factorization, SGPRT_PG_biscale, SGPRT_PG_material,
+           SGPRT_PG_scene)
 
 
 def register():

@@ -4,9 +4,9 @@ A technique (base.Technique) plugs in by registering: ``register(MyTechnique())`
 the shader cache and the scene state look techniques up here by the material's choice
 (MaterialParams.technique); none is named in them.  Built in: wang2009's SG lobes, parametric
 (sg_parametric) and from a stored lobe fit (sg_fitted); mccool2001's factored BRDF (factored); kautz2002's
-spherical harmonics (spherical_harmonics).
+spherical harmonics (spherical_harmonics); iwasaki2012's bi-scale materials on the SG lobes (sg_biscale).
 """
-from . import factored, sg_fitted, sg_parametric, spherical_harmonics
+from . import factored, sg_biscale, sg_fitted, sg_parametric, spherical_harmonics
 from .base import DrawContext, ObjectInputs, Technique
 
 DEFAULT = sg_parametric.NAME
@@ -64,6 +64,7 @@ register(sg_parametric.TECHNIQUE)
 register(sg_fitted.TECHNIQUE)
 register(factored.TECHNIQUE)
 register(spherical_harmonics.TECHNIQUE)
+register(sg_biscale.TECHNIQUE)
 
 __all__ = ["DEFAULT", "DrawContext", "ObjectInputs", "Technique", "enum_items", "for_material", "get", "names",
            "of_settings", "register", "unregister"]

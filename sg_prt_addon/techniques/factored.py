@@ -29,7 +29,8 @@ FORM = "pqpr"
 RESOLUTION = 64
 SAMPLES = 256                   # views x lights of the fit: SAMPLES^2 pairs
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "normal_map")
-LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "env_prefilter.glsl", "ssdf.glsl")
+LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "env_prefilter.glsl",
+                 "hemisphere_map.glsl", "ssdf.glsl")
 VISIBILITY_KIND = "ssdf"        # the per-vertex precomputation it reads (visibility.per_vertex kinds)
 CACHE_SIZE = 16
 
@@ -199,7 +200,7 @@ class Factored(Technique):
     def create_info_calls(self, key):
         files = [name for name in LIBRARY_FILES if (name != "lights.glsl" or key.has_lights)
                  and (name != "env_prefilter.glsl" or key.has_environment)
-                 and (name != "ssdf.glsl" or key.visibility_layers)]
+                 and (name not in ("hemisphere_map.glsl", "ssdf.glsl") or key.visibility_layers)]
         sources = [shader_sources.library_source(name) for name in files]
         sources += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl",
                                                                                  "surface_io.glsl")]

@@ -59,6 +59,7 @@ class VariantKey:
     shared_light_visibility: bool = False
     warp_mode: str = warp.DEFAULT_MODE      # of the view slice (MaterialParams.warp_mode); with a specular term
     layering: tuple = ()            # surface_layering.flags of the material
+    biscale_resolution: int = 0     # sg_biscale: the tables' lattice R (0: not bi-scale)
 
     @property
     def has_visibility(self):
@@ -83,6 +84,8 @@ class VariantKey:
             parts.append(f"warp {self.warp_mode}")
         if self.layering:
             parts.append("layering: " + ", ".join(self.layering))
+        if self.biscale_resolution:
+            parts.append(f"bi-scale tables at {self.biscale_resolution} x {self.biscale_resolution}")
         if not self.has_diffuse:
             parts.append("no diffuse")
         if not self.has_specular:
@@ -226,7 +229,7 @@ class SGLobes(Technique):
         if not (key.has_environment and key.has_specular):
             skip.add("env_prefilter.glsl")
         files = [name for name in LIBRARY_FILES if name not in skip]
-        return files + (["ssdf.glsl"] if key.visibility_layers else [])
+        return files + (["hemisphere_map.glsl", "ssdf.glsl"] if key.visibility_layers else [])
 
     def technique_files(self, key):
         wanted = set(self.model_files(key) if key.has_specular else ()) | {"sg_shading.glsl"}
@@ -333,7 +336,7 @@ def vertex_visibility_calls(visibility_layers, rows, has_environment):
               ("sampler", (0, "FLOAT_2D", "visibility_coefficients")), ("sampler", (1, "FLOAT_2D", "vertex_normals")),
               ("sampler", (2, "FLOAT_2D_ARRAY", "visibility_basis")), ("fragment_out", (0, "VEC4", "out_fractions"))]
     sources = [shader_sources.library_source(name)
-               for name in ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "ssdf.glsl")]
+               for name in ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "hemisphere_map.glsl", "ssdf.glsl")]
     sources += [shader_sources.technique_source("common", "lobe_visibility.glsl"),
                 shader_sources.technique_source(GLSL_DIR, "vertex_visibility.frag.glsl")]
     calls.append(("fragment_source", ("\n".join(sources),)))

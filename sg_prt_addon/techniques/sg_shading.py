@@ -51,7 +51,7 @@ import numpy as np
 from ..lighting import env_prefilter, equirect, lights
 from ..reflectance import brdf, ggx_albedo, layering, models
 from ..spherical import clamped_cosine, sg, texture_fetch, warp
-from . import surface_layering
+from . import biscale_shading, surface_layering
 
 FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
@@ -448,6 +448,14 @@ class _Pixels:
     slice_colour: np.ndarray
     slice_cosine: np.ndarray    # I(S_j, n), unshadowed
     albedo: object              # the model's directional albedo where it is tabulated, else None
+    biscale: object = None      # a bi-scale material's biscale.bvndf.BVNDF (biscale_shading), else None
+
+    def diffuse_factor(self, world_axis):
+        """The bi-scale diffuse factor D(i, o) at world directions (N, P, 3) (1 without bi-scale)."""
+        if self.biscale is None:
+            return FLOAT(1)
+        local = np.einsum("nji,npj->npi", self.frame, np.asarray(world_axis, FLOAT))
+        return biscale_shading.diffuse_factor(self.biscale, local, self.view_local)
 
     def visible(self, axis, sharpness):
         if self.visibility is None:
@@ -470,14 +478,19 @@ class _Pixels:
 
 
 def _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
-            warp_mode):
+            warp_mode, biscale=None):
     position = np.asarray(position, FLOAT)
     n, t, b = shading_frame(normal, tangent)
     view = view_directions(position, view_origin, is_perspective)
     frame = np.stack([t, b, n], axis=-1)                          # local -> world: columns t, b, n
     view_local = np.einsum("nji,nj->ni", frame, view).astype(FLOAT)
 
-    slice_axis, slice_sharpness, slice_amplitude = specular_slice(model, params, lobe_count, view_local, warp_mode)
+    if biscale is not None:
+        slice_axis, slice_sharpness, slice_amplitude = biscale_shading.slice_lobes(biscale, model, params, view_local,
+                                                                                    warp_mode)
+    else:
+        slice_axis, slice_sharpness, slice_amplitude = specular_slice(model, params, lobe_count, view_local,
+                                                                      warp_mode)
     slice_axis = np.einsum("nij,nkj->nki", frame, slice_axis).astype(FLOAT)    # to world
     slice_sharpness = slice_sharpness.astype(FLOAT)
     slice_amplitude = slice_amplitude.astype(FLOAT)
@@ -488,13 +501,13 @@ def _pixels(position, normal, tangent, view_origin, is_perspective, model, param
     # I(S_j, n) unshadowed: the lobes' albedo, capped at the model's own where it is known (GGX: the lobes
     # overshoot it several times over at grazing views), and the environment's weights below
     slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n[:, None, :])  # (N, J)
-    albedo = model_albedo(model, params, view_local)
+    albedo = model_albedo(model, params, view_local) if biscale is None else None
     if albedo is not None:
         scale = np.minimum(FLOAT(1), albedo / np.maximum(np.sum(slice_cosine, axis=1), FLOAT(1e-30)))[:, None]
         slice_amplitude = (slice_amplitude * scale).astype(FLOAT)
         slice_cosine = (slice_cosine * scale).astype(FLOAT)
     return _Pixels(position, n, frame, view, view_local, model, params, visibility, warp_mode, slice_axis,
-                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo)
+                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo, biscale)
 
 
 def _light_sets(position, light_data):
@@ -516,7 +529,8 @@ def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, sp
     visibility = px.visibility
     light_cosine = _clamped_cosine_integral(light_axis, light_sharpness, FLOAT(1), n[:, None, :])    # (N, P)
     light_visible = px.visible(light_axis, light_sharpness)
-    irradiance += np.sum(light_amplitude * (light_cosine * light_visible)[..., None], axis=1)
+    irradiance += np.sum(light_amplitude * (light_cosine * light_visible * px.diffuse_factor(light_axis))[..., None],
+                         axis=1)
     # (N, P, 1) x (N, 1, J): every light against every slice lobe
     axis_m, sharpness_m, amplitude_m = sg.product(
         light_axis[:, :, None, :], light_sharpness[:, :, None], FLOAT(1),
@@ -531,7 +545,7 @@ def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, sp
         weight = np.where(decoded, weight * px.per_node(px.visible(axis_m[:, :, centre], sharpness_m[:, :, centre])),
                           weight)
     weight = np.sum(weight[..., None] * px.slice_colour[:, None], axis=2)                          # (N, P, 3)
-    if px.model != FITTED_MODEL:
+    if px.model != FITTED_MODEL and px.biscale is None:
         tail = light_tail(px.model, px.params, px.view_local, px.frame, light_axis, light_sharpness, light_cosine,
                           px.slice_axis, px.slice_sharpness, px.slice_amplitude)
         weight = np.maximum(weight + (tail * light_visible)[..., None], FLOAT(0))
@@ -566,26 +580,28 @@ def _add_environment(px, environment, irradiance, specular):
             # the closed form, as the shader evaluates it from the lobes' sharpness terms (scene block)
             irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
-                env_visible)[..., None], axis=1)
+                env_visible * px.diffuse_factor(sg.normalize(env_axis)))[..., None], axis=1)
         radiance = environment_radiance(environment, lookup_axis, px.slice_sharpness)               # (N, J, 3)
         specular += np.sum(radiance * (slice_cosine[..., None] * slice_colour), axis=1)
         if tail is not None:
             specular += tail[0][:, None] * environment_radiance(environment, tail[1], tail[2])
         return
     colour = np.asarray(environment.colour, FLOAT)
+    # a bi-scale material's diffuse sees the constant world through its mean factor A(o)
+    lit = colour if px.biscale is None else colour * biscale_shading.albedo(px.biscale, px.view_local)[:, None]
     if visibility is None:
-        irradiance += np.pi * colour
+        irradiance += np.pi * lit
     elif visibility.diffuse is not None:
-        irradiance += np.pi * colour * np.asarray(visibility.diffuse, FLOAT)[:, :1]
+        irradiance += np.pi * lit * np.asarray(visibility.diffuse, FLOAT)[:, :1]
     else:       # the cosine lobe alone: a zero-sharpness G at the normal
-        irradiance += np.pi * colour * px.visible(n_lobe, np.zeros((len(n), 1), FLOAT))
+        irradiance += np.pi * lit * px.visible(n_lobe, np.zeros((len(n), 1), FLOAT))
     specular += np.sum(slice_cosine[..., None] * slice_colour, axis=1) * colour
     if tail is not None:
         specular += tail[0][:, None] * colour
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
-          light_data, environment, lobe_count=1, visibility=None, warp_mode=None):
+          light_data, environment, lobe_count=1, visibility=None, warp_mode=None, biscale=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
     ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
     applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
@@ -593,9 +609,10 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     view_origin: camera position (perspective) or the camera's forward direction (orthographic).
     visibility: a Visibility (the SSDF shadows of the HAS_VISIBILITY variant) or None (unshadowed).
     warp_mode: spherical.warp's mode of the view slice (the material's view warp; None: the default).
+    biscale: a bi-scale material's biscale.bvndf.BVNDF (model: its small-scale model), or None.
     """
     px = _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
-                 warp_mode)
+                 warp_mode, biscale)
     irradiance = np.zeros(px.position.shape, FLOAT)
     specular = np.zeros(px.position.shape, FLOAT)
     for light_axis, light_sharpness, light_amplitude in _light_sets(px.position, light_data):
@@ -700,14 +717,17 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
             value = value * sample_material_texture(textures[name], uv)[:, 0]
         params[name] = value
     shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
-    roughness_texture = textures["roughness"] if surface_layering.textured_roughness(material.model, textures) else None
-    diffuse_color, specular_color = surface_layers(material, roughness_texture, uv, diffuse_color, specular_color,
-                                                   shading_normal, position, view_origin, is_perspective)
+    biscale = getattr(material, "biscale", None)
+    if biscale is None:         # a bi-scale material's variant has no glossy layer (sg_biscale)
+        roughness_texture = textures["roughness"] if surface_layering.textured_roughness(material.model, textures) \
+            else None
+        diffuse_color, specular_color = surface_layers(material, roughness_texture, uv, diffuse_color, specular_color,
+                                                       shading_normal, position, view_origin, is_perspective)
     model = material.model
     model_params = {key: params[key] for key in models.BY_NAME[model].parameters}
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
                  diffuse_color, specular_color, light_data, environment,
                  lobe_count=material.lobe_count if model in models.ANISOTROPIC else 1,
-                 visibility=visibility, warp_mode=getattr(material, "warp_mode", None))
+                 visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale)
 
 

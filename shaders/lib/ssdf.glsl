@@ -1,8 +1,6 @@
 /* SSDF visibility (wang2009 eq. 23-31): GLSL mirror of sg_prt_addon/visibility/decode.py and
- * visibility/hemisphere_map.py.  Depends on sg.glsl and hemisphere.glsl.
+ * visibility/hemisphere_map.py.  Depends on sg.glsl, hemisphere.glsl and hemisphere_map.glsl.
  *
- *   ssdf_disc_to_square            <- hemisphere_map.disc_to_square
- *   ssdf_hemisphere_to_square      <- hemisphere_map.hemisphere_to_square
  *   ssdf_horizon_lookup            <- hemisphere_map.horizon_lookup (vec3(square.xy, angle below horizon))
  *   ssdf_local_frame, ssdf_to_local <- hemisphere_map.local_frame (default tangent)
  *   ssdf_decode                    <- decode.decode, in the packed layout of decode.pack_basis_texture
@@ -25,29 +23,8 @@
 #error "SSDF_MAX_LAYERS: define the coefficient rows a vertex before ssdf.glsl"
 #endif
 
-const float SSDF_QUARTER_PI = 0.25 * SG_PI;
 const vec3 SSDF_FRAME_REFERENCE_AXIS = vec3(0.2672612419124244, 0.5345224838248488, 0.8017837257372732);
 const vec3 SSDF_FRAME_FALLBACK_AXIS = vec3(0.8017837257372732, -0.2672612419124244, -0.5345224838248488);
-
-/* Inverse concentric map (Shirley & Chiu 1997): disc point -> square point. */
-vec2 ssdf_disc_to_square(vec2 disc)
-{
-  /* one atan for both octant cases: selects, not branches (a shader pays for both sides of a branch) */
-  float radius = length(disc);
-  bool x_major = abs(disc.x) >= abs(disc.y);
-  float major = x_major ? disc.x : disc.y;
-  float minor = x_major ? disc.y : disc.x;
-  float signed_radius = major < 0.0 ? -radius : radius;
-  float other = major == 0.0 ? 0.0 : signed_radius * atan(minor / major) / SSDF_QUARTER_PI;
-  return x_major ? vec2(signed_radius, other) : vec2(other, signed_radius);
-}
-
-/* Unit direction with z >= 0 -> square point; the disc point (x, y) / sqrt(1 + z) has no cancellation. */
-vec2 ssdf_hemisphere_to_square(vec3 direction)
-{
-  float z = clamp(direction.z, 0.0, 1.0);
-  return ssdf_disc_to_square(direction.xy / sqrt(1.0 + z));
-}
 
 /* Square point of a local direction and the angle below the horizon (0 above it): below, the
  * horizon point of the same azimuth (straight down: azimuth 0). */
@@ -57,7 +34,7 @@ vec3 ssdf_horizon_lookup(vec3 direction)
   bool below = direction.z < 0.0;
   float horizontal = length(direction.xy);
   vec3 on_horizon = horizontal > 0.0 ? vec3(direction.xy / horizontal, 0.0) : vec3(1.0, 0.0, 0.0);
-  return vec3(ssdf_hemisphere_to_square(below ? on_horizon : direction),
+  return vec3(hemisphere_map_to_square(below ? on_horizon : direction),
               below ? atan(-direction.z, horizontal) : 0.0);
 }
 

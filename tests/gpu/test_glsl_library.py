@@ -20,10 +20,11 @@ DEPENDENCIES = {
     "warp.glsl": ["sg.glsl"],
     "lights.glsl": ["sg.glsl"],
     "env_prefilter.glsl": ["sg.glsl"],
-    "ssdf.glsl": ["sg.glsl", "hemisphere.glsl", f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n"],
+    "hemisphere_map.glsl": ["sg.glsl"],
+    "ssdf.glsl": ["sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n"],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
-         "lights.glsl", "env_prefilter.glsl", "ssdf.glsl"]
+         "lights.glsl", "env_prefilter.glsl", "hemisphere_map.glsl", "ssdf.glsl"]
 
 
 def test_every_file_is_listed():

@@ -5,7 +5,7 @@ from sg_prt_addon.spherical import hemisphere
 from sg_prt_addon.visibility import decode, hemisphere_map
 
 N = 20000
-LIB = ["sg.glsl", "hemisphere.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl"]
+LIB = ["sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl"]
 
 
 def _directions(fuzz, count):

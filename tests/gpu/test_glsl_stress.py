@@ -485,14 +485,14 @@ def test_ssdf_stress(glsl, fuzz):
     ssdf_local_frame(n.xyz, t, b, unit_normal);
     vec3 local = ssdf_to_local(d.xyz, n.xyz);
     vec3 lookup = ssdf_horizon_lookup(u.xyz);
-    vec2 square = ssdf_disc_to_square(q.xy) + ssdf_hemisphere_to_square(vec3(u.xy, abs(u.z)));
+    vec2 square = hemisphere_map_disc_to_square(q.xy) + hemisphere_map_to_square(vec3(u.xy, abs(u.z)));
     float theta_d = ssdf_decode(ssdf_basis, c, 3, local);
     result = vec4(dot(t + b + unit_normal + local + lookup, vec3(1.0)) + square.x + square.y,
                   theta_d,
                   ssdf_visibility_amplitude(d.w, q.z, n.w) + ssdf_visibility_amplitude(d.w, q.z, theta_d),
                   ssdf_shadowed_integral(local, d.w, q.z, ssdf_basis, c, 3));
     """
-    library = ["sg.glsl", "hemisphere.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl"]
+    library = ["sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl"]
     out = glsl(library, body, inputs, 4, textures={"ssdf_basis": _ssdf_basis(fuzz.rng)})
     _assert_finite(out, "ssdf.glsl")
     assert out[:, 2:].min() >= 0
@@ -572,7 +572,7 @@ def test_lobe_visibility_stress(glsl, fuzz):
     set_visibility_frame(s.xyz);
     result = vec4(lobe_visibility(p.xyz, p.w, n.xyz), 0.0, 0.0, 0.0);
     """
-    library = LIBRARY_ORDER + ["#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl", source]
+    library = LIBRARY_ORDER + ["hemisphere_map.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl", source]
     inputs = {"p": np.c_[x["axis1"], x["sharpness"]], "n": x["normal"], "s": ssdf_normal,
               "c0": rows[:, :4], "c1": rows[:, 4:8], "c2": rows[:, 8:]}
     out = glsl(library, body, inputs, 1, textures={"visibility_basis": _ssdf_basis(fuzz.rng)})
@@ -909,7 +909,7 @@ COVERED = {
     test_lights_helpers_stress: ["blender_point_light_intensity", "light_cap_energy_lobe", "sphere_light_cap",
                                  "point_light_sg"],
     test_env_prefilter_helpers_stress: ["env_sign_not_zero", "oct_encode", "env_prefilter_blend_parameter"],
-    test_ssdf_stress: ["ssdf_disc_to_square", "ssdf_hemisphere_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",
+    test_ssdf_stress: ["hemisphere_map_disc_to_square", "hemisphere_map_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",
                        "ssdf_to_local", "ssdf_decode", "ssdf_visibility_amplitude", "ssdf_shadowed_integral"],
     test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility"],
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],

@@ -10,7 +10,10 @@
  * broad diffuse lobes' visible fractions come interpolated from the vertices (diffuse_fractions, filled
  * by surface.frag.glsl from the pass of vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with
  * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; techniques.sg_shading.shares_light_visibility): every light is narrow on
- * the object, and its products with the slice lobes take its own visibility instead of a decode each. */
+ * the object, and its products with the slice lobes take its own visibility instead of a decode each.
+ * BISCALE (biscale.glsl before this file): the lobes are a bi-scale material's effective lobes (NDF_LOBES of
+ * them, iwasaki2012 eq. 15) with their tables' factors and the small-scale M, and the diffuse term is scaled by
+ * the tile's D(i, o); no light or environment tail (those are GGX's own). */
 
 #ifdef HAS_VISIBILITY
 #define LOBE_VISIBILITY(axis, sharpness) lobe_visibility(axis, sharpness, n)
@@ -29,6 +32,7 @@ vec4 diffuse_fractions[DIFFUSE_VISIBILITY_ROWS];
 #endif
 
 #ifdef HAS_SPECULAR
+#ifndef BISCALE
 /* NDF lobe k of the model (brdf.glsl's <model>_ndf_lobe, or the anisotropy table), local
  * frame.  p = (roughness, ior, exponent, alpha_x), q = (alpha_y, nu, nv, rf0). */
 void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude)
@@ -59,6 +63,7 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
                     sqrt((nu + 1.0) * (nv + 1.0)) / (2.0 * SG_PI), k, axis, sharpness, amplitude);
 #endif
 }
+#endif
 
 #ifdef MODEL_FITTED
 /* The stored lobe fit (blender.lobe_fit format 1, export.FittedLobes; mirrored by techniques.sg_shading's
@@ -179,7 +184,7 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
 #endif
 }
 
-#if defined(HAS_LIGHTS) && !defined(MODEL_FITTED)
+#if defined(HAS_LIGHTS) && !defined(MODEL_FITTED) && !defined(BISCALE)
 /* What the slice lobes miss of the model's own BRDF at a light's centre (techniques.sg_shading.light_tail) */
 #define LIGHT_TAIL
 
@@ -212,6 +217,15 @@ float model_specular(vec3 wo, vec3 wi, vec4 p, vec4 q)
 
 
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
+
+#ifdef BISCALE
+/* the bi-scale diffuse factor D(i, o) at a world direction, and its mean A(o) for a constant world */
+#define BISCALE_DIFFUSE(world_direction) biscale_diffuse((world_direction) * frame)
+#define BISCALE_ALBEDO biscale_albedo()
+#else
+#define BISCALE_DIFFUSE(world_direction) 1.0
+#define BISCALE_ALBEDO 1.0
+#endif
 
 #if defined(HAS_VISIBILITY) && defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
 /* A partly occluded slice lobe reads the environment at the mean of its visible part (techniques.sg_shading.
@@ -246,11 +260,16 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   vec3 irradiance = vec3(0.0);
   vec3 radiance = vec3(0.0);
 
-#ifdef HAS_SPECULAR
+#if defined(HAS_SPECULAR) || defined(BISCALE)
   vec3 view = scene.camera.w > 0.5 ? safe_normalize(scene.camera.xyz - position)
                                    : -safe_normalize(scene.camera.xyz);
   mat3 frame = mat3(t, b, n);                    /* local -> world */
   vec3 view_local = view * frame;                /* transpose(frame) * view */
+#endif
+#ifdef BISCALE
+  biscale_set_view(view_local);
+#endif
+#ifdef HAS_SPECULAR
 
   /* BRDF slice: NDF lobes warped to the view (WARP_NODES per NDF lobe) times M_o at their centres, in world space */
   vec3 slice_axis[SLICE_LOBES];
@@ -260,10 +279,17 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef MODEL_FITTED
   p.z = fitted_shadowing_of(view_local);       /* S(o), for model_m_factor */
 #endif
+#ifdef BISCALE
+  vec2 small_lobe = biscale_small_lobe(p);
+#endif
   for (int k = 0; k < NDF_LOBES; k++) {
     vec3 ndf_axis;
     float ndf_sharpness, ndf_amplitude;
-#ifdef MODEL_FITTED
+#ifdef BISCALE
+    float bvndf_sharpness;      /* eta_j, for the product axis of M */
+    biscale_lobe(k, small_lobe, ndf_axis, ndf_sharpness, ndf_amplitude, bvndf_sharpness);
+    vec3 colour = vec3(1.0);
+#elif defined(MODEL_FITTED)
     vec4 fitted_lobe = fitted_layer(1 + 2 * k);
     ndf_axis = safe_normalize(fitted_lobe.xyz);
     ndf_sharpness = fitted_lobe.w;
@@ -285,8 +311,14 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
     for (int node = 0; node < WARP_NODES; node++) {
       int j = WARP_NODES * k + node;
+#ifdef BISCALE
+      slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
+                                                biscale_m_factor(k, ndf_axis, bvndf_sharpness, small_lobe.x,
+                                                                 view_local, warped_axis[node], p));
+#else
       slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
                                                 model_m_factor(view_local, warped_axis[node], p, q));
+#endif
       slice_axis[j] = frame * warped_axis[node];
       slice_colour[j] = colour;
       slice_sharpness[j] = warped_sharpness[node];
@@ -334,7 +366,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_visibility = LOBE_VISIBILITY(light_axis, light_sharpness);
 #endif
 #ifdef HAS_DIFFUSE
-    irradiance += light_amplitude * (light_cosine * light_visibility);   /* eq. 42 */
+    irradiance += light_amplitude * (light_cosine * light_visibility * BISCALE_DIFFUSE(light_axis));   /* eq. 42 */
 #endif
 #ifdef HAS_SPECULAR
     vec3 weight = vec3(0.0);
@@ -447,11 +479,12 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
                   (clamped_cosine_from_terms(dot(safe_normalize(scene.env_axis_sharpness[e].xyz), n),
                                              scene.env_axis_sharpness[e].w, scene.env_cosine_terms[2 * e],
                                              scene.env_cosine_terms[2 * e + 1]) *
-                   DIFFUSE_VISIBILITY(e, scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w));   /* eq. 39 */
+                   DIFFUSE_VISIBILITY(e, scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w) *
+                   BISCALE_DIFFUSE(safe_normalize(scene.env_axis_sharpness[e].xyz)));   /* eq. 39 */
   }
 #else
   /* a constant world: the cosine lobe alone (a zero-sharpness G) */
-  irradiance += SG_PI * scene.world_colour.rgb * DIFFUSE_VISIBILITY(0, n, 0.0);
+  irradiance += SG_PI * scene.world_colour.rgb * DIFFUSE_VISIBILITY(0, n, 0.0) * BISCALE_ALBEDO;
 #endif
 #endif
 

@@ -1,0 +1,94 @@
+"""A bi-scale material's small-scale tile read from Blender (material.sgprt.biscale) and its BVNDF
+(biscale.bvndf), computed when the tile or its settings change and kept by content: an edit of the height
+image or the tile mesh makes the next export (the viewport's next frame) recompute it; a redraw does not.
+
+Failures (no image, an unreadable file, NaN heights, a tile that faces down) leave the material rendering with
+the default technique and a warning that names the reason, as export does for any unusable technique.
+"""
+import hashlib
+import time
+from collections import OrderedDict
+
+import numpy as np
+
+from ..biscale import bvndf, microgeometry
+
+CACHE_SIZE = 8
+_cache = OrderedDict()          # content key -> BVNDF, least recently used first
+_status = {}                    # material name -> the last computation's one-line report (the panel shows it)
+
+
+def last_status(material):
+    return _status.get(material.name, "")
+
+
+def _image_heights(image):
+    from .export import image_has_pixels, image_pixels
+
+    if image is None:
+        raise ValueError("no height image")
+    if not image_has_pixels(image):
+        raise ValueError(f"height image '{image.name}': file '{image.filepath}' missing or unreadable")
+    pixels = image_pixels(image)
+    # Blender's row 0 is the bottom: the tile's rows start at the top (biscale.microgeometry)
+    return np.flipud(pixels[..., :3].mean(axis=-1))
+
+
+def _tile_mesh(obj):
+    if obj is None:
+        raise ValueError("no tile object")
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    vertices = np.empty(len(mesh.vertices) * 3, np.float64)
+    mesh.vertices.foreach_get("co", vertices)
+    triangles = np.empty(len(mesh.loop_triangles) * 3, np.int64)
+    mesh.loop_triangles.foreach_get("vertices", triangles)
+    vertices = vertices.reshape(-1, 3)
+    if not len(vertices):
+        raise ValueError(f"tile object '{obj.name}' has no vertices")
+    low = vertices.min(axis=0)
+    size = np.ptp(vertices[:, :2], axis=0)
+    return vertices - np.array([low[0], low[1], 0.0]), triangles.reshape(-1, 3), (float(size[0]), float(size[1]))
+
+
+def _geometry_and_key(settings):
+    """(microgeometry, content key) of the settings' tile."""
+    digest = hashlib.sha1()
+    if settings.source == "IMAGE":
+        heights = _image_heights(settings.height_image)
+        digest.update(np.ascontiguousarray(heights, np.float32).tobytes())
+        digest.update(repr(float(settings.height_scale)).encode())
+        geometry = microgeometry.from_height_field(heights, height_scale=float(settings.height_scale))
+    else:
+        vertices, triangles, size = _tile_mesh(settings.tile_object)
+        digest.update(vertices.tobytes() + triangles.tobytes())
+        geometry = microgeometry.from_mesh(vertices, triangles, size)
+    digest.update(repr((settings.source, int(settings.lobes), int(settings.resolution), int(settings.samples))).encode())
+    return geometry, digest.hexdigest()
+
+
+def tables(material):
+    """(BVNDF, None) of the material's tile, or (None, the reason it has none)."""
+    settings = material.sgprt.biscale
+    try:
+        geometry, key = _geometry_and_key(settings)
+    except ValueError as error:
+        _status[material.name] = str(error)
+        return None, str(error)
+    model = _cache.get(key)
+    if model is not None:
+        _cache.move_to_end(key)
+        return model, None
+    start = time.perf_counter()
+    try:
+        model = bvndf.compute(geometry, lobes=int(settings.lobes), resolution=int(settings.resolution),
+                              samples=int(settings.samples))
+    except ValueError as error:
+        _status[material.name] = str(error)
+        return None, str(error)
+    _cache[key] = model
+    while len(_cache) > CACHE_SIZE:
+        _cache.popitem(last=False)
+    _status[material.name] = (f"{model.lobe_count} lobes from {len(geometry.triangles)} triangles in "
+                              f"{time.perf_counter() - start:.2f} s")
+    return model, None

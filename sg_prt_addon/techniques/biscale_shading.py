@@ -1,0 +1,122 @@
+"""Numpy mirror of shaders/techniques/sg/biscale.glsl: a bi-scale material's effective lobes (iwasaki2012
+eq. 15) as the SG technique's BRDF slice, and its diffuse factor; and the GPU layout of a biscale.bvndf.BVNDF.
+
+The small-scale BRDF is the material's own model and parameters (per pixel, textures included), so editing it
+needs no recomputation; the tile's BVNDF (lobes and tables) changes only with the geometry.
+"""
+import numpy as np
+
+from ..biscale import bvndf as bvndf_tables
+from ..reflectance import brdf, models
+from ..spherical import sg, warp
+from ..visibility import hemisphere_map
+
+FLOAT = np.float32
+# Small-scale models: the isotropic ones, each with its one SG lobe (brdf.<Model>.ndf_lobes())
+SMALL_SCALE_MODELS = tuple(model.name for model in models.MODELS if not model.anisotropic)
+
+
+def small_lobe(model, params):
+    """(sharpness (N,), amplitude (N,)) of the small-scale model's one NDF lobe per pixel (biscale_small_lobe)."""
+    if model not in SMALL_SCALE_MODELS:
+        raise ValueError(f"a bi-scale material's small-scale model must be isotropic, not {model}")
+    instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
+    _, sharpness, amplitude = instance.ndf_lobes()
+    return np.asarray(sharpness, np.float64)[..., 0], np.asarray(amplitude, np.float64)[..., 0]
+
+
+def effective_lobes(tables, small_sharpness, small_amplitude):
+    """biscale_lobe for every pixel and BVNDF lobe: axis (N, J, 3), sharpness (N, J), amplitude (N, J)."""
+    eta_j = np.asarray(tables.sharpness, np.float64)[None, :]
+    eta_s = small_sharpness[:, None]
+    total = np.maximum(eta_j + eta_s, 1e-30)
+    axis = np.broadcast_to(sg.normalize(tables.axes)[None], (len(eta_s),) + tables.axes.shape)
+    return axis, eta_j * eta_s / total, 2.0 * np.pi * small_amplitude[:, None] / total
+
+
+def m_factor_rows(tables, model, params, small_sharpness, nodes):
+    """m_factor(wo, wi) for warp.brdf_slice_lobes: rows (lobe j's nodes one after the other, leading) times
+    mu_j(wi, wo) at the product axis n* = normalize(eta_j xi_j + eta_s h) (biscale_m_factor)."""
+    instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[None] for k, v in params.items()})
+    lobe_of_row = np.repeat(np.arange(tables.lobe_count), nodes)
+    axes = sg.normalize(np.asarray(tables.axes, np.float64))[lobe_of_row][:, None, :]          # (K', 1, 3)
+    eta_j = np.asarray(tables.sharpness, np.float64)[lobe_of_row][:, None, None]
+
+    def m_factor(wo, wi):          # (K', N, 3) each
+        wo = sg.normalize(np.asarray(wo, np.float64))
+        wi = sg.normalize(np.asarray(wi, np.float64))
+        facet = sg.normalize(eta_j * axes + small_sharpness[None, :, None] * sg.normalize(wo + wi))
+        frames = hemisphere_map.local_frame(facet)
+        local_o = np.einsum("...ij,...j->...i", frames, wo)
+        local_i = np.einsum("...ij,...j->...i", frames, wi)
+        amplitude = paired_amplitudes(tables, lobe_of_row, wi, wo)
+        above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
+        return np.where(above, amplitude * instance.m_factor(local_o, local_i), 0.0)
+
+    return m_factor
+
+
+def paired_amplitudes(tables, lobe_of_row, wi, wo):
+    """mu_j(wi, wo) with a table per row: (K', N)."""
+    values = np.empty(wi.shape[:-1])
+    for lobe in range(tables.lobe_count):
+        rows = lobe_of_row == lobe
+        values[rows] = bvndf_tables.interpolate(tables.amplitudes[lobe:lobe + 1], wi[rows], wo[rows],
+                                                tables.resolution)[0]
+    return values
+
+
+def slice_lobes(tables, model, params, view_local, warp_mode=None):
+    """The BRDF slice of a bi-scale material (sg_shading.glsl's slice loop under BISCALE): axis (N, K', 3)
+    local, sharpness (N, K'), amplitude (N, K')."""
+    mode = warp_mode or warp.DEFAULT_MODE
+    small_sharpness, small_amplitude = small_lobe(model, params)
+    axis, sharpness, amplitude = effective_lobes(tables, small_sharpness, small_amplitude)
+    m_factor = m_factor_rows(tables, model, params, small_sharpness, warp.nodes_per_lobe(mode))
+    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, m_factor, mode=mode)
+
+
+def diffuse_factor(tables, directions_local, view_local):
+    """D(i, o) at local incident directions (N, P, 3) for each pixel's view (N, 3): (N, P) (biscale_diffuse)."""
+    directions_local = np.asarray(directions_local, np.float64)
+    view = np.broadcast_to(np.asarray(view_local, np.float64)[:, None, :], directions_local.shape)
+    values = bvndf_tables.interpolate(np.asarray(tables.integral)[None], directions_local, view,
+                                      tables.resolution)[0]
+    return np.where(directions_local[..., 2] > 0, values, 0.0).astype(FLOAT)
+
+
+def albedo(tables, view_local):
+    """A(o) for each pixel's view (N,) (biscale_albedo): the albedo row read at o as the GPU reads it."""
+    texture = np.broadcast_to(np.asarray(tables.albedo)[None, :], (len(tables.directions),) * 2)
+    up = np.array([0.0, 0.0, 1.0])
+    return bvndf_tables.interpolate(texture[None], up, np.asarray(view_local, np.float64),
+                                    tables.resolution)[0].astype(FLOAT)
+
+
+# ---------------------------------------------------------------- GPU layout
+
+def lobe_layers(lobe_count):
+    return -(-lobe_count // 4)
+
+
+def table_texture(tables):
+    """(layers, R^2, R^2, 4) float32 of biscale.glsl's biscale_tables: texel (row o_b R + i_b, column o_a R + i_a)
+    of layer t channel c is mu_{4t+c}(i, o); the last layer holds (D(i, o), A(o), 0, 0)."""
+    resolution = tables.resolution
+    nodes = resolution * resolution
+    count = tables.lobe_count
+    layers = lobe_layers(count)
+    values = np.zeros((layers * 4 + 4, nodes, nodes), np.float32)                   # [channel, i node, o node]
+    values[:count] = tables.amplitudes
+    values[layers * 4] = tables.integral
+    values[layers * 4 + 1] = np.asarray(tables.albedo)[None, :]
+    # node index b R + a -> (b, a) for i and o, then rows (o_b, i_b) and columns (o_a, i_a)
+    grid = values.reshape(layers + 1, 4, resolution, resolution, resolution, resolution)  # l, c, ib, ia, ob, oa
+    texture = grid.transpose(0, 4, 2, 5, 3, 1).reshape(layers + 1, nodes, nodes, 4)
+    return np.ascontiguousarray(texture)
+
+
+def lobe_texture(tables):
+    """(1, J, 4) float32 of biscale_lobes: (axis xyz, sharpness) of each BVNDF lobe."""
+    return np.concatenate([np.asarray(tables.axes, np.float32), np.asarray(tables.sharpness, np.float32)[:, None]],
+                          axis=1)[None]

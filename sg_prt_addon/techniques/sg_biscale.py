@@ -1,0 +1,64 @@
+"""iwasaki2012's bi-scale materials rendered by wang2009's SG shading: the effective BRDF of a small-scale tile
+(its BVNDF's lobes and tables, biscale.bvndf, from export.MaterialParams.biscale) with the material's own
+isotropic model as the small-scale BRDF (shaders/techniques/sg/biscale.glsl; mirror biscale_shading.py)."""
+from . import biscale_shading
+from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
+from .sg_parametric import material_terms
+
+NAME = "SG_BISCALE"
+# the small-scale parameters a texture may scale per pixel, and the colours and normal map
+TEXTURES = ("diffuse_color", "specular_color", "roughness", "ior", "exponent", "alpha_x", "normal_map")
+
+
+class SGBiScale(SGLobes):
+    name = NAME
+    label = "Bi-Scale SG Lobes (Iwasaki 2012)"
+    description = ("The effective BRDF of a small-scale height field or mesh tile under the material's model, as "
+                   "SG lobes: all-frequency light and SSDF shadows (Iwasaki et al. 2012, Wang et al. 2009)")
+    number = 4
+    paper = "iwasaki2012"
+
+    def variant_key(self, params, inputs):
+        tables = getattr(params, "biscale", None)
+        if tables is None:
+            raise ValueError(f"material '{params.name}' has no small-scale geometry for {self.label}")
+        if params.model not in biscale_shading.SMALL_SCALE_MODELS:
+            raise ValueError(f"material '{params.name}': a bi-scale material's model must be isotropic "
+                             f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}")
+        has_diffuse, has_specular = material_terms(params)
+        textures = tuple(sorted(name for name in params.textures if name in TEXTURES and name in TEXTURE_SLOTS))
+        return VariantKey(self.name, params.model, int(tables.lobe_count), textures=textures,
+                          has_diffuse=has_diffuse, has_specular=has_specular, warp_mode=warp_mode_of(params),
+                          biscale_resolution=int(tables.resolution), **scene_fields(inputs, has_diffuse, has_specular))
+
+    def model_defines(self, key):
+        # the key's lobe count is the BVNDF's
+        return {"BISCALE": 1, "BISCALE_RESOLUTION": key.biscale_resolution,
+                "BISCALE_LOBE_LAYERS": biscale_shading.lobe_layers(key.ndf_lobes)}
+
+    def library_files(self, key):
+        """The BRDF (the small-scale M, even for a diffuse-only variant: biscale.glsl compiles it) and the
+        hemisphere map (the tables' lattice) besides what the SG shading takes."""
+        files = super().library_files(key)
+        if "brdf.glsl" not in files:
+            files.insert(files.index("sg.glsl") + 1, "brdf.glsl")
+        if "hemisphere_map.glsl" not in files:
+            files.append("hemisphere_map.glsl")
+        return files
+
+    def technique_files(self, key):
+        files = super().technique_files(key)
+        return [("sg", "biscale.glsl")] + files
+
+    def model_samplers(self, key):
+        return [("FLOAT_2D", "biscale_lobes"), ("FLOAT_2D_ARRAY", "biscale_tables")]
+
+    def bind_model(self, shader, key, context):
+        tables = context.params.biscale
+        shader.uniform_sampler("biscale_lobes", context.material_table(
+            ("biscale_lobes", tables.signature), lambda: biscale_shading.lobe_texture(tables)))
+        shader.uniform_sampler("biscale_tables", context.material_table(
+            ("biscale_tables", tables.signature), lambda: biscale_shading.table_texture(tables)))
+
+
+TECHNIQUE = SGBiScale()

@@ -1,0 +1,126 @@
+/* Bi-scale materials (iwasaki2012 eq. 15): the effective BRDF's lobes and factors, mirrored by
+ * sg_prt_addon/techniques/biscale_shading.py.  Needs sg.glsl, brdf.glsl, hemisphere_map.glsl, and:
+ *   biscale_lobes  (sampler2D, BISCALE_LOBES x 1): texel j = (axis xyz in the local frame, sharpness) of BVNDF lobe j;
+ *   biscale_tables (sampler2DArray, R^2 x R^2 RGBA32F, linear filtering): the node pair (i, o) of the lattice
+ *     (biscale/bvndf.py, R = BISCALE_RESOLUTION) at texel (o_a R + i_a, o_b R + i_b); layer t, channel c:
+ *     mu_j(i, o) per unit cos(theta_i) of lobe j = 4 t + c; layer BISCALE_LOBE_LAYERS: (D(i, o), A(o), 0, 0),
+ *     the diffuse factor and its cosine-weighted mean over i.
+ * The sampler interpolates i inside an o node's block; o's four nodes are blended here (biscale_set_view:
+ * once a pixel, the view is fixed). */
+
+const float BISCALE_R = float(BISCALE_RESOLUTION);
+vec2 biscale_view_corner[4];
+float biscale_view_weight[4];
+
+/* Continuous lattice coordinates in [0, R - 1] of a local direction (clamped to the hemisphere). */
+vec2 biscale_lattice(vec3 direction)
+{
+  vec3 clamped = safe_normalize(vec3(direction.xy, max(direction.z, 0.0)));
+  return clamp((hemisphere_map_to_square(clamped) + 1.0) * (0.5 * (BISCALE_R - 1.0)), 0.0, BISCALE_R - 1.0);
+}
+
+void biscale_set_view(vec3 view_local)
+{
+  vec2 c = biscale_lattice(view_local);
+  vec2 low = min(floor(c), vec2(BISCALE_R - 2.0));
+  vec2 f = c - low;
+  biscale_view_corner[0] = low;
+  biscale_view_corner[1] = low + vec2(1.0, 0.0);
+  biscale_view_corner[2] = low + vec2(0.0, 1.0);
+  biscale_view_corner[3] = low + vec2(1.0, 1.0);
+  biscale_view_weight[0] = (1.0 - f.x) * (1.0 - f.y);
+  biscale_view_weight[1] = f.x * (1.0 - f.y);
+  biscale_view_weight[2] = (1.0 - f.x) * f.y;
+  biscale_view_weight[3] = f.x * f.y;
+}
+
+/* The tables of one layer at the local incident direction wi and the pixel's view. */
+vec4 biscale_fetch(int layer, vec3 wi)
+{
+  vec2 ci = biscale_lattice(wi);
+  vec4 value = vec4(0.0);
+  for (int k = 0; k < 4; k++) {
+    vec2 texel = biscale_view_corner[k] * BISCALE_R + ci + 0.5;
+    value += biscale_view_weight[k] * texture(biscale_tables, vec3(texel / (BISCALE_R * BISCALE_R), float(layer)));
+  }
+  return value;
+}
+
+float biscale_amplitude(int lobe, vec3 wi)
+{
+  return biscale_fetch(lobe / 4, wi)[lobe % 4];
+}
+
+/* D(i, o): the Lambertian term's factor at a local incident direction (0 below the horizon). */
+float biscale_diffuse(vec3 wi)
+{
+  return wi.z > 0.0 ? biscale_fetch(BISCALE_LOBE_LAYERS, wi).x : 0.0;
+}
+
+/* A(o): the diffuse factor's cosine-weighted mean over the incident hemisphere (a constant world). */
+float biscale_albedo()
+{
+  return biscale_fetch(BISCALE_LOBE_LAYERS, vec3(0.0, 0.0, 1.0)).y;
+}
+
+/* The small-scale model's one NDF lobe around the facet normal: (sharpness, amplitude). */
+vec2 biscale_small_lobe(vec4 p)
+{
+#if defined(MODEL_GGX)
+  return ggx_ndf_lobe(p.x);
+#elif defined(MODEL_COOK_TORRANCE)
+  return cook_torrance_ndf_lobe(p.x);
+#elif defined(MODEL_BLINN_PHONG)
+  return blinn_phong_ndf_lobe(p.z);
+#elif defined(MODEL_WARD_ISO)
+  return ward_isotropic_ndf_lobe(p.w);
+#else
+  return vec2(0.0);
+#endif
+}
+
+/* Effective lobe j (eq. 14-15): BVNDF lobe j (xi_j, eta_j) convolved with the small-scale lobe (eta_s, mu_s):
+ * axis xi_j, sharpness eta_j eta_s / (eta_j + eta_s), amplitude 2 pi mu_s / (eta_j + eta_s). */
+void biscale_lobe(int j, vec2 small_lobe, out vec3 axis, out float sharpness, out float amplitude,
+                  out float ndf_sharpness)
+{
+  vec4 lobe = texelFetch(biscale_lobes, ivec2(j, 0), 0);
+  axis = safe_normalize(lobe.xyz);
+  ndf_sharpness = lobe.w;
+  float total = max(ndf_sharpness + small_lobe.x, 1.0e-30);
+  sharpness = ndf_sharpness * small_lobe.x / total;
+  amplitude = 2.0 * SG_PI * small_lobe.y / total;
+}
+
+/* M_o(i) of the small-scale model (brdf.glsl), directions in a facet's frame. */
+float biscale_small_m_factor(vec3 wo, vec3 wi, vec4 p)
+{
+#if defined(MODEL_GGX)
+  return ggx_m_factor(wo, wi, p.x);
+#elif defined(MODEL_COOK_TORRANCE)
+  return cook_torrance_m_factor(wo, wi, p.x, p.y);
+#elif defined(MODEL_BLINN_PHONG)
+  return blinn_phong_m_factor(wo, wi, p.z);
+#elif defined(MODEL_WARD_ISO)
+  return ward_isotropic_m_factor(wo, wi);
+#else
+  return 0.0;
+#endif
+}
+
+/* mu_j(i, o) times the small-scale M at the product axis n* = normalize(eta_j xi_j + eta_s h), directions in
+ * n*'s frame (the models are isotropic: any tangent). */
+float biscale_m_factor(int j, vec3 axis, float ndf_sharpness, float small_sharpness, vec3 wo, vec3 wi, vec4 p)
+{
+  wo = safe_normalize(wo);
+  wi = safe_normalize(wi);
+  if (!(wo.z > 0.0 && wi.z > 0.0)) {
+    return 0.0;
+  }
+  vec3 facet = safe_normalize(ndf_sharpness * axis + small_sharpness * safe_normalize(wo + wi));
+  vec3 helper = abs(facet.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+  vec3 t = normalize(cross(helper, facet));
+  vec3 b = cross(facet, t);
+  mat3 to_facet = transpose(mat3(t, b, facet));
+  return biscale_amplitude(j, wi) * biscale_small_m_factor(to_facet * wo, to_facet * wi, p);
+}
