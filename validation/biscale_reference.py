@@ -9,11 +9,13 @@ fitted or convolved.  Its noise is the rays' standard error, returned with it.
 import numpy as np
 
 from sg_prt_addon.biscale import microgeometry
+from sg_prt_addon.reflectance import brdf
 from sg_prt_addon.visibility import hemisphere_map
 
 
 def facet_brdf(small, model, normals, wi, wo):
-    """(N, 3) small-scale BRDF kd / pi + ks rho_s on facets with normals (N, 3), directions in the tile frame."""
+    """(N, 3) small-scale BRDF kd / pi + ks rho_s on facets with normals (N, 3), directions (3,) or (N, 3) in the
+    tile frame."""
     frames = hemisphere_map.local_frame(normals)
     local_i = np.einsum("nij,nj->ni", frames, np.broadcast_to(wi, normals.shape))
     local_o = np.einsum("nij,nj->ni", frames, np.broadcast_to(wo, normals.shape))
@@ -120,3 +122,48 @@ def random_bumps(resolution=64, amplitude=0.04, cutoff=4, seed=7):
 
 
 TILES = {"egg crate": egg_crate, "grooves": grooves, "random bumps": random_bumps}
+
+
+class TracedEffectiveBRDF:
+    """validation.reference's specular-model protocol for a bi-scale material: specular(wo, wi) is an unbiased
+    estimate of the whole effective BRDF (diffuse and glossy, RGB, without the large-scale cosine), one ray
+    dropped on the tile along -o and one shadow ray towards i per estimate (`rays` of them averaged), so the
+    reference renders the ray-traced tile itself, noise included in its error estimate.  Sampling: GGX about the
+    large-scale normal at a roughness widened by the tile's slopes (any proposal is unbiased with its own pdf)."""
+
+    def __init__(self, geometry, small, rays=2, seed=11):
+        self.geometry, self.small, self.rays = geometry, small, int(rays)
+        self.model = small.brdf()
+        self.normals, _ = geometry.facets()
+        self.tracer = microgeometry.TiledTracer(geometry)
+        self.rng = np.random.default_rng(seed)
+        normals, areas = self.normals, geometry.facets()[1]
+        slope2 = float(np.sum(areas * (1.0 - normals[:, 2] ** 2) / np.maximum(normals[:, 2] ** 2, 1e-6)) /
+                       np.sum(areas))
+        alpha = float(getattr(self.model, "roughness", 0.3)) ** 2
+        self.proposal = brdf.GGX(roughness=float((alpha * alpha + slope2 + 0.01) ** 0.25))
+
+    def specular(self, wo, wi):
+        wo, wi = np.asarray(wo, np.float64), np.asarray(wi, np.float64)
+        count = len(wo)
+        total = np.zeros((count, 3))
+        for _ in range(self.rays):
+            start = np.column_stack([self.rng.random(count) * self.geometry.size[0],
+                                     self.rng.random(count) * self.geometry.size[1],
+                                     np.full(count, self.tracer.top + 1e-3 * max(self.geometry.size))])
+            hit, positions, triangle = self.tracer.first_hit(start, -wo)
+            facet = self.normals[np.maximum(triangle, 0)]
+            cos_i = np.sum(facet * wi, axis=1)
+            lit = hit & (cos_i > 0) & (np.sum(facet * wo, axis=1) > 0) & (wi[:, 2] > 0) & (wo[:, 2] > 0)
+            if not np.any(lit):
+                continue
+            visible = self.tracer.visible(positions[lit], facet[lit], wi[lit])
+            value = facet_brdf(self.small, self.model, facet[lit], wi[lit], wo[lit])
+            total[lit] += value * (cos_i[lit] * visible / np.maximum(wi[lit, 2], 1e-6))[:, None]
+        return total / self.rays
+
+    def sample(self, wo, u):
+        return self.proposal.sample(wo, u)
+
+    def pdf(self, wo, wi):
+        return self.proposal.pdf(wo, wi)

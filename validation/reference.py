@@ -52,7 +52,7 @@ _MIN_VIEW_COSINE = 1e-3
 class Material:
     diffuse_color: Any = (0.8, 0.8, 0.8)     # kd (3,), albedo of the Lambertian term kd / pi
     specular_color: Any = (0.0, 0.0, 0.0)    # ks (3,), scales the specular model
-    specular_model: Any = None               # object with specular / sample / pdf, or None
+    specular_model: Any = None               # object with specular (N,) or (N, 3) RGB / sample / pdf, or None
     # Spatial variation: callable uv (N, 2) -> dict with any of diffuse_color (N, 3),
     # specular_color (N, 3) and specular_model (a model whose parameters are (N,) arrays),
     # replacing the constant fields above at those points.  None: a homogeneous material.
@@ -327,15 +327,17 @@ class _Renderer:
         cosine = np.maximum(wi_local[:, 2], 0.0)
         if not points.groups:
             return points.diffuse_over_pi * cosine[:, None]
-        specular = np.zeros(len(wi_local))
+        specular = np.zeros((len(wi_local), 3))
         for group in points.groups:
             idx = group.idx
             is_above = cosine[idx] > 0
             above = idx[is_above]
             if len(above):
-                value = group.model_for(is_above).specular(points.wo_local[above], wi_local[above])
+                # a model's specular is a scalar (N,) or, for one that holds its own colours, RGB (N, 3)
+                value = np.asarray(group.model_for(is_above).specular(points.wo_local[above], wi_local[above]))
+                value = value[:, None] if value.ndim == 1 else value
                 specular[above] = np.nan_to_num(value, nan=0.0, posinf=0.0, neginf=0.0)
-        return (points.diffuse_over_pi + points.specular_color * specular[:, None]) * cosine[:, None]
+        return (points.diffuse_over_pi + points.specular_color * specular) * cosine[:, None]
 
     def _brdf_pdf(self, points, wi_local):
         q = points.specular_probability

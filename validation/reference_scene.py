@@ -7,10 +7,11 @@ light transport differs.
 """
 import numpy as np
 
+from sg_prt_addon.biscale import effective_brdf
 from sg_prt_addon.blender import export
 from sg_prt_addon.reflectance import brdf, models
 from sg_prt_addon.techniques import sg_shading
-from validation import reference
+from validation import biscale_reference, reference
 from validation.camera import Camera
 
 
@@ -36,10 +37,17 @@ def _texture_lookup(params, images):
     return lookup
 
 
-def reference_material(params, texture_pixels):
+def reference_material(params, texture_pixels, biscale_geometry=None):
     """validation.reference.Material of an export.MaterialParams; texture_pixels(texture, slot, decode) gives
     what the shader samples for that slot (export.slot_pixels of an image name or Expression), or None for a
-    missing image."""
+    missing image.  A bi-scale material (params.biscale) renders its ray-traced tile: biscale_geometry(name)
+    gives the material's biscale.microgeometry tile."""
+    if getattr(params, "biscale", None) is not None and biscale_geometry is not None:
+        small = effective_brdf.SmallScaleMaterial(
+            tuple(params.diffuse_color), tuple(params.specular_color), params.model,
+            tuple((name, float(getattr(params, name))) for name in models.BY_NAME[params.model].parameters))
+        return reference.Material((0.0, 0.0, 0.0), (1.0, 1.0, 1.0),
+                                  biscale_reference.TracedEffectiveBRDF(biscale_geometry(params.name), small))
     constant = {name: float(getattr(params, name)) for name in models.BY_NAME[params.model].parameters}
     material = reference.Material(np.asarray(params.diffuse_color, float), np.asarray(params.specular_color, float),
                                   brdf.model_from_name(params.model, **constant))
@@ -86,10 +94,12 @@ def anisotropy_tangents(mesh, entry, materials):
     return tangents
 
 
-def reference_scene(state, texture_pixels):
-    """validation.reference.Scene of a synced engine SceneState; texture_pixels as reference_material takes it."""
+def reference_scene(state, texture_pixels, biscale_geometry=None):
+    """validation.reference.Scene of a synced engine SceneState; texture_pixels and biscale_geometry as
+    reference_material takes them."""
     material_names = list(state.materials)
-    materials = [reference_material(state.materials[name], texture_pixels) for name in material_names]
+    materials = [reference_material(state.materials[name], texture_pixels, biscale_geometry)
+                 for name in material_names]
     vertices, normals, uvs, tangents, triangles, material_index = [], [], [], [], [], []
     offset = 0
     for entry in state.objects.values():
@@ -131,9 +141,15 @@ def reference_inputs(depsgraph, width, height):
             return None
         return export.slot_pixels(value, slot, decode)
 
+    def biscale_geometry(material_name):
+        from sg_prt_addon.blender import biscale_source
+
+        return biscale_source.geometry(bpy.data.materials[material_name])
+
     scene = depsgraph.scene
     camera = export.export_camera(scene.camera.evaluated_get(depsgraph), depsgraph, width, height)
-    return reference_scene(state, texture_pixels), Camera(camera.view, camera.projection, width, height)
+    return reference_scene(state, texture_pixels, biscale_geometry), Camera(camera.view, camera.projection, width,
+                                                                            height)
 
 
 class AnalyticSpecular:

@@ -67,6 +67,11 @@ def _geometry_and_key(settings):
     return geometry, digest.hexdigest()
 
 
+def geometry(material):
+    """The material's biscale.microgeometry tile (ValueError with the reason when it has none)."""
+    return _geometry_and_key(material.sgprt.biscale)[0]
+
+
 def tables(material):
     """(BVNDF, None) of the material's tile, or (None, the reason it has none)."""
     settings = material.sgprt.biscale

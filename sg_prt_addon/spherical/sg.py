@@ -139,3 +139,13 @@ def convolution_lobe(sharpness1, amplitude1, sharpness2, amplitude2):
     l1, l2 = np.asarray(sharpness1), np.asarray(sharpness2)
     total = np.maximum(l1 + l2, np.finfo(_float_dtype(l1, l2)).tiny)
     return l1 * l2 / total, TWO_PI * np.asarray(amplitude1) * np.asarray(amplitude2) / total
+
+
+def axis_cosine_integral(sharpness):
+    """Integral of G(h; n, lambda, 1) (h.n) over the hemisphere around its own axis n:
+    2 pi (1 - (1 - e^-lambda) / lambda) / lambda, the projected mass of an NDF lobe (1 for a normalized NDF)."""
+    sharpness = np.asarray(sharpness)
+    dtype = _float_dtype(sharpness)
+    safe = np.where(sharpness > 1e-3, sharpness, 1.0)
+    value = np.where(sharpness > 1e-3, (1.0 - one_minus_exp_over_x(safe)) / safe, 0.5 - sharpness / 6.0)
+    return (TWO_PI * value).astype(dtype, copy=False)

@@ -16,36 +16,52 @@ FLOAT = np.float32
 SMALL_SCALE_MODELS = tuple(model.name for model in models.MODELS if not model.anisotropic)
 
 
-def small_lobe(model, params):
-    """(sharpness (N,), amplitude (N,)) of the small-scale model's one NDF lobe per pixel (biscale_small_lobe)."""
+def small_lobe_count(model):
+    """The small-scale model's SG lobes: GGX's two-lobe fit (its tail holds a quarter of its mass at roughness
+    0.5), one for the others."""
+    return 2 if model == "GGX" else 1
+
+
+def small_lobes(model, params):
+    """(sharpness (N, S), amplitude (N, S)) of the small-scale model's NDF lobes per pixel (biscale_small_lobes),
+    their projected mass made 1, as the NDF's (biscale.effective_brdf.SmallScaleMaterial.ndf_lobes)."""
     if model not in SMALL_SCALE_MODELS:
         raise ValueError(f"a bi-scale material's small-scale model must be isotropic, not {model}")
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
-    _, sharpness, amplitude = instance.ndf_lobes()
-    return np.asarray(sharpness, np.float64)[..., 0], np.asarray(amplitude, np.float64)[..., 0]
+    lobes = instance.ndf_lobes(2) if model == "GGX" else instance.ndf_lobes()
+    sharpness = np.asarray(lobes[1], np.float64)
+    amplitude = np.asarray(lobes[2], np.float64)
+    mass = np.sum(amplitude * sg.axis_cosine_integral(sharpness), axis=-1, keepdims=True)
+    return sharpness, amplitude / np.maximum(mass, 1e-30)
 
 
 def effective_lobes(tables, small_sharpness, small_amplitude):
-    """biscale_lobe for every pixel and BVNDF lobe: axis (N, J, 3), sharpness (N, J), amplitude (N, J)."""
-    eta_j = np.asarray(tables.sharpness, np.float64)[None, :]
-    eta_s = small_sharpness[:, None]
+    """biscale_lobe for every pixel, BVNDF lobe j and small-scale lobe s (index j S + s): axis (N, J S, 3),
+    sharpness (N, J S), amplitude (N, J S)."""
+    count, small = small_sharpness.shape
+    eta_j = np.repeat(np.asarray(tables.sharpness, np.float64), small)[None, :]
+    eta_s = np.tile(small_sharpness, (1, tables.lobe_count))
+    mu_s = np.tile(small_amplitude, (1, tables.lobe_count))
     total = np.maximum(eta_j + eta_s, 1e-30)
-    axis = np.broadcast_to(sg.normalize(tables.axes)[None], (len(eta_s),) + tables.axes.shape)
-    return axis, eta_j * eta_s / total, 2.0 * np.pi * small_amplitude[:, None] / total
+    axes = np.repeat(sg.normalize(np.asarray(tables.axes, np.float64)), small, axis=0)
+    return np.broadcast_to(axes[None], (count,) + axes.shape), eta_j * eta_s / total, 2.0 * np.pi * mu_s / total
 
 
 def m_factor_rows(tables, model, params, small_sharpness, nodes):
-    """m_factor(wo, wi) for warp.brdf_slice_lobes: rows (lobe j's nodes one after the other, leading) times
-    mu_j(wi, wo) at the product axis n* = normalize(eta_j xi_j + eta_s h) (biscale_m_factor)."""
+    """m_factor(wo, wi) for warp.brdf_slice_lobes: rows (effective lobe j S + s's nodes one after the other,
+    leading) times mu_j(wi, wo), M at the product axis n* = normalize(eta_j xi_j + eta_s h) (biscale_m_factor)."""
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[None] for k, v in params.items()})
-    lobe_of_row = np.repeat(np.arange(tables.lobe_count), nodes)
+    small = small_sharpness.shape[1]
+    effective_of_row = np.repeat(np.arange(tables.lobe_count * small), nodes)
+    lobe_of_row = effective_of_row // small
     axes = sg.normalize(np.asarray(tables.axes, np.float64))[lobe_of_row][:, None, :]          # (K', 1, 3)
     eta_j = np.asarray(tables.sharpness, np.float64)[lobe_of_row][:, None, None]
+    eta_s = small_sharpness.T[effective_of_row % small][..., None]                              # (K', N, 1)
 
     def m_factor(wo, wi):          # (K', N, 3) each
         wo = sg.normalize(np.asarray(wo, np.float64))
         wi = sg.normalize(np.asarray(wi, np.float64))
-        facet = sg.normalize(eta_j * axes + small_sharpness[None, :, None] * sg.normalize(wo + wi))
+        facet = sg.normalize(eta_j * axes + eta_s * sg.normalize(wo + wi))
         frames = hemisphere_map.local_frame(facet)
         local_o = np.einsum("...ij,...j->...i", frames, wo)
         local_i = np.einsum("...ij,...j->...i", frames, wi)
@@ -70,7 +86,7 @@ def slice_lobes(tables, model, params, view_local, warp_mode=None):
     """The BRDF slice of a bi-scale material (sg_shading.glsl's slice loop under BISCALE): axis (N, K', 3)
     local, sharpness (N, K'), amplitude (N, K')."""
     mode = warp_mode or warp.DEFAULT_MODE
-    small_sharpness, small_amplitude = small_lobe(model, params)
+    small_sharpness, small_amplitude = small_lobes(model, params)
     axis, sharpness, amplitude = effective_lobes(tables, small_sharpness, small_amplitude)
     m_factor = m_factor_rows(tables, model, params, small_sharpness, warp.nodes_per_lobe(mode))
     return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, m_factor, mode=mode)

@@ -1,7 +1,7 @@
 """iwasaki2012's bi-scale materials rendered by wang2009's SG shading: the effective BRDF of a small-scale tile
 (its BVNDF's lobes and tables, biscale.bvndf, from export.MaterialParams.biscale) with the material's own
 isotropic model as the small-scale BRDF (shaders/techniques/sg/biscale.glsl; mirror biscale_shading.py)."""
-from . import biscale_shading
+from . import biscale_shading, sg_parametric
 from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
 from .sg_parametric import material_terms
 
@@ -27,14 +27,16 @@ class SGBiScale(SGLobes):
                              f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}")
         has_diffuse, has_specular = material_terms(params)
         textures = tuple(sorted(name for name in params.textures if name in TEXTURES and name in TEXTURE_SLOTS))
-        return VariantKey(self.name, params.model, int(tables.lobe_count), textures=textures,
+        lobes = int(tables.lobe_count) * biscale_shading.small_lobe_count(params.model)
+        return VariantKey(self.name, params.model, lobes, textures=textures,
                           has_diffuse=has_diffuse, has_specular=has_specular, warp_mode=warp_mode_of(params),
                           biscale_resolution=int(tables.resolution), **scene_fields(inputs, has_diffuse, has_specular))
 
     def model_defines(self, key):
-        # the key's lobe count is the BVNDF's
-        return {"BISCALE": 1, "BISCALE_RESOLUTION": key.biscale_resolution,
-                "BISCALE_LOBE_LAYERS": biscale_shading.lobe_layers(key.ndf_lobes)}
+        # the key's lobe count is the effective lobes': the BVNDF's times the small-scale model's
+        small = biscale_shading.small_lobe_count(key.model)
+        return {"BISCALE": 1, "BISCALE_RESOLUTION": key.biscale_resolution, "BISCALE_SMALL_LOBES": small,
+                "BISCALE_LOBE_LAYERS": biscale_shading.lobe_layers(key.ndf_lobes // small)}
 
     def library_files(self, key):
         """The BRDF (the small-scale M, even for a diffuse-only variant: biscale.glsl compiles it) and the
@@ -47,11 +49,13 @@ class SGBiScale(SGLobes):
         return files
 
     def technique_files(self, key):
-        files = super().technique_files(key)
-        return [("sg", "biscale.glsl")] + files
+        """biscale.glsl (after GGX's two-lobe table reader) before the SG shading it plugs into."""
+        own = ([("sg", "ggx_two_lobes.glsl")] if key.model == "GGX" else []) + [("sg", "biscale.glsl")]
+        return own + [entry for entry in super().technique_files(key) if entry not in own]
 
     def model_samplers(self, key):
-        return [("FLOAT_2D", "biscale_lobes"), ("FLOAT_2D_ARRAY", "biscale_tables")]
+        samplers = [("FLOAT_2D", "biscale_lobes"), ("FLOAT_2D_ARRAY", "biscale_tables")]
+        return samplers + ([("FLOAT_2D", "ggx_table")] if key.model == "GGX" else [])
 
     def bind_model(self, shader, key, context):
         tables = context.params.biscale
@@ -59,6 +63,8 @@ class SGBiScale(SGLobes):
             ("biscale_lobes", tables.signature), lambda: biscale_shading.lobe_texture(tables)))
         shader.uniform_sampler("biscale_tables", context.material_table(
             ("biscale_tables", tables.signature), lambda: biscale_shading.table_texture(tables)))
+        if key.model == "GGX":
+            shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", sg_parametric.ggx_table))
 
 
 TECHNIQUE = SGBiScale()

@@ -81,8 +81,8 @@ def test_flat_tile_is_the_small_scale_sg_brdf():
     wi, wo = reference.direction_pairs(30)
     lobe_sharpness, lobe_amplitude = GGX_05.ndf_lobes()
     h = sg.normalize(wi + wo)
-    expected = GGX_05.brdf().m_factor(wo, wi) * sg.evaluate(h, np.array([0.0, 0.0, 1.0]), lobe_sharpness,
-                                                           lobe_amplitude)
+    expected = GGX_05.brdf().m_factor(wo, wi) * np.sum(sg.evaluate(h[:, None], np.array([0.0, 0.0, 1.0]),
+                                                                  lobe_sharpness, lobe_amplitude), axis=1)
     # within the capped sharpness of the flat lobe (spherical_em.MAX_SHARPNESS): 33 / 1e5 of the exponent
     np.testing.assert_allclose(effective.specular(wi, wo), expected, rtol=5e-3)
     np.testing.assert_allclose(effective.diffuse_factor(wi, wo), 1.0, rtol=1e-5)

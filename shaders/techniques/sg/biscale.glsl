@@ -63,33 +63,46 @@ float biscale_albedo()
   return biscale_fetch(BISCALE_LOBE_LAYERS, vec3(0.0, 0.0, 1.0)).y;
 }
 
-/* The small-scale model's one NDF lobe around the facet normal: (sharpness, amplitude). */
-vec2 biscale_small_lobe(vec4 p)
+/* The small-scale model's NDF lobes around the facet normal, (sharpness, amplitude) each, their projected
+ * mass made 1 (spherical.sg.axis_cosine_integral: 2 pi (1 - (1 - e^-s) / s) / s): GGX's two-lobe fit
+ * (ggx_two_lobes.glsl), one lobe for the others.  Set once a pixel by biscale_set_small_lobes. */
+vec2 biscale_small[BISCALE_SMALL_LOBES];
+
+void biscale_set_small_lobes(vec4 p)
 {
+  float mass = 0.0;
+  for (int s = 0; s < BISCALE_SMALL_LOBES; s++) {
+    vec2 lobe = vec2(1.0);
 #if defined(MODEL_GGX)
-  return ggx_ndf_lobe(p.x);
+    ggx_two_lobes(ggx_table, p.x, s, lobe.x, lobe.y);
 #elif defined(MODEL_COOK_TORRANCE)
-  return cook_torrance_ndf_lobe(p.x);
+    lobe = cook_torrance_ndf_lobe(p.x);
 #elif defined(MODEL_BLINN_PHONG)
-  return blinn_phong_ndf_lobe(p.z);
+    lobe = blinn_phong_ndf_lobe(p.z);
 #elif defined(MODEL_WARD_ISO)
-  return ward_isotropic_ndf_lobe(p.w);
-#else
-  return vec2(0.0);
+    lobe = ward_isotropic_ndf_lobe(p.w);
 #endif
+    float sharpness = max(lobe.x, 0.0);
+    mass += lobe.y * (sharpness > 1.0e-3 ? 2.0 * SG_PI * (1.0 - (1.0 - exp(-sharpness)) / sharpness) / sharpness
+                                         : 2.0 * SG_PI * (0.5 - sharpness / 6.0));
+    biscale_small[s] = vec2(sharpness, lobe.y);
+  }
+  for (int s = 0; s < BISCALE_SMALL_LOBES; s++) {
+    biscale_small[s].y /= max(mass, 1.0e-30);
+  }
 }
 
-/* Effective lobe j (eq. 14-15): BVNDF lobe j (xi_j, eta_j) convolved with the small-scale lobe (eta_s, mu_s):
- * axis xi_j, sharpness eta_j eta_s / (eta_j + eta_s), amplitude 2 pi mu_s / (eta_j + eta_s). */
-void biscale_lobe(int j, vec2 small_lobe, out vec3 axis, out float sharpness, out float amplitude,
-                  out float ndf_sharpness)
+/* Effective lobe k = j S + s (eq. 14-15): BVNDF lobe j (xi_j, eta_j) convolved with small-scale lobe s
+ * (eta_s, mu_s): axis xi_j, sharpness eta_j eta_s / (eta_j + eta_s), amplitude 2 pi mu_s / (eta_j + eta_s). */
+void biscale_lobe(int k, out vec3 axis, out float sharpness, out float amplitude, out float ndf_sharpness)
 {
-  vec4 lobe = texelFetch(biscale_lobes, ivec2(j, 0), 0);
+  vec4 lobe = texelFetch(biscale_lobes, ivec2(k / BISCALE_SMALL_LOBES, 0), 0);
+  vec2 small = biscale_small[k % BISCALE_SMALL_LOBES];
   axis = safe_normalize(lobe.xyz);
   ndf_sharpness = lobe.w;
-  float total = max(ndf_sharpness + small_lobe.x, 1.0e-30);
-  sharpness = ndf_sharpness * small_lobe.x / total;
-  amplitude = 2.0 * SG_PI * small_lobe.y / total;
+  float total = max(ndf_sharpness + small.x, 1.0e-30);
+  sharpness = ndf_sharpness * small.x / total;
+  amplitude = 2.0 * SG_PI * small.y / total;
 }
 
 /* M_o(i) of the small-scale model (brdf.glsl), directions in a facet's frame. */
@@ -108,10 +121,11 @@ float biscale_small_m_factor(vec3 wo, vec3 wi, vec4 p)
 #endif
 }
 
-/* mu_j(i, o) times the small-scale M at the product axis n* = normalize(eta_j xi_j + eta_s h), directions in
- * n*'s frame (the models are isotropic: any tangent). */
-float biscale_m_factor(int j, vec3 axis, float ndf_sharpness, float small_sharpness, vec3 wo, vec3 wi, vec4 p)
+/* mu_j(i, o) of effective lobe k = j S + s times the small-scale M at the product axis
+ * n* = normalize(eta_j xi_j + eta_s h), directions in n*'s frame (the models are isotropic: any tangent). */
+float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, vec4 p)
 {
+  float small_sharpness = biscale_small[k % BISCALE_SMALL_LOBES].x;
   wo = safe_normalize(wo);
   wi = safe_normalize(wi);
   if (!(wo.z > 0.0 && wi.z > 0.0)) {
@@ -122,5 +136,5 @@ float biscale_m_factor(int j, vec3 axis, float ndf_sharpness, float small_sharpn
   vec3 t = normalize(cross(helper, facet));
   vec3 b = cross(facet, t);
   mat3 to_facet = transpose(mat3(t, b, facet));
-  return biscale_amplitude(j, wi) * biscale_small_m_factor(to_facet * wo, to_facet * wi, p);
+  return biscale_amplitude(k / BISCALE_SMALL_LOBES, wi) * biscale_small_m_factor(to_facet * wo, to_facet * wi, p);
 }

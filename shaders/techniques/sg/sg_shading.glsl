@@ -280,14 +280,14 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   p.z = fitted_shadowing_of(view_local);       /* S(o), for model_m_factor */
 #endif
 #ifdef BISCALE
-  vec2 small_lobe = biscale_small_lobe(p);
+  biscale_set_small_lobes(p);
 #endif
   for (int k = 0; k < NDF_LOBES; k++) {
     vec3 ndf_axis;
     float ndf_sharpness, ndf_amplitude;
 #ifdef BISCALE
     float bvndf_sharpness;      /* eta_j, for the product axis of M */
-    biscale_lobe(k, small_lobe, ndf_axis, ndf_sharpness, ndf_amplitude, bvndf_sharpness);
+    biscale_lobe(k, ndf_axis, ndf_sharpness, ndf_amplitude, bvndf_sharpness);
     vec3 colour = vec3(1.0);
 #elif defined(MODEL_FITTED)
     vec4 fitted_lobe = fitted_layer(1 + 2 * k);
@@ -313,8 +313,8 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
       int j = WARP_NODES * k + node;
 #ifdef BISCALE
       slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
-                                                biscale_m_factor(k, ndf_axis, bvndf_sharpness, small_lobe.x,
-                                                                 view_local, warped_axis[node], p));
+                                                biscale_m_factor(k, ndf_axis, bvndf_sharpness, view_local,
+                                                                 warped_axis[node], p));
 #else
       slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
                                                 model_m_factor(view_local, warped_axis[node], p, q));
