@@ -67,6 +67,15 @@ def _geometry_and_key(settings):
     return geometry, digest.hexdigest()
 
 
+def reads(material):
+    """The datablocks the tile comes from, as export.MaterialParams.reads holds them."""
+    settings = material.sgprt.biscale
+    if settings.source == "IMAGE":
+        return () if settings.height_image is None else (("IMAGE", settings.height_image.name),)
+    tile = settings.tile_object
+    return () if tile is None else (("OBJECT", tile.name),) + ((("MESH", tile.data.name),) if tile.data else ())
+
+
 def geometry(material):
     """The material's biscale.microgeometry tile (ValueError with the reason when it has none)."""
     return _geometry_and_key(material.sgprt.biscale)[0]

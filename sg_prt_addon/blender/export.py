@@ -135,6 +135,9 @@ class MaterialParams:
     fitted: object = None          # FittedLobes with the fitted-lobes technique and a VALID stored fit
     factorization: object = None   # techniques.factored.FactoredTables of VALID stored factors (factored technique)
     biscale: object = None         # biscale.bvndf.BVNDF of the material's small-scale tile (bi-scale technique)
+    # datablocks the look is computed from besides its texture images, ("IMAGE" | "OBJECT" | "MESH", name): the
+    # scene state exports the material again when one changes (a bi-scale tile's height image or mesh)
+    reads: tuple = ()
 
     def values_key(self):
         """Everything but textures, hashable: the material UBO is rebuilt when this changes."""
@@ -471,6 +474,7 @@ def _usable_biscale(material, params):
         warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} needs an isotropic small-scale model "
              f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}: rendered as a single scale")
         return techniques.DEFAULT
+    params.reads = biscale_source.reads(material)
     params.biscale, reason = biscale_source.tables(material)
     if params.biscale is None:
         warn(f"material '{material.name}': no usable small-scale geometry ({reason}): rendered as a single scale")

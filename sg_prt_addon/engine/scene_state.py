@@ -270,6 +270,7 @@ class SceneState:
                 dirty.materials.add(datablock.name)
             elif isinstance(datablock, bpy.types.Image):
                 dirty.images.add(datablock.name)
+                self._export_readers(("IMAGE", datablock.name), dirty)
                 if self.world.image_name == datablock.name and depsgraph.scene.world is not None:
                     self.world = export.export_world(depsgraph.scene.world)
                     self.environment = environment_data(self.world, self.environment_layer_size)
@@ -282,14 +283,28 @@ class SceneState:
                 membership_changed = True       # objects may have been added, removed or hidden
             elif isinstance(datablock, bpy.types.Object):
                 self._update_object(depsgraph, datablock.evaluated_get(depsgraph), update, dirty)
+                if update.is_updated_geometry:
+                    self._export_readers(("OBJECT", datablock.name), dirty)
             elif isinstance(datablock, bpy.types.Light):
                 dirty.lights = True
+            elif isinstance(datablock, bpy.types.Mesh) and update.is_updated_geometry:
+                self._export_readers(("MESH", datablock.name), dirty)
         if membership_changed:
             self._sync_membership(depsgraph, dirty)
         if dirty.lights:
             self.lights = [export.export_light(obj) for obj in depsgraph.objects if obj.type == "LIGHT"]
             self.lights = [light for light in self.lights if light is not None]
         return dirty
+
+    def _export_readers(self, source, dirty):
+        """Export again the materials computed from `source` (export.MaterialParams.reads), e.g. after its pixels
+        or its mesh changed."""
+        import bpy
+
+        for name in [name for name, params in self.materials.items() if source in params.reads]:
+            if name in bpy.data.materials:
+                self.materials[name] = export.export_material(bpy.data.materials[name])
+                dirty.materials.add(name)
 
     def _sync_membership(self, depsgraph, dirty):
         """Drop objects no longer in the evaluated scene (or now indirect only), export the ones that appeared,

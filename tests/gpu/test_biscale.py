@@ -60,3 +60,72 @@ def test_unusable_tile_renders_single_scale_with_a_reason(blender):
     assert "error" not in result
     assert result["state"].materials[material.name].technique == "SG_PARAMETRIC"
     assert any("no usable small-scale geometry (no height image)" in w for w in result["state"].warnings)
+
+
+def test_an_edited_height_field_or_tile_mesh_is_followed(blender):
+    """What view_update sees: painting the height image, or editing the tile mesh, exports the material again
+    with the new tile's tables (a new signature); a redraw without an edit keeps them."""
+    import bpy
+
+    fx.ensure_registered()
+    scene = bpy.context.scene
+    for obj in list(scene.objects):
+        bpy.data.objects.remove(obj)
+    material = biscale_material("biscale_edit", biscale_reference.egg_crate(16), model="GGX", roughness=0.3)
+    sphere = fx.uv_sphere(scene, "biscale_edit_sphere", (0.0, 0.0, 1.0), segments=12, rings=6)
+    sphere.data.materials.append(material)
+    tile = fx.grid(scene, "biscale_edit_tile", (5.0, 0.0, 0.0), size=1.0, segments=8)
+    view_layer = bpy.context.view_layer
+    try:
+        with fx.tracked_state(scene, view_layer) as state:
+            first = state.materials[material.name].biscale.signature
+            image = material.sgprt.biscale.height_image
+            pixels = np.repeat(np.flipud(biscale_reference.egg_crate(16, amplitude=0.1))[..., None], 4, axis=-1)
+            image.pixels.foreach_set(pixels.astype(np.float32).ravel())
+            image.update()
+            image.update_tag()                           # what painting the image tags
+            view_layer.update()
+            assert material.name in state.consume_dirty().materials
+            second = state.materials[material.name].biscale.signature
+            assert second != first
+            view_layer.update()                          # nothing changed: nothing exported
+            assert material.name not in state.consume_dirty().materials
+            # the mesh tile: a bump in the grid is a new tile
+            material.sgprt.biscale.source = "OBJECT"
+            material.sgprt.biscale.tile_object = tile
+            view_layer.update()
+            state.consume_dirty()
+            flat = state.materials[material.name].biscale.signature
+            tile.data.vertices[40].co.z += 0.1
+            tile.data.update()
+            view_layer.update()
+            assert material.name in state.consume_dirty().materials
+            assert state.materials[material.name].biscale.signature not in (flat, second)
+    finally:
+        for obj in list(scene.objects):
+            bpy.data.objects.remove(obj)
+
+
+def test_saved_file_reopens_and_renders_the_same_image(blender, tmp_path):
+    """Settings, the packed height image and the tile object survive; the reopened file computes the same
+    tables (the same seed) and renders the same image."""
+    import bpy
+
+    fx.ensure_registered()
+    material = biscale_material("biscale_saved", biscale_reference.random_bumps(16), model="BLINN_PHONG",
+                                exponent=300.0, diffuse_color=(0.2, 0.3, 0.4), specular_color=(0.7, 0.6, 0.5))
+    material.sgprt.biscale.height_image.pack()
+    material.sgprt.biscale.lobes = 6
+    scene = _scene("biscale_saved_scene", material, "colour")
+    before = fx.render(scene)["passes"]["Combined"].copy()
+    assert before[..., :3].max() > 0.05
+    path = tmp_path / "biscale.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    settings = bpy.data.materials["biscale_saved"].sgprt
+    assert (settings.technique, settings.biscale.source, settings.biscale.lobes, settings.biscale.samples,
+            settings.biscale.height_image.name) == ("SG_BISCALE", "IMAGE", 6, 2048, "biscale_saved_height")
+    result = fx.render(bpy.data.scenes["biscale_saved_scene"])
+    assert result["state"].materials["biscale_saved"].technique == "SG_BISCALE"
+    np.testing.assert_array_equal(result["passes"]["Combined"], before)
