@@ -178,9 +178,63 @@ def build_brushed_metal(resolution=512):
     return scene
 
 
+def _hammered_heights(size=64, dents=40, seed=3):
+    """A tileable field of overlapping round dents (heights in tile widths), as a hammered metal sheet."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[0:size, 0:size] / size
+    heights = np.zeros((size, size))
+    for cx, cy, radius in zip(rng.random(dents), rng.random(dents), rng.uniform(0.08, 0.16, dents)):
+        dx = (x - cx + 0.5) % 1.0 - 0.5             # periodic distance: the sheet tiles
+        dy = (y - cy + 0.5) % 1.0 - 0.5
+        depth = np.sqrt(np.maximum(radius * radius - dx * dx - dy * dy, 0.0)) - 0.85 * radius   # rims at 32 degrees
+        heights = np.minimum(heights, -np.maximum(depth, 0.0))
+    return heights
+
+
+def _height_image(name, heights):
+    """A packed float image of heights (row 0 at the top), Non-Color."""
+    size = heights.shape[0]
+    image = bpy.data.images.new(name, size, size, alpha=False, float_buffer=True)
+    image.colorspace_settings.name = "Non-Color"
+    rgba = np.repeat(heights[::-1, :, None], 4, axis=-1)
+    rgba[..., 3] = 1.0
+    image.pixels.foreach_set(np.ascontiguousarray(rgba, np.float32).ravel())
+    image.pack()
+    return image
+
+
+def build_hammered_metal(resolution=512):
+    """A hammered gold sphere (a bi-scale material, iwasaki2012: a height field of dents under a glossy GGX)
+    beside a smooth one of the same small-scale BRDF, on a floor under courtyard.exr."""
+    scene = _empty_file()
+    scene.render.engine = ENGINE_ID
+    scene.render.resolution_x = scene.render.resolution_y = resolution
+    _world_with_hdri(scene, bundled_hdri("courtyard"))
+    gold = dict(model="GGX", diffuse_color=(0.0, 0.0, 0.0), specular_color=(1.0, 0.78, 0.34), roughness=0.2)
+    hammered = _material("Hammered Gold", technique="SG_BISCALE", **gold)
+    hammered.sgprt.biscale.height_image = _height_image("hammered_heights", _hammered_heights())
+    hammered.sgprt.biscale.height_scale = 1.0
+    smooth = _material("Smooth Gold", **gold)
+    floor_material = _material("Floor", model="GGX", diffuse_color=(0.35, 0.35, 0.35),
+                               specular_color=(0.05, 0.05, 0.05), roughness=0.6)
+
+    floor = _grid("Floor", size=8.0, subdivisions=64)
+    floor.data.materials.append(floor_material)
+    for name, material, x in (("Hammered", hammered, -1.15), ("Smooth", smooth, 1.15)):
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0, location=(x, 0.0, 1.0))
+        sphere = bpy.context.active_object
+        sphere.name = name
+        sphere.data.shade_smooth()
+        sphere.data.materials.append(material)
+
+    _add_camera(scene, location=(0.0, -6.0, 2.4), target=(0.0, 0.0, 0.9))
+    return scene
+
+
 SCENES = {
     "suzanne_courtyard": build_suzanne_courtyard,
     "brushed_metal": build_brushed_metal,
+    "hammered_metal": build_hammered_metal,
 }
 
 

@@ -33,6 +33,7 @@ HORIZON_LIFT = np.radians(3.0)
 _SOLVER_ITERATIONS = 200
 AMPLITUDE_SOLVES = ("responsibility", "least_squares")
 ALBEDO_POINTS = 2048
+NORMAL_BIN = 1e-2             # per normal component, about 0.6 degree: below the lobes' widths (docs/ACCURACY.md)
 
 
 def lattice_directions(resolution):
@@ -97,15 +98,15 @@ def trace_tile(geometry, resolution=DEFAULT_RESOLUTION, samples=microgeometry.DE
     points = microgeometry.sample_points(geometry, samples, seed)
     own = tracer is None
     tracer = tracer or microgeometry.TiledTracer(geometry)
+    cosines = np.maximum(points.normals @ directions.T, 0.0)
+    point_index, node_index = np.nonzero(cosines)       # a facet turned away needs no ray: its weight is 0
     try:
-        count, nodes = len(points.positions), len(directions)
-        repeated = np.repeat(directions[None], count, axis=0).reshape(-1, 3)
-        visible = tracer.visible(np.repeat(points.positions, nodes, axis=0),
-                                 np.repeat(points.normals, nodes, axis=0), repeated).reshape(count, nodes)
+        visible = tracer.visible(points.positions[point_index], points.normals[point_index],
+                                 directions[node_index])
     finally:
         if own:
             tracer.close()
-    cosines = np.maximum(points.normals @ directions.T, 0.0) * visible
+    cosines[point_index[~visible], node_index[~visible]] = 0.0
     projected = points.area * cosines.sum(axis=0)
     if np.any(projected <= 0):
         raise ValueError("the tile shows nothing towards some directions of the lattice "
@@ -128,10 +129,23 @@ def solve_nonnegative(gram, right, iterations=_SOLVER_ITERATIONS):
     return mu
 
 
+def binned_normals(normals, areas, step=NORMAL_BIN):
+    """The triangles' normals merged where they agree within `step` (per component), their areas summed:
+    (normals (M, 3), areas (M,)), M at most the distinct directions, not the triangles (iwasaki2012 bins the
+    NDF on a cube map first; a height field of 256^2 texels has 131k triangles, far fewer distinct normals
+    at the lobes' widths)."""
+    keys = np.round(np.asarray(normals, np.float64) / step).astype(np.int64)
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    summed = np.zeros((len(unique), 3))
+    np.add.at(summed, inverse, normals * areas[:, None])
+    return sg.normalize(summed), np.bincount(inverse, areas, minlength=len(unique))
+
+
 def fit_ndf(geometry, lobes=DEFAULT_LOBES):
-    """The NDF's lobes: spherical EM over the triangles' normals weighted by their areas (eq. 6)."""
+    """The NDF's lobes: spherical EM over the triangles' normals weighted by their areas (eq. 6), binned."""
     normals, areas = geometry.facets()
-    return spherical_em.fit(normals, areas, lobes)
+    return spherical_em.fit(*binned_normals(normals, areas), lobes)
 
 
 def compute(geometry, lobes=DEFAULT_LOBES, resolution=DEFAULT_RESOLUTION, samples=microgeometry.DEFAULT_SAMPLES,

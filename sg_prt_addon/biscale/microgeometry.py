@@ -14,8 +14,8 @@ from ..visibility import raytrace
 
 # Sample points of the area integrals (eq. 2): iwasaki2012 section 5 samples the tile by area this way.
 DEFAULT_SAMPLES = 8192
-# Segments of one period sideways a ray is traced through before it counts as escaped (TiledTracer)
-MAX_SEGMENTS = 24
+# Cell sides a ray crosses before it counts as escaped (TiledTracer)
+MAX_SEGMENTS = 64
 
 
 @dataclass(frozen=True)
@@ -126,19 +126,17 @@ def sample_points(geometry, count=DEFAULT_SAMPLES, seed=0):
 
 
 class TiledTracer:
-    """Rays against the periodic surface: the tile and its 8 neighbours are traced in segments that move at
-    most one period sideways; a ray that passes a segment is wrapped back into the tile and goes on, until it
-    rises above the geometry (then nothing can stop it) or MAX_SEGMENTS have passed (then it counts as free:
-    only rays within a few degrees of the horizon over a steep tile get there)."""
+    """Rays against the periodic surface, with the tile traced alone: a ray goes from cell side to cell side
+    (the tile's x y box) and, where it leaves, comes back in at the opposite side, until it stops, rises above
+    the geometry (then nothing can stop it) or has crossed MAX_SEGMENTS sides (then it counts as free: rays
+    within a few degrees of the horizon over a steep tile)."""
 
     def __init__(self, geometry, threads=2):
         self.geometry = geometry
-        offsets = [(i * geometry.size[0], j * geometry.size[1], 0.0) for i in (-1, 0, 1) for j in (-1, 0, 1)]
-        vertices = np.concatenate([geometry.vertices + np.asarray(offset) for offset in offsets])
-        triangles = np.concatenate([geometry.triangles + k * len(geometry.vertices) for k in range(len(offsets))])
-        self._tracer = raytrace.RayTracer(vertices, triangles, threads=threads)
+        self._tracer = raytrace.RayTracer(geometry.vertices, geometry.triangles, threads=threads)
         self.offset = 1e-4 * max(geometry.size)
         self.top = float(geometry.vertices[:, 2].max()) if len(geometry.vertices) else 0.0
+        self._size = np.asarray(geometry.size, np.float64)
 
     def wrap(self, points):
         """Points moved by whole periods into the tile."""
@@ -147,30 +145,42 @@ class TiledTracer:
         points[..., 1] = np.mod(points[..., 1], self.geometry.size[1])
         return points
 
-    def _segment_length(self, directions):
-        """Ray parameter over which a ray moves one period sideways (inf straight up or down)."""
-        sideways = np.hypot(directions[:, 0], directions[:, 1])
-        return np.where(sideways > 0, min(self.geometry.size) / np.maximum(sideways, 1e-300), np.inf)
+    def _to_side(self, origins, directions):
+        """(ray parameter to the side of the cell the ray leaves by (N,), that side's axis (N,))."""
+        distance = np.full((len(origins), 2), np.inf)
+        for axis in (0, 1):
+            d = directions[:, axis]
+            forward, backward = d > 0, d < 0
+            distance[forward, axis] = (self._size[axis] - origins[forward, axis]) / d[forward]
+            distance[backward, axis] = -origins[backward, axis] / d[backward]
+        axis = np.argmin(distance, axis=1)
+        return np.maximum(distance[np.arange(len(origins)), axis], 0.0), axis
 
     def _march(self, origins, directions, query, out):
-        """Trace segment by segment: query(origins, directions, lengths) -> (stopped (M,) bool, value (M, ...))
-        for the rays still going; a stopped ray's value goes to its row of out.  Returns (N,) stopped."""
+        """Trace side to side: query(origins, directions, lengths) -> (stopped (M,) bool, value (M, ...)) for
+        the rays still going; a stopped ray's value goes to its row of out.  Returns (N,) stopped."""
         origins = self.wrap(origins)
         directions = np.asarray(directions, np.float64)
-        lengths = self._segment_length(directions)
         going = np.arange(len(origins))
         stopped = np.zeros(len(origins), bool)
-        for _ in range(MAX_SEGMENTS):
+        for segment in range(MAX_SEGMENTS):
             if not len(going):
                 break
-            done, value = query(origins[going], directions[going], np.minimum(lengths[going], 1e30))
+            o, d = (origins, directions) if segment == 0 else (origins[going], directions[going])
+            length, axis = self._to_side(o, d)
+            done, value = query(o, d, np.minimum(length, 1e30))
             out[going[done]] = value[done]
             stopped[going[done]] = True
-            going = going[~done]
-            ends = origins[going] + np.minimum(lengths[going], 1e30)[:, None] * directions[going]
-            escaped = (ends[:, 2] > self.top) | ~np.isfinite(lengths[going])
-            going = going[~escaped]
-            origins[going] = self.wrap(ends[~escaped])
+            keep = ~done & np.isfinite(length)
+            ends = o[keep] + length[keep, None] * d[keep]
+            keep[keep] = ends[:, 2] <= self.top          # risen above the geometry: free
+            ends = ends[ends[:, 2] <= self.top]
+            going, axis, d = going[keep], axis[keep], d[keep]
+            rows = np.arange(len(going))
+            ends = self.wrap(ends)
+            # in again at the opposite side (exactly on it: a wrap would take the far side to 0 again)
+            ends[rows, axis] = np.where(d[rows, axis] > 0, 0.0, self._size[axis])
+            origins[going] = ends
         return stopped
 
     def visible(self, positions, normals, directions):
