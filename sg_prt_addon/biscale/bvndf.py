@@ -134,8 +134,9 @@ def binned_normals(normals, areas, step=NORMAL_BIN):
     (normals (M, 3), areas (M,)), M at most the distinct directions, not the triangles (iwasaki2012 bins the
     NDF on a cube map first; a height field of 256^2 texels has 131k triangles, far fewer distinct normals
     at the lobes' widths)."""
-    keys = np.round(np.asarray(normals, np.float64) / step).astype(np.int64)
-    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    cells = int(np.ceil(2.0 / step)) + 1          # per component, over [-1, 1]
+    keys = np.round((np.asarray(normals, np.float64) + 1.0) / step).astype(np.int64)
+    unique, inverse = np.unique((keys[:, 0] * cells + keys[:, 1]) * cells + keys[:, 2], return_inverse=True)
     inverse = inverse.reshape(-1)
     summed = np.zeros((len(unique), 3))
     np.add.at(summed, inverse, normals * areas[:, None])
@@ -159,10 +160,12 @@ def compute(geometry, lobes=DEFAULT_LOBES, resolution=DEFAULT_RESOLUTION, sample
 
 def _lobe_weighted_sums(tile, weights):
     """sum_s w_s(i, o) weights[s, j] for every pair of nodes: (J, K, K), per unit cos(theta_i)."""
-    cosines = tile.cosines.astype(np.float64)
+    cosines = tile.cosines                         # float32: sums of a few thousand terms, 1e-6 relative
+    weights = np.asarray(weights, np.float32)
     # per unit cos(theta_i): the lattice's lifted horizon ring keeps a finite, continuous value
     scale = tile.points.area / (tile.projected_area[None, :] * tile.directions[:, 2][:, None])     # (K_i, K_o)
-    return np.stack([(cosines * weights[:, j:j + 1]).T @ cosines for j in range(weights.shape[1])]) * scale[None]
+    sums = np.stack([(cosines * weights[:, j:j + 1]).T @ cosines for j in range(weights.shape[1])])
+    return sums.astype(np.float64) * scale[None]
 
 
 def from_samples(tile, axes, sharpness, mixture, resolution, solve="responsibility"):
