@@ -49,7 +49,8 @@ def effective_lobes(tables, small_sharpness, small_amplitude):
 
 def m_factor_rows(tables, model, params, small_sharpness, nodes):
     """m_factor(wo, wi) for warp.brdf_slice_lobes: rows (effective lobe j S + s's nodes one after the other,
-    leading) times mu_j(wi, wo), M at the product axis n* = normalize(eta_j xi_j + eta_s h) (biscale_m_factor)."""
+    leading) times mu_j at lobe j's mirror direction and the view, and M at the product axis
+    n* = normalize(eta_j xi_j + eta_s h) (biscale_m_factor)."""
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[None] for k, v in params.items()})
     small = small_sharpness.shape[1]
     effective_of_row = np.repeat(np.arange(tables.lobe_count * small), nodes)
@@ -65,7 +66,9 @@ def m_factor_rows(tables, model, params, small_sharpness, nodes):
         frames = hemisphere_map.local_frame(facet)
         local_o = np.einsum("...ij,...j->...i", frames, wo)
         local_i = np.einsum("...ij,...j->...i", frames, wi)
-        amplitude = paired_amplitudes(tables, lobe_of_row, wi, wo)
+        # mu_j read once a BVNDF lobe, at its mirror direction (biscale_set_lobe_amplitude)
+        mirror = 2.0 * np.sum(wo * axes, axis=-1, keepdims=True) * axes - wo
+        amplitude = paired_amplitudes(tables, lobe_of_row, mirror, wo)
         above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
         return np.where(above, amplitude * instance.m_factor(local_o, local_i), 0.0)
 

@@ -121,8 +121,20 @@ float biscale_small_m_factor(vec3 wo, vec3 wi, vec4 p)
 #endif
 }
 
-/* mu_j(i, o) of effective lobe k = j S + s times the small-scale M at the product axis
- * n* = normalize(eta_j xi_j + eta_s h), directions in n*'s frame (the models are isotropic: any tangent). */
+/* mu_j at BVNDF lobe j's mirror direction 2 (o.xi_j) xi_j - o, the centre of its warped lobes (iwasaki2012's
+ * mu'_j(xi'_j, o)): one table read for the lobe's small-scale lobes and warped nodes, set by the shading loop
+ * at each j's first effective lobe. */
+float biscale_lobe_amplitude;
+
+void biscale_set_lobe_amplitude(int k, vec3 axis, vec3 wo)
+{
+  if (k % BISCALE_SMALL_LOBES == 0) {
+    biscale_lobe_amplitude = biscale_amplitude(k / BISCALE_SMALL_LOBES, 2.0 * dot(wo, axis) * axis - wo);
+  }
+}
+
+/* That amplitude times the small-scale M at the product axis n* = normalize(eta_j xi_j + eta_s h) of effective
+ * lobe k = j S + s, directions in n*'s frame (the models are isotropic: any tangent). */
 float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, vec4 p)
 {
   float small_sharpness = biscale_small[k % BISCALE_SMALL_LOBES].x;
@@ -136,5 +148,5 @@ float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, 
   vec3 t = normalize(cross(helper, facet));
   vec3 b = cross(facet, t);
   mat3 to_facet = transpose(mat3(t, b, facet));
-  return biscale_amplitude(k / BISCALE_SMALL_LOBES, wi) * biscale_small_m_factor(to_facet * wo, to_facet * wi, p);
+  return biscale_lobe_amplitude * biscale_small_m_factor(to_facet * wo, to_facet * wi, p);
 }

@@ -288,6 +288,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef BISCALE
     float bvndf_sharpness;      /* eta_j, for the product axis of M */
     biscale_lobe(k, ndf_axis, ndf_sharpness, ndf_amplitude, bvndf_sharpness);
+    biscale_set_lobe_amplitude(k, ndf_axis, safe_normalize(view_local));
     vec3 colour = vec3(1.0);
 #elif defined(MODEL_FITTED)
     vec4 fitted_lobe = fitted_layer(1 + 2 * k);
