@@ -5,9 +5,10 @@
    points' masking and shadowing towards the 144 lattice directions, the NDF's spherical EM, the amplitudes.
    Median of --runs.
 2. In the engine (pip bpy, examples/build_scenes.py's hammered_metal at --size): the steady frame with the
-   bi-scale material against the same scene with that material on the SG technique (its small-scale BRDF as
-   one scale: the baseline, measured in the same run), and the viewport's next frame after the height image
-   is edited (export again, upload, draw), beside its frame after a plain material edit.
+   bi-scale material (16 lobes and 8, the three-lobe and the one-lobe view warp) against the same scene with
+   that material on the SG technique (its small-scale BRDF as one scale: the baseline, measured in the same
+   run), and the viewport's next frame after the height image is edited (export again, upload, draw), beside
+   its frame after a plain material edit.
 
     .venv/bin/python -m benchmarks.biscale_editing [--size 512] [--runs 5]
 """
@@ -68,7 +69,7 @@ def engine_figures(size, redraws):
     build_scenes.SCENES["hammered_metal"](size)
     material = bpy.data.materials["Hammered Gold"]
     render_seconds()                                     # compiles, prefilters, computes the tables
-    figures = {"bi-scale frame": steady_frame(redraws)}
+    figures = {"bi-scale frame, 16 lobes, warp split3 (the defaults)": steady_frame(redraws)}
     image = material.sgprt.biscale.height_image
     edits = iter(range(1, 1000))
 
@@ -99,6 +100,11 @@ def engine_figures(size, redraws):
     export, painted, touched = render_engine.last_render["after_frame"]
     figures.update({"height edit: export (tables)": export, "height edit: next frame": painted,
                     "material edit: next frame": touched})
+    for lobes, warp in ((16, "PAPER"), (8, "SPLIT3"), (8, "PAPER")):
+        material.sgprt.biscale.lobes, material.sgprt.view_warp = lobes, warp
+        render_seconds()
+        figures[f"bi-scale frame, {lobes} lobes, warp {warp.lower()}"] = steady_frame(redraws)
+    material.sgprt.biscale.lobes, material.sgprt.view_warp = 16, "SPLIT3"
     material.sgprt.technique = "SG_PARAMETRIC"
     render_seconds()
     figures["single-scale frame (SG technique)"] = steady_frame(redraws)
@@ -122,7 +128,7 @@ def main(argv=None):
     baseline = figures["single-scale frame (SG technique)"]
     print(f"\nhammered_metal at {arguments.size}x{arguments.size}, seconds (ratio to the single-scale frame, same run)")
     for name, seconds in figures.items():
-        print(f"  {name:40s} {seconds:.4f}  ({seconds / baseline:.2f}x)")
+        print(f"  {name:52s} {seconds:.4f}  ({seconds / baseline:.2f}x)")
 
 
 if __name__ == "__main__":
