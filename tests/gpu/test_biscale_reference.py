@@ -6,7 +6,7 @@ import engine_fixtures as fx
 import numpy as np
 import pytest
 from scipy.ndimage import binary_erosion
-from test_biscale import biscale_material
+from test_biscale_engine import biscale_material
 
 from validation import biscale_reference, image_error
 from validation.reference import render_to_noise
