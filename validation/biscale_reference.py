@@ -167,3 +167,22 @@ class TracedEffectiveBRDF:
 
     def pdf(self, wo, wi):
         return self.proposal.pdf(wo, wi)
+
+
+class BlendedTiles:
+    """Two TracedEffectiveBRDFs blended per point by weights (N,) of the second (a bi-scale mask): the
+    specular-model protocol for the points a reference texture lookup returns it for."""
+
+    def __init__(self, first, second, weight):
+        self.first, self.second, self.weight = first, second, np.asarray(weight, np.float64)
+
+    def specular(self, wo, wi):
+        weight = self.weight[:, None]
+        return (1.0 - weight) * self.first.specular(wo, wi) + weight * self.second.specular(wo, wi)
+
+    def sample(self, wo, u):
+        return self.first.sample(wo, u)
+
+    def pdf(self, wo, wi):
+        return self.first.pdf(wo, wi)
+

@@ -40,14 +40,25 @@ def _texture_lookup(params, images):
 def reference_material(params, texture_pixels, biscale_geometry=None):
     """validation.reference.Material of an export.MaterialParams; texture_pixels(texture, slot, decode) gives
     what the shader samples for that slot (export.slot_pixels of an image name or Expression), or None for a
-    missing image.  A bi-scale material (params.biscale) renders its ray-traced tile: biscale_geometry(name)
-    gives the material's biscale.microgeometry tile."""
+    missing image.  A bi-scale material (params.biscale) renders its ray-traced tile: biscale_geometry(name,
+    second) gives the material's biscale.microgeometry tile (or the second one its mask chooses)."""
     if getattr(params, "biscale", None) is not None and biscale_geometry is not None:
         small = effective_brdf.SmallScaleMaterial(
             tuple(params.diffuse_color), tuple(params.specular_color), params.model,
             tuple((name, float(getattr(params, name))) for name in models.BY_NAME[params.model].parameters))
-        return reference.Material((0.0, 0.0, 0.0), (1.0, 1.0, 1.0),
-                                  biscale_reference.TracedEffectiveBRDF(biscale_geometry(params.name), small))
+        first = biscale_reference.TracedEffectiveBRDF(biscale_geometry(params.name, False), small)
+        material = reference.Material((0.0, 0.0, 0.0), (1.0, 1.0, 1.0), first)
+        if sg_shading.BISCALE_MASK in params.textures:       # two tiles, chosen by the mask
+            second = biscale_reference.TracedEffectiveBRDF(biscale_geometry(params.name, True), small, seed=12)
+            mask = texture_pixels(params.textures[sg_shading.BISCALE_MASK], sg_shading.BISCALE_MASK)
+
+            def lookup(uv):
+                uv = sg_shading.material_uv(params, uv)
+                weight = np.clip(sg_shading.sample_material_texture(mask, uv)[:, 0].astype(np.float64), 0.0, 1.0)
+                return {"specular_model": biscale_reference.BlendedTiles(first, second, weight)}
+
+            material.textures = lookup
+        return material
     constant = {name: float(getattr(params, name)) for name in models.BY_NAME[params.model].parameters}
     material = reference.Material(np.asarray(params.diffuse_color, float), np.asarray(params.specular_color, float),
                                   brdf.model_from_name(params.model, **constant))
@@ -141,10 +152,10 @@ def reference_inputs(depsgraph, width, height):
             return None
         return export.slot_pixels(value, slot, decode)
 
-    def biscale_geometry(material_name):
+    def biscale_geometry(material_name, second):
         from sg_prt_addon.blender import biscale_source
 
-        return biscale_source.geometry(bpy.data.materials[material_name])
+        return biscale_source.geometry(bpy.data.materials[material_name], second)
 
     scene = depsgraph.scene
     camera = export.export_camera(scene.camera.evaluated_get(depsgraph), depsgraph, width, height)

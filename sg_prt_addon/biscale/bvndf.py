@@ -75,6 +75,35 @@ class BVNDF:
             digest.update(np.ascontiguousarray(array).tobytes())
         return digest.hexdigest()
 
+    # the shading's view of one tile or two (MaskedTiles): lobes [0, first_lobes) are the first tile's
+    first_lobes = property(lambda self: self.lobe_count)
+    diffuse_tiles = property(lambda self: self.integral[None])
+    albedo_tiles = property(lambda self: self.albedo[None])
+
+
+@dataclass(frozen=True)
+class MaskedTiles:
+    """Two tiles chosen per pixel by a mask (iwasaki2012 fig. 1c): the first where the mask is 0, the second
+    where it is 1, their effective BRDFs blended linearly between (a pixel partly covered by each).  Shading
+    reads the two BVNDFs' lobes one after the other, the second's amplitudes and diffuse scaled by the mask."""
+    first: BVNDF
+    second: BVNDF
+
+    def __post_init__(self):
+        if self.first.resolution != self.second.resolution:
+            raise ValueError("the two tiles' tables need the same direction lattice")
+
+    lobe_count = property(lambda self: self.first.lobe_count + self.second.lobe_count)
+    first_lobes = property(lambda self: self.first.lobe_count)
+    resolution = property(lambda self: self.first.resolution)
+    directions = property(lambda self: self.first.directions)
+    signature = property(lambda self: self.first.signature + self.second.signature)
+    axes = property(lambda self: np.concatenate([self.first.axes, self.second.axes]))
+    sharpness = property(lambda self: np.concatenate([self.first.sharpness, self.second.sharpness]))
+    amplitudes = property(lambda self: np.concatenate([self.first.amplitudes, self.second.amplitudes]))
+    diffuse_tiles = property(lambda self: np.stack([self.first.integral, self.second.integral]))
+    albedo_tiles = property(lambda self: np.stack([self.first.albedo, self.second.albedo]))
+
 
 @dataclass(frozen=True)
 class TileSamples:

@@ -12,6 +12,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..biscale import bvndf, microgeometry
+from .images import image_has_pixels, image_pixels
 
 CACHE_SIZE = 8
 _cache = OrderedDict()          # content key -> BVNDF, least recently used first
@@ -23,8 +24,6 @@ def last_status(material):
 
 
 def _image_heights(image):
-    from .export import image_has_pixels, image_pixels
-
     if image is None:
         raise ValueError("no height image")
     if not image_has_pixels(image):
@@ -51,58 +50,76 @@ def _tile_mesh(obj):
     return vertices - np.array([low[0], low[1], 0.0]), triangles.reshape(-1, 3), (float(size[0]), float(size[1]))
 
 
-def _geometry_and_key(settings):
-    """(microgeometry, content key) of the settings' tile."""
+def _geometry_and_key(settings, second=False):
+    """(microgeometry, content key) of the settings' tile (second: the mask's second tile, a height image)."""
     digest = hashlib.sha1()
-    if settings.source == "IMAGE":
-        heights = _image_heights(settings.height_image)
+    if second or settings.source == "IMAGE":
+        image, scale = ((settings.second_height_image, settings.second_height_scale) if second
+                        else (settings.height_image, settings.height_scale))
+        heights = _image_heights(image)
         digest.update(np.ascontiguousarray(heights, np.float32).tobytes())
-        digest.update(repr(float(settings.height_scale)).encode())
-        geometry = microgeometry.from_height_field(heights, height_scale=float(settings.height_scale))
+        digest.update(repr(float(scale)).encode())
+        geometry = microgeometry.from_height_field(heights, height_scale=float(scale))
     else:
         vertices, triangles, size = _tile_mesh(settings.tile_object)
         digest.update(vertices.tobytes() + triangles.tobytes())
         geometry = microgeometry.from_mesh(vertices, triangles, size)
-    digest.update(repr((settings.source, int(settings.lobes), int(settings.resolution), int(settings.samples))).encode())
+    digest.update(repr((second or settings.source, int(settings.lobes), int(settings.resolution),
+                        int(settings.samples))).encode())
     return geometry, digest.hexdigest()
 
 
+def masked(settings):
+    """Whether the settings choose between two tiles (a mask and a second height image)."""
+    return settings.mask is not None and settings.second_height_image is not None
+
+
 def reads(material):
-    """The datablocks the tile comes from, as export.MaterialParams.reads holds them."""
+    """The datablocks the tiles come from, as export.MaterialParams.reads holds them."""
     settings = material.sgprt.biscale
+    out = ()
     if settings.source == "IMAGE":
-        return () if settings.height_image is None else (("IMAGE", settings.height_image.name),)
-    tile = settings.tile_object
-    return () if tile is None else (("OBJECT", tile.name),) + ((("MESH", tile.data.name),) if tile.data else ())
+        out = () if settings.height_image is None else (("IMAGE", settings.height_image.name),)
+    elif settings.tile_object is not None:
+        tile = settings.tile_object
+        out = (("OBJECT", tile.name),) + ((("MESH", tile.data.name),) if tile.data else ())
+    return out + ((("IMAGE", settings.second_height_image.name),) if masked(settings) else ())
 
 
-def geometry(material):
-    """The material's biscale.microgeometry tile (ValueError with the reason when it has none)."""
-    return _geometry_and_key(material.sgprt.biscale)[0]
+def geometry(material, second=False):
+    """The material's biscale.microgeometry tile, or its second (ValueError with the reason when it has none)."""
+    return _geometry_and_key(material.sgprt.biscale, second)[0]
 
 
-def tables(material):
-    """(BVNDF, None) of the material's tile, or (None, the reason it has none)."""
-    settings = material.sgprt.biscale
-    try:
-        geometry, key = _geometry_and_key(settings)
-    except ValueError as error:
-        _status[material.name] = str(error)
-        return None, str(error)
+def _tile_tables(settings, second):
+    """(BVNDF, seconds computing it: 0 when cached) of one tile; ValueError says why there is none."""
+    geometry, key = _geometry_and_key(settings, second)
     model = _cache.get(key)
     if model is not None:
         _cache.move_to_end(key)
-        return model, None
+        return model, 0.0, geometry
     start = time.perf_counter()
-    try:
-        model = bvndf.compute(geometry, lobes=int(settings.lobes), resolution=int(settings.resolution),
-                              samples=int(settings.samples))
-    except ValueError as error:
-        _status[material.name] = str(error)
-        return None, str(error)
+    model = bvndf.compute(geometry, lobes=int(settings.lobes), resolution=int(settings.resolution),
+                          samples=int(settings.samples))
     _cache[key] = model
     while len(_cache) > CACHE_SIZE:
         _cache.popitem(last=False)
-    _status[material.name] = (f"{model.lobe_count} lobes from {len(geometry.triangles)} triangles in "
-                              f"{time.perf_counter() - start:.2f} s")
+    return model, time.perf_counter() - start, geometry
+
+
+def tables(material):
+    """(BVNDF or bvndf.MaskedTiles, None) of the material's tile(s), or (None, the reason it has none)."""
+    settings = material.sgprt.biscale
+    try:
+        model, seconds, geometry = _tile_tables(settings, False)
+        triangles = len(geometry.triangles)
+        if masked(settings):
+            second, more, other = _tile_tables(settings, True)
+            model, seconds, triangles = bvndf.MaskedTiles(model, second), seconds + more, \
+                triangles + len(other.triangles)
+    except ValueError as error:
+        _status[material.name] = str(error)
+        return None, str(error)
+    if seconds:
+        _status[material.name] = f"{model.lobe_count} lobes from {triangles} triangles in {seconds:.2f} s"
     return model, None

@@ -25,7 +25,16 @@ import numpy as np
 
 from .. import techniques
 from ..reflectance import layering, models, principled
-from ..techniques import biscale_shading, factored, sg_biscale, sg_fitted, spherical_harmonics, surface_layering
+from ..techniques import (
+    biscale_shading,
+    factored,
+    sg_biscale,
+    sg_fitted,
+    sg_shading,
+    spherical_harmonics,
+    surface_layering,
+)
+from .images import image_has_pixels, image_pixels
 
 # Mesh exports since import; tests read it to check what an update re-exported.
 export_counter = {"meshes": 0}
@@ -479,6 +488,11 @@ def _usable_biscale(material, params):
     if params.biscale is None:
         warn(f"material '{material.name}': no usable small-scale geometry ({reason}): rendered as a single scale")
         return techniques.DEFAULT
+    settings = material.sgprt.biscale
+    if biscale_source.masked(settings):
+        params.textures[sg_shading.BISCALE_MASK] = settings.mask.name
+    elif settings.mask is not None:
+        warn(f"material '{material.name}': its bi-scale mask has no second height image: the mask is not applied")
     layers = surface_layering.flags(params)
     if layers:
         warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} does not apply {', '.join(layers)}")
@@ -570,33 +584,11 @@ def _finite_settings(params):
         params.fitted.table = finite_texels(params.fitted.table, f"material '{params.name}': stored lobe fit table")
 
 
-def image_pixels(image):
-    """(H, W, 4) float32 pixels of a bpy Image, Blender's orientation (row 0 at the bottom).
-    Colour images come as Blender stores them in float (linear for float buffers, else the
-    byte values / 255: data textures such as normal maps stay as authored)."""
-    width, height = image.size
-    pixels = np.empty(width * height * image.channels, np.float32)
-    image.pixels.foreach_get(pixels)
-    pixels = pixels.reshape(height, width, image.channels)
-    if image.channels == 4:
-        return pixels
-    out = np.ones((height, width, 4), np.float32)
-    out[..., :min(3, image.channels)] = pixels[..., :3]
-    if image.channels == 1:
-        out[..., 1] = out[..., 2] = pixels[..., 0]
-    return out
-
-
 COLOUR_SLOTS = ("diffuse_color", "specular_color")
 # What a texture whose image has no pixels (a missing or unreadable file) samples, and what the warning calls it:
 # Blender's magenta for colours (what its own engines show), a flat normal for the normal map, 1 for scalars.
 MISSING_TEXEL = {"colour": ((1.0, 0.0, 1.0, 1.0), "magenta"), "normal_map": ((0.5, 0.5, 1.0, 1.0), "a flat normal"),
                  "scalar": ((1.0, 1.0, 1.0, 1.0), "the factor alone")}
-
-
-def image_has_pixels(image):
-    """False for an image Blender could not load (a missing or unreadable file: size 0 x 0)."""
-    return image.size[0] > 0 and image.size[1] > 0 and image.channels > 0
 
 
 def _no_pixels_reason(image):

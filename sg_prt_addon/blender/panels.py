@@ -77,6 +77,10 @@ class SGPRT_PT_material_biscale(MaterialPanel, bpy.types.Panel):
             layout.prop(settings, "height_scale")
         else:
             layout.prop(settings, "tile_object")
+        layout.template_ID(settings, "mask", open="image.open")
+        if settings.mask is not None:
+            layout.template_ID(settings, "second_height_image", open="image.open")
+            layout.prop(settings, "second_height_scale")
         for name in ("lobes", "resolution", "samples"):
             layout.prop(settings, name)
         status = biscale_source.last_status(context.material)

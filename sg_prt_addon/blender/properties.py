@@ -174,6 +174,15 @@ class SGPRT_PG_biscale(bpy.types.PropertyGroup):
                                 soft_max=0.5, description="Height of an image value of 1, in tile widths")
     tile_object: PointerProperty(update=_tag_material_changed, type=bpy.types.Object, name="Tile", poll=_is_mesh,
                                  description="Mesh whose faces are one tile of the surface (object space)")
+    mask: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Mask",
+                          description="Where the second tile replaces the first: its red channel over the UV map "
+                                      "(0: the first tile, 1: the second, between: both, blended)")
+    second_height_image: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Second Height",
+                                         description="The second tile's tileable height field, used where the "
+                                                     "mask is 1")
+    second_height_scale: FloatProperty(update=_tag_material_changed, name="Second Height Scale", default=0.05,
+                                       min=0.0, soft_max=0.5,
+                                       description="Height of an image value of 1 in the second tile, in tile widths")
     lobes: IntProperty(update=_tag_material_changed, name="Lobes", default=16, min=1, max=32,
                        description="SG lobes of the tile's normal distribution (more follow sharp small-scale "
                                    "BRDFs better; docs/ACCURACY.md, bi-scale)")

@@ -1,5 +1,6 @@
 """Numpy mirror of shaders/techniques/sg/biscale.glsl: a bi-scale material's effective lobes (iwasaki2012
-eq. 15) as the SG technique's BRDF slice, and its diffuse factor; and the GPU layout of a biscale.bvndf.BVNDF.
+eq. 15) as the SG technique's BRDF slice, and its diffuse factor; and the GPU layout of a biscale.bvndf.BVNDF
+(or of two tiles a mask chooses between, bvndf.MaskedTiles).
 
 The small-scale BRDF is the material's own model and parameters (per pixel, textures included), so editing it
 needs no recomputation; the tile's BVNDF (lobes and tables) changes only with the geometry.
@@ -47,7 +48,22 @@ def effective_lobes(tables, small_sharpness, small_amplitude):
     return np.broadcast_to(axes[None], (count,) + axes.shape), eta_j * eta_s / total, 2.0 * np.pi * mu_s / total
 
 
-def m_factor_rows(tables, model, params, small_sharpness, nodes):
+def tile_weights(tables, mask, count):
+    """(N, T) weight of each tile per pixel: 1 for one tile; (1 - m, m) for two by the mask m (biscale_mask)."""
+    if mask is None or tables.diffuse_tiles.shape[0] == 1:
+        return np.ones((count, 1))
+    m = np.clip(np.asarray(mask, np.float64), 0.0, 1.0)
+    return np.stack([1.0 - m, m], axis=1)
+
+
+def lobe_weights(tables, mask, count):
+    """(N, J): each BVNDF lobe's tile weight (the second tile's lobes follow the first's)."""
+    tile_of_lobe = (np.arange(tables.lobe_count) >= tables.first_lobes).astype(np.int64)
+    weights = tile_weights(tables, mask, count)
+    return weights[:, np.minimum(tile_of_lobe, weights.shape[1] - 1)]
+
+
+def m_factor_rows(tables, model, params, small_sharpness, nodes, mask=None):
     """m_factor(wo, wi) for warp.brdf_slice_lobes: rows (effective lobe j S + s's nodes one after the other,
     leading) times mu_j at lobe j's mirror direction and the view, and M at the product axis
     n* = normalize(eta_j xi_j + eta_s h) (biscale_m_factor)."""
@@ -58,6 +74,7 @@ def m_factor_rows(tables, model, params, small_sharpness, nodes):
     axes = sg.normalize(np.asarray(tables.axes, np.float64))[lobe_of_row][:, None, :]          # (K', 1, 3)
     eta_j = np.asarray(tables.sharpness, np.float64)[lobe_of_row][:, None, None]
     eta_s = small_sharpness.T[effective_of_row % small][..., None]                              # (K', N, 1)
+    weight = lobe_weights(tables, mask, small_sharpness.shape[0]).T[lobe_of_row]                  # (K', N)
 
     def m_factor(wo, wi):          # (K', N, 3) each
         wo = sg.normalize(np.asarray(wo, np.float64))
@@ -68,7 +85,7 @@ def m_factor_rows(tables, model, params, small_sharpness, nodes):
         local_i = np.einsum("...ij,...j->...i", frames, wi)
         # mu_j read once a BVNDF lobe, at its mirror direction (biscale_set_lobe_amplitude)
         mirror = 2.0 * np.sum(wo * axes, axis=-1, keepdims=True) * axes - wo
-        amplitude = paired_amplitudes(tables, lobe_of_row, mirror, wo)
+        amplitude = paired_amplitudes(tables, lobe_of_row, mirror, wo) * weight
         above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
         return np.where(above, amplitude * instance.m_factor(local_o, local_i), 0.0)
 
@@ -85,31 +102,34 @@ def paired_amplitudes(tables, lobe_of_row, wi, wo):
     return values
 
 
-def slice_lobes(tables, model, params, view_local, warp_mode=None):
+def slice_lobes(tables, model, params, view_local, warp_mode=None, mask=None):
     """The BRDF slice of a bi-scale material (sg_shading.glsl's slice loop under BISCALE): axis (N, K', 3)
-    local, sharpness (N, K'), amplitude (N, K')."""
+    local, sharpness (N, K'), amplitude (N, K'); mask (N,) the mask's value per pixel with two tiles."""
     mode = warp_mode or warp.DEFAULT_MODE
     small_sharpness, small_amplitude = small_lobes(model, params)
     axis, sharpness, amplitude = effective_lobes(tables, small_sharpness, small_amplitude)
-    m_factor = m_factor_rows(tables, model, params, small_sharpness, warp.nodes_per_lobe(mode))
+    m_factor = m_factor_rows(tables, model, params, small_sharpness, warp.nodes_per_lobe(mode), mask)
     return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, m_factor, mode=mode)
 
 
-def diffuse_factor(tables, directions_local, view_local):
+def diffuse_factor(tables, directions_local, view_local, mask=None):
     """D(i, o) at local incident directions (N, P, 3) for each pixel's view (N, 3): (N, P) (biscale_diffuse)."""
     directions_local = np.asarray(directions_local, np.float64)
     view = np.broadcast_to(np.asarray(view_local, np.float64)[:, None, :], directions_local.shape)
-    values = bvndf_tables.interpolate(np.asarray(tables.integral)[None], directions_local, view,
-                                      tables.resolution)[0]
-    return np.where(directions_local[..., 2] > 0, values, 0.0).astype(FLOAT)
+    values = bvndf_tables.interpolate(np.asarray(tables.diffuse_tiles), directions_local, view,
+                                      tables.resolution)                                         # (T, N, P)
+    weights = tile_weights(tables, mask, len(view_local))
+    blended = np.einsum("tnp,nt->np", values, weights)
+    return np.where(directions_local[..., 2] > 0, blended, 0.0).astype(FLOAT)
 
 
-def albedo(tables, view_local):
+def albedo(tables, view_local, mask=None):
     """A(o) for each pixel's view (N,) (biscale_albedo): the albedo row read at o as the GPU reads it."""
-    texture = np.broadcast_to(np.asarray(tables.albedo)[None, :], (len(tables.directions),) * 2)
+    nodes = len(tables.directions)
+    texture = np.broadcast_to(np.asarray(tables.albedo_tiles)[:, None, :], (len(tables.albedo_tiles), nodes, nodes))
     up = np.array([0.0, 0.0, 1.0])
-    return bvndf_tables.interpolate(texture[None], up, np.asarray(view_local, np.float64),
-                                    tables.resolution)[0].astype(FLOAT)
+    values = bvndf_tables.interpolate(texture, up, np.asarray(view_local, np.float64), tables.resolution)  # (T, N)
+    return np.sum(values.T * tile_weights(tables, mask, len(view_local)), axis=1).astype(FLOAT)
 
 
 # ---------------------------------------------------------------- GPU layout
@@ -120,15 +140,17 @@ def lobe_layers(lobe_count):
 
 def table_texture(tables):
     """(layers, R^2, R^2, 4) float32 of biscale.glsl's biscale_tables: texel (row o_b R + i_b, column o_a R + i_a)
-    of layer t channel c is mu_{4t+c}(i, o); the last layer holds (D(i, o), A(o), 0, 0)."""
+    of layer t channel c is mu_{4t+c}(i, o); the last layer holds (D(i, o), A(o)) of the first tile, then of the
+    second (0 with one tile)."""
     resolution = tables.resolution
     nodes = resolution * resolution
     count = tables.lobe_count
     layers = lobe_layers(count)
     values = np.zeros((layers * 4 + 4, nodes, nodes), np.float32)                   # [channel, i node, o node]
     values[:count] = tables.amplitudes
-    values[layers * 4] = tables.integral
-    values[layers * 4 + 1] = np.asarray(tables.albedo)[None, :]
+    for tile, (diffuse, tile_albedo) in enumerate(zip(tables.diffuse_tiles, tables.albedo_tiles)):
+        values[layers * 4 + 2 * tile] = diffuse
+        values[layers * 4 + 2 * tile + 1] = np.asarray(tile_albedo)[None, :]
     # node index b R + a -> (b, a) for i and o, then rows (o_b, i_b) and columns (o_a, i_a)
     grid = values.reshape(layers + 1, 4, resolution, resolution, resolution, resolution)  # l, c, ib, ia, ob, oa
     texture = grid.transpose(0, 4, 2, 5, 3, 1).reshape(layers + 1, nodes, nodes, 4)

@@ -1,13 +1,14 @@
 """iwasaki2012's bi-scale materials rendered by wang2009's SG shading: the effective BRDF of a small-scale tile
 (its BVNDF's lobes and tables, biscale.bvndf, from export.MaterialParams.biscale) with the material's own
 isotropic model as the small-scale BRDF (shaders/techniques/sg/biscale.glsl; mirror biscale_shading.py)."""
-from . import biscale_shading, sg_parametric
-from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
+from . import biscale_shading, sg_parametric, sg_shading
+from .sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
 from .sg_parametric import material_terms
 
 NAME = "SG_BISCALE"
 # the small-scale parameters a texture may scale per pixel, and the colours and normal map
-TEXTURES = ("diffuse_color", "specular_color", "roughness", "ior", "exponent", "alpha_x", "normal_map")
+TEXTURES = ("diffuse_color", "specular_color", "roughness", "ior", "exponent", "alpha_x", "normal_map",
+            sg_shading.BISCALE_MASK)
 
 
 class SGBiScale(SGLobes):
@@ -26,16 +27,18 @@ class SGBiScale(SGLobes):
             raise ValueError(f"material '{params.name}': a bi-scale material's model must be isotropic "
                              f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}")
         has_diffuse, has_specular = material_terms(params)
-        textures = tuple(sorted(name for name in params.textures if name in TEXTURES and name in TEXTURE_SLOTS))
+        textures = tuple(sorted(name for name in params.textures if name in TEXTURES))
         lobes = int(tables.lobe_count) * biscale_shading.small_lobe_count(params.model)
         return VariantKey(self.name, params.model, lobes, textures=textures,
                           has_diffuse=has_diffuse, has_specular=has_specular, warp_mode=warp_mode_of(params),
-                          biscale_resolution=int(tables.resolution), **scene_fields(inputs, has_diffuse, has_specular))
+                          biscale_resolution=int(tables.resolution), biscale_first_lobes=int(tables.first_lobes),
+                          **scene_fields(inputs, has_diffuse, has_specular))
 
     def model_defines(self, key):
         # the key's lobe count is the effective lobes': the BVNDF's times the small-scale model's
         small = biscale_shading.small_lobe_count(key.model)
         return {"BISCALE": 1, "BISCALE_RESOLUTION": key.biscale_resolution, "BISCALE_SMALL_LOBES": small,
+                "BISCALE_FIRST_LOBES": key.biscale_first_lobes,
                 "BISCALE_LOBE_LAYERS": biscale_shading.lobe_layers(key.ndf_lobes // small)}
 
     def library_files(self, key):

@@ -60,6 +60,7 @@ class VariantKey:
     warp_mode: str = warp.DEFAULT_MODE      # of the view slice (MaterialParams.warp_mode); with a specular term
     layering: tuple = ()            # surface_layering.flags of the material
     biscale_resolution: int = 0     # sg_biscale: the tables' lattice R (0: not bi-scale)
+    biscale_first_lobes: int = 0    # sg_biscale: the first tile's BVNDF lobes (all of them with one tile)
 
     @property
     def has_visibility(self):

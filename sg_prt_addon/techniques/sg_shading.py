@@ -448,14 +448,15 @@ class _Pixels:
     slice_colour: np.ndarray
     slice_cosine: np.ndarray    # I(S_j, n), unshadowed
     albedo: object              # the model's directional albedo where it is tabulated, else None
-    biscale: object = None      # a bi-scale material's biscale.bvndf.BVNDF (biscale_shading), else None
+    biscale: object = None      # a bi-scale material's biscale.bvndf.BVNDF or MaskedTiles (biscale_shading), else None
+    biscale_mask: object = None  # (N,) the mask between its two tiles, else None
 
     def diffuse_factor(self, world_axis):
         """The bi-scale diffuse factor D(i, o) at world directions (N, P, 3) (1 without bi-scale)."""
         if self.biscale is None:
             return FLOAT(1)
         local = np.einsum("nji,npj->npi", self.frame, np.asarray(world_axis, FLOAT))
-        return biscale_shading.diffuse_factor(self.biscale, local, self.view_local)
+        return biscale_shading.diffuse_factor(self.biscale, local, self.view_local, self.biscale_mask)
 
     def visible(self, axis, sharpness):
         if self.visibility is None:
@@ -478,7 +479,7 @@ class _Pixels:
 
 
 def _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
-            warp_mode, biscale=None):
+            warp_mode, biscale=None, biscale_mask=None):
     position = np.asarray(position, FLOAT)
     n, t, b = shading_frame(normal, tangent)
     view = view_directions(position, view_origin, is_perspective)
@@ -487,7 +488,7 @@ def _pixels(position, normal, tangent, view_origin, is_perspective, model, param
 
     if biscale is not None:
         slice_axis, slice_sharpness, slice_amplitude = biscale_shading.slice_lobes(biscale, model, params, view_local,
-                                                                                    warp_mode)
+                                                                                    warp_mode, biscale_mask)
     else:
         slice_axis, slice_sharpness, slice_amplitude = specular_slice(model, params, lobe_count, view_local,
                                                                       warp_mode)
@@ -507,7 +508,7 @@ def _pixels(position, normal, tangent, view_origin, is_perspective, model, param
         slice_amplitude = (slice_amplitude * scale).astype(FLOAT)
         slice_cosine = (slice_cosine * scale).astype(FLOAT)
     return _Pixels(position, n, frame, view, view_local, model, params, visibility, warp_mode, slice_axis,
-                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo, biscale)
+                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo, biscale, biscale_mask)
 
 
 def _light_sets(position, light_data):
@@ -588,7 +589,8 @@ def _add_environment(px, environment, irradiance, specular):
         return
     colour = np.asarray(environment.colour, FLOAT)
     # a bi-scale material's diffuse sees the constant world through its mean factor A(o)
-    lit = colour if px.biscale is None else colour * biscale_shading.albedo(px.biscale, px.view_local)[:, None]
+    lit = colour if px.biscale is None else \
+        colour * biscale_shading.albedo(px.biscale, px.view_local, px.biscale_mask)[:, None]
     if visibility is None:
         irradiance += np.pi * lit
     elif visibility.diffuse is not None:
@@ -601,7 +603,7 @@ def _add_environment(px, environment, irradiance, specular):
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
-          light_data, environment, lobe_count=1, visibility=None, warp_mode=None, biscale=None):
+          light_data, environment, lobe_count=1, visibility=None, warp_mode=None, biscale=None, biscale_mask=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
     ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
     applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
@@ -609,10 +611,11 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     view_origin: camera position (perspective) or the camera's forward direction (orthographic).
     visibility: a Visibility (the SSDF shadows of the HAS_VISIBILITY variant) or None (unshadowed).
     warp_mode: spherical.warp's mode of the view slice (the material's view warp; None: the default).
-    biscale: a bi-scale material's biscale.bvndf.BVNDF (model: its small-scale model), or None.
+    biscale: a bi-scale material's biscale.bvndf.BVNDF or MaskedTiles (model: its small-scale model), or None;
+    biscale_mask: (N,) the mask between MaskedTiles' two tiles.
     """
     px = _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
-                 warp_mode, biscale)
+                 warp_mode, biscale, biscale_mask)
     irradiance = np.zeros(px.position.shape, FLOAT)
     specular = np.zeros(px.position.shape, FLOAT)
     for light_axis, light_sharpness, light_amplitude in _light_sets(px.position, light_data):
@@ -690,6 +693,9 @@ def surface_layers(material, roughness_texture, uv, diffuse_color, specular_colo
     return diffuse_color * diffuse_factor[:, None], specular
 
 
+BISCALE_MASK = "biscale_mask"      # the texture slot of a bi-scale material's mask between its two tiles
+
+
 def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,
                     is_perspective, light_data, environment, visibility=None):
     """Mirror of surface.frag.glsl's main(): per-fragment inputs as the G-buffer holds them.
@@ -718,6 +724,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
         params[name] = value
     shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
     biscale = getattr(material, "biscale", None)
+    biscale_mask = sample_material_texture(textures[BISCALE_MASK], uv)[:, 0] if BISCALE_MASK in textures else None
     if biscale is None:         # a bi-scale material's variant has no glossy layer (sg_biscale)
         roughness_texture = textures["roughness"] if surface_layering.textured_roughness(material.model, textures) \
             else None
@@ -728,6 +735,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
                  diffuse_color, specular_color, light_data, environment,
                  lobe_count=material.lobe_count if model in models.ANISOTROPIC else 1,
-                 visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale)
+                 visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale,
+                 biscale_mask=biscale_mask)
 
 

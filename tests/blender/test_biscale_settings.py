@@ -72,6 +72,25 @@ def test_export_gives_the_tables_and_what_it_reads(empty_file):
     assert _export(material)[0].biscale is params.biscale
 
 
+def test_a_mask_and_a_second_height_field_make_two_tiles(empty_file):
+    from sg_prt_addon.biscale import bvndf
+    from sg_prt_addon.blender import panels
+
+    material = _biscale("masked_biscale", model="GGX")
+    settings = material.sgprt.biscale
+    settings.height_image = _height_image("masked_first", 0.05 * np.eye(8))
+    settings.mask = _height_image("masked_mask", np.tri(8))
+    params, warnings = _export(material)
+    assert any("no second height image: the mask is not applied" in warning for warning in warnings)
+    assert isinstance(params.biscale, bvndf.BVNDF) and "biscale_mask" not in params.textures
+    assert ("template_ID", "second_height_image") in _drawn(panels.SGPRT_PT_material_biscale, material)
+    settings.second_height_image = _height_image("masked_second", np.zeros((8, 8)))
+    params, warnings = _export(material)
+    assert isinstance(params.biscale, bvndf.MaskedTiles) and params.biscale.lobe_count == 4 + 4
+    assert params.textures["biscale_mask"] == "masked_mask" and not warnings
+    assert ("IMAGE", "masked_second") in params.reads
+
+
 @pytest.mark.parametrize("case, expected", [
     ("no image", "no usable small-scale geometry (no height image)"),
     ("nan", "no usable small-scale geometry (the height field has 1 texel(s) that are not finite"),

@@ -182,3 +182,35 @@ def test_small_scale_models_are_the_engines_own():
     assert isinstance(small.brdf(), brdf.BlinnPhong)
     sharpness, _ = small.ndf_lobes()
     assert sharpness.shape == (1,)
+
+
+def test_masked_tiles_blend_the_two_tiles_by_the_mask():
+    """Two tiles chosen by a mask (iwasaki2012 fig. 1c): at 0 the first tile's slice and diffuse, at 1 the
+    second's, in between the blend of the two (techniques.biscale_shading, the GLSL's mirror)."""
+    from sg_prt_addon.spherical import clamped_cosine
+    from sg_prt_addon.techniques import biscale_shading
+
+    first = bvndf.compute(microgeometry.from_height_field(reference.egg_crate(16)), lobes=4, samples=1024)
+    second = bvndf.compute(microgeometry.from_height_field(reference.grooves(16)), lobes=3, samples=1024)
+    both = bvndf.MaskedTiles(first, second)
+    views = sg.normalize(np.array([[0.3, 0.1, 0.9], [-0.5, 0.2, 0.6], [0.0, 0.7, 0.4]]))
+    params = {"roughness": np.full(3, 0.3, np.float32)}
+
+    def albedo(tables, mask=None):
+        axis, sharpness, amplitude = biscale_shading.slice_lobes(tables, "GGX", params, views, mask=mask)
+        return np.sum(clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, amplitude,
+                                                                np.array([0.0, 0.0, 1.0])), axis=1)
+
+    light = sg.normalize(np.array([[[0.2, -0.3, 0.8]]] * 3))
+    diffuse = {name: biscale_shading.diffuse_factor(tables, light, views) for name, tables in
+               (("first", first), ("second", second))}
+    for mask, expected, expected_diffuse in ((0.0, albedo(first), diffuse["first"]),
+                                             (1.0, albedo(second), diffuse["second"]),
+                                             (0.25, 0.75 * albedo(first) + 0.25 * albedo(second),
+                                              0.75 * diffuse["first"] + 0.25 * diffuse["second"])):
+        np.testing.assert_allclose(albedo(both, np.full(3, mask)), expected, rtol=1e-6)
+        np.testing.assert_allclose(biscale_shading.diffuse_factor(both, light, views, np.full(3, mask)),
+                                   expected_diffuse, rtol=1e-6)
+    with pytest.raises(ValueError, match="same direction lattice"):
+        bvndf.MaskedTiles(first, bvndf.compute(microgeometry.from_height_field(np.zeros((4, 4))), lobes=1,
+                                               samples=64, resolution=8))

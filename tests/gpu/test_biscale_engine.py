@@ -49,6 +49,25 @@ def test_biscale_shader_matches_its_mirror(blender, world):
     assert max(errors.values()) < TOLERANCE, errors
 
 
+def test_masked_tiles_shader_matches_its_mirror(blender):
+    """Two tiles chosen by a checker mask (iwasaki2012 fig. 1c), Blinn-Phong at the small scale."""
+    fx.ensure_registered()
+    material = biscale_material("biscale_masked", biscale_reference.egg_crate(16), model="BLINN_PHONG",
+                                exponent=150.0, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.6, 0.6, 0.6))
+    checker = (np.add.outer(np.arange(8), np.arange(8)) % 2).astype(np.float32)
+    mask = fx.image("biscale_masked_mask", np.repeat(checker[..., None], 4, axis=-1))
+    second = np.repeat(np.flipud(biscale_reference.grooves(16))[..., None], 4, axis=-1).astype(np.float32)
+    settings = material.sgprt.biscale
+    settings.mask = mask
+    settings.second_height_image = fx.image("biscale_masked_second", second)
+    settings.second_height_scale = 1.0
+    result = fx.render(_scene("biscale_mirror_masked", material, "texture"), gbuffer=True)
+    params = result["state"].materials[material.name]
+    assert params.technique == "SG_BISCALE" and params.biscale.first_lobes == 8 and params.biscale.lobe_count == 16
+    errors = _errors(result)
+    assert max(errors.values()) < TOLERANCE, errors
+
+
 def test_unusable_tile_renders_single_scale_with_a_reason(blender):
     import bpy
 

@@ -3,14 +3,18 @@
  *   biscale_lobes  (sampler2D, BISCALE_LOBES x 1): texel j = (axis xyz in the local frame, sharpness) of BVNDF lobe j;
  *   biscale_tables (sampler2DArray, R^2 x R^2 RGBA32F, linear filtering): the node pair (i, o) of the lattice
  *     (biscale/bvndf.py, R = BISCALE_RESOLUTION) at texel (o_a R + i_a, o_b R + i_b); layer t, channel c:
- *     mu_j(i, o) per unit cos(theta_i) of lobe j = 4 t + c; layer BISCALE_LOBE_LAYERS: (D(i, o), A(o), 0, 0),
- *     the diffuse factor and its cosine-weighted mean over i.
+ *     mu_j(i, o) per unit cos(theta_i) of lobe j = 4 t + c; layer BISCALE_LOBE_LAYERS: (D(i, o), A(o)) of the
+ *     first tile and of the second: the diffuse factor and its cosine-weighted mean over i.
+ * HAS_TEXTURE_BISCALE_MASK: two tiles (biscale.bvndf.MaskedTiles), lobes [0, BISCALE_FIRST_LOBES) the first's,
+ *     chosen per pixel by the mask texture's red channel m: the first's amplitudes and diffuse weighted 1 - m,
+ *     the second's m.
  * The sampler interpolates i inside an o node's block; o's four nodes are blended here (biscale_set_view:
  * once a pixel, the view is fixed). */
 
 const float BISCALE_R = float(BISCALE_RESOLUTION);
 vec2 biscale_view_corner[4];
 float biscale_view_weight[4];
+float biscale_mask = 0.0;
 
 /* Continuous lattice coordinates in [0, R - 1] of a local direction (clamped to the hemisphere). */
 vec2 biscale_lattice(vec3 direction)
@@ -32,6 +36,19 @@ void biscale_set_view(vec3 view_local)
   biscale_view_weight[1] = f.x * (1.0 - f.y);
   biscale_view_weight[2] = (1.0 - f.x) * f.y;
   biscale_view_weight[3] = f.x * f.y;
+#ifdef HAS_TEXTURE_BISCALE_MASK
+  biscale_mask = clamp(material_texture(texture_biscale_mask).r, 0.0, 1.0);
+#endif
+}
+
+/* The weight of BVNDF lobe j's tile at this pixel. */
+float biscale_tile_weight(int j)
+{
+#ifdef HAS_TEXTURE_BISCALE_MASK
+  return j < BISCALE_FIRST_LOBES ? 1.0 - biscale_mask : biscale_mask;
+#else
+  return 1.0;
+#endif
 }
 
 /* The tables of one layer at the local incident direction wi and the pixel's view. */
@@ -54,38 +71,38 @@ float biscale_amplitude(int lobe, vec3 wi)
 /* D(i, o): the Lambertian term's factor at a local incident direction (0 below the horizon). */
 float biscale_diffuse(vec3 wi)
 {
-  return wi.z > 0.0 ? biscale_fetch(BISCALE_LOBE_LAYERS, wi).x : 0.0;
+  vec4 tiles = biscale_fetch(BISCALE_LOBE_LAYERS, wi);
+  return wi.z > 0.0 ? mix(tiles.x, tiles.z, biscale_mask) : 0.0;
 }
 
 /* A(o): the diffuse factor's cosine-weighted mean over the incident hemisphere (a constant world). */
 float biscale_albedo()
 {
-  return biscale_fetch(BISCALE_LOBE_LAYERS, vec3(0.0, 0.0, 1.0)).y;
+  vec4 tiles = biscale_fetch(BISCALE_LOBE_LAYERS, vec3(0.0, 0.0, 1.0));
+  return mix(tiles.y, tiles.w, biscale_mask);
 }
+
+#ifdef HAS_SPECULAR
+/* The small-scale model's lobes and M: sg_shading.glsl's, defined after this file. */
+void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude);
+float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q);
 
 /* The small-scale model's NDF lobes around the facet normal, (sharpness, amplitude) each, their projected
  * mass made 1 (spherical.sg.axis_cosine_integral: 2 pi (1 - (1 - e^-s) / s) / s): GGX's two-lobe fit
- * (ggx_two_lobes.glsl), one lobe for the others.  Set once a pixel by biscale_set_small_lobes. */
+ * (NDF_LOBES is never 1 here), one lobe for the others.  Set once a pixel by biscale_set_small_lobes. */
 vec2 biscale_small[BISCALE_SMALL_LOBES];
 
-void biscale_set_small_lobes(vec4 p)
+void biscale_set_small_lobes(vec4 p, vec4 q)
 {
   float mass = 0.0;
   for (int s = 0; s < BISCALE_SMALL_LOBES; s++) {
-    vec2 lobe = vec2(1.0);
-#if defined(MODEL_GGX)
-    ggx_two_lobes(ggx_table, p.x, s, lobe.x, lobe.y);
-#elif defined(MODEL_COOK_TORRANCE)
-    lobe = cook_torrance_ndf_lobe(p.x);
-#elif defined(MODEL_BLINN_PHONG)
-    lobe = blinn_phong_ndf_lobe(p.z);
-#elif defined(MODEL_WARD_ISO)
-    lobe = ward_isotropic_ndf_lobe(p.w);
-#endif
-    float sharpness = max(lobe.x, 0.0);
-    mass += lobe.y * (sharpness > 1.0e-3 ? 2.0 * SG_PI * (1.0 - (1.0 - exp(-sharpness)) / sharpness) / sharpness
-                                         : 2.0 * SG_PI * (0.5 - sharpness / 6.0));
-    biscale_small[s] = vec2(sharpness, lobe.y);
+    vec3 axis;
+    float sharpness, amplitude;
+    model_ndf_lobe(p, q, s, axis, sharpness, amplitude);
+    sharpness = max(sharpness, 0.0);
+    mass += amplitude * (sharpness > 1.0e-3 ? 2.0 * SG_PI * (1.0 - (1.0 - exp(-sharpness)) / sharpness) / sharpness
+                                            : 2.0 * SG_PI * (0.5 - sharpness / 6.0));
+    biscale_small[s] = vec2(sharpness, amplitude);
   }
   for (int s = 0; s < BISCALE_SMALL_LOBES; s++) {
     biscale_small[s].y /= max(mass, 1.0e-30);
@@ -105,22 +122,6 @@ void biscale_lobe(int k, out vec3 axis, out float sharpness, out float amplitude
   amplitude = 2.0 * SG_PI * small.y / total;
 }
 
-/* M_o(i) of the small-scale model (brdf.glsl), directions in a facet's frame. */
-float biscale_small_m_factor(vec3 wo, vec3 wi, vec4 p)
-{
-#if defined(MODEL_GGX)
-  return ggx_m_factor(wo, wi, p.x);
-#elif defined(MODEL_COOK_TORRANCE)
-  return cook_torrance_m_factor(wo, wi, p.x, p.y);
-#elif defined(MODEL_BLINN_PHONG)
-  return blinn_phong_m_factor(wo, wi, p.z);
-#elif defined(MODEL_WARD_ISO)
-  return ward_isotropic_m_factor(wo, wi);
-#else
-  return 0.0;
-#endif
-}
-
 /* mu_j at BVNDF lobe j's mirror direction 2 (o.xi_j) xi_j - o, the centre of its warped lobes (iwasaki2012's
  * mu'_j(xi'_j, o)): one table read for the lobe's small-scale lobes and warped nodes, set by the shading loop
  * at each j's first effective lobe. */
@@ -129,13 +130,14 @@ float biscale_lobe_amplitude;
 void biscale_set_lobe_amplitude(int k, vec3 axis, vec3 wo)
 {
   if (k % BISCALE_SMALL_LOBES == 0) {
-    biscale_lobe_amplitude = biscale_amplitude(k / BISCALE_SMALL_LOBES, 2.0 * dot(wo, axis) * axis - wo);
+    int j = k / BISCALE_SMALL_LOBES;
+    biscale_lobe_amplitude = biscale_amplitude(j, 2.0 * dot(wo, axis) * axis - wo) * biscale_tile_weight(j);
   }
 }
 
 /* That amplitude times the small-scale M at the product axis n* = normalize(eta_j xi_j + eta_s h) of effective
  * lobe k = j S + s, directions in n*'s frame (the models are isotropic: any tangent). */
-float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, vec4 p)
+float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, vec4 p, vec4 q)
 {
   float small_sharpness = biscale_small[k % BISCALE_SMALL_LOBES].x;
   wo = safe_normalize(wo);
@@ -148,5 +150,6 @@ float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, 
   vec3 t = normalize(cross(helper, facet));
   vec3 b = cross(facet, t);
   mat3 to_facet = transpose(mat3(t, b, facet));
-  return biscale_lobe_amplitude * biscale_small_m_factor(to_facet * wo, to_facet * wi, p);
+  return biscale_lobe_amplitude * model_m_factor(to_facet * wo, to_facet * wi, p, q);
 }
+#endif

@@ -32,7 +32,6 @@ vec4 diffuse_fractions[DIFFUSE_VISIBILITY_ROWS];
 #endif
 
 #ifdef HAS_SPECULAR
-#ifndef BISCALE
 /* NDF lobe k of the model (brdf.glsl's <model>_ndf_lobe, or the anisotropy table), local
  * frame.  p = (roughness, ior, exponent, alpha_x), q = (alpha_y, nu, nv, rf0). */
 void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude)
@@ -63,7 +62,6 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
                     sqrt((nu + 1.0) * (nv + 1.0)) / (2.0 * SG_PI), k, axis, sharpness, amplitude);
 #endif
 }
-#endif
 
 #ifdef MODEL_FITTED
 /* The stored lobe fit (blender.lobe_fit format 1, export.FittedLobes; mirrored by techniques.sg_shading's
@@ -280,7 +278,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   p.z = fitted_shadowing_of(view_local);       /* S(o), for model_m_factor */
 #endif
 #ifdef BISCALE
-  biscale_set_small_lobes(p);
+  biscale_set_small_lobes(p, q);
 #endif
   for (int k = 0; k < NDF_LOBES; k++) {
     vec3 ndf_axis;
@@ -315,7 +313,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef BISCALE
       slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
                                                 biscale_m_factor(k, ndf_axis, bvndf_sharpness, view_local,
-                                                                 warped_axis[node], p));
+                                                                 warped_axis[node], p, q));
 #else
       slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
                                                 model_m_factor(view_local, warped_axis[node], p, q));
