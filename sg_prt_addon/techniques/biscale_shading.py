@@ -50,8 +50,10 @@ def effective_lobes(tables, small_sharpness, small_amplitude):
 
 def tile_weights(tables, mask, count):
     """(N, T) weight of each tile per pixel: 1 for one tile; (1 - m, m) for two by the mask m (biscale_mask)."""
-    if mask is None or tables.diffuse_tiles.shape[0] == 1:
+    if tables.diffuse_tiles.shape[0] == 1:
         return np.ones((count, 1))
+    if mask is None:
+        raise ValueError("two bi-scale tiles need the mask's value at each pixel")
     m = np.clip(np.asarray(mask, np.float64), 0.0, 1.0)
     return np.stack([1.0 - m, m], axis=1)
 
