@@ -101,7 +101,7 @@ def _tile_rows():
         solves = {solve: bvndf.compute(geometry, tile=tile, solve=solve) for solve in bvndf.AMPLITUDE_SOLVES}
         errors = {solve: bvndf_probe_error(tile, model, pairs) for solve, model in solves.items()}
         rows.append(dict(name=f"BVNDF as 16 SG lobes (eq. 7), {tile_name}: least-squares / responsibility "
-                              "amplitudes", reference="gamma~ of the 8192 sample points through a probe lobe "
+                              "amplitudes", reference=f"gamma~ of the {microgeometry.DEFAULT_SAMPLES} sample points through a probe lobe "
                                                       "(sharpness 250) at the pair's half vector",
                          metric="relative L2 over 60 lattice pairs, half at the mirror node",
                          max_error=errors["least_squares"], mean_error=errors["responsibility"],
@@ -150,11 +150,12 @@ def _setting_rows():
                           "reports 4-8 lobes enough for gamma~'s RMS"))
     by_samples = {count: reference.relative_rms(effective_brdf.compute(bvndf.compute(geometry, samples=count),
                                                                        small).evaluate(wi, wo), truth, wi)
-                  for count in (2048, 8192, 32768)}
+                  for count in (2048, microgeometry.DEFAULT_SAMPLES, 32768)}
     rows.append(dict(name="effective BRDF by sample points, egg crate, GGX 0.2: 2048 / 32768 points",
                      reference="ray-traced tile, 40k rays a pair", metric="relative RMS over 40 pairs",
                      max_error=by_samples[2048], mean_error=by_samples[32768],
-                     note=f"8192 (the default): {by_samples[8192]:.3g}"))
+                     note=f"{microgeometry.DEFAULT_SAMPLES} (the default): "
+                          f"{by_samples[microgeometry.DEFAULT_SAMPLES]:.3g}"))
     return rows
 
 

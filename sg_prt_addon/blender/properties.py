@@ -188,7 +188,7 @@ class SGPRT_PG_biscale(bpy.types.PropertyGroup):
                                    "BRDFs better; docs/ACCURACY.md, bi-scale)")
     resolution: IntProperty(update=_tag_material_changed, name="Directions", default=12, min=4, max=20,
                             description="Lattice of view and light directions per side (12: 144 each, the paper's)")
-    samples: IntProperty(update=_tag_material_changed, name="Samples", default=8192, min=256, max=65536,
+    samples: IntProperty(update=_tag_material_changed, name="Samples", default=4096, min=256, max=65536,
                          description="Points on the tile whose shadowing and masking are traced")
 
 
