@@ -13,7 +13,7 @@ from ..spherical import sg, warp
 from ..visibility import hemisphere_map
 
 FLOAT = np.float32
-# Small-scale models: the isotropic ones, each with its one SG lobe (brdf.<Model>.ndf_lobes())
+# Small-scale models: the isotropic ones (iwasaki2012 sec. 7: as its previous method, isotropic small-scale BRDFs)
 SMALL_SCALE_MODELS = tuple(model.name for model in models.MODELS if not model.anisotropic)
 
 

@@ -42,23 +42,23 @@ class SGBiScale(SGLobes):
                 "BISCALE_LOBE_LAYERS": biscale_shading.lobe_layers(key.ndf_lobes // small)}
 
     def library_files(self, key):
-        """The BRDF (the small-scale M, even for a diffuse-only variant: biscale.glsl compiles it) and the
-        hemisphere map (the tables' lattice) besides what the SG shading takes."""
+        """The hemisphere map (the tables' lattice) besides what the SG shading takes."""
         files = super().library_files(key)
-        if "brdf.glsl" not in files:
-            files.insert(files.index("sg.glsl") + 1, "brdf.glsl")
-        if "hemisphere_map.glsl" not in files:
-            files.append("hemisphere_map.glsl")
-        return files
+        return files if "hemisphere_map.glsl" in files else files + ["hemisphere_map.glsl"]
+
+    @staticmethod
+    def _reads_ggx_table(key):
+        """GGX's two small-scale lobes come from its table, read with the specular term only."""
+        return key.model == "GGX" and key.has_specular
 
     def technique_files(self, key):
         """biscale.glsl (after GGX's two-lobe table reader) before the SG shading it plugs into."""
-        own = ([("sg", "ggx_two_lobes.glsl")] if key.model == "GGX" else []) + [("sg", "biscale.glsl")]
+        own = ([("sg", "ggx_two_lobes.glsl")] if self._reads_ggx_table(key) else []) + [("sg", "biscale.glsl")]
         return own + [entry for entry in super().technique_files(key) if entry not in own]
 
     def model_samplers(self, key):
         samplers = [("FLOAT_2D", "biscale_lobes"), ("FLOAT_2D_ARRAY", "biscale_tables")]
-        return samplers + ([("FLOAT_2D", "ggx_table")] if key.model == "GGX" else [])
+        return samplers + ([("FLOAT_2D", "ggx_table")] if self._reads_ggx_table(key) else [])
 
     def bind_model(self, shader, key, context):
         tables = context.params.biscale
@@ -66,7 +66,7 @@ class SGBiScale(SGLobes):
             ("biscale_lobes", tables.signature), lambda: biscale_shading.lobe_texture(tables)))
         shader.uniform_sampler("biscale_tables", context.material_table(
             ("biscale_tables", tables.signature), lambda: biscale_shading.table_texture(tables)))
-        if key.model == "GGX":
+        if self._reads_ggx_table(key):
             shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", sg_parametric.ggx_table))
 
 
