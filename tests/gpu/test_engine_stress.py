@@ -130,6 +130,43 @@ def test_extreme_materials(engine, model, world):
     assert result["passes"]["Specular"][..., :3].max() > 0
 
 
+def _height_image(name, heights):
+    pixels = np.repeat(np.flipud(np.asarray(heights, np.float32))[..., None], 4, axis=-1)
+    return fx.image(name, pixels)
+
+
+@pytest.mark.parametrize("model", ["GGX", "COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO"])
+def test_extreme_bi_scale_materials(engine, model):
+    """The bi-scale technique (SG_BISCALE) with the extreme settings above on a flat tile, a tile of near-vertical
+    walls and a single spike, under the HDRI and the lights: every pass finite."""
+    scene = fx.new_scene(f"stress_biscale_{model}", SIZE, SIZE)
+    _world_image(scene, _hdri("stress_biscale_hdri"))
+    fx.point_light(scene, f"{scene.name}_point", (1.0, -3.0, 3.0), 1000.0, radius=0.0)
+    fx.point_light(scene, f"{scene.name}_sun", (0.0, 0.0, 5.0), 3.0, kind="SUN")
+    spike = np.zeros((8, 8))
+    spike[3, 4] = 1.0
+    walls = (np.add.outer(np.arange(8), np.arange(8)) % 2).astype(float)
+    tiles = {"flat": (np.zeros((4, 4)), 1.0), "walls": (walls, 5.0), "spike": (spike, 2.0)}
+    for index, (name, settings) in enumerate(EXTREMES.items()):
+        tile_name = list(tiles)[index % len(tiles)]
+        heights, scale = tiles[tile_name]
+        sphere = fx.uv_sphere(scene, f"{scene.name}_{name}", (-2.5 + index, 0.0, 1.0), radius=0.45, segments=16,
+                              rings=8)
+        material = fx.material(f"{scene.name}_{name}", model=model, technique="SG_BISCALE")
+        material.sgprt.biscale.height_image = _height_image(f"{scene.name}_{tile_name}", heights)
+        material.sgprt.biscale.height_scale = scale
+        material.sgprt.biscale.samples = 512
+        material.sgprt.biscale.lobes = 4
+        _set_raw(material.sgprt, **settings)
+        sphere.data.materials.append(material)
+    result = _render(scene)
+    techniques_used = {params.technique for name, params in result["state"].materials.items()
+                       if name.startswith(scene.name)}
+    assert techniques_used == {"SG_BISCALE"}, _warnings(result)
+    assert _covered(result).mean() > 0.05
+    assert result["passes"]["Specular"][..., :3].max() > 0
+
+
 def test_non_finite_material_settings(engine):
     """NaN / Inf settings stored by a script: the defaults are used, and said."""
     scene = fx.new_scene("stress_nan_settings", 16, 16)
