@@ -1,6 +1,8 @@
 /* Bi-scale materials (iwasaki2012 eq. 15): the effective BRDF's lobes and factors, mirrored by
- * sg_prt_addon/techniques/biscale_shading.py.  Needs sg.glsl, brdf.glsl, hemisphere_map.glsl, and:
- *   biscale_lobes  (sampler2D, BISCALE_LOBES x 1): texel j = (axis xyz in the local frame, sharpness) of BVNDF lobe j;
+ * sg_prt_addon/techniques/biscale_shading.py.  Needs sg.glsl, hemisphere_map.glsl, surface_io.glsl (the mask's
+ * material_texture); with HAS_SPECULAR, brdf.glsl, (MODEL_GGX) ggx_two_lobes.glsl and the ggx_table sampler, and
+ * sg_shading.glsl after this file (its model_ndf_lobe and model_m_factor); and:
+ *   biscale_lobes  (sampler2D, J x 1): texel j = (axis xyz in the local frame, sharpness) of BVNDF lobe j;
  *   biscale_tables (sampler2DArray, R^2 x R^2 RGBA32F, linear filtering): the node pair (i, o) of the lattice
  *     (biscale/bvndf.py, R = BISCALE_RESOLUTION) at texel (o_a R + i_a, o_b R + i_b); layer t, channel c:
  *     mu_j(i, o) per unit cos(theta_i) of lobe j = 4 t + c; layer BISCALE_LOBE_LAYERS: (D(i, o), A(o)) of the
