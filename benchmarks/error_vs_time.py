@@ -59,7 +59,7 @@ JSON_PATH = ROOT / "docs" / "error_vs_time.json"
 PLOT_PATH = ROOT / "docs" / "images" / "error_vs_time.png"
 DOC_PATH = ROOT / "docs" / "PERFORMANCE.md"
 SECTION_TITLE = "## Error vs time"
-SCENES = ("suzanne_courtyard", "brushed_metal")
+SCENES = ("suzanne_courtyard", "brushed_metal", "hammered_metal")
 
 FULL = dict(size=512, noise=0.015, max_reference_spp=256, reference_seconds=240, reference_curve=(1, 4, 16),
             bake_resolutions=(8, 16, 32),
