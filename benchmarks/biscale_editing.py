@@ -82,7 +82,7 @@ def engine_figures(size, redraws):
             pixels = np.repeat(heights[::-1, :, None], 4, axis=-1).astype(np.float32)
             image.pixels.foreach_set(pixels.ravel())
             start = time.perf_counter()
-            edited_state._export_readers(("IMAGE", image.name), edited_state.dirty)
+            edited_state._export_readers({("IMAGE", image.name)}, edited_state.dirty)
             exports.append(time.perf_counter() - start)
 
         def touch(edited_state):

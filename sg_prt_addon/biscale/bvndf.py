@@ -211,9 +211,11 @@ def from_samples(tile, axes, sharpness, mixture, resolution, solve="responsibili
         density = sg.evaluate(normals, axes[None], sharpness[None], 1.0) * \
             (mixture * spherical_em.normalization(sharpness))[None]
         responsibility = density / np.maximum(density.sum(axis=1, keepdims=True), 1e-300)
-        amplitudes = _lobe_weighted_sums(tile, responsibility).reshape(lobes, -1) / \
-            sg.sphere_integral(sharpness)[:, None]
-    integral = _lobe_weighted_sums(tile, np.ones((len(tile.points.normals), 1)))[0].astype(np.float32)
+        sums = _lobe_weighted_sums(tile, responsibility)
+        amplitudes = sums.reshape(lobes, -1) / sg.sphere_integral(sharpness)[:, None]
+    # the responsibilities share each point's weight whole among the lobes: their sums add up to gamma~'s
+    integral = (sums.sum(axis=0) if solve == "responsibility" else
+                _lobe_weighted_sums(tile, np.ones((len(tile.points.normals), 1)))[0]).astype(np.float32)
     return BVNDF(axes, sharpness, mixture, amplitudes.reshape(len(sharpness), nodes, nodes).astype(np.float32),
                  integral, diffuse_albedo(integral, resolution), tile.directions, int(resolution))
 

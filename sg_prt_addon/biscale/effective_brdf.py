@@ -50,16 +50,8 @@ class SmallScaleMaterial:
         return brdf_models.model_from_name(self.model, **dict(self.parameters))
 
     def ndf_lobes(self):
-        """(sharpness (S,), amplitude (S,)) of the small-scale NDF's SG lobes, all on the facet normal, scaled so
-        their projected mass integral D(h) (n.h) dh is 1, as the NDF's own: the fits match the peak and lose
-        the tail (GGX roughness 0.35: 23% of the mass), which the convolution with the tile's lobes spreads
-        into the whole highlight."""
-        model = self.brdf()
-        lobes = model.ndf_lobes(self.ndf_lobe_count) if self.model == "GGX" else model.ndf_lobes()
-        _, sharpness, amplitude = lobes
-        sharpness = np.asarray(sharpness, np.float64).reshape(-1)
-        amplitude = np.asarray(amplitude, np.float64).reshape(-1)
-        return sharpness, amplitude / np.sum(amplitude * sg.axis_cosine_integral(sharpness))
+        """(sharpness (S,), amplitude (S,)) of the small-scale NDF's SG lobes (small_scale_lobes)."""
+        return small_scale_lobes(self.brdf(), self.model, self.ndf_lobe_count)
 
 
 @dataclass(frozen=True)
@@ -83,7 +75,7 @@ class EffectiveBRDF:
     @property
     def sharpness(self):
         """eta_l of eq. 14-15: eta_j eta_s / (eta_j + eta_s)."""
-        return self.ndf_sharpness * self.small_sharpness / (self.ndf_sharpness + self.small_sharpness)
+        return sg.convolution_lobe(self.ndf_sharpness, 1.0, self.small_sharpness, 1.0)[0]
 
     def m_factors(self, wi, wo):
         """(L, ...) the small-scale M at each lobe's product axis n* for directions (..., 3)."""
@@ -122,6 +114,18 @@ class EffectiveBRDF:
                 self.specular(wi, wo, convolution)[..., None] * np.asarray(self.small.specular_color))
 
 
+def small_scale_lobes(model, name, lobe_count=2):
+    """(sharpness (..., S), amplitude (..., S)) of a small-scale model's NDF lobes (a reflectance.brdf model
+    called `name`, its parameters scalars or per-pixel arrays), all on the facet normal: GGX's `lobe_count`-lobe
+    fit, one lobe for the others; amplitudes scaled so the lobes' projected mass integral D(h) (n.h) dh is 1,
+    as the NDF's own: the fits match the peak and lose the tail (GGX roughness 0.35: 23% of the mass), which the
+    convolution with the tile's lobes spreads into the whole highlight."""
+    _, sharpness, amplitude = model.ndf_lobes(lobe_count) if name == "GGX" else model.ndf_lobes()
+    sharpness, amplitude = np.asarray(sharpness, np.float64), np.asarray(amplitude, np.float64)
+    mass = np.sum(amplitude * sg.axis_cosine_integral(sharpness), axis=-1, keepdims=True)
+    return sharpness, amplitude / np.maximum(mass, 1e-30)
+
+
 def facet_m_factor(model, normals, wi, wo):
     """M(i, o) of the small-scale model on facets with normals (..., 3): the directions in each facet's frame."""
     frames = hemisphere_map.local_frame(normals)
@@ -134,9 +138,8 @@ def compute(model, small):
     """The effective BRDF of a BVNDF (bvndf.compute) and a SmallScaleMaterial (eq. 15's lobes)."""
     small.brdf()                                     # refuses an unknown or anisotropic model now, not at shading
     small_sharpness, small_amplitude = small.ndf_lobes()
-    eta_j = model.sharpness[:, None]
-    eta_s = small_sharpness[None, :]
-    scale = 2.0 * np.pi * small_amplitude[None, :] / (eta_j + eta_s)              # (J, S)
+    _, scale = sg.convolution_lobe(model.sharpness[:, None], 1.0, small_sharpness[None, :],
+                                   small_amplitude[None, :])                     # (J, S): 2 pi mu_s / (eta_j + eta_s)
     tables = model.amplitudes[:, None].astype(np.float64) * scale[..., None, None]
     count, nodes = tables.shape[0] * tables.shape[1], len(model.directions)
     return EffectiveBRDF(

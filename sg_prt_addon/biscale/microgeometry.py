@@ -32,10 +32,6 @@ class Microgeometry:
         """Area of the tile's projection on the large-scale plane."""
         return float(self.size[0] * self.size[1])
 
-    @property
-    def height_range(self):
-        return float(np.ptp(self.vertices[:, 2])) if len(self.vertices) else 0.0
-
     def facets(self):
         """(normals (T, 3) unit, areas (T,)) of the triangles; degenerate ones have area 0 and normal z+."""
         p0, p1, p2 = (self.vertices[self.triangles[:, k]] for k in range(3))

@@ -19,8 +19,7 @@ KMEANS_ROUNDS = 8
 
 def normalization(sharpness):
     """c(sharpness): the amplitude that makes G integrate to 1 over the sphere."""
-    sharpness = np.asarray(sharpness, np.float64)
-    return 1.0 / (4.0 * np.pi * sg.one_minus_exp_over_x(2.0 * sharpness))
+    return 1.0 / sg.sphere_integral(np.asarray(sharpness, np.float64))
 
 
 def sharpness_from_mean_length(mean_length):

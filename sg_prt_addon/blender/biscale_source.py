@@ -15,7 +15,7 @@ from ..biscale import bvndf, microgeometry
 from .images import image_has_pixels, image_pixels
 
 CACHE_SIZE = 8
-_cache = OrderedDict()          # content key -> BVNDF, least recently used first
+_cache = OrderedDict()          # content key -> (BVNDF, its tile's triangles), least recently used first
 _status = {}                    # material name -> the last computation's one-line report (the panel shows it)
 
 
@@ -51,7 +51,8 @@ def _tile_mesh(obj):
 
 
 def _geometry_and_key(settings, second=False):
-    """(microgeometry, content key) of the settings' tile (second: the mask's second tile, a height image)."""
+    """(a function building the microgeometry, content key) of the settings' tile (second: the mask's second
+    tile, a height image): the pixels or the mesh are read for the key, the tile is built only when needed."""
     digest = hashlib.sha1()
     if second or settings.source == "IMAGE":
         image, scale = ((settings.second_height_image, settings.second_height_scale) if second
@@ -59,14 +60,18 @@ def _geometry_and_key(settings, second=False):
         heights = _image_heights(image)
         digest.update(np.ascontiguousarray(heights, np.float32).tobytes())
         digest.update(repr(float(scale)).encode())
-        geometry = microgeometry.from_height_field(heights, height_scale=float(scale))
+
+        def build():
+            return microgeometry.from_height_field(heights, height_scale=float(scale))
     else:
         vertices, triangles, size = _tile_mesh(settings.tile_object)
         digest.update(vertices.tobytes() + triangles.tobytes())
-        geometry = microgeometry.from_mesh(vertices, triangles, size)
+
+        def build():
+            return microgeometry.from_mesh(vertices, triangles, size)
     digest.update(repr((second or settings.source, int(settings.lobes), int(settings.resolution),
                         int(settings.samples))).encode())
-    return geometry, digest.hexdigest()
+    return build, digest.hexdigest()
 
 
 def masked(settings):
@@ -88,35 +93,35 @@ def reads(material):
 
 def geometry(material, second=False):
     """The material's biscale.microgeometry tile, or its second (ValueError with the reason when it has none)."""
-    return _geometry_and_key(material.sgprt.biscale, second)[0]
+    return _geometry_and_key(material.sgprt.biscale, second)[0]()
 
 
 def _tile_tables(settings, second):
-    """(BVNDF, seconds computing it: 0 when cached) of one tile; ValueError says why there is none."""
-    geometry, key = _geometry_and_key(settings, second)
-    model = _cache.get(key)
-    if model is not None:
+    """(BVNDF, seconds computing it (0 when cached), its triangles) of one tile; ValueError says why there is
+    none."""
+    build, key = _geometry_and_key(settings, second)
+    cached = _cache.get(key)
+    if cached is not None:
         _cache.move_to_end(key)
-        return model, 0.0, geometry
+        return cached[0], 0.0, cached[1]
     start = time.perf_counter()
+    geometry = build()
     model = bvndf.compute(geometry, lobes=int(settings.lobes), resolution=int(settings.resolution),
                           samples=int(settings.samples))
-    _cache[key] = model
+    _cache[key] = (model, len(geometry.triangles))
     while len(_cache) > CACHE_SIZE:
         _cache.popitem(last=False)
-    return model, time.perf_counter() - start, geometry
+    return model, time.perf_counter() - start, len(geometry.triangles)
 
 
 def tables(material):
     """(BVNDF or bvndf.MaskedTiles, None) of the material's tile(s), or (None, the reason it has none)."""
     settings = material.sgprt.biscale
     try:
-        model, seconds, geometry = _tile_tables(settings, False)
-        triangles = len(geometry.triangles)
+        model, seconds, triangles = _tile_tables(settings, False)
         if masked(settings):
             second, more, other = _tile_tables(settings, True)
-            model, seconds, triangles = bvndf.MaskedTiles(model, second), seconds + more, \
-                triangles + len(other.triangles)
+            model, seconds, triangles = bvndf.MaskedTiles(model, second), seconds + more, triangles + other
     except ValueError as error:
         _status[material.name] = str(error)
         return None, str(error)

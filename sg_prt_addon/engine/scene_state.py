@@ -263,6 +263,7 @@ class SceneState:
         self._edited_meshes = {update.id.name for update in depsgraph.updates
                                if isinstance(update.id, bpy.types.Mesh) and update.is_updated_geometry}
         self._roles = export.render_roles(depsgraph.view_layer)
+        changed_sources = set()         # datablocks materials are computed from (export.MaterialParams.reads)
         for update in depsgraph.updates:
             datablock = update.id
             if isinstance(datablock, bpy.types.Material):
@@ -270,7 +271,7 @@ class SceneState:
                 dirty.materials.add(datablock.name)
             elif isinstance(datablock, bpy.types.Image):
                 dirty.images.add(datablock.name)
-                self._export_readers(("IMAGE", datablock.name), dirty)
+                changed_sources.add(("IMAGE", datablock.name))
                 if self.world.image_name == datablock.name and depsgraph.scene.world is not None:
                     self.world = export.export_world(depsgraph.scene.world)
                     self.environment = environment_data(self.world, self.environment_layer_size)
@@ -284,11 +285,13 @@ class SceneState:
             elif isinstance(datablock, bpy.types.Object):
                 self._update_object(depsgraph, datablock.evaluated_get(depsgraph), update, dirty)
                 if update.is_updated_geometry:
-                    self._export_readers(("OBJECT", datablock.name), dirty)
+                    changed_sources.add(("OBJECT", datablock.name))
             elif isinstance(datablock, bpy.types.Light):
                 dirty.lights = True
             elif isinstance(datablock, bpy.types.Mesh) and update.is_updated_geometry:
-                self._export_readers(("MESH", datablock.name), dirty)
+                changed_sources.add(("MESH", datablock.name))
+        if changed_sources:
+            self._export_readers(changed_sources, dirty)
         if membership_changed:
             self._sync_membership(depsgraph, dirty)
         if dirty.lights:
@@ -296,12 +299,12 @@ class SceneState:
             self.lights = [light for light in self.lights if light is not None]
         return dirty
 
-    def _export_readers(self, source, dirty):
-        """Export again the materials computed from `source` (export.MaterialParams.reads), e.g. after its pixels
-        or its mesh changed."""
+    def _export_readers(self, sources, dirty):
+        """Export again, once each, the materials computed from any of `sources` (export.MaterialParams.reads),
+        e.g. after their pixels or their mesh changed (a mesh edit updates both the object and its mesh)."""
         import bpy
 
-        for name in [name for name, params in self.materials.items() if source in params.reads]:
+        for name in [name for name, params in self.materials.items() if sources.intersection(params.reads)]:
             if name in bpy.data.materials:
                 self.materials[name] = export.export_material(bpy.data.materials[name])
                 dirty.materials.add(name)

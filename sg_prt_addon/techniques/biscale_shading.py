@@ -8,9 +8,9 @@ needs no recomputation; the tile's BVNDF (lobes and tables) changes only with th
 import numpy as np
 
 from ..biscale import bvndf as bvndf_tables
+from ..biscale import effective_brdf
 from ..reflectance import brdf, models
 from ..spherical import sg, warp
-from ..visibility import hemisphere_map
 
 FLOAT = np.float32
 # Small-scale models: the isotropic ones (iwasaki2012 sec. 7: as its previous method, isotropic small-scale BRDFs)
@@ -29,11 +29,7 @@ def small_lobes(model, params):
     if model not in SMALL_SCALE_MODELS:
         raise ValueError(f"a bi-scale material's small-scale model must be isotropic, not {model}")
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
-    lobes = instance.ndf_lobes(2) if model == "GGX" else instance.ndf_lobes()
-    sharpness = np.asarray(lobes[1], np.float64)
-    amplitude = np.asarray(lobes[2], np.float64)
-    mass = np.sum(amplitude * sg.axis_cosine_integral(sharpness), axis=-1, keepdims=True)
-    return sharpness, amplitude / np.maximum(mass, 1e-30)
+    return effective_brdf.small_scale_lobes(instance, model, small_lobe_count(model))
 
 
 def effective_lobes(tables, small_sharpness, small_amplitude):
@@ -43,9 +39,9 @@ def effective_lobes(tables, small_sharpness, small_amplitude):
     eta_j = np.repeat(np.asarray(tables.sharpness, np.float64), small)[None, :]
     eta_s = np.tile(small_sharpness, (1, tables.lobe_count))
     mu_s = np.tile(small_amplitude, (1, tables.lobe_count))
-    total = np.maximum(eta_j + eta_s, 1e-30)
+    sharpness, amplitude = sg.convolution_lobe(eta_j, 1.0, eta_s, mu_s)
     axes = np.repeat(sg.normalize(np.asarray(tables.axes, np.float64)), small, axis=0)
-    return np.broadcast_to(axes[None], (count,) + axes.shape), eta_j * eta_s / total, 2.0 * np.pi * mu_s / total
+    return np.broadcast_to(axes[None], (count,) + axes.shape), sharpness, amplitude
 
 
 def tile_weights(tables, mask, count):
@@ -82,14 +78,11 @@ def m_factor_rows(tables, model, params, small_sharpness, nodes, mask=None):
         wo = sg.normalize(np.asarray(wo, np.float64))
         wi = sg.normalize(np.asarray(wi, np.float64))
         facet = sg.normalize(eta_j * axes + eta_s * sg.normalize(wo + wi))
-        frames = hemisphere_map.local_frame(facet)
-        local_o = np.einsum("...ij,...j->...i", frames, wo)
-        local_i = np.einsum("...ij,...j->...i", frames, wi)
         # mu_j read once a BVNDF lobe, at its mirror direction (biscale_set_lobe_amplitude)
         mirror = 2.0 * np.sum(wo * axes, axis=-1, keepdims=True) * axes - wo
         amplitude = paired_amplitudes(tables, lobe_of_row, mirror, wo) * weight
         above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
-        return np.where(above, amplitude * instance.m_factor(local_o, local_i), 0.0)
+        return np.where(above, amplitude * effective_brdf.facet_m_factor(instance, facet, wi, wo), 0.0)
 
     return m_factor
 
