@@ -8,29 +8,29 @@ fitted or convolved.  Its noise is the rays' standard error, returned with it.
 """
 import numpy as np
 
-from sg_prt_addon.biscale import microgeometry
+from sg_prt_addon.biscale import effective_brdf, microgeometry
 from sg_prt_addon.reflectance import brdf
-from sg_prt_addon.visibility import hemisphere_map
 
 
-def facet_brdf(small, model, normals, wi, wo):
-    """(N, 3) small-scale BRDF kd / pi + ks rho_s on facets with normals (N, 3), directions (3,) or (N, 3) in the
-    tile frame."""
-    frames = hemisphere_map.local_frame(normals)
-    local_i = np.einsum("nij,nj->ni", frames, np.broadcast_to(wi, normals.shape))
-    local_o = np.einsum("nij,nj->ni", frames, np.broadcast_to(wo, normals.shape))
-    specular = model.specular(local_o, local_i)
-    lit = (local_i[:, 2] > 0) & (local_o[:, 2] > 0)
-    return np.where(lit[:, None], np.asarray(small.diffuse_color) / np.pi +
-                    specular[:, None] * np.asarray(small.specular_color), 0.0)
+class AnalyticSmallScale:
+    """A validation.brdf_generators.AnalyticMaterial (the BRDF a measured file was generated from) as a small-scale
+    BRDF of the ground truth: what a bi-scale material with a lobe fit to that file should look like."""
+
+    def __init__(self, analytic):
+        self.analytic = analytic
+        self.typical_roughness = float(np.max(analytic.roughness))
+
+    def evaluate_on_facets(self, normals, wi, wo):
+        local_i, local_o = effective_brdf.facet_directions(normals, wi, wo)
+        return self.analytic.evaluate(local_o, local_i)
 
 
 def effective_brdf_traced(geometry, small, wi, wo, rays=20000, seed=1, tracer=None):
     """(rho (P, 3), standard error (P, 3)): the effective BRDF without the large-scale cosine (f / cos(theta_i))
-    at pairs of unit directions wi, wo (P, 3) in the tile frame, by ray tracing the tile."""
+    at pairs of unit directions wi, wo (P, 3) in the tile frame, by ray tracing the tile; small: a small-scale
+    BRDF (biscale.effective_brdf's, or AnalyticSmallScale)."""
     wi = np.atleast_2d(np.asarray(wi, np.float64))
     wo = np.atleast_2d(np.asarray(wo, np.float64))
-    model = small.brdf()
     normals, _ = geometry.facets()
     own = tracer is None
     tracer = tracer or microgeometry.TiledTracer(geometry)
@@ -46,7 +46,7 @@ def effective_brdf_traced(geometry, small, wi, wo, rays=20000, seed=1, tracer=No
             shade = np.zeros((rays, 3))
             if np.any(lit):
                 visible = tracer.visible(positions[lit], facet[lit], np.broadcast_to(i, (int(lit.sum()), 3)))
-                f = facet_brdf(small, model, facet[lit], i, o) * (facet[lit] @ i)[:, None]
+                f = small.evaluate_on_facets(facet[lit], i, o) * (facet[lit] @ i)[:, None]
                 shade[lit] = f * visible[:, None]
             cos_i = max(i[2], 1e-6)
             values.append(shade.mean(axis=0) / cos_i)
@@ -60,11 +60,10 @@ def effective_brdf_traced(geometry, small, wi, wo, rays=20000, seed=1, tracer=No
 def effective_brdf_of_samples(tile, small, i_index, o_index):
     """rho (3,) at a pair of lattice nodes from the BVNDF's own samples with the exact small-scale BRDF: eq. 1
     as the tables discretize it, before any SG (bvndf.TileSamples)."""
-    model = small.brdf()
     weights = tile.weights(i_index, o_index).astype(np.float64)
     keep = weights > 0
     i, o = tile.directions[i_index], tile.directions[o_index]
-    f = facet_brdf(small, model, tile.points.normals[keep], i, o)
+    f = small.evaluate_on_facets(tile.points.normals[keep], i, o)
     return (weights[keep] @ f) / i[2]
 
 
@@ -133,14 +132,13 @@ class TracedEffectiveBRDF:
 
     def __init__(self, geometry, small, rays=2, seed=11):
         self.geometry, self.small, self.rays = geometry, small, int(rays)
-        self.model = small.brdf()
         self.normals, _ = geometry.facets()
         self.tracer = microgeometry.TiledTracer(geometry)
         self.rng = np.random.default_rng(seed)
         normals, areas = self.normals, geometry.facets()[1]
         slope2 = float(np.sum(areas * (1.0 - normals[:, 2] ** 2) / np.maximum(normals[:, 2] ** 2, 1e-6)) /
                        np.sum(areas))
-        alpha = float(getattr(self.model, "roughness", 0.3)) ** 2
+        alpha = small.typical_roughness ** 2
         self.proposal = brdf.GGX(roughness=float((alpha * alpha + slope2 + 0.01) ** 0.25))
 
     def specular(self, wo, wi):
@@ -158,7 +156,7 @@ class TracedEffectiveBRDF:
             if not np.any(lit):
                 continue
             visible = self.tracer.visible(positions[lit], facet[lit], wi[lit])
-            value = facet_brdf(self.small, self.model, facet[lit], wi[lit], wo[lit])
+            value = self.small.evaluate_on_facets(facet[lit], wi[lit], wo[lit])
             total[lit] += value * (cos_i[lit] * visible / np.maximum(wi[lit, 2], 1e-6))[:, None]
         return total / self.rays
 

@@ -37,15 +37,28 @@ def _texture_lookup(params, images):
     return lookup
 
 
+def small_scale_brdf(params):
+    """A bi-scale material's small-scale BRDF: its stored lobe fit (one texel: a fit to one measured file), else
+    its model with its constant parameters."""
+    if getattr(params, "fitted", None) is not None:
+        if params.fitted.layers.shape[1:3] != (1, 1):
+            raise ValueError(f"material '{params.name}': the reference renders a bi-scale lobe fit of one texel only")
+        texel, diffuse = sg_shading.fitted_texel_values(params.fitted, np.zeros((1, 2)))
+        return effective_brdf.FittedSmallScale.from_arrays(
+            diffuse[0], texel["eta"][0], texel["axis"][0], texel["sharpness"][0], texel["colour"][0],
+            texel["shadowing_theta"], texel["shadowing"][0])
+    return effective_brdf.SmallScaleMaterial(
+        tuple(params.diffuse_color), tuple(params.specular_color), params.model,
+        tuple((name, float(getattr(params, name))) for name in models.BY_NAME[params.model].parameters))
+
+
 def reference_material(params, texture_pixels, biscale_geometry=None):
     """validation.reference.Material of an export.MaterialParams; texture_pixels(texture, slot, decode) gives
     what the shader samples for that slot (export.slot_pixels of an image name or Expression), or None for a
     missing image.  A bi-scale material (params.biscale) renders its ray-traced tile: biscale_geometry(name,
     second) gives the material's biscale.microgeometry tile (or the second one its mask chooses)."""
     if getattr(params, "biscale", None) is not None and biscale_geometry is not None:
-        small = effective_brdf.SmallScaleMaterial(
-            tuple(params.diffuse_color), tuple(params.specular_color), params.model,
-            tuple((name, float(getattr(params, name))) for name in models.BY_NAME[params.model].parameters))
+        small = small_scale_brdf(params)
         first = biscale_reference.TracedEffectiveBRDF(biscale_geometry(params.name, False), small)
         material = reference.Material((0.0, 0.0, 0.0), (1.0, 1.0, 1.0), first)
         if sg_shading.BISCALE_MASK in params.textures:       # two tiles, chosen by the mask

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import techniques
+from ..biscale import effective_brdf
 from ..reflectance import layering, models, principled
 from ..techniques import (
     biscale_shading,
@@ -476,31 +477,58 @@ def _usable_technique(material, params):
 
 
 def _usable_biscale(material, params):
-    """The bi-scale technique with the material's tile (params.biscale), or the default with the reason."""
+    """The bi-scale technique with the material's tile (params.biscale) and small-scale BRDF (its model, or its
+    stored lobe fit in params.fitted), or a single-scale technique with the reason."""
     from . import biscale_source
 
-    if params.model not in biscale_shading.SMALL_SCALE_MODELS:
-        warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} needs an isotropic small-scale model "
+    settings = material.sgprt.biscale
+    label = sg_biscale.TECHNIQUE.label
+    if settings.small_scale == "LOBE_FIT":
+        params.fitted, reason = _isotropic_lobe_fit(material)
+        if params.fitted is None:
+            warn(f"material '{material.name}': {label}: no usable small-scale lobe fit ({reason}): rendered as a "
+                 "single scale with its model")
+            return techniques.DEFAULT
+    elif params.model not in biscale_shading.SMALL_SCALE_MODELS:
+        warn(f"material '{material.name}': {label} needs an isotropic small-scale model "
              f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}: rendered as a single scale")
         return techniques.DEFAULT
     params.reads = biscale_source.reads(material)
     params.biscale, reason = biscale_source.tables(material)
     if params.biscale is None:
-        warn(f"material '{material.name}': no usable small-scale geometry ({reason}): rendered as a single scale")
-        return techniques.DEFAULT
-    settings = material.sgprt.biscale
+        fallback = techniques.DEFAULT if params.fitted is None else sg_fitted.NAME
+        warn(f"material '{material.name}': no usable small-scale geometry ({reason}): rendered as a single scale"
+             f"{' with its lobe fit' if params.fitted is not None else ''}")
+        return fallback
     if biscale_source.masked(settings):
         params.textures[sg_shading.BISCALE_MASK] = settings.mask.name
     elif settings.mask is not None:
         warn(f"material '{material.name}': its bi-scale mask has no second height image: the mask is not applied")
     layers = surface_layering.flags(params)
-    if layers:
-        warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} does not apply {', '.join(layers)}")
-    ignored = sorted(slot for slot in params.textures if slot not in sg_biscale.TEXTURES)
+    if layers and params.fitted is None:
+        warn(f"material '{material.name}': {label} does not apply {', '.join(layers)}")
+    ignored = sorted(slot for slot in params.textures if slot not in sg_biscale.texture_slots(params))
     if ignored:
-        warn(f"material '{material.name}': {sg_biscale.TECHNIQUE.label} does not apply the textures on "
-             f"{', '.join(ignored)}")
+        warn(f"material '{material.name}': {label} does not apply the textures on {', '.join(ignored)}"
+             f"{' (the lobe fit holds the small-scale look)' if params.fitted is not None else ''}")
     return sg_biscale.NAME
+
+
+def _isotropic_lobe_fit(material):
+    """(FittedLobes, None) of the material's stored fit when its lobes lie about the normal (a small-scale BRDF
+    must be isotropic), else (None, the reason)."""
+    from . import lobe_fit
+
+    fitted = export_fitted_lobes(material)
+    if fitted is None:
+        state, message = lobe_fit.fit_status(material)
+        return None, message or state.lower()
+    axes = fitted.layers[1:1 + 2 * fitted.lobe_count:2, ..., :3].astype(np.float64)
+    tilt = np.linalg.norm(axes[..., :2], axis=-1) / np.maximum(np.linalg.norm(axes, axis=-1), 1e-30)
+    if np.any(tilt > effective_brdf.AXIS_TOLERANCE):
+        return None, (f"its lobes leave the normal by up to {np.degrees(np.arcsin(min(float(tilt.max()), 1.0))):.1f}"
+                      " degrees: fit with Axes Auto for an isotropic small-scale BRDF")
+    return fitted, None
 
 
 def export_material(material):

@@ -68,7 +68,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from .. import techniques
 from ..measured import merl as merl_format
 from ..measured import microfacet_fit, svbrdf_table
-from ..techniques import sg_fitted
+from ..techniques import sg_biscale, sg_fitted
 from .background_job import BackgroundJob, MaterialFileJobOperator, active_material
 from .panels import MaterialPanel
 
@@ -335,7 +335,10 @@ def store_lobe_fit(material, result, path, free_axes=None):
     settings.date = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     settings.seconds = float(result["seconds"])
     settings.format_version = FORMAT_VERSION
-    material.sgprt.technique = sg_fitted.NAME
+    if techniques.of_settings(material.sgprt) == sg_biscale.NAME:
+        material.sgprt.biscale.small_scale = "LOBE_FIT"      # a bi-scale material's fit is its small-scale BRDF
+    else:
+        material.sgprt.technique = sg_fitted.NAME
     material.update_tag()
 
 
@@ -491,7 +494,10 @@ class SGPRT_PT_material_lobe_fit(MaterialPanel, bpy.types.Panel):
         if state == "NONE":
             column.label(text="No fitted lobes: renders the model above", icon="INFO")
             return
-        if techniques.of_settings(material.sgprt) != sg_fitted.NAME:
+        technique = techniques.of_settings(material.sgprt)
+        if technique == sg_biscale.NAME and material.sgprt.biscale.small_scale == "LOBE_FIT":
+            column.label(text="The small-scale BRDF of the bi-scale material", icon="INFO")
+        elif technique != sg_fitted.NAME:
             column.label(text="Renders the model: pick the fitted technique above to render the fit", icon="INFO")
         if state == "INVALID":
             column.alert = True

@@ -86,7 +86,11 @@ class SGPRT_PT_material_biscale(MaterialPanel, bpy.types.Panel):
         status = biscale_source.last_status(context.material)
         if status:
             layout.label(text=status, icon="INFO")
-        layout.label(text="Small-scale BRDF: the model above (isotropic)", icon="MATERIAL")
+        layout.prop(settings, "small_scale")
+        if settings.small_scale == "LOBE_FIT":
+            layout.label(text="The lobe fit below (Measured BRDF): isotropic, Axes Auto", icon="MATERIAL")
+        else:
+            layout.label(text="The model above (isotropic)", icon="MATERIAL")
 
 
 class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):

@@ -172,6 +172,12 @@ class SGPRT_PG_biscale(bpy.types.PropertyGroup):
                                               "in tile widths")
     height_scale: FloatProperty(update=_tag_material_changed, name="Height Scale", default=0.05, min=0.0,
                                 soft_max=0.5, description="Height of an image value of 1, in tile widths")
+    small_scale: EnumProperty(update=_tag_material_changed, name="Small-Scale BRDF", default="MODEL",
+                              items=(("MODEL", "Material Model", "The material's own isotropic model, colours and "
+                                                                 "textures"),
+                                     ("LOBE_FIT", "Lobe Fit", "The material's stored lobe fit (Fit Lobes: a measured "
+                                                              "BRDF, isotropic, Axes Auto)")),
+                              description="What the small-scale geometry's surface reflects with")
     tile_object: PointerProperty(update=_tag_material_changed, type=bpy.types.Object, name="Tile", poll=_is_mesh,
                                  description="Mesh whose faces are one tile of the surface (object space)")
     mask: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Mask",

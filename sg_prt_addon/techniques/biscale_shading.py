@@ -2,8 +2,9 @@
 eq. 15) as the SG technique's BRDF slice, and its diffuse factor; and the GPU layout of a biscale.bvndf.BVNDF
 (or of two tiles a mask chooses between, bvndf.MaskedTiles).
 
-The small-scale BRDF is the material's own model and parameters (per pixel, textures included), so editing it
-needs no recomputation; the tile's BVNDF (lobes and tables) changes only with the geometry.
+The small-scale BRDF is the material's own model and parameters (per pixel, textures included), or its stored
+lobe fit (model FITTED: the fit's lobes, colours and M at each pixel's texel), so editing it needs no
+recomputation; the tile's BVNDF (lobes and tables) changes only with the geometry.
 """
 import numpy as np
 
@@ -11,25 +12,52 @@ from ..biscale import bvndf as bvndf_tables
 from ..biscale import effective_brdf
 from ..reflectance import brdf, models
 from ..spherical import sg, warp
+from .fitted_texels import FITTED_MODEL, fitted_m_factor
 
 FLOAT = np.float32
 # Small-scale models: the isotropic ones (iwasaki2012 sec. 7: as its previous method, isotropic small-scale BRDFs)
 SMALL_SCALE_MODELS = tuple(model.name for model in models.MODELS if not model.anisotropic)
 
 
-def small_lobe_count(model):
-    """The small-scale model's SG lobes: GGX's two-lobe fit (its tail holds a quarter of its mass at roughness
-    0.5), one for the others."""
+def small_lobe_count(model, fitted=None):
+    """The small-scale BRDF's SG lobes: a stored fit's (fitted: its export.FittedLobes), GGX's two-lobe fit (its
+    tail holds a quarter of its mass at roughness 0.5), one for the other models."""
+    if fitted is not None:
+        return int(fitted.lobe_count)
     return 2 if model == "GGX" else 1
 
 
 def small_lobes(model, params):
-    """(sharpness (N, S), amplitude (N, S)) of the small-scale model's NDF lobes per pixel (biscale_small_lobes),
-    their projected mass made 1, as the NDF's (biscale.effective_brdf.SmallScaleMaterial.ndf_lobes)."""
+    """(sharpness (N, S), amplitude (N, S)) of the small-scale NDF lobes per pixel (biscale_set_small_lobes): a
+    model's with their projected mass made 1, as the NDF's (biscale.effective_brdf.SmallScaleMaterial.ndf_lobes);
+    a fit's as they are, amplitude 1 (their colours are slice_colours')."""
+    if model == FITTED_MODEL:
+        sharpness = np.asarray(params["sharpness"], np.float64)
+        return sharpness, np.ones_like(sharpness)
     if model not in SMALL_SCALE_MODELS:
         raise ValueError(f"a bi-scale material's small-scale model must be isotropic, not {model}")
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
     return effective_brdf.small_scale_lobes(instance, model, small_lobe_count(model))
+
+
+def slice_colours(tables, model, params, nodes):
+    """(N, J S nodes, 3) RGB factor of each slice lobe with a fitted small scale: lobe j S + s takes the fit's
+    lobe s colour; None for a model (its ks is the specular colour)."""
+    if model != FITTED_MODEL:
+        return None
+    colour = np.tile(np.asarray(params["colour"], FLOAT), (1, tables.lobe_count, 1))
+    return np.repeat(colour, nodes, axis=1)
+
+
+def facet_m_factor(model, params):
+    """M of the small-scale BRDF on facets, f(normals, wi, wo) with (K', N, 3) arrays, the pixel index second."""
+    if model == FITTED_MODEL:
+        def fitted(normals, wi, wo):
+            local_i, local_o = effective_brdf.facet_directions(normals, wi, wo)
+            return fitted_m_factor(params, local_o, local_i)
+        return fitted
+    instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[None] for k, v in params.items()})
+    return lambda normals, wi, wo: effective_brdf.facet_m_factor(instance, normals, wi, wo)
 
 
 def effective_lobes(tables, small_sharpness, small_amplitude):
@@ -65,7 +93,7 @@ def m_factor_rows(tables, model, params, small_sharpness, nodes, mask=None):
     """m_factor(wo, wi) for warp.brdf_slice_lobes: rows (effective lobe j S + s's nodes one after the other,
     leading) times mu_j at lobe j's mirror direction and the view, and M at the product axis
     n* = normalize(eta_j xi_j + eta_s h) (biscale_m_factor)."""
-    instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[None] for k, v in params.items()})
+    small_m_factor = facet_m_factor(model, params)
     small = small_sharpness.shape[1]
     effective_of_row = np.repeat(np.arange(tables.lobe_count * small), nodes)
     lobe_of_row = effective_of_row // small
@@ -82,7 +110,7 @@ def m_factor_rows(tables, model, params, small_sharpness, nodes, mask=None):
         mirror = 2.0 * np.sum(wo * axes, axis=-1, keepdims=True) * axes - wo
         amplitude = paired_amplitudes(tables, lobe_of_row, mirror, wo) * weight
         above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
-        return np.where(above, amplitude * effective_brdf.facet_m_factor(instance, facet, wi, wo), 0.0)
+        return np.where(above, amplitude * small_m_factor(facet, wi, wo), 0.0)
 
     return m_factor
 

@@ -24,7 +24,7 @@ class SGFitted(SGLobes):
                           **scene_fields(inputs))
 
     def model_defines(self, key):
-        return {"FITTED_COMPONENTS": key.shadowing_components,
+        return {"FITTED_LOBES": key.ndf_lobes, "FITTED_COMPONENTS": key.shadowing_components,
                 "FITTED_SHADOWING_LAYERS": -(-key.shadowing_components // 4)}
 
     def model_samplers(self, key):

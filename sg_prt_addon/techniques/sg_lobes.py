@@ -61,6 +61,7 @@ class VariantKey:
     layering: tuple = ()            # surface_layering.flags of the material
     biscale_resolution: int = 0     # sg_biscale: the tables' lattice R (0: not bi-scale)
     biscale_first_lobes: int = 0    # sg_biscale: the first tile's BVNDF lobes (all of them with one tile)
+    biscale_small_lobes: int = 0    # sg_biscale: the small-scale BRDF's lobes (a BVNDF lobe's effective lobes)
 
     @property
     def has_visibility(self):

@@ -52,6 +52,7 @@ from ..lighting import env_prefilter, equirect, lights
 from ..reflectance import brdf, ggx_albedo, layering, models
 from ..spherical import clamped_cosine, sg, texture_fetch, warp
 from . import biscale_shading, surface_layering
+from .fitted_texels import FITTED_MODEL, fitted_m_factor, fitted_texel_values
 
 FLOAT = np.float32
 # GGX NDF as two SG lobes (ndf_fit.ggx_two_lobes): the one-lobe L2 mapping keeps only 0.77-0.80 of
@@ -316,60 +317,12 @@ def ndf_lobes(model, params, lobe_count=1):
     return instance.ndf_lobes()
 
 
-FITTED_MODEL = "FITTED"
-
-
-def fitted_texel_values(fitted, uv):
-    """surface.frag.glsl's fitted_select_texel + fetches: the nearest texel of the UV (floor(uv * size),
-    clamped) in an export.FittedLobes; returns the shade() params of model FITTED and (kd (N, 3), eta (N,))."""
-    layers = np.asarray(fitted.layers, FLOAT)                       # (L, H, W, 4), row 0 at t = 0
-    height, width = layers.shape[1:3]
-    uv = np.asarray(uv, FLOAT)
-    x = np.clip(np.floor(uv[:, 0] * FLOAT(width)).astype(np.int64), 0, width - 1)
-    y = np.clip(np.floor(uv[:, 1] * FLOAT(height)).astype(np.int64), 0, height - 1)
-    texel = layers[:, y, x]                                         # (L, N, 4)
-    count = fitted.lobe_count
-    lobes = np.stack([texel[1 + 2 * k] for k in range(count)], axis=1)        # (N, K, 4)
-    colour = np.stack([texel[2 + 2 * k, :, :3] for k in range(count)], axis=1)
-    coefficients = np.concatenate([texel[1 + 2 * count + j] for j in range(fitted.shadowing_layers)],
-                                  axis=1)[:, :fitted.components]
-    table = np.asarray(fitted.table, np.float64)[..., 0]
-    from ..measured.microfacet_fit import decompress_shadowing
-    shadowing = decompress_shadowing(table[1], table[2:2 + fitted.components], coefficients.astype(np.float64))
-    params = {"axis": sg.normalize(lobes[..., :3]), "sharpness": lobes[..., 3], "colour": colour,
-              "eta": texel[0, :, 3], "shadowing": shadowing, "shadowing_theta": table[0]}
-    return params, texel[0, :, :3]
-
-
-def fitted_shadowing(params, direction):
-    """S of each pixel's texel at local directions (N, M, 3) -> (N, M) (sg_shading.glsl's fitted_shadowing_of)."""
-    from ..measured.svbrdf_table import interpolate_shadowing
-    w = sg.normalize(np.asarray(direction, FLOAT)).astype(np.float64)
-    theta = np.arctan2(np.hypot(w[..., 0], w[..., 1]), np.maximum(w[..., 2], 0))
-    return interpolate_shadowing(params["shadowing"], params["shadowing_theta"], theta)
-
-
 def fitted_slice(params, view_local, warp_mode=None):
-    """Slice lobes of the stored fit: its NDF lobes (amplitude 1) warped to the view, times
-    M_o(i) = F_eta(|i.h|) S(o) S(i) / (pi (i.n)(o.n)); the RGB lobe amplitudes come separately."""
+    """Slice lobes of the stored fit: its NDF lobes (amplitude 1) warped to the view, times its M_o(i); the RGB
+    lobe amplitudes come separately."""
     axis, sharpness = params["axis"], params["sharpness"]
-    shadowing_o = fitted_shadowing(params, np.asarray(view_local)[:, None, :])[:, 0]          # (N,)
-    eta = np.asarray(params["eta"], np.float64)
-
-    def m_factor(wo, wi):          # (K', N, 3), lobe index leading
-        wo = sg.normalize(np.asarray(wo, FLOAT)).astype(np.float64)
-        wi = sg.normalize(np.asarray(wi, FLOAT)).astype(np.float64)
-        h = sg.normalize(wo + wi)
-        fresnel = brdf.fresnel_dielectric(np.sum(wi * h, axis=-1), eta[None])
-        shadowing_i = fitted_shadowing(params, np.moveaxis(wi, 0, 1)).T                        # (K', N)
-        above = (wo[..., 2] > 0) & (wi[..., 2] > 0)
-        with np.errstate(all="ignore"):
-            value = fresnel * shadowing_o[None] * shadowing_i / (
-                np.pi * np.maximum(wi[..., 2], brdf.COSINE_EPSILON) * np.maximum(wo[..., 2], brdf.COSINE_EPSILON))
-        return np.where(above, value, 0.0)
-
-    return warp.brdf_slice_lobes(axis, sharpness, np.ones_like(sharpness), view_local, m_factor,
-                                 mode=warp_mode or warp.DEFAULT_MODE)
+    return warp.brdf_slice_lobes(axis, sharpness, np.ones_like(sharpness), view_local,
+                                 lambda wo, wi: fitted_m_factor(params, wo, wi), mode=warp_mode or warp.DEFAULT_MODE)
 
 
 def slice_colours(model, params, slice_count):
@@ -495,7 +448,8 @@ def _pixels(position, normal, tangent, view_origin, is_perspective, model, param
     slice_axis = np.einsum("nij,nkj->nki", frame, slice_axis).astype(FLOAT)    # to world
     slice_sharpness = slice_sharpness.astype(FLOAT)
     slice_amplitude = slice_amplitude.astype(FLOAT)
-    slice_colour = slice_colours(model, params, slice_sharpness.shape[1])
+    slice_colour = slice_colours(model, params, slice_sharpness.shape[1]) if biscale is None else \
+        biscale_shading.slice_colours(biscale, model, params, warp.nodes_per_lobe(warp_mode or warp.DEFAULT_MODE))
     if slice_colour is None:
         slice_colour = np.ones(slice_sharpness.shape + (3,), FLOAT)
 
@@ -709,12 +663,15 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     """
     count = len(position)
     fitted = getattr(material, "fitted", None)
-    if fitted is not None:         # the stored lobe fit (MODEL_FITTED): only a normal map applies
+    biscale = getattr(material, "biscale", None)
+    biscale_mask = sample_material_texture(textures[BISCALE_MASK], uv)[:, 0] if BISCALE_MASK in textures else None
+    if fitted is not None:         # the stored lobe fit (MODEL_FITTED): only a normal map (and a bi-scale mask) apply
         model_params, diffuse_color = fitted_texel_values(fitted, uv)
         shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
         return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
                      model_params, diffuse_color, np.ones((count, 3), FLOAT), light_data, environment,
-                     visibility=visibility, warp_mode=getattr(material, "warp_mode", None))
+                     visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale,
+                     biscale_mask=biscale_mask)
     diffuse_color, specular_color = surface_colours(material, textures, uv, count)
     params = {}
     for name in SCALAR_SLOTS:
@@ -723,8 +680,6 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
             value = value * sample_material_texture(textures[name], uv)[:, 0]
         params[name] = value
     shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
-    biscale = getattr(material, "biscale", None)
-    biscale_mask = sample_material_texture(textures[BISCALE_MASK], uv)[:, 0] if BISCALE_MASK in textures else None
     if biscale is None:         # a bi-scale material's variant has no glossy layer (sg_biscale)
         roughness_texture = textures["roughness"] if surface_layering.textured_roughness(material.model, textures) \
             else None

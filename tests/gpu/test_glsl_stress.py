@@ -852,7 +852,7 @@ def test_fitted_pieces_stress(glsl, fuzz):
     uv = _f32(rng.uniform(-0.5, 1.5, (SMALL_ROWS, 2)))
     eta = _f32(rng.uniform(0.0, 4.0, SMALL_ROWS))
     shading = _resource("sg_shading.glsl")
-    source = (f"#define NDF_LOBES {lobes}\n#define FITTED_COMPONENTS {components}\n"
+    source = (f"#define NDF_LOBES {lobes}\n#define FITTED_LOBES {lobes}\n#define FITTED_COMPONENTS {components}\n"
               f"#define FITTED_SHADOWING_LAYERS {shadowing_layers}\n"
               "ivec2 fitted_texel;\nfloat fitted_coefficients[4 * FITTED_SHADOWING_LAYERS];\n"
               + "".join(_glsl_function(shading, name) for name in (

@@ -7,6 +7,8 @@
  *     (biscale/bvndf.py, R = BISCALE_RESOLUTION) at texel (o_a R + i_a, o_b R + i_b); layer t, channel c:
  *     mu_j(i, o) per unit cos(theta_i) of lobe j = 4 t + c; layer BISCALE_LOBE_LAYERS: (D(i, o), A(o)) of the
  *     first tile and of the second: the diffuse factor and its cosine-weighted mean over i.
+ * MODEL_FITTED: the small-scale BRDF is the stored lobe fit at the pixel's texel (sg_shading.glsl's fitted_*
+ *     functions: its lobes about the facet normal, their RGB amplitudes, its M with S(o) in each facet's frame).
  * HAS_TEXTURE_BISCALE_MASK: two tiles (biscale.bvndf.MaskedTiles), lobes [0, BISCALE_FIRST_LOBES) the first's,
  *     chosen per pixel by the mask texture's red channel m: the first's amplitudes and diffuse weighted 1 - m,
  *     the second's m.
@@ -85,17 +87,30 @@ float biscale_albedo()
 }
 
 #ifdef HAS_SPECULAR
-/* The small-scale model's lobes and M: sg_shading.glsl's, defined after this file. */
+/* The small-scale model's lobes and M, or the stored fit's: sg_shading.glsl's, defined after this file. */
 void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude);
 float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q);
+#ifdef MODEL_FITTED
+vec4 fitted_layer(int layer);
+float fitted_shadowing_of(vec3 w);
+float fitted_m_factor(vec3 wo, vec3 wi, float eta, float shadowing_o);
+vec3 biscale_small_colour[BISCALE_SMALL_LOBES];     /* the fit's RGB lobe amplitudes */
+#endif
 
 /* The small-scale model's NDF lobes around the facet normal, (sharpness, amplitude) each, their projected
  * mass made 1 (spherical.sg.axis_cosine_integral: 2 pi (1 - (1 - e^-s) / s) / s): GGX's two-lobe fit
- * (NDF_LOBES is never 1 here), one lobe for the others.  Set once a pixel by biscale_set_small_lobes. */
+ * (NDF_LOBES is never 1 here), one lobe for the others; a fit's lobes as they are (amplitude 1, their colours
+ * apart: the fit is the BRDF, tail included).  Set once a pixel by biscale_set_small_lobes. */
 vec2 biscale_small[BISCALE_SMALL_LOBES];
 
 void biscale_set_small_lobes(vec4 p, vec4 q)
 {
+#ifdef MODEL_FITTED
+  for (int s = 0; s < BISCALE_SMALL_LOBES; s++) {
+    biscale_small[s] = vec2(max(fitted_layer(1 + 2 * s).w, 0.0), 1.0);
+    biscale_small_colour[s] = fitted_layer(2 + 2 * s).rgb;
+  }
+#else
   float mass = 0.0;
   for (int s = 0; s < BISCALE_SMALL_LOBES; s++) {
     vec3 axis;
@@ -109,6 +124,7 @@ void biscale_set_small_lobes(vec4 p, vec4 q)
   for (int s = 0; s < BISCALE_SMALL_LOBES; s++) {
     biscale_small[s].y /= max(mass, 1.0e-30);
   }
+#endif
 }
 
 /* Effective lobe k = j S + s (eq. 14-15): BVNDF lobe j (xi_j, eta_j) convolved with small-scale lobe s
@@ -152,6 +168,11 @@ float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, 
   vec3 t = normalize(cross(helper, facet));
   vec3 b = cross(facet, t);
   mat3 to_facet = transpose(mat3(t, b, facet));
+#ifdef MODEL_FITTED
+  vec3 facet_wo = to_facet * wo;     /* S(o) in the facet's frame, not the pixel's p.z */
+  return biscale_lobe_amplitude * fitted_m_factor(facet_wo, to_facet * wi, p.y, fitted_shadowing_of(facet_wo));
+#else
   return biscale_lobe_amplitude * model_m_factor(to_facet * wo, to_facet * wi, p, q);
+#endif
 }
 #endif

@@ -66,8 +66,9 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
 #ifdef MODEL_FITTED
 /* The stored lobe fit (blender.lobe_fit format 1, export.FittedLobes; mirrored by techniques.sg_shading's
  * fitted_* functions).  fitted_layers: 0 base (kd RGB, eta), 1 + 2k lobe k (axis xyz local,
- * sharpness), 2 + 2k lobe k amplitude RGB, 1 + 2K + j shadowing PCA coefficients 4j..4j+3; read
- * with texelFetch at the nearest texel of the UV (the paper's per-texel free-axis lobes).
+ * sharpness), 2 + 2k lobe k amplitude RGB, 1 + 2K + j shadowing PCA coefficients 4j..4j+3 (K = FITTED_LOBES:
+ * NDF_LOBES, or a bi-scale material's small-scale lobes); read with texelFetch at the nearest texel of the UV
+ * (the paper's per-texel free-axis lobes).
  * fitted_shadowing: S x (C + 2) texels, R: row 0 theta_s, row 1 the mean, rows 2.. the basis. */
 ivec2 fitted_texel;
 float fitted_coefficients[4 * FITTED_SHADOWING_LAYERS];
@@ -82,7 +83,7 @@ void fitted_select_texel(vec2 uv)
   ivec2 size = textureSize(fitted_layers, 0).xy;
   fitted_texel = clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1);
   for (int j = 0; j < FITTED_SHADOWING_LAYERS; j++) {
-    vec4 c = fitted_layer(1 + 2 * NDF_LOBES + j);
+    vec4 c = fitted_layer(1 + 2 * FITTED_LOBES + j);
     fitted_coefficients[4 * j] = c.x;
     fitted_coefficients[4 * j + 1] = c.y;
     fitted_coefficients[4 * j + 2] = c.z;
@@ -287,7 +288,11 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float bvndf_sharpness;      /* eta_j, for the product axis of M */
     biscale_lobe(k, ndf_axis, ndf_sharpness, ndf_amplitude, bvndf_sharpness);
     biscale_set_lobe_amplitude(k, ndf_axis, safe_normalize(view_local));
+#ifdef MODEL_FITTED
+    vec3 colour = biscale_small_colour[k % BISCALE_SMALL_LOBES];
+#else
     vec3 colour = vec3(1.0);
+#endif
 #elif defined(MODEL_FITTED)
     vec4 fitted_lobe = fitted_layer(1 + 2 * k);
     ndf_axis = safe_normalize(fitted_lobe.xyz);
