@@ -134,6 +134,32 @@ def test_effective_brdf_against_the_ray_traced_tile(egg_crate):
     assert reference.relative_rms(flat, traced, wi) > 0.3
 
 
+def test_flat_tile_under_a_lobe_fit_is_the_fit():
+    """A measured small-scale BRDF on a flat tile: the effective BRDF is the fit itself (lobes, colours, M)."""
+    fitted, _, _ = accuracy.measured_small_scale()
+    flat = microgeometry.from_height_field(np.zeros((8, 8)))
+    effective = effective_brdf.compute(bvndf.compute(flat), fitted)
+    wi, wo = reference.direction_pairs(40)
+    truth, _ = reference.effective_brdf_traced(flat, fitted, wi, wo, rays=2000)
+    assert reference.relative_rms(effective.evaluate(wi, wo), truth, wi) < 0.01
+
+
+def test_effective_brdf_of_a_measured_small_scale_brdf(egg_crate):
+    """iwasaki2012 fig. 8: a lobe fit to a MERL file as the small-scale BRDF, against the ray-traced tile with
+    the fit and with the analytic BRDF the file was measured from (docs/ACCURACY.md, bi-scale)."""
+    errors = accuracy.measured_errors(egg_crate[0], rays=20000)
+    assert errors["noise"] < 0.02
+    assert errors["traced"] < 0.06                  # the fit's error, seen through the tile
+    assert errors["same_fit"] < 0.22                # the bi-scale steps (0.18 at 32 x 32)
+    assert errors["source"] < 0.26                  # the whole chain (0.21)
+
+
+def test_a_free_axes_fit_is_refused_as_a_small_scale_brdf():
+    with pytest.raises(ValueError, match="lobes off the normal"):
+        effective_brdf.FittedSmallScale.from_arrays((0.1, 0.1, 0.1), 1.5, [[0.2, 0.0, 1.0]], [100.0],
+                                                    [[1.0, 1.0, 1.0]], [0.0, 1.0], [1.0, 0.5])
+
+
 def test_grooves_make_an_anisotropic_brdf():
     """Grooves along y spread the highlight of views across them (in x z) and not along them, as brute force."""
     geometry = microgeometry.from_height_field(reference.grooves(32))
