@@ -85,6 +85,13 @@ class SmallScaleMaterial:
 AXIS_TOLERANCE = 1e-3      # sin of the largest tilt of a fitted lobe's axis from the facet normal taken as isotropic
 
 
+def axis_tilt(axes):
+    """(sin of the largest tilt of lobe axes (..., 3) from the normal z, that tilt in degrees)."""
+    axes = np.asarray(axes, np.float64)
+    tilt = float(np.max(np.linalg.norm(axes[..., :2], axis=-1) / np.maximum(np.linalg.norm(axes, axis=-1), 1e-30)))
+    return tilt, float(np.degrees(np.arcsin(min(tilt, 1.0))))
+
+
 @dataclass(frozen=True)
 class FittedSmallScale:
     """One texel of a lobe fit (measured.microfacet_fit.LobeFit, or the stored fit's layers) as the small-scale
@@ -101,12 +108,10 @@ class FittedSmallScale:
     def from_arrays(cls, diffuse, eta, axis, sharpness, colours, shadowing_theta, shadowing):
         """From one texel's arrays: axis (S, 3), sharpness (S,), colours (S, 3); ValueError for lobes whose axes
         leave the normal (a free-axes fit is anisotropic or off-specular; iwasaki2012 takes isotropic BRDFs)."""
-        axis = np.asarray(axis, np.float64)
-        tilt = np.linalg.norm(axis[:, :2], axis=1) / np.maximum(np.linalg.norm(axis, axis=1), 1e-30)
-        if np.any(tilt > AXIS_TOLERANCE):
-            raise ValueError(f"the small-scale lobe fit has lobes off the normal (up to "
-                             f"{np.degrees(np.arcsin(min(float(tilt.max()), 1.0))):.1f} degrees): a bi-scale material "
-                             "needs an isotropic fit (Fit Lobes with Axes: Auto, 1-2 lobes)")
+        tilt, degrees = axis_tilt(axis)
+        if tilt > AXIS_TOLERANCE:
+            raise ValueError(f"the small-scale lobe fit has lobes off the normal (up to {degrees:.1f} degrees): a "
+                             "bi-scale material needs an isotropic fit (Fit Lobes with Axes: Auto, 1-2 lobes)")
         as_tuple = lambda values: tuple(np.asarray(values, np.float64).tolist())       # noqa: E731 (hashable)
         return cls(as_tuple(diffuse), float(eta), as_tuple(sharpness), tuple(map(tuple, np.asarray(colours, float))),
                    as_tuple(shadowing_theta), as_tuple(shadowing))

@@ -523,11 +523,10 @@ def _isotropic_lobe_fit(material):
     if fitted is None:
         state, message = lobe_fit.fit_status(material)
         return None, message or state.lower()
-    axes = fitted.layers[1:1 + 2 * fitted.lobe_count:2, ..., :3].astype(np.float64)
-    tilt = np.linalg.norm(axes[..., :2], axis=-1) / np.maximum(np.linalg.norm(axes, axis=-1), 1e-30)
-    if np.any(tilt > effective_brdf.AXIS_TOLERANCE):
-        return None, (f"its lobes leave the normal by up to {np.degrees(np.arcsin(min(float(tilt.max()), 1.0))):.1f}"
-                      " degrees: fit with Axes Auto for an isotropic small-scale BRDF")
+    tilt, degrees = effective_brdf.axis_tilt(fitted.layers[1:1 + 2 * fitted.lobe_count:2, ..., :3])
+    if tilt > effective_brdf.AXIS_TOLERANCE:
+        return None, (f"its lobes leave the normal by up to {degrees:.1f} degrees: fit with Axes Auto for an "
+                      "isotropic small-scale BRDF")
     return fitted, None
 
 
