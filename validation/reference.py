@@ -18,7 +18,10 @@ Estimators, per pixel sample (one camera ray):
     and directional lights (cone of angular radius a, a = 0 a delta): one light
     sample, uniform over the solid angle the light subtends; lights of finite
     size seen by points with a specular model add one BRDF sample, power
-    heuristic (sharp lobes rarely meet a light sample).
+    heuristic (sharp lobes rarely meet a light sample);
+  - area lights (one-sided rectangles and ellipses, Cycles' spread): one sample
+    uniform over the area and, for points with a specular model, one BRDF
+    sample that may hit the light, power heuristic.
 
 Conventions:
   - Pixels whose camera ray misses the scene show the environment radiance
@@ -40,6 +43,8 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
+from sg_prt_addon.lighting import lights
+from sg_prt_addon.visibility import hemisphere_map
 from sg_prt_addon.visibility.raytrace import RayTracer, offset_origins
 from validation.env_sampling import LUMINANCE_WEIGHTS, EnvironmentSampler
 
@@ -93,6 +98,58 @@ class DirectionalLight:
 
 
 @dataclass
+class AreaLight:
+    """One-sided Lambertian emitter of a Blender area light's shape (Cycles' area light): radiance
+    power / (pi A) along directions at angle a from its normal, times the spread's soft-box attenuation
+    (lighting.lights.emission_factor), sampled exactly over its area."""
+    centre: Any                               # (3,) world
+    edge_u: Any                               # (3,) world vector spanning the light (size along local x)
+    edge_v: Any                               # (3,) likewise along local y
+    normal: Any                               # (3,) the direction it emits along (-Z of the object)
+    power: Any                                # (3,) W
+    shape: str = "SQUARE"                     # lighting.lights.AREA_SHAPES
+    spread: float = np.pi                     # full spread angle
+
+    @property
+    def elliptic(self):
+        return self.shape in ("DISK", "ELLIPSE")
+
+    @property
+    def area(self):
+        return lights.area_light_area(self.shape, np.linalg.norm(self.edge_u), np.linalg.norm(self.edge_v))
+
+    def sample(self, uniforms):
+        """(N, 3) points uniform over the light's area."""
+        square = 2.0 * uniforms - 1.0
+        if self.elliptic:
+            square = hemisphere_map.square_to_disc(square)
+        return (np.asarray(self.centre, float) + 0.5 * square[:, :1] * np.asarray(self.edge_u, float)
+                + 0.5 * square[:, 1:] * np.asarray(self.edge_v, float))
+
+    def hit(self, origins, directions):
+        """Distance (N,) along rays to the light's front face, inf where they miss it."""
+        normal = _normalize(np.asarray(self.normal, float)[None], np.array([0.0, 0.0, 1.0]))[0]
+        facing = directions @ normal
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = ((np.asarray(self.centre, float) - origins) @ normal) / facing
+        offset = origins + np.where(np.isfinite(t), t, 0.0)[:, None] * directions - np.asarray(self.centre, float)
+        u = 2.0 * (offset @ self.edge_u) / max(float(np.dot(self.edge_u, self.edge_u)), 1e-300)
+        v = 2.0 * (offset @ self.edge_v) / max(float(np.dot(self.edge_v, self.edge_v)), 1e-300)
+        inside = (u * u + v * v <= 1.0) if self.elliptic else ((np.abs(u) <= 1.0) & (np.abs(v) <= 1.0))
+        return np.where((facing < 0) & (t > 0) & inside, t, np.inf)
+
+    def radiance(self, directions_to_light):
+        """(N, 3) radiance leaving the light toward points that see it along directions_to_light (N, 3)."""
+        normal = _normalize(np.asarray(self.normal, float)[None], np.array([0.0, 0.0, 1.0]))[0]
+        tan_half, normalization = lights.spread_parameters(self.spread)
+        cos_angle = -(directions_to_light @ normal)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            factor = lights.emission_factor(cos_angle, -1.0, 0.0, True, tan_half, normalization)
+            factor = np.where(cos_angle > 0, factor / cos_angle, 0.0)     # the cosine is the area's, not L's
+        return factor[:, None] * (np.asarray(self.power, float) / (np.pi * max(self.area, 1e-300)))[None]
+
+
+@dataclass
 class Scene:
     vertices: Any                             # (V, 3)
     triangles: Any                            # (T, 3) int, counter-clockwise seen from the front
@@ -101,7 +158,7 @@ class Scene:
     material_index: Any = None                # (T,) int into materials; None: all 0
     uvs: Any = None                           # (V, 2), read by materials with textures
     tangents: Any = None                      # (V, 3) for anisotropic models; None: built from the normal
-    lights: Sequence[Any] = ()                # PointLight / DirectionalLight
+    lights: Sequence[Any] = ()                # PointLight / DirectionalLight / AreaLight
     environment: Any = None                   # equirect (H, W, 3) radiance, Blender world mapping
     background: Any = None                    # (3,) constant radiance, used when environment is None
 
@@ -452,6 +509,8 @@ class _Renderer:
         count = len(points.position)
         uniforms = rng.random((count, 2))
         cone = None   # (axis, 1 - cos of the half-angle, radiance, sphere centre distance or None)
+        if isinstance(light, AreaLight):
+            return self._area_light_contribution(points, light, uniforms, rng)
         if isinstance(light, PointLight):
             to_centre = np.asarray(light.position, float)[None, :] - points.position
             distance = np.linalg.norm(to_centre, axis=-1)
@@ -512,6 +571,40 @@ class _Renderer:
         value = self._brdf_cosine(points, wi_local) * radiance * weight[:, None]
         max_distance = None if distance is None else _sphere_entry(distance, radius, cos_to_axis)
         return total + value * self._visible(points, wi, max_distance, np.any(value > 0, axis=-1))[:, None]
+
+    def _area_light_contribution(self, points, light, uniforms, rng):
+        """One sample over the light's area and, for glossy points, one BRDF sample that may hit it,
+        combined by the power heuristic (pdfs in solid angle: distance^2 / (A cos) for the area's)."""
+        count = len(points.position)
+        normal = _normalize(np.asarray(light.normal, float)[None], np.array([0.0, 0.0, 1.0]))[0]
+        area = max(light.area, 1e-300)
+
+        def solid_angle_pdf(wi, distance):
+            cos_light = np.maximum(-(wi @ normal), 0.0)
+            return np.where(cos_light > 0, distance ** 2 / (area * np.maximum(cos_light, 1e-300)), 0.0)
+
+        to_light = light.sample(uniforms) - points.position
+        distance = np.linalg.norm(to_light, axis=-1)
+        wi = _normalize(to_light, normal)
+        light_pdf = solid_angle_pdf(wi, distance)
+        wi_local = np.einsum("nij,nj->ni", points.frame, wi)
+        value = self._brdf_cosine(points, wi_local) * light.radiance(wi)
+        value *= np.where(light_pdf > 0, 1.0 / np.where(light_pdf > 0, light_pdf, 1.0), 0.0)[:, None]
+        use_mis = bool(points.groups)
+        if use_mis:
+            value *= _power_weight(light_pdf, self._brdf_pdf(points, wi_local))[:, None]
+        total = value * self._visible(points, wi, distance, np.any(value > 0, axis=-1))[:, None]
+        if not use_mis:
+            return total
+        wi_local, brdf_pdf = self._brdf_sample(points, rng.random((count, 3)))
+        wi = _normalize(np.einsum("nji,nj->ni", points.frame, wi_local), points.frame[:, 2])
+        distance = light.hit(points.position, wi)
+        hit = np.isfinite(distance) & (brdf_pdf > 0)
+        distance = np.where(hit, distance, 1.0)
+        light_pdf = np.where(hit, solid_angle_pdf(wi, distance), 0.0)
+        weight = np.where(hit, _power_weight(brdf_pdf, light_pdf) / np.where(brdf_pdf > 0, brdf_pdf, 1.0), 0.0)
+        value = self._brdf_cosine(points, wi_local) * light.radiance(wi) * weight[:, None]
+        return total + value * self._visible(points, wi, distance, np.any(value > 0, axis=-1))[:, None]
 
     def _environment_contribution(self, points, rng):
         """MIS of `environment_samples` environment samples and as many BRDF samples, stratified

@@ -89,6 +89,10 @@ def reference_lights(light_exports):
         if light.kind == "SUN":
             lights.append(reference.DirectionalLight(-np.asarray(light.direction), np.asarray(light.colour_intensity),
                                                      angular_radius=0.5 * light.angle))
+        elif light.kind == "AREA":
+            lights.append(reference.AreaLight(np.asarray(light.position), np.asarray(light.edge_u),
+                                              np.asarray(light.edge_v), np.asarray(light.direction),
+                                              np.asarray(light.colour_intensity), light.shape, light.spread))
         else:
             spot = dict(spot_direction=np.asarray(light.direction), spot_size=light.spot_size,
                         spot_blend=light.spot_blend) if light.is_spot else {}

@@ -194,17 +194,22 @@ def export_fitted_lobes(material):
 
 @dataclass
 class LightExport:
-    """One light: kind 'POINT' (point, spot, area as sphere) or 'SUN'."""
+    """One light: kind 'POINT' (point, spot), 'AREA' or 'SUN'."""
     name: str
     kind: str
-    position: tuple                # world position (POINT)
+    position: tuple                # world position (POINT, AREA: the centre)
     direction: tuple               # world direction the light points along (-Z of the object)
-    colour_intensity: tuple        # POINT: radiant intensity W/sr per channel; SUN: irradiance per channel
+    colour_intensity: tuple        # POINT: radiant intensity W/sr per channel; SUN: irradiance per channel;
+                                   # AREA: power W per channel
     radius: float = 0.0            # POINT sphere radius
     angle: float = 0.0             # SUN full angular diameter
     spot_size: float = np.pi       # >= pi: no cone
     spot_blend: float = 0.0
     is_spot: bool = False
+    shape: str = "SQUARE"          # AREA: lighting.lights.AREA_SHAPES
+    edge_u: tuple = (0.0, 0.0, 0.0)  # AREA: world vectors spanning the light (size along local x and y)
+    edge_v: tuple = (0.0, 0.0, 0.0)
+    spread: float = np.pi          # AREA: full spread angle
 
 
 @dataclass
@@ -692,14 +697,18 @@ def _finite_setting(value, default, what):
     return default
 
 
-def export_light(object_eval):
-    """LightExport of an evaluated light object in Blender's units; None for unsupported types (and
-    for a light whose transform is not finite).  Intensities are finite and at most
-    MAX_LIGHT_INTENSITY in magnitude, sizes and angles finite (warned otherwise)."""
+# narrower area light spreads are beams from the patch centres (lighting.lights.MIN_SPREAD)
+AREA_SPREAD_WARNING = np.radians(30.0)
+
+
+def export_light(object_eval, matrix_world=None):
+    """LightExport of an evaluated light object in Blender's units, at matrix_world (an instance's; default
+    the object's); None for unsupported types (and for a light whose transform is not finite).  Intensities
+    are finite and at most MAX_LIGHT_INTENSITY in magnitude, sizes and angles finite (warned otherwise)."""
     from ..lighting import lights as core_lights
 
     light = object_eval.data
-    matrix = matrix_to_numpy(object_eval.matrix_world)
+    matrix = matrix_to_numpy(object_eval.matrix_world if matrix_world is None else matrix_world)
     if not np.all(np.isfinite(matrix)):
         warn(f"light '{object_eval.name}': transform not finite, left out")
         return None
@@ -707,16 +716,18 @@ def export_light(object_eval):
     position = tuple(matrix[:3, 3])
     direction = -matrix[:3, 2]
     direction = tuple(direction / max(np.linalg.norm(direction), 1e-30))
-    colour = np.asarray(light.color, np.float64)
+    power = _emitted_power(light)
     if light.type == "SUN":
-        irradiance = _clamped_intensity(colour * float(core_lights.blender_sun_irradiance(light.energy)),
-                                        object_eval.name)
+        irradiance = _clamped_intensity(power * float(core_lights.blender_sun_irradiance(1.0)), object_eval.name)
         return LightExport(object_eval.name, "SUN", position, direction, tuple(irradiance),
                            angle=_finite_setting(light.angle, 0.0, what + " angle"))
-    intensity = _clamped_intensity(colour * float(core_lights.blender_point_light_intensity(light.energy)),
-                                   object_eval.name)
+    normalized = bool(getattr(light, "normalize", True))
     if light.type in ("POINT", "SPOT"):
         radius = _finite_setting(getattr(light, "shadow_soft_size", 0.0), 0.0, what + " radius")
+        # Cycles: an unnormalized sphere has the radiance P / pi, whatever its size (radius 0: intensity P / pi)
+        unnormalized = 4 * np.pi * radius * radius if radius > 0 else 4.0
+        intensity = _clamped_intensity(power * float(core_lights.blender_point_light_intensity(1.0))
+                                       * (1.0 if normalized else unnormalized), object_eval.name)
         export = LightExport(object_eval.name, "POINT", position, direction, tuple(intensity), radius=radius)
         if light.type == "SPOT":
             export.is_spot = True
@@ -724,13 +735,31 @@ def export_light(object_eval):
             export.spot_blend = _finite_setting(light.spot_blend, 0.0, what + " spot blend")
         return export
     if light.type == "AREA":
-        # An area light becomes a sphere of the same area (4 pi r^2 = A) and power.
+        # a one-sided emitter of its shape, cut into patches by the scene state (lights.area_light_patches)
+        shape = light.shape
         size_x = _finite_setting(light.size, 0.0, what + " size")
-        size_y = _finite_setting(light.size_y, 0.0, what + " size y") if light.shape in ("RECTANGLE", "ELLIPSE") else size_x
-        area = size_x * size_y * (np.pi / 4 if light.shape in ("DISK", "ELLIPSE") else 1.0)
-        return LightExport(object_eval.name, "POINT", position, direction, tuple(intensity),
-                           radius=float(np.sqrt(area / (4 * np.pi))))
+        size_y = _finite_setting(light.size_y, 0.0, what + " size y") if shape in ("RECTANGLE", "ELLIPSE") else size_x
+        edge_u, edge_v = matrix[:3, 0] * size_x, matrix[:3, 1] * size_y
+        spread = _finite_setting(getattr(light, "spread", np.pi), np.pi, what + " spread")
+        if spread < AREA_SPREAD_WARNING:
+            warn(f"{what} a spread of {np.degrees(spread):.0f} degrees is rendered as a beam from each of its "
+                 f"patches: the edge of its shaft of light is approximate (Cycles: exact)")
+        if not normalized:      # Cycles: the radiance P / pi, whatever the area, so the power P A
+            power = power * core_lights.area_light_area(shape, np.linalg.norm(edge_u), np.linalg.norm(edge_v))
+        return LightExport(object_eval.name, "AREA", position, direction,
+                           tuple(_clamped_intensity(power, object_eval.name)), shape=shape,
+                           edge_u=tuple(edge_u), edge_v=tuple(edge_v), spread=spread)
     return None
+
+
+def _emitted_power(light):
+    """A light's power (a sun's strength) per colour as Cycles takes it: colour x energy x 2^exposure, the
+    colour tinted by the blackbody colour of its temperature where that is on (Blender 4.5+)."""
+    colour = np.asarray(light.color, np.float64)
+    if getattr(light, "use_temperature", False):
+        colour = colour * np.asarray(light.temperature_color, np.float64)[:3]
+    exposure = float(getattr(light, "exposure", 0.0))
+    return colour * float(light.energy) * 2.0 ** (exposure if np.isfinite(exposure) else 0.0)
 
 
 # --------------------------------------------------------------------------- world

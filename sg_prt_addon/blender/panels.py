@@ -130,6 +130,7 @@ class SGPRT_PT_sampling(RenderPanel, bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         layout.prop(context.scene.sgprt, "render_samples")
+        layout.prop(context.scene.sgprt, "area_light_patches")
 
 
 classes = (SGPRT_PT_material, SGPRT_PT_material_biscale, SGPRT_PT_material_geometry, SGPRT_PT_sampling)

@@ -17,6 +17,7 @@ from bpy.props import (
 )
 
 from .. import techniques
+from ..lighting.lights import AREA_PATCHES_PER_SIDE
 from ..reflectance import models
 
 # How each NDF lobe is warped to the view slice: spherical.warp's modes, upper case (figures from its docstring).
@@ -95,15 +96,15 @@ def _set_source(self, value):
     self.id_data.update_tag()
 
 
-def _tag_material_changed(self, context):
-    """Edits from Python do not tag the material for the depsgraph (the UI does): tag it, so
-    view_update sees every change, whoever made it."""
+def _tag_changed(self, context):
+    """Edits from Python do not tag the datablock (a material, a scene) for the depsgraph (the UI does): tag
+    it, so view_update sees every change, whoever made it."""
     self.id_data.update_tag()
 
 
 def _texture(name):
     return PointerProperty(
-        type=bpy.types.Image, update=_tag_material_changed, name=f"{name.replace('_', ' ').title()} Texture",
+        type=bpy.types.Image, update=_tag_changed, name=f"{name.replace('_', ' ').title()} Texture",
         description=f"Image over the active UV map multiplying {name.replace('_', ' ')} "
                     "(RGB for colours, red channel for scalars)")
 
@@ -162,39 +163,39 @@ def _is_mesh(self, obj):
 class SGPRT_PG_biscale(bpy.types.PropertyGroup):
     """A bi-scale material's small-scale geometry (technique SG_BISCALE; blender/biscale_source.py): a tileable
     height field or a mesh tile, seen under the material's own model."""
-    source: EnumProperty(update=_tag_material_changed, name="Geometry", default="IMAGE",
+    source: EnumProperty(update=_tag_changed, name="Geometry", default="IMAGE",
                          items=(("IMAGE", "Height Field", "A tileable height image (its mean of RGB) over one tile"),
                                 ("OBJECT", "Mesh Tile", "A mesh object's faces, one period of the surface across "
                                                         "its X and Y extent, facing +Z")),
                          description="What the surface is made of at the small scale")
-    height_image: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Height",
+    height_image: PointerProperty(update=_tag_changed, type=bpy.types.Image, name="Height",
                                   description="Tileable height field: heights are its values times Height Scale, "
                                               "in tile widths")
-    height_scale: FloatProperty(update=_tag_material_changed, name="Height Scale", default=0.05, min=0.0,
+    height_scale: FloatProperty(update=_tag_changed, name="Height Scale", default=0.05, min=0.0,
                                 soft_max=0.5, description="Height of an image value of 1, in tile widths")
-    small_scale: EnumProperty(update=_tag_material_changed, name="Small-Scale BRDF", default="MODEL",
+    small_scale: EnumProperty(update=_tag_changed, name="Small-Scale BRDF", default="MODEL",
                               items=(("MODEL", "Material Model", "The material's own isotropic model, colours and "
                                                                  "textures"),
                                      ("LOBE_FIT", "Lobe Fit", "The material's stored lobe fit (Fit Lobes: a measured "
                                                               "BRDF, isotropic, Axes Auto)")),
                               description="What the small-scale geometry's surface reflects with")
-    tile_object: PointerProperty(update=_tag_material_changed, type=bpy.types.Object, name="Tile", poll=_is_mesh,
+    tile_object: PointerProperty(update=_tag_changed, type=bpy.types.Object, name="Tile", poll=_is_mesh,
                                  description="Mesh whose faces are one tile of the surface (object space)")
-    mask: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Mask",
+    mask: PointerProperty(update=_tag_changed, type=bpy.types.Image, name="Mask",
                           description="Where the second tile replaces the first: its red channel over the UV map "
                                       "(0: the first tile, 1: the second, between: both, blended)")
-    second_height_image: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Second Height",
+    second_height_image: PointerProperty(update=_tag_changed, type=bpy.types.Image, name="Second Height",
                                          description="The second tile's tileable height field, used where the "
                                                      "mask is 1")
-    second_height_scale: FloatProperty(update=_tag_material_changed, name="Second Height Scale", default=0.05,
+    second_height_scale: FloatProperty(update=_tag_changed, name="Second Height Scale", default=0.05,
                                        min=0.0, soft_max=0.5,
                                        description="Height of an image value of 1 in the second tile, in tile widths")
-    lobes: IntProperty(update=_tag_material_changed, name="Lobes", default=16, min=1, max=32,
+    lobes: IntProperty(update=_tag_changed, name="Lobes", default=16, min=1, max=32,
                        description="SG lobes of the tile's normal distribution (more follow sharp small-scale "
                                    "BRDFs better; docs/ACCURACY.md, bi-scale)")
-    resolution: IntProperty(update=_tag_material_changed, name="Directions", default=12, min=4, max=20,
+    resolution: IntProperty(update=_tag_changed, name="Directions", default=12, min=4, max=20,
                             description="Lattice of view and light directions per side (12: 144 each, the paper's)")
-    samples: IntProperty(update=_tag_material_changed, name="Samples", default=4096, min=256, max=65536,
+    samples: IntProperty(update=_tag_changed, name="Samples", default=4096, min=256, max=65536,
                          description="Points on the tile whose shadowing and masking are traced")
 
 
@@ -203,30 +204,30 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                          description="What the material's look is read from: its shader nodes, or the SG-PRT "
                                      "settings (default: the node tree, unless the material has SG-PRT settings)")
     # default 0: the number of techniques.DEFAULT; a file without the setting: techniques.of_settings
-    technique: EnumProperty(update=_tag_material_changed, name="Technique", items=technique_items, default=0,
+    technique: EnumProperty(update=_tag_changed, name="Technique", items=technique_items, default=0,
                             description="The rendering method of this material (techniques/: the reference each "
                                         "implements is in its description)")
-    model: EnumProperty(update=_tag_material_changed, name="Model", items=models.enum_items(), default="GGX",
+    model: EnumProperty(update=_tag_changed, name="Model", items=models.enum_items(), default="GGX",
                         description="Specular reflectance model, rendered with spherical Gaussian NDF lobes")
-    diffuse_color: FloatVectorProperty(update=_tag_material_changed, name="Diffuse", subtype="COLOR", size=3, default=(0.5, 0.5, 0.5),
+    diffuse_color: FloatVectorProperty(update=_tag_changed, name="Diffuse", subtype="COLOR", size=3, default=(0.5, 0.5, 0.5),
                                        min=0.0, soft_max=1.0, description="Lambertian albedo kd")
-    specular_color: FloatVectorProperty(update=_tag_material_changed, name="Specular", subtype="COLOR", size=3, default=(0.25, 0.25, 0.25),
+    specular_color: FloatVectorProperty(update=_tag_changed, name="Specular", subtype="COLOR", size=3, default=(0.25, 0.25, 0.25),
                                         min=0.0, soft_max=1.0, description="Specular colour ks")
-    roughness: FloatProperty(update=_tag_material_changed, name="Roughness", default=0.3, min=0.001, max=1.0,
+    roughness: FloatProperty(update=_tag_changed, name="Roughness", default=0.3, min=0.001, max=1.0,
                              description="Cook-Torrance m; for GGX Blender's roughness (alpha = roughness^2)")
-    ior: FloatProperty(update=_tag_material_changed, name="IOR", default=1.5, min=1.0, max=4.0,
+    ior: FloatProperty(update=_tag_changed, name="IOR", default=1.5, min=1.0, max=4.0,
                        description="Relative index of refraction of the Cook-Torrance Fresnel term")
-    exponent: FloatProperty(update=_tag_material_changed, name="Exponent", default=100.0, min=1.0, max=1e5,
+    exponent: FloatProperty(update=_tag_changed, name="Exponent", default=100.0, min=1.0, max=1e5,
                             description="Blinn-Phong specular exponent")
-    alpha_x: FloatProperty(update=_tag_material_changed, name="Alpha X", default=0.2, min=0.001, max=1.0,
+    alpha_x: FloatProperty(update=_tag_changed, name="Alpha X", default=0.2, min=0.001, max=1.0,
                            description="Ward roughness along the tangent (the isotropic model uses this only)")
-    alpha_y: FloatProperty(update=_tag_material_changed, name="Alpha Y", default=0.05, min=0.001, max=1.0,
+    alpha_y: FloatProperty(update=_tag_changed, name="Alpha Y", default=0.05, min=0.001, max=1.0,
                            description="Ward roughness along the bitangent")
-    nu: FloatProperty(update=_tag_material_changed, name="Nu", default=100.0, min=1.0, max=1e5,
+    nu: FloatProperty(update=_tag_changed, name="Nu", default=100.0, min=1.0, max=1e5,
                       description="Ashikhmin-Shirley exponent along the tangent")
-    nv: FloatProperty(update=_tag_material_changed, name="Nv", default=1000.0, min=1.0, max=1e5,
+    nv: FloatProperty(update=_tag_changed, name="Nv", default=1000.0, min=1.0, max=1e5,
                       description="Ashikhmin-Shirley exponent along the bitangent")
-    lobe_count: IntProperty(update=_tag_material_changed, name="Lobes", default=4, min=1, max=8,
+    lobe_count: IntProperty(update=_tag_changed, name="Lobes", default=4, min=1, max=8,
                             description="Spherical Gaussian lobes fitted to an anisotropic NDF")
 
     diffuse_color_texture: _texture("diffuse_color")
@@ -239,42 +240,42 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
     nu_texture: _texture("nu")
     nv_texture: _texture("nv")
 
-    view_warp: EnumProperty(update=_tag_material_changed, name="View Warp", items=VIEW_WARPS, default="SPLIT3",
+    view_warp: EnumProperty(update=_tag_changed, name="View Warp", items=VIEW_WARPS, default="SPLIT3",
                             description="Lobes each NDF lobe becomes in the view slice (wang2009 eq. 17-22 and its "
                                         "split): fewer render faster, more are more accurate at grazing views")
-    sh_order: IntProperty(update=_tag_material_changed, name="SH Order", default=5, min=2, max=8,
+    sh_order: IntProperty(update=_tag_changed, name="SH Order", default=5, min=2, max=8,
                           description="Bands of the spherical-harmonic technique (order N: N^2 coefficients; "
                                       "Kautz 2002 used 5): higher follows sharper lights and glossier lobes")
-    sh_window: EnumProperty(update=_tag_material_changed, name="SH Window", items=SH_WINDOWS, default="NONE",
+    sh_window: EnumProperty(update=_tag_changed, name="SH Window", items=SH_WINDOWS, default="NONE",
                             description="Smoothing of the lighting's bands against ringing (it blurs)")
-    fresnel: EnumProperty(update=_tag_material_changed, name="Fresnel", items=FRESNEL_MODES, default="NONE",
+    fresnel: EnumProperty(update=_tag_changed, name="Fresnel", items=FRESNEL_MODES, default="NONE",
                           description="How the specular colour changes with angle (reflectance/layering.py)")
-    multiscatter: BoolProperty(update=_tag_material_changed, name="Multiscatter", default=False,
+    multiscatter: BoolProperty(update=_tag_changed, name="Multiscatter", default=False,
                                description="Add the energy of light scattered between microfacets, as Blender's "
                                            "Multiscatter GGX does (brighter and more saturated rough metals)")
-    layered_diffuse: BoolProperty(update=_tag_material_changed, name="Layered Diffuse", default=False,
+    layered_diffuse: BoolProperty(update=_tag_changed, name="Layered Diffuse", default=False,
                                   description="The diffuse lies under a dielectric coat of the IOR and loses what "
                                               "the coat reflects at each view (Blender's Principled BSDF)")
-    emission_color: FloatVectorProperty(update=_tag_material_changed, name="Emission", subtype="COLOR", size=3,
+    emission_color: FloatVectorProperty(update=_tag_changed, name="Emission", subtype="COLOR", size=3,
                                         default=(1.0, 1.0, 1.0), min=0.0, soft_max=1.0,
                                         description="Colour of the light the surface emits")
-    emission_strength: FloatProperty(update=_tag_material_changed, name="Emission Strength", default=0.0, min=0.0,
+    emission_strength: FloatProperty(update=_tag_changed, name="Emission Strength", default=0.0, min=0.0,
                                      soft_max=10.0, description="Emitted radiance, times the colour (it lights "
                                                                 "nothing else)")
-    normal_map: PointerProperty(update=_tag_material_changed, type=bpy.types.Image, name="Normal Map",
+    normal_map: PointerProperty(update=_tag_changed, type=bpy.types.Image, name="Normal Map",
                                 description="Tangent-space normal map (OpenGL convention, +Y up)")
-    normal_strength: FloatProperty(update=_tag_material_changed, name="Strength", default=1.0, min=0.0, max=10.0,
+    normal_strength: FloatProperty(update=_tag_changed, name="Strength", default=1.0, min=0.0, max=10.0,
                                    description="Blend from the mesh normal (0) to the mapped normal (1) and beyond")
-    tangent_source: EnumProperty(update=_tag_material_changed, 
+    tangent_source: EnumProperty(update=_tag_changed, 
         name="Tangent", default="UV_MAP",
         items=(("UV_MAP", "UV Map", "Tangents from the active UV map"),
                ("OBJECT_AXIS", "Object Axis", "A fixed object-space direction projected onto the surface")),
         description="Where the anisotropy direction comes from")
-    tangent_axis: FloatVectorProperty(update=_tag_material_changed, name="Axis", size=3, default=(1.0, 0.0, 0.0), subtype="XYZ",
+    tangent_axis: FloatVectorProperty(update=_tag_changed, name="Axis", size=3, default=(1.0, 0.0, 0.0), subtype="XYZ",
                                       description="Object-space tangent direction when the source is Object Axis")
-    tangent_rotation: FloatProperty(update=_tag_material_changed, name="Rotation", default=0.0, subtype="ANGLE",
+    tangent_rotation: FloatProperty(update=_tag_changed, name="Rotation", default=0.0, subtype="ANGLE",
                                     description="Rotation of the tangent about the normal")
-    show_textures: BoolProperty(update=_tag_material_changed, name="Show Textures", default=True,
+    show_textures: BoolProperty(update=_tag_changed, name="Show Textures", default=True,
                                 description="Show the texture slot next to each parameter")
     factorization: PointerProperty(type=SGPRT_PG_factorization, name="BRDF Factors",
                                    description="A measured BRDF factorized by sgprt.factor_brdf")
@@ -291,6 +292,11 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
                                             "offset: anti-aliasing with a 1-pixel box filter, as Cycles' Box "
                                             "filter (4 = a 2x2 grid per pixel); each sample costs one frame. The "
                                             "viewport draws one")
+    area_light_patches: IntProperty(name="Area Light Patches", default=AREA_PATCHES_PER_SIDE, min=1, max=8,
+                                    update=_tag_changed,
+                                    description="An area light is cut into about this many patches a side, each "
+                                                "a small light with its own shadow: more are exact closer to the "
+                                                "light and cost a light each (16 at 4)")
 
 
 classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_factorization, SGPRT_PG_biscale, SGPRT_PG_material,

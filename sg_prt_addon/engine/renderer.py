@@ -93,7 +93,7 @@ def scene_block(camera, light_data, environment):
         vec4_array(MAX_POINT_LIGHTS, np.pad(light_data.point_intensity, ((0, 0), (0, 1))) if points else []),
         vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.spot_direction,
                                                      light_data.spot_size[:, None]], 1) if points else []),
-        vec4_array(MAX_POINT_LIGHTS, np.pad(light_data.spot_blend[:, None], ((0, 0), (0, 3)))
+        vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.spot_blend[:, None], light_data.point_emitter], 1)
                    if points else []),
         vec4_array(MAX_SUNS, np.concatenate([light_data.sun_axis, light_data.sun_sharpness[:, None]], 1)
                    if suns else []),

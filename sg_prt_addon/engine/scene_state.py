@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..blender import export
+from ..lighting import lights as core_lights
 from ..lighting.scene_lighting import EnvironmentData, LightData
 from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility import decode, per_vertex
@@ -122,6 +123,7 @@ class SceneState:
         self.per_vertex_status = {}  # mesh key -> {kind: why there is (or is no) data of that kind}
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
+        self.area_patches = core_lights.AREA_PATCHES_PER_SIDE   # scene.sgprt.area_light_patches
         self.world = export.WorldExport()
         self.environment = EnvironmentData()
         self.dirty = Dirty()
@@ -142,15 +144,15 @@ class SceneState:
         self.per_vertex_status.clear()
         self.materials = {"": export.MaterialParams()}
         self.lights = []
+        self.area_patches = _area_patches(depsgraph.scene)
         seen_meshes = set()
         unrendered = set()          # objects named once in the warnings
         roles = export.render_roles(depsgraph.view_layer)
         for instance in depsgraph.object_instances:
             obj = instance.object
             if obj.type == "LIGHT":
-                light = export.export_light(obj)
+                light = export.export_light(obj, instance.matrix_world)
                 if light is not None:
-                    light.position = tuple(np.asarray(instance.matrix_world)[:3, 3])
                     self.lights.append(light)
                 continue
             if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
@@ -282,6 +284,9 @@ class SceneState:
                 dirty.world = True
             elif isinstance(datablock, (bpy.types.Scene, bpy.types.Collection)):
                 membership_changed = True       # objects may have been added, removed or hidden
+                if _area_patches(depsgraph.scene) != self.area_patches:
+                    self.area_patches = _area_patches(depsgraph.scene)
+                    dirty.lights = True
             elif isinstance(datablock, bpy.types.Object):
                 self._update_object(depsgraph, datablock.evaluated_get(depsgraph), update, dirty)
                 if update.is_updated_geometry:
@@ -369,11 +374,11 @@ class SceneState:
     # ----------------------------------------------------------------- shader-side data
 
     def light_data(self):
-        return light_data(self.lights)
+        return light_data(self.lights, self.area_patches)
 
     def dropped_lights(self, max_points, max_suns):
         """Names of the lights beyond the shader's limits (the dimmest are dropped)."""
-        kept = set(light.name for light in _strongest(self.lights, max_points, max_suns))
+        kept = set(light.name for light in _strongest(self.lights, max_points, max_suns, self.area_patches))
         return [light.name for light in self.lights if light.name not in kept]
 
 
@@ -386,32 +391,61 @@ def _visible(obj):
         return True
 
 
-def _strongest(light_exports, max_points, max_suns):
-    """At most max_points point-like lights and max_suns suns, the brightest first."""
+def _area_patches(scene):
+    """The scene's patches a side of an area light (its SG-PRT render setting)."""
+    settings = getattr(scene, "sgprt", None)
+    return int(getattr(settings, "area_light_patches", core_lights.AREA_PATCHES_PER_SIDE))
+
+
+def _point_count(light, area_patches):
+    """How many of the shader's point lights a light takes: an area light's patches, else one."""
+    if light.kind != "AREA":
+        return 1
+    n_u, n_v = core_lights.area_grid(np.linalg.norm(light.edge_u), np.linalg.norm(light.edge_v), area_patches)
+    return n_u * n_v
+
+
+def _strongest(light_exports, max_points, max_suns, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
+    """The lights kept within max_points point lights (an area light counts its patches) and max_suns suns,
+    the brightest first (by intensity, or an area light's power over 4 pi: a point light of that power)."""
     def power(light):
-        return -float(np.sum(light.colour_intensity))
-    points = sorted((light for light in light_exports if light.kind == "POINT"), key=power)[:max_points]
+        scale = 1.0 / (4 * np.pi) if light.kind == "AREA" else 1.0
+        return -float(np.sum(light.colour_intensity)) * scale
+    points, used = [], 0
+    for light in sorted((light for light in light_exports if light.kind in ("POINT", "AREA")), key=power):
+        count = _point_count(light, area_patches)
+        if used + count <= max_points:
+            points.append(light)
+            used += count
     suns = sorted((light for light in light_exports if light.kind == "SUN"), key=power)[:max_suns]
     return points + suns
 
 
-def light_data(light_exports):
-    """LightData (float32) from export.LightExport records (the shader's limits applied:
-    the dimmest lights beyond them are left out)."""
-    from ..lighting import lights as core_lights
+def _point_rows(light, area_patches):
+    """(position, radius, intensity, direction, spot size, spot blend, emitter) rows of one point-like light:
+    one for a point or spot, a patch each for an area light."""
+    if light.kind != "AREA":
+        return [(light.position, light.radius, light.colour_intensity, light.direction,
+                 light.spot_size if light.is_spot else -1.0, light.spot_blend if light.is_spot else 0.0,
+                 (0.0, 0.0, 0.0))]
+    patches = core_lights.area_light_patches(light.position, light.edge_u, light.edge_v, light.direction,
+                                             light.shape, light.colour_intensity, area_patches, light.spread)
+    emitter = (1.0, patches.tan_half_spread, patches.spread_normalization)
+    return [(position, radius, intensity, patches.normal, -1.0, 0.0, emitter)
+            for position, radius, intensity in zip(patches.position, patches.radius, patches.intensity)]
 
-    kept = _strongest(light_exports, MAX_POINT_LIGHTS, MAX_SUNS)
-    points = [light for light in kept if light.kind == "POINT"]
+
+def light_data(light_exports, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
+    """LightData (float32) from export.LightExport records, an area light cut into about area_patches^2
+    patches (the shader's limits applied: the dimmest lights beyond them are left out)."""
+    kept = _strongest(light_exports, MAX_POINT_LIGHTS, MAX_SUNS, area_patches)
+    rows = [row for light in kept if light.kind != "SUN" for row in _point_rows(light, area_patches)]
     suns = [light for light in kept if light.kind == "SUN"]
     data = LightData()
     f = np.float32
-    if points:
-        data.point_position = np.array([light.position for light in points], f)
-        data.point_radius = np.array([light.radius for light in points], f)
-        data.point_intensity = np.array([light.colour_intensity for light in points], f)
-        data.spot_direction = np.array([light.direction for light in points], f)
-        data.spot_size = np.array([light.spot_size if light.is_spot else -1.0 for light in points], f)
-        data.spot_blend = np.array([light.spot_blend if light.is_spot else 0.0 for light in points], f)
+    if rows:
+        (data.point_position, data.point_radius, data.point_intensity, data.spot_direction, data.spot_size,
+         data.spot_blend, data.point_emitter) = (np.array(column, f) for column in zip(*rows))
     if suns:
         axis, sharpness, amplitude = core_lights.directional_light_sg(
             -np.array([light.direction for light in suns], np.float64),

@@ -30,9 +30,12 @@ its disc of angular diameter a, i.e. irradiance S [W/m^2] on a surface facing
 it (exactly 2 S / (1 + cos(a/2)) since the disc is a cap).  Blender's default
 "soft falloff" point light differs from a sphere only closer than a few radii.
 """
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..spherical import sg
+from ..visibility import hemisphere_map
 
 MAX_SHARPNESS = 1e6  # sg.py kernels are stable up to here; radius 0 lights clamp to it
 _LN10 = np.log(10.0)
@@ -114,10 +117,8 @@ def spot_light_sg(shading_position, light_position, spot_direction, spot_size, s
     """
     axis, sharpness, amplitude = sphere_light_sg(shading_position, light_position, radius, intensity, model)
     cos_angle = np.sum(-axis.astype(np.float64) * sg.normalize(np.asarray(spot_direction, dtype=np.float64)), axis=-1)
-    cos_half = np.cos(0.5 * np.asarray(spot_size, dtype=np.float64))
-    width = np.maximum((1.0 - cos_half) * np.asarray(spot_blend, dtype=np.float64), 1e-12)
-    t = np.clip((cos_angle - cos_half) / width, 0.0, 1.0)
-    falloff = t * t * (3.0 - 2.0 * t)
+    falloff = emission_factor(cos_angle, np.asarray(spot_size, np.float64), np.asarray(spot_blend, np.float64),
+                              False, 0.0, 0.0)
     falloff = falloff.reshape(falloff.shape + (1,) * (np.ndim(amplitude) - np.ndim(falloff)))
     return axis, sharpness, (amplitude * falloff).astype(amplitude.dtype)
 
@@ -142,6 +143,172 @@ def directional_light_sg(direction, angular_radius, irradiance, model="energy"):
     amplitude = _broadcast_colour(amplitude, np.asarray(irradiance, dtype=np.float64))
     axis = sg.normalize(direction)
     return axis.astype(dtype), sharpness.astype(dtype), _finite(amplitude, dtype)
+
+
+# --------------------------------------------------------------------------- area lights
+
+AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
+# the grid's default patches a side: irradiance within 1.6% relative L2 of Lambert's formula from half the
+# light's size away (docs/ACCURACY.md, "area lights")
+AREA_PATCHES_PER_SIDE = 4
+# Cycles turns a spread of 0 into a delta beam; below this a beam from each patch centre is all a patch can
+# give (blender/export.py warns where the shaft's edge is then approximate)
+MIN_SPREAD = 1e-3
+
+
+@dataclass
+class AreaPatches:
+    """An area light cut into equal-area patches: position (K, 3), radius (K,) of the sphere of each patch's
+    area, intensity (K, C) in W/sr along the light's normal (3,); the spread's (tan of the half angle,
+    normalization), normalization 0 for none."""
+    position: np.ndarray
+    radius: np.ndarray
+    intensity: np.ndarray
+    normal: np.ndarray
+    tan_half_spread: float = 0.0
+    spread_normalization: float = 0.0
+
+
+def area_light_area(shape, size_u, size_v):
+    """Area of a light of Blender's shape with edge lengths (world) size_u, size_v (a disk's diameter)."""
+    return size_u * size_v * (np.pi / 4 if shape in ("DISK", "ELLIPSE") else 1.0)
+
+
+def spread_parameters(spread):
+    """(tan of the half angle, normalization) of Cycles' soft-box attenuation for an area light of full
+    spread angle ``spread``: max((tan h - tan a) N, 0) at angle a from the normal, N = 1 / (tan h - h)
+    (3 / h^3 below h = 0.05, its series), which keeps the light's power; (0, 0) for a spread of pi (none)."""
+    half = 0.5 * float(np.clip(spread, MIN_SPREAD, np.pi))
+    if half >= 0.5 * np.pi - 1e-6:
+        return 0.0, 0.0
+    tan_half = float(np.tan(half))
+    return tan_half, float(1.0 / (tan_half - half) if half > 0.05 else 3.0 / half ** 3)
+
+
+def area_grid(size_u, size_v, per_side):
+    """Patch counts (n_u, n_v) along the two edges: about per_side^2 patches, each near square."""
+    aspect = np.sqrt(max(size_u, 1e-12) / max(size_v, 1e-12))
+    n_u = int(np.clip(round(per_side * aspect), 1, per_side * per_side))
+    n_v = int(np.clip(round(per_side / aspect), 1, per_side * per_side))
+    return n_u, n_v
+
+
+def area_light_patches(centre, edge_u, edge_v, normal, shape, power, per_side, spread=np.pi):
+    """AreaPatches of a Blender area light: centre (3,), edge_u / edge_v (3,) the world vectors spanning
+    the light (its size along local x and y, object scale included), normal (3,) the direction it emits
+    along (-Z), shape in AREA_SHAPES, power (C,) W per colour, per_side the grid's patches per side.
+
+    A rectangle is cut into an n_u x n_v grid; a disk or ellipse into the same grid through the concentric
+    map, which keeps areas equal.  Each patch carries the intensity P / (pi K) along the normal (the
+    radiance P / (pi A) times its area A / K), so a light of zero size is a Lambertian point emitter."""
+    centre, edge_u, edge_v = (np.asarray(v, np.float64) for v in (centre, edge_u, edge_v))
+    size_u, size_v = float(np.linalg.norm(edge_u)), float(np.linalg.norm(edge_v))
+    n_u, n_v = area_grid(size_u, size_v, int(per_side))
+    u = (np.arange(n_u) + 0.5) / n_u * 2.0 - 1.0
+    v = (np.arange(n_v) + 0.5) / n_v * 2.0 - 1.0
+    square = np.stack(np.meshgrid(u, v, indexing="xy"), -1).reshape(-1, 2)
+    if shape in ("DISK", "ELLIPSE"):
+        square = hemisphere_map.square_to_disc(square)
+    count = len(square)
+    position = centre + 0.5 * square[:, :1] * edge_u + 0.5 * square[:, 1:] * edge_v
+    patch_area = area_light_area(shape, size_u, size_v) / count
+    radius = np.full(count, np.sqrt(patch_area / np.pi))
+    intensity = np.broadcast_to(np.asarray(power, np.float64) / (np.pi * count), (count,) + np.shape(power))
+    tan_half, normalization = spread_parameters(spread)
+    return AreaPatches(position, radius, np.array(intensity), sg.normalize(np.asarray(normal, np.float64)),
+                       tan_half, normalization)
+
+
+def emission_factor(cos_angle, spot_size, spot_blend, area, tan_half_spread, spread_normalization):
+    """The factor on a point-like light's intensity toward a shading point, cos_angle = the cosine between
+    the light's direction (spot axis, area normal) and the ray from the light to the point: an area patch's
+    one-sided cosine times its spread attenuation (area true), a spot's cone smoothstep (spot_size >= 0),
+    else 1.  Broadcasts; keeps float32 inputs float32 (the shaders' lights.glsl light_emission_factor)."""
+    cos_angle = np.asarray(cos_angle)
+    dtype = np.result_type(cos_angle, np.float32)
+    one = dtype.type(1)
+    cos_half = np.cos(dtype.type(0.5) * np.maximum(spot_size, 0).astype(dtype))
+    width = np.maximum((one - cos_half) * spot_blend, dtype.type(1e-12))
+    t = np.clip((cos_angle - cos_half) / width, 0, 1)
+    spot = np.where(np.asarray(spot_size) >= 0, t * t * (3 - 2 * t), one)
+    facing = np.maximum(cos_angle, 0)
+    with np.errstate(divide="ignore", invalid="ignore"):     # facing 0: tan inf, times a normalization of 0
+        tan_angle = np.sqrt(np.maximum(one - facing * facing, 0)) / facing
+        attenuation = np.maximum((tan_half_spread - tan_angle) * spread_normalization, 0)
+    attenuation = np.where(np.asarray(spread_normalization) > 0, attenuation, one)
+    return np.where(area, facing * attenuation, spot).astype(dtype)
+
+
+def patches_irradiance(position, normal, patches):
+    """Irradiance (N, C) at points (N, 3) with normals (N, 3) from AreaPatches as the engine shades them: each
+    patch a sphere light's SG times its emission factor, against the clamped cosine (the accurate closed form
+    of spherical.clamped_cosine).  What the area lights' accuracy rows measure."""
+    from ..spherical import clamped_cosine
+
+    position, normal = np.atleast_2d(position), np.atleast_2d(normal)
+    axis, sharpness, amplitude = sphere_light_sg(position[:, None], patches.position[None], patches.radius[None], 1.0)
+    factor = emission_factor(np.sum(-axis * patches.normal, axis=-1), -1.0, 0.0, True, patches.tan_half_spread,
+                             patches.spread_normalization)
+    integral = clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, amplitude * factor, normal[:, None])
+    return integral @ patches.intensity
+
+
+def area_irradiance_quadrature(position, normal, centre, edge_u, edge_v, light_normal, spread=np.pi, nodes=400):
+    """Irradiance (N,) from a rectangular light of unit radiance (times the spread's attenuation) by the
+    midpoint rule over its area on nodes x nodes points: the reference where a spread rules out Lambert's
+    formula (polygon_irradiance)."""
+    s = (np.arange(nodes) + 0.5) / nodes - 0.5
+    grid = np.stack(np.meshgrid(s, s), -1).reshape(-1, 2)
+    points = np.asarray(centre) + grid[:, :1] * np.asarray(edge_u) + grid[:, 1:] * np.asarray(edge_v)
+    tan_half, normalization = spread_parameters(spread)
+    light_normal = sg.normalize(np.asarray(light_normal, np.float64))
+    result = []
+    for x, n in zip(np.atleast_2d(position), np.atleast_2d(normal)):
+        to_point = x - points
+        distance2 = np.sum(to_point ** 2, axis=-1)
+        direction = to_point / np.sqrt(distance2)[:, None]
+        emitted = emission_factor(direction @ light_normal, -1.0, 0.0, True, tan_half, normalization)
+        result.append(np.sum(emitted * np.maximum(-direction @ n, 0.0) / distance2) / nodes ** 2)
+    return np.array(result) * abs(np.linalg.norm(np.cross(edge_u, edge_v)))
+
+
+def polygon_irradiance(position, normal, vertices, radiance=1.0):
+    """Exact irradiance at points (N, 3) with normals (N, 3) from a planar polygon (M, 3) of uniform
+    radiance, emitting to the side its vertices turn anticlockwise about (Lambert's formula on the
+    polygon clipped to each point's upper hemisphere; 0 behind the emitter).  The reference of the area
+    lights' patch grid."""
+    position, normal = np.atleast_2d(position).astype(np.float64), np.atleast_2d(normal).astype(np.float64)
+    vertices = np.asarray(vertices, np.float64)
+    emitter_normal = sg.normalize(np.cross(vertices[1] - vertices[0], vertices[2] - vertices[0]))
+    result = np.zeros(len(position))
+    for k, (x, n) in enumerate(zip(position, normal)):
+        if np.dot(x - vertices[0], emitter_normal) <= 0:
+            continue
+        polygon = _clip_to_half_space(vertices - x, n)
+        if len(polygon) < 3:
+            continue
+        r = polygon / np.linalg.norm(polygon, axis=-1, keepdims=True)
+        r_next = np.roll(r, -1, axis=0)
+        cross = np.cross(r, r_next)
+        length = np.linalg.norm(cross, axis=-1)
+        angle = np.arctan2(length, np.sum(r * r_next, axis=-1))
+        total = np.sum(angle * (cross @ n) / np.maximum(length, 1e-300))
+        result[k] = 0.5 * abs(total)
+    return result * radiance
+
+
+def _clip_to_half_space(polygon, normal):
+    """Sutherland-Hodgman: the part of a polygon (M, 3) where dot(p, normal) >= 0."""
+    out = []
+    side = polygon @ normal
+    for i in range(len(polygon)):
+        j = (i + 1) % len(polygon)
+        if side[i] >= 0:
+            out.append(polygon[i])
+        if (side[i] >= 0) != (side[j] >= 0):
+            t = side[i] / (side[i] - side[j])
+            out.append(polygon[i] + t * (polygon[j] - polygon[i]))
+    return np.array(out).reshape(-1, 3)
 
 
 def _broadcast_colour(per_lobe, intensity):

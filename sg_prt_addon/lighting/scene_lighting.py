@@ -13,7 +13,9 @@ class LightData:
     """Lights as the shader gets them (float32).
 
     point: position (P, 3), radius (P,), intensity (P, 3) W/sr, spot: direction (P, 3),
-    spot_size (P,) full cone angle (negative: a point light), spot_blend (P,).
+    spot_size (P,) full cone angle (negative: a point light), spot_blend (P,); emitter (P, 3): x 1 for a
+    patch of an area light (one-sided, its normal the spot direction: lights.emission_factor), y and z
+    the tan of its spread's half angle and the spread's normalization (0: none).
     sun: axis (S, 3), sharpness (S,), amplitude (S, 3) (precomputed SGs).
     """
     point_position: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
@@ -22,6 +24,7 @@ class LightData:
     spot_direction: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
     spot_size: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
     spot_blend: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
+    point_emitter: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
     sun_axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
     sun_sharpness: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
     sun_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))

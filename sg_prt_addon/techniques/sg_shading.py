@@ -232,15 +232,17 @@ def point_light_sgs(position, light_data):
     position = np.asarray(position, FLOAT)[:, None, :]
     axis, sharpness, amplitude = lights.sphere_light_sg(
         position, light_data.point_position[None], light_data.point_radius[None], FLOAT(1))
-    is_spot = light_data.spot_size >= 0
-    if np.any(is_spot):
-        _, _, spot_amplitude = lights.spot_light_sg(
-            position, light_data.point_position[None], light_data.spot_direction[None],
-            np.maximum(light_data.spot_size, 0)[None], light_data.spot_blend[None], FLOAT(1),
-            light_data.point_radius[None])
-        amplitude = np.where(is_spot[None], spot_amplitude, amplitude)
-    amplitude = amplitude[..., None] * light_data.point_intensity[None]
+    amplitude = (amplitude * point_light_emission(axis, light_data))[..., None] * light_data.point_intensity[None]
     return axis.astype(FLOAT), sharpness.astype(FLOAT), amplitude.astype(FLOAT)
+
+
+def point_light_emission(axis, light_data):
+    """(N, P) emission factor of every point-like light toward the points that see it along axis (N, P, 3):
+    spots' cones, area lights' patches (lights.emission_factor; the shaders' scene_light_emission)."""
+    cos_angle = np.sum(-axis * sg.normalize(light_data.spot_direction)[None], axis=-1).astype(FLOAT)
+    emitter = light_data.point_emitter
+    return lights.emission_factor(cos_angle, light_data.spot_size[None], light_data.spot_blend[None],
+                                  emitter[None, :, 0] > 0.5, emitter[None, :, 1], emitter[None, :, 2])
 
 
 def world_bounds(positions, matrix_world):

@@ -27,7 +27,7 @@ def _table_coefficients(table, o, parameter):
 
 def _cap_flux_and_factors(position, light_data, order):
     """(axis (N, P, 3), flux (N, P, 3), g (N, P, order), sine of the angular radius (N, P)) of the point and
-    spot lights as uniform caps."""
+    spot lights and area lights' patches as uniform caps."""
     to_light = light_data.point_position[None] - position[:, None]
     distance2 = np.sum(to_light * to_light, axis=-1)
     radius2 = light_data.point_radius[None] ** 2
@@ -37,14 +37,8 @@ def _cap_flux_and_factors(position, light_data, order):
     cos_half = np.sqrt(np.maximum(1 - sin2, 0)).astype(FLOAT)
     g = projection.cap_factors(sin2 / (1 + cos_half), order, FLOAT)
     sine = np.sqrt(sin2).astype(FLOAT)
-    flux = light_data.point_intensity[None] * (2 / (effective2 * (1 + cos_half)))[..., None]
-    spot = light_data.spot_size >= 0
-    if np.any(spot):
-        cos_angle = np.sum(-axis * sg.normalize(light_data.spot_direction)[None], axis=-1)
-        cos_spot = np.cos(FLOAT(0.5) * light_data.spot_size)[None]
-        width = np.maximum((1 - cos_spot) * light_data.spot_blend[None], FLOAT(1e-12))
-        s = np.clip((cos_angle - cos_spot) / width, 0, 1)
-        flux = flux * np.where(spot[None], s * s * (3 - 2 * s), FLOAT(1))[..., None]
+    emission = sg_shading.point_light_emission(axis, light_data)
+    flux = light_data.point_intensity[None] * (2 / (effective2 * (1 + cos_half)) * emission)[..., None]
     return axis.astype(FLOAT), flux.astype(FLOAT), g, sine
 
 

@@ -28,7 +28,7 @@ ENGINE_DIR = os.path.join(SHADER_DIR, "engine")
 TECHNIQUE_DIR = os.path.join(SHADER_DIR, "techniques")
 
 # Sizes of the scene block's arrays (engine/scene_data.glsl, filled by engine.renderer.scene_block)
-MAX_POINT_LIGHTS = 32
+MAX_POINT_LIGHTS = 128     # an area light is lights.area_grid's patches (16 at the default 4 a side)
 MAX_SUNS = 8
 MAX_ENV_LOBES = 16
 MAX_LAYERS = 48

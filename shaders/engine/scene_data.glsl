@@ -20,7 +20,8 @@ struct SceneData {
   vec4 point_intensity[SGPRT_MAX_POINT_LIGHTS];
   /* xyz spot axis, w spot size (full cone angle; negative: a point light) */
   vec4 spot_direction_size[SGPRT_MAX_POINT_LIGHTS];
-  /* x spot blend */
+  /* x spot blend; y 1 for an area light's patch (one-sided along the spot axis), z tan of its spread's half
+   * angle, w the spread's normalization (0: none): lights.glsl light_emission_factor */
   vec4 spot_blend[SGPRT_MAX_POINT_LIGHTS];
   /* suns as ready SGs: xyz axis, w sharpness; rgb amplitude */
   vec4 sun_axis_sharpness[SGPRT_MAX_SUNS];

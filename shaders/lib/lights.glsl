@@ -7,6 +7,7 @@
  *   point_light_sg                <- lights.point_light_sg (energy model)
  *   spot_light_sg                 <- lights.spot_light_sg (energy model)
  *   directional_light_sg          <- lights.directional_light_sg(model="energy")
+ *   light_emission_factor         <- lights.emission_factor (spots' cones, area lights' patches)
  *
  * Lobes come back in out parameters (axis, sharpness, amplitude); intensity
  * and irradiance are scalars: for a colour pass 1 and multiply.  lights.py
@@ -85,6 +86,31 @@ void spot_light_sg(vec3 shading_position, vec3 light_position, vec3 spot_directi
   float width = max((1.0 - cos_half) * spot_blend, 1.0e-12);
   float t = clamp((cos_angle - cos_half) / width, 0.0, 1.0);
   amplitude *= t * t * (3.0 - 2.0 * t);
+}
+
+/* The factor on a point-like light's intensity toward the shading point, seen along axis (from the point to the
+ * light): an area light's patch (area) emits one-sided along direction with the cosine, times Cycles' soft-box
+ * spread attenuation max((tan_half_spread - tan a) normalization, 0) where normalization > 0; a spot
+ * (spot_size >= 0) its cone's smoothstep; anything else 1. */
+float light_emission_factor(vec3 axis, vec3 direction, float spot_size, float spot_blend, bool area,
+                            float tan_half_spread, float spread_normalization)
+{
+  float cos_angle = dot(-axis, safe_normalize(direction));
+  if (area) {
+    float facing = max(cos_angle, 0.0);
+    if (spread_normalization <= 0.0) {
+      return facing;
+    }
+    float tan_angle = sqrt(max(1.0 - facing * facing, 0.0)) / max(facing, 1.0e-30);
+    return facing * max((tan_half_spread - tan_angle) * spread_normalization, 0.0);
+  }
+  if (spot_size < 0.0) {
+    return 1.0;
+  }
+  float cos_half = cos(0.5 * spot_size);
+  float width = max((1.0 - cos_half) * spot_blend, 1.0e-12);
+  float t = clamp((cos_angle - cos_half) / width, 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
 }
 
 /* Distant disc light (eq. 33), e.g. Blender's sun: angular_radius = sun.angle / 2,

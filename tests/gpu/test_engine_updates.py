@@ -160,3 +160,26 @@ def test_new_object_with_new_material_is_uploaded(tracked_scene):
     dirty = state.consume_dirty()
     assert third.name in state.objects
     assert fresh.name in dirty.materials and state.objects[third.name].mesh_key in dirty.meshes
+
+
+def test_area_lights_count_their_patches_against_the_limit():
+    """An area light takes a point light a patch (about 4 x 4 at the default): only as many as fit are kept,
+    whole, the brightest first, and the rest are named as dropped."""
+    from sg_prt_addon.blender import export
+    from sg_prt_addon.engine import scene_state
+    from sg_prt_addon.techniques import shader_sources
+
+    def area(i):
+        return export.LightExport(f"area{i}", "AREA", (0.0, 0.0, 3.0), (0.0, 0.0, -1.0), (100.0 + i,) * 3,
+                                  edge_u=(1.0, 0.0, 0.0), edge_v=(0.0, 1.0, 0.0))
+    fitting = shader_sources.MAX_POINT_LIGHTS // 16
+    lights = [area(i) for i in range(fitting + 2)]
+    data = scene_state.light_data(lights)
+    assert len(data.point_radius) == 16 * fitting
+    assert np.all(data.point_emitter[:, 0] == 1) and np.all(data.spot_size < 0)
+    assert np.allclose(data.point_intensity.sum(axis=0), sum(101.0 + i for i in range(2, fitting + 2)) / np.pi,
+                       rtol=1e-5)                       # each light's patches carry P / pi along its normal
+    state = scene_state.SceneState()
+    state.lights = lights
+    assert state.dropped_lights(shader_sources.MAX_POINT_LIGHTS, shader_sources.MAX_SUNS) == ["area0", "area1"]
+    assert len(scene_state.light_data(lights[:1], area_patches=2).point_radius) == 4

@@ -88,3 +88,21 @@ def test_directional_light(glsl, fuzz, record_error):
     power = fuzz.log_uniform(1e-2, 1e4, N)
     out = glsl(LIB, "vec4(blender_point_light_intensity(p.x))", {"p": power}, 1)
     assert fuzz.relative_error(out, lights.blender_point_light_intensity(power), 1e-30).max() <= 1e-6
+
+
+def test_area_patch_emission(glsl, fuzz, record_error):
+    """light_emission_factor for area lights' patches: the one-sided cosine, times the spread's attenuation
+    (spreads from 5 degrees to none), against lights.emission_factor in float64."""
+    axis = fuzz.unit_vectors(N)
+    normal = fuzz.near(-axis, 1.2)
+    spread = np.where(fuzz.rng.integers(0, 4, N) == 0, np.pi, fuzz.uniform(np.radians(5.0), np.pi, N))
+    tan_half, normalization = np.array([lights.spread_parameters(s) for s in spread]).T
+    inputs = {"a": np.c_[axis, tan_half], "n": np.c_[normal, normalization]}
+    got = glsl(LIB, "result = vec4(light_emission_factor(a.xyz, n.xyz, -1.0, 0.0, true, a.w, n.w));", inputs, 1)
+    cos_angle = np.sum(-axis * normal / np.linalg.norm(normal, axis=-1, keepdims=True), axis=-1)
+    expected = lights.emission_factor(cos_angle, -1.0, 0.0, True, tan_half, normalization)
+    # the attenuation's slope is the normalization: compare to the on-axis value tan_half N (1 without spread)
+    scale = np.where(normalization > 0, tan_half * normalization, 1.0)
+    assert record_error("lights light_emission_factor (area patch), relative to its peak",
+                        (np.abs(got[:, 0] - expected) / scale).max()) <= 2e-5
+    assert np.all(got[cos_angle < -1e-6, 0] == 0)                 # one-sided

@@ -39,21 +39,22 @@ vec3 rotate_tangent(vec3 normal, vec3 tangent, float rotation)
 }
 
 #ifdef HAS_LIGHTS
-/* Light l (point/spot first, then suns) as an SG at the shading position. */
+/* Point-like light l's emission toward a point that sees it along axis (lights.glsl light_emission_factor). */
+float scene_light_emission(int l, vec3 axis)
+{
+  vec4 blend = scene.spot_blend[l];
+  return light_emission_factor(axis, scene.spot_direction_size[l].xyz, scene.spot_direction_size[l].w, blend.x,
+                               blend.y > 0.5, blend.z, blend.w);
+}
+
+/* Light l (point/spot/area patch first, then suns) as an SG at the shading position. */
 void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, out vec3 amplitude)
 {
   if (l < scene.counts.x) {
     float scalar_amplitude;
-    if (scene.spot_direction_size[l].w >= 0.0) {
-      spot_light_sg(position, scene.point_position_radius[l].xyz, scene.spot_direction_size[l].xyz,
-                    scene.spot_direction_size[l].w, scene.spot_blend[l].x, 1.0, scene.point_position_radius[l].w,
+    sphere_light_sg(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w, 1.0,
                     axis, sharpness, scalar_amplitude);
-    }
-    else {
-      sphere_light_sg(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w, 1.0,
-                      axis, sharpness, scalar_amplitude);
-    }
-    amplitude = scalar_amplitude * scene.point_intensity[l].rgb;
+    amplitude = scalar_amplitude * scene_light_emission(l, axis) * scene.point_intensity[l].rgb;
   }
   else {
     int s = l - scene.counts.x;

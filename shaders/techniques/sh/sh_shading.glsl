@@ -3,7 +3,7 @@
  * frame, the table lookup by it, then (ours, on the GPU) one rotation (sh_rotate) of the looked-up vector
  * into the world frame, where the environment's coefficients live (the same dot product as rotating the
  * lighting into the local frame, one vector instead of three colours).  Lights are caps (point and spot
- * lights, by sphere_light_cap) and SGs (suns), zonal about their direction: Phi g_l Y_lm(axis).  Diffuse:
+ * lights and area lights' patches, by sphere_light_cap) and SGs (suns), zonal about their direction: Phi g_l Y_lm(axis).  Diffuse:
  * the clamped cosine's bands A_l (Funk-Hecke), the lights' by the addition theorem; a light wholly below
  * the horizon adds nothing (its expansion would add only ringing).  Every band of the lighting is scaled by
  * the window's SH_WINDOW[l].  Mirrored by techniques/sh_shading.py.
@@ -111,14 +111,7 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
       float cos_half = sqrt(max(1.0 - sin2, 0.0));
       sh_cap_factors(sin2 / (1.0 + cos_half), g);
       /* radiance I / (pi r^2) over the cap's solid angle 2 pi (1 - cos): 2 I / (d^2 (1 + cos)) */
-      flux = scene.point_intensity[l].rgb * (2.0 / (effective2 * (1.0 + cos_half)));
-      if (scene.spot_direction_size[l].w >= 0.0) {
-        float cos_angle = dot(-axis, safe_normalize(scene.spot_direction_size[l].xyz));
-        float cos_spot = cos(0.5 * scene.spot_direction_size[l].w);
-        float width = max((1.0 - cos_spot) * scene.spot_blend[l].x, 1.0e-12);
-        float s = clamp((cos_angle - cos_spot) / width, 0.0, 1.0);
-        flux *= s * s * (3.0 - 2.0 * s);
-      }
+      flux = scene.point_intensity[l].rgb * (2.0 / (effective2 * (1.0 + cos_half))) * scene_light_emission(l, axis);
     }
     else {
       int s = l - scene.counts.x;
