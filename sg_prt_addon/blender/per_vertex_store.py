@@ -4,13 +4,18 @@ A record of kind K (an SSDF bake is kind "ssdf"; blender/visibility_bake.py docu
 
 - ``sgprt_K_00`` .. ``sgprt_K_{L-1}``: POINT-domain FLOAT_COLOR attributes (4 float32 a vertex; saved,
   reloaded and propagated through modifiers by 4.2 and 5.x alike), together the rows, L <= MAX_ROWS;
-- ``mesh["sgprt_K"]``: an ID property group.  ``format_version``, ``layers`` L, ``vertex_count`` and
+- ``mesh["sgprt_K"]``: an ID property group.  ``format_version``, ``layers`` L, ``vertex_count``,
   ``topology_hash`` (visibility.pipeline.topology_hash of the vertex count and the loop triangles' vertex
-  indices: mesh_topology_hash) are this module's; the kind adds its own fields.
+  indices: mesh_topology_hash), ``face_hash`` (of its faces' corners: mesh_face_hash) and ``occluders`` (the
+  fingerprints of what the bake traced, blender/occluders.py, as JSON; optional) are this module's; the kind
+  adds its own fields.
 
-A record whose vertex count or topology hash no longer matches the mesh is STALE; missing or inconsistent
-data is INVALID; both are unusable.  load() reads and checks any kind the same way.
+A record whose vertex count or faces no longer match the mesh is STALE (records made before ``face_hash``
+compare the loop triangles, which re-triangulated quads change); missing or inconsistent data is INVALID; both
+are unusable.  load() reads and checks any kind the same way.
 """
+import hashlib
+import json
 from dataclasses import dataclass
 from typing import Optional
 
@@ -44,6 +49,20 @@ def mesh_topology_hash(mesh):
     return topology_hash(len(mesh.vertices), mesh_triangles(mesh))
 
 
+def mesh_face_hash(mesh):
+    """Digest of a bpy Mesh's topology as faces: its vertex count, each face's corner count and the corners'
+    vertices.  Moving vertices (a Displace modifier applied) keeps it, though Blender may then cut quads into
+    other triangles."""
+    sizes = np.empty(len(mesh.polygons), np.int32)
+    mesh.polygons.foreach_get("loop_total", sizes)
+    corners = np.empty(len(mesh.loops), np.int32)
+    mesh.loops.foreach_get("vertex_index", corners)
+    digest = hashlib.blake2b(np.int64(len(mesh.vertices)).tobytes(), digest_size=16)
+    digest.update(sizes.tobytes())
+    digest.update(corners.tobytes())
+    return digest.hexdigest()
+
+
 @dataclass
 class StoredRecord:
     """A record read back from a mesh.  rows is None unless ``status`` is VALID (and rows were read)."""
@@ -55,6 +74,7 @@ class StoredRecord:
     vertex_count: int = 0
     topology_hash: str = ""
     rows: Optional[np.ndarray] = None   # (V, 4 L) float32
+    occluders: Optional[dict] = None    # the fingerprints of what the bake traced (blender/occluders.py)
 
 
 def has_record(mesh, kind):
@@ -74,8 +94,9 @@ def clear_record(mesh, kind):
     return found
 
 
-def store_record(mesh, kind, rows, format_version, vertex_topology_hash, metadata):
-    """Write rows (V, 4 L) and the kind's metadata to a mesh datablock, replacing any record of that kind."""
+def store_record(mesh, kind, rows, format_version, vertex_topology_hash, metadata, occluders=None):
+    """Write rows (V, 4 L) and the kind's metadata to a mesh datablock, replacing any record of that kind;
+    occluders: the fingerprints of what the bake traced (blender/occluders.py), or None."""
     rows = np.asarray(rows, np.float32)
     layers = rows.shape[1] // 4
     if rows.shape[0] != len(mesh.vertices):
@@ -88,7 +109,8 @@ def store_record(mesh, kind, rows, format_version, vertex_topology_hash, metadat
         attribute.data.foreach_set("color", np.ascontiguousarray(rows[:, 4 * layer:4 * layer + 4]).ravel())
     mesh[property_name(kind)] = {"format_version": int(format_version), "layers": int(layers),
                                  "vertex_count": int(rows.shape[0]), "topology_hash": str(vertex_topology_hash),
-                                 **metadata}
+                                 "face_hash": mesh_face_hash(mesh), **metadata,
+                                 **({"occluders": json.dumps(occluders)} if occluders is not None else {})}
 
 
 def load_record(mesh, kind, format_version, evaluated_mesh=None, read_rows=True, check_layers=None):
@@ -122,9 +144,15 @@ def load_record(mesh, kind, format_version, evaluated_mesh=None, read_rows=True,
         record.message = (f"stale: the mesh has {len(current.vertices)} vertices, the bake "
                           f"{record.vertex_count}: re-bake")
         return record
-    if mesh_topology_hash(current) != record.topology_hash:
+    face_hash = group.get("face_hash")
+    if (mesh_face_hash(current) != str(face_hash) if face_hash is not None
+            else mesh_topology_hash(current) != record.topology_hash):
         record.status, record.message = "STALE", "stale: the mesh topology changed since the bake: re-bake"
         return record
+    try:
+        record.occluders = json.loads(group["occluders"]) if "occluders" in group else None
+    except (TypeError, ValueError):
+        record.occluders = None             # unreadable: the render cannot say what moved, the bake still shades
     for layer in range(record.layers):
         attribute = mesh.attributes.get(attribute_name(kind, layer))
         if (attribute is None or attribute.data_type != "FLOAT_COLOR" or attribute.domain != "POINT"

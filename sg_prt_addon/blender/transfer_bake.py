@@ -63,6 +63,7 @@ class StoredTransfer:
     packed_coefficients: Optional[np.ndarray] = None   # (V, 4 L) rows [1, w_0, ...]
     mean: Optional[np.ndarray] = None                  # (D,) float32
     basis: Optional[np.ndarray] = None                 # (K, D) float32
+    occluders: Optional[dict] = None                   # what it traced (blender/occluders.py fingerprints)
 
     @property
     def usable(self):
@@ -81,8 +82,9 @@ def clear_transfer_bake(mesh):
     return per_vertex_store.clear_record(mesh, KIND)
 
 
-def store_transfer_bake(mesh, result, options):
-    """Write a finished visibility.transfer.TransferResult to a mesh datablock, replacing any previous one."""
+def store_transfer_bake(mesh, result, options, occluder_fingerprints=None):
+    """Write a finished visibility.transfer.TransferResult to a mesh datablock, replacing any previous one
+    (occluder_fingerprints: see visibility_bake.store_visibility_bake)."""
     if result.vertex_count != len(mesh.vertices):
         raise ValueError(f"transfer of {result.vertex_count} vertices does not fit '{mesh.name}' "
                          f"({len(mesh.vertices)} vertices)")
@@ -95,7 +97,7 @@ def store_transfer_bake(mesh, result, options):
         "seconds": float(result.seconds),
         "mean": np.asarray(result.mean, np.float32).astype(np.float64).tolist(),
         "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
-    })
+    }, occluder_fingerprints)
 
 
 def _check_layers(group, layers):
@@ -119,7 +121,8 @@ def load_transfer_bake(mesh, evaluated_mesh=None, read_arrays=True):
     try:
         stored = StoredTransfer(record.status, record.message, order=int(group["order"]), terms=int(group["terms"]),
                                 layers=record.layers, relative_error=float(group["relative_error"]),
-                                vertex_count=record.vertex_count, date=str(group.get("date", "")))
+                                vertex_count=record.vertex_count, date=str(group.get("date", "")),
+                                occluders=record.occluders)
     except (KeyError, TypeError, ValueError) as error:
         return StoredTransfer("INVALID", f"transfer metadata damaged ({error}): re-bake")
     if not stored.usable:
@@ -248,13 +251,13 @@ class SGPRT_OT_bake_transfer(SceneJobOperator, bpy.types.Operator):
         inputs = bake_inputs(self, context, mesh_objects(context, self.target), "transfer bake")
         if inputs is None:
             return None
-        receivers, occluder_vertices, occluder_triangles, self._topology = inputs
+        receivers, occluder_vertices, occluder_triangles, self._topology, self._occluders = inputs
         return TransferJob(receivers, occluder_vertices, occluder_triangles, _transfer_options(self),
                            hook=progress_hook)
 
     def _finish(self, context, job):
         def store(mesh, result):
-            store_transfer_bake(mesh, result, job.options)
+            store_transfer_bake(mesh, result, job.options, self._occluders)
             return (f"order {result.order}, {result.terms} terms, error {result.relative_error:.3f}, "
                     f"{result.seconds:.1f} s")
 

@@ -37,19 +37,21 @@ per-vertex kind):
   (visibility.per_vertex.MAX_ROWS);
 - ``mesh["sgprt_ssdf"]``, an ID property group: the store's ``format_version``,
   ``layers`` L, ``vertex_count``, ``topology_hash`` (``visibility.pipeline.topology_hash`` of the
-  vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``), and the bake's
+  vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``), ``face_hash``,
+  ``occluders`` (per_vertex_store's), and the bake's
   ``resolution`` R, ``terms`` N, ``rms_error`` (radians),
   ``frame_reference_axis`` (3), ``date`` (ISO 8601 UTC), ``seconds``,
   ``refinement``, ``error_target`` (-1 for fixed terms), ``rays_traced``, and the
   basis ``basis`` (N R R) and ``mean`` (R R) as float arrays (stored as double:
   the float32 values round-trip bit-exactly through save and reopen).
 
-A bake whose vertex count or topology hash no longer matches the mesh is
-STALE; missing or inconsistent data is INVALID; both are unusable.  Moving
-vertices keeps the topology (and the bake usable) but makes the shadows wrong:
-re-bake.  Only the receivers are stored: moving an occluder also needs a
-re-bake.  Occluders are all visible objects with geometry (evaluated, world
-space), the receivers included; a hidden receiver does not shadow itself.
+A bake whose vertex count or faces no longer match the mesh is STALE; missing
+or inconsistent data is INVALID; both are unusable.  Moving vertices keeps the
+faces (and the bake usable) but makes the shadows wrong, as does moving an
+occluder: the bake keeps the fingerprints of what it traced
+(blender/occluders.py) and the render names what moved or changed since.
+Occluders are all visible objects with geometry (evaluated, world space), the
+receivers included; a hidden receiver does not shadow itself.
 
 Operators: ``sgprt.bake_visibility`` (execute: synchronous with printed
 progress, for ``blender -b`` and tests; invoke: a background thread polled by
@@ -68,17 +70,17 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 from ..visibility import decode
 from ..visibility.per_vertex import MAX_ROWS, MAX_TERMS
 from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
-from . import export, per_vertex_store
+from . import export, occluders, per_vertex_store
 from .background_job import BackgroundJob, SceneJobOperator
+from .occluders import occluder_arrays
 from .panels import RenderPanel
-from .per_vertex_store import mesh_topology_hash, mesh_triangles
+from .per_vertex_store import mesh_face_hash, mesh_topology_hash, mesh_triangles
 
 FORMAT_VERSION = 1
 KIND = "ssdf"           # the bake's per-vertex kind (visibility.per_vertex; stored by per_vertex_store)
 PROPERTY = per_vertex_store.property_name(KIND)
 ATTRIBUTE_PREFIX = per_vertex_store.attribute_name(KIND, 0)[:-2]
 MAX_LAYERS = MAX_ROWS
-GEOMETRY_TYPES = ("MESH", "CURVE", "SURFACE", "META", "FONT")
 
 # Tests (and scripts) may set this to a callable(fraction, message) -> bool: True cancels the bake.
 progress_hook = None
@@ -116,42 +118,13 @@ def receiver_arrays(obj, depsgraph):
     if len(obj.data.polygons) == 0:
         raise ValueError(f"'{obj.name}' has no faces: nothing to bake")
     mesh = obj.evaluated_get(depsgraph).data
-    if len(mesh.vertices) != len(obj.data.vertices) or mesh_topology_hash(mesh) != mesh_topology_hash(obj.data):
+    if len(mesh.vertices) != len(obj.data.vertices) or mesh_face_hash(mesh) != mesh_face_hash(obj.data):
         raise ValueError(f"'{obj.name}': its modifiers change the topology; apply them before baking")
     matrix = _matrix(obj.evaluated_get(depsgraph).matrix_world)
     vertices = _to_world(_vertex_array(mesh, "co"), matrix)
     normals = _vertex_array(mesh, "normal") @ np.linalg.inv(matrix[:3, :3])   # inverse transpose
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
     return vertices, normals, mesh_triangles(mesh)
-
-
-def occluder_arrays(depsgraph):
-    """(vertices (P, 3) float32, triangles (T, 3) int32) of every object with geometry a render shows (visible
-    and not disabled in renders: export.render_roles), world space."""
-    by_object = {}
-    vertices, triangles, offset = [], [], 0
-    hidden = export.render_roles(depsgraph.view_layer).hidden
-    for instance in depsgraph.object_instances:
-        obj = instance.object
-        if obj.type not in GEOMETRY_TYPES or obj.name in hidden:
-            continue
-        key = obj.name
-        if key not in by_object:
-            mesh = obj.to_mesh()
-            try:
-                by_object[key] = (_vertex_array(mesh, "co"), mesh_triangles(mesh))
-            finally:
-                obj.to_mesh_clear()
-        local, tris = by_object[key]
-        if len(tris) == 0:
-            continue
-        vertices.append(_to_world(local, _matrix(instance.matrix_world)))
-        triangles.append(tris + offset)
-        offset += len(local)
-    if not vertices:
-        return np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32)
-    return (np.ascontiguousarray(np.concatenate(vertices), np.float32),
-            np.ascontiguousarray(np.concatenate(triangles), np.int32))
 
 
 # --------------------------------------------------------------------------- storage
@@ -174,6 +147,7 @@ class StoredBake:
     packed_coefficients: Optional[np.ndarray] = None   # (V, 4 L) float32 rows [1, w_0, ...]
     basis: Optional[np.ndarray] = None                 # (N, R, R) float32
     mean: Optional[np.ndarray] = None                  # (R, R) float32
+    occluders: Optional[dict] = None                   # what it traced (blender/occluders.py fingerprints)
 
     @property
     def usable(self):
@@ -207,8 +181,9 @@ def clear_visibility_bake(mesh):
     return per_vertex_store.clear_record(mesh, KIND)
 
 
-def store_visibility_bake(mesh, result, options=None):
-    """Write a finished ``BakeResult`` to a mesh datablock, replacing any previous bake."""
+def store_visibility_bake(mesh, result, options=None, occluder_fingerprints=None):
+    """Write a finished ``BakeResult`` to a mesh datablock, replacing any previous bake; with the fingerprints
+    of the occluders it traced (occluders.fingerprints), a render can name what moved since."""
     if result.vertex_count != len(mesh.vertices):
         raise ValueError(f"bake of {result.vertex_count} vertices does not fit '{mesh.name}' "
                          f"({len(mesh.vertices)} vertices)")
@@ -229,7 +204,7 @@ def store_visibility_bake(mesh, result, options=None):
         "rays_traced": int(result.rays_traced),
         "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
         "mean": np.asarray(result.mean, np.float32).ravel().astype(np.float64).tolist(),
-    })
+    }, occluder_fingerprints)
 
 
 def float_array(value):
@@ -266,7 +241,7 @@ def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
             resolution=int(group["resolution"]), terms=int(group["terms"]), layers=record.layers,
             rms_error=float(group["rms_error"]), vertex_count=record.vertex_count,
             topology_hash=record.topology_hash, frame_reference_axis=float_array(group["frame_reference_axis"]),
-            date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)))
+            date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)), occluders=record.occluders)
     except (KeyError, TypeError, ValueError) as error:
         return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
     if not stored.usable:
@@ -410,8 +385,9 @@ def mesh_objects(context, target):
 
 def bake_inputs(operator, context, objects, what):
     """(receivers [(mesh key, object name, vertices, normals, triangles)], occluder vertices, occluder
-    triangles, {mesh key: topology hash}) of the objects a per-vertex bake writes to, world space; None
-    after the operator reported why not.  what: the bake's name in messages ("bake", "transfer bake")."""
+    triangles, {mesh key: topology hash}, the occluders' fingerprints (occluders.fingerprints, stored with
+    the bake)) of the objects a per-vertex bake writes to, world space; None after the operator reported why
+    not.  what: the bake's name in messages ("bake", "transfer bake")."""
     if not objects:
         operator.report({"ERROR"}, f"SG-PRT {what}: no mesh object selected" if operator.target == "SELECTED"
                         else f"SG-PRT {what}: no visible mesh object")
@@ -433,9 +409,10 @@ def bake_inputs(operator, context, objects, what):
     if not receivers:
         operator.report({"ERROR"}, f"SG-PRT {what}: none of the objects can be baked (see the warnings)")
         return None
-    occluder_vertices, occluder_triangles = occluder_arrays(depsgraph)
+    geometry = occluders.scene_geometry(depsgraph)
+    occluder_vertices, occluder_triangles = occluder_arrays(depsgraph, geometry)
     topology = {key: mesh_topology_hash(bpy.data.meshes[key]) for key, *_ in receivers}
-    return receivers, occluder_vertices, occluder_triangles, topology
+    return receivers, occluder_vertices, occluder_triangles, topology, occluders.fingerprints(geometry)
 
 
 def store_results(operator, job, topology, store, what, done):
@@ -490,13 +467,13 @@ class SGPRT_OT_bake_visibility(SceneJobOperator, bpy.types.Operator):
         inputs = bake_inputs(self, context, mesh_objects(context, self.target), "bake")
         if inputs is None:
             return None
-        receivers, occluder_vertices, occluder_triangles, self._topology = inputs
+        receivers, occluder_vertices, occluder_triangles, self._topology, self._occluders = inputs
         return BakeJob(receivers, occluder_vertices, occluder_triangles, _bake_options(self),
                        hook=progress_hook)
 
     def _finish(self, context, job):
         def store(mesh, result):
-            store_visibility_bake(mesh, result, job.options)
+            store_visibility_bake(mesh, result, job.options, self._occluders)
             return f"{result.terms} terms, {np.degrees(result.rms_error):.2f} deg, {result.seconds:.1f} s"
 
         outcome = store_results(self, job, self._topology, store, "bake", "SG-PRT baked")

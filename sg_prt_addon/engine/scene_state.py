@@ -90,6 +90,7 @@ def transfer_data(stored, mesh):
 SSDF = "ssdf"
 TRANSFER = "transfer"
 PER_VERTEX_KINDS = {SSDF: (visibility_for, ssdf_data), TRANSFER: (transfer_for, transfer_data)}
+BAKE_NAMES = {SSDF: "visibility bake", TRANSFER: "transfer bake"}
 
 
 @dataclass
@@ -121,6 +122,7 @@ class SceneState:
         self.meshes = {}            # mesh key -> export.MeshExport
         self.per_vertex = {}        # mesh key -> {kind: visibility.per_vertex.PerVertexData} (usable ones only)
         self.per_vertex_status = {}  # mesh key -> {kind: why there is (or is no) data of that kind}
+        self.bake_occluders = {}    # mesh key -> {kind: the fingerprints of what its usable bake traced}
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
         self.area_patches = core_lights.AREA_PATCHES_PER_SIDE   # scene.sgprt.area_light_patches
@@ -142,6 +144,7 @@ class SceneState:
         self.meshes.clear()
         self.per_vertex.clear()
         self.per_vertex_status.clear()
+        self.bake_occluders.clear()
         self.materials = {"": export.MaterialParams()}
         self.lights = []
         self.area_patches = _area_patches(depsgraph.scene)
@@ -177,25 +180,46 @@ class SceneState:
                                              self._read_materials(obj), obj.original.name in roles.holdout)
         self.world = export.export_world(depsgraph.scene.world)
         self.environment = environment_data(self.world, self.environment_layer_size)
+        self._warn_outdated_bakes(depsgraph)
         self.mark_all_dirty()
+
+    def _warn_outdated_bakes(self, depsgraph):
+        """A warning for each object whose usable bake traced the scene as it no longer is: what moved, changed
+        shape, appeared or went since (blender/occluders.py).  Its shadows are still drawn, as they were baked."""
+        if not any(self.bake_occluders.values()):
+            return
+        from ..blender import occluders
+
+        current = occluders.fingerprints(occluders.scene_geometry(depsgraph))
+        named = set()
+        for entry in self.objects.values():
+            for kind, baked in self.bake_occluders.get(entry.mesh_key, {}).items():
+                changes = occluders.changed_since(baked, current)
+                if changes and (entry.mesh_key, kind) not in named:
+                    named.add((entry.mesh_key, kind))
+                    export.warn(f"object '{entry.name.split('#')[0]}': its {BAKE_NAMES[kind]} was made before "
+                                f"{'; '.join(changes)}: its shadows are as they were then (re-bake)")
 
     def _export_mesh(self, obj, mesh_key):
         """Export an evaluated object's mesh and look up its per-vertex data of every kind."""
         mesh = export.export_object_mesh(obj)
         self.meshes[mesh_key] = mesh
-        found, status = {}, {}
+        found, status, traced = {}, {}, {}
         for kind, (source, to_data) in PER_VERTEX_KINDS.items():
             try:
                 record = source(obj)
             except Exception as error:          # a damaged bake must not stop the render: unshadowed
-                data, message = None, f"bake unreadable: {error}"
+                record, data, message = None, None, f"bake unreadable: {error}"
             else:
                 data, message = to_data(record, mesh)
             if data is not None:
                 found[kind] = data
+                if getattr(record, "occluders", None):
+                    traced[kind] = record.occluders
             status[kind] = message
         self.per_vertex[mesh_key] = found
         self.per_vertex_status[mesh_key] = status
+        self.bake_occluders[mesh_key] = traced
         return mesh
 
     @property

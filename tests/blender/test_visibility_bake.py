@@ -386,3 +386,66 @@ def test_a_bake_from_blender_4_2_loads_bit_exactly_in_this_blender(addon, tmp_pa
         stored = vb.load_visibility_bake(mesh)
         assert stored.usable, (mesh.name, stored.message)
         assert np.array_equal(_bits(stored.packed_coefficients), _bits(expected[mesh.name])), mesh.name
+
+
+def test_moved_vertices_keep_the_faces_and_the_bake(scene):
+    """Moving vertices keeps the faces, so the bake stays usable, though Blender cuts some quads along their
+    other diagonal (the loop triangles' hash, which bakes before face_hash compare, changes); a Displace
+    modifier that keeps the faces can be baked through."""
+    from sg_prt_addon.blender import per_vertex_store
+
+    _, floor, suzanne = scene
+    _select(floor)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    triangles_before = per_vertex_store.mesh_topology_hash(floor.data)
+    rng = np.random.default_rng(3)
+    for vertex in floor.data.vertices:
+        vertex.co.z += rng.uniform(-0.4, 0.4)
+    floor.data.update()
+    assert per_vertex_store.mesh_topology_hash(floor.data) != triangles_before      # quads cut the other way
+    assert vb.load_visibility_bake(floor.data).usable
+    group = floor.data[vb.PROPERTY]
+    del group["face_hash"]                      # a bake made before face_hash: the triangles decide, as then
+    assert vb.load_visibility_bake(floor.data).status == "STALE"
+
+    displace = floor.modifiers.new("Displace", "DISPLACE")
+    displace.strength = 0.3
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    obj_eval = floor.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    assert vb.visibility_for_object(obj_eval).usable
+
+
+def _render_warnings():
+    from sg_prt_addon.engine import scene_state
+
+    state = scene_state.SceneState()
+    state.sync(bpy.context.evaluated_depsgraph_get())
+    return [warning for warning in state.warnings if "was made before" in warning]
+
+
+def test_render_names_what_moved_since_the_bake(scene):
+    """A bake keeps the fingerprints of what it traced: the render names each object whose bake saw the scene
+    otherwise (moved, changed shape, appeared), and says nothing once the scene is as baked again."""
+    _, floor, suzanne = scene
+    assert bpy.ops.sgprt.bake_visibility(target="ALL") == {"FINISHED"}
+    assert _render_warnings() == []
+
+    suzanne.location.z += 0.5
+    warnings = _render_warnings()
+    assert len(warnings) == 2 and all("'Suzanne' moved" in warning for warning in warnings), warnings
+    assert any(warning.startswith("object 'Floor'") for warning in warnings)
+    suzanne.location.z -= 0.5
+    assert _render_warnings() == []
+
+    baked_co = suzanne.data.vertices[0].co.copy()
+    suzanne.data.vertices[0].co.x += 0.2
+    suzanne.data.update()
+    assert all("'Suzanne' changed shape" in warning for warning in _render_warnings())
+    suzanne.data.vertices[0].co = baked_co
+    suzanne.data.update()
+
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(1.0, 1.0, 0.5))
+    warnings = _render_warnings()
+    assert len(warnings) == 2 and all("'Cube' appeared" in warning for warning in warnings), warnings
+    bpy.context.active_object.hide_render = True            # left out of renders: it shadows nothing
+    assert _render_warnings() == []

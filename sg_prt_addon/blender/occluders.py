@@ -1,0 +1,97 @@
+"""What per-vertex bakes trace and what they remember of it: every object with geometry a render shows, as one
+world-space triangle soup (the occluders), and a fingerprint of each, stored with a bake so that a render can
+name the objects that moved or changed since (SceneState.outdated_bake_warnings).
+
+A fingerprint is (placement, vertex count, shape): a digest of the world matrices of the object's instances,
+the evaluated vertex count, and a digest of its evaluated local vertex positions.  The viewport evaluates
+modifiers at their viewport levels and a final render at their render levels, so a shape is compared only
+where the vertex counts agree: a Subdivision Surface with a higher render level is not reported as changed (nor
+is an occluder edited to a new vertex count; the receiver's own edits are caught by its topology check).
+"""
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import export
+from .per_vertex_store import mesh_triangles
+
+GEOMETRY_TYPES = ("MESH", "CURVE", "SURFACE", "META", "FONT")
+
+
+@dataclass
+class OccluderObject:
+    """One object's evaluated geometry: local vertices (P, 3), triangles (T, 3), its instances' world matrices."""
+    vertices: np.ndarray
+    triangles: np.ndarray
+    matrices: list
+
+
+def scene_geometry(depsgraph):
+    """{object name: OccluderObject} of every object with geometry a render shows (visible and not disabled in
+    renders: export.render_roles)."""
+    objects = {}
+    hidden = export.render_roles(depsgraph.view_layer).hidden
+    for instance in depsgraph.object_instances:
+        obj = instance.object
+        if obj.type not in GEOMETRY_TYPES or obj.name in hidden:
+            continue
+        if obj.name not in objects:
+            mesh = obj.to_mesh()
+            try:
+                count = len(mesh.vertices)
+                local = np.empty(count * 3, np.float32)
+                mesh.vertices.foreach_get("co", local)
+                objects[obj.name] = OccluderObject(local.reshape(-1, 3), mesh_triangles(mesh), [])
+            finally:
+                obj.to_mesh_clear()
+        objects[obj.name].matrices.append(np.array([list(row) for row in instance.matrix_world], np.float64))
+    return objects
+
+
+def occluder_arrays(depsgraph, geometry=None):
+    """(vertices (P, 3) float32, triangles (T, 3) int32) of scene_geometry, world space."""
+    geometry = scene_geometry(depsgraph) if geometry is None else geometry
+    vertices, triangles, offset = [], [], 0
+    for occluder in geometry.values():
+        if len(occluder.triangles) == 0:
+            continue
+        for matrix in occluder.matrices:
+            vertices.append(occluder.vertices.astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3])
+            triangles.append(occluder.triangles + offset)
+            offset += len(occluder.vertices)
+    if not vertices:
+        return np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32)
+    return (np.ascontiguousarray(np.concatenate(vertices), np.float32),
+            np.ascontiguousarray(np.concatenate(triangles), np.int32))
+
+
+def fingerprints(geometry):
+    """{object name: [placement digest, vertex count, shape digest]} of scene_geometry (JSON-ready)."""
+    def digest(data):
+        return hashlib.blake2b(data, digest_size=8).hexdigest()
+    return {name: [digest(b"".join(sorted(np.asarray(m, np.float32).tobytes() for m in occluder.matrices))),
+                   int(len(occluder.vertices)), digest(np.ascontiguousarray(occluder.vertices).tobytes())]
+            for name, occluder in geometry.items()}
+
+
+def changed_since(baked, current):
+    """Sentences naming the objects whose fingerprints differ between a bake's (`baked`) and the scene's now
+    (`current`): moved, changed shape, added, or gone; [] when the scene is as it was baked."""
+    moved, reshaped, added, gone = [], [], [], []
+    for name in sorted(set(baked) | set(current)):
+        then, now = baked.get(name), current.get(name)
+        if then is None:
+            added.append(name)
+        elif now is None:
+            gone.append(name)
+        elif then[0] != now[0]:
+            moved.append(name)
+        elif then[1] == now[1] and then[2] != now[2]:
+            reshaped.append(name)
+
+    def names(items):
+        return ", ".join(f"'{name}'" for name in items[:4]) + (f" and {len(items) - 4} more" if len(items) > 4 else "")
+    return [f"{names(items)} {verb}" for items, verb in
+            ((moved, "moved"), (reshaped, "changed shape"), (added, "appeared"), (gone, "went"))
+            if items]
