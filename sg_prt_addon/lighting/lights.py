@@ -224,9 +224,9 @@ def emission_factor(cos_angle, spot_size, spot_blend, area, tan_half_spread, spr
     the light's direction (spot axis, area normal) and the ray from the light to the point: an area patch's
     one-sided cosine times its spread attenuation (area true), a spot's cone smoothstep (spot_size >= 0),
     else 1.  Broadcasts; keeps float32 inputs float32 (the shaders' lights.glsl light_emission_factor)."""
-    cos_angle = np.asarray(cos_angle)
-    dtype = np.result_type(cos_angle, np.float32)
+    dtype = np.result_type(np.asarray(cos_angle), np.float32)
     one = dtype.type(1)
+    cos_angle = np.clip(cos_angle, -one, one)
     cos_half = np.cos(dtype.type(0.5) * np.maximum(spot_size, 0).astype(dtype))
     width = np.maximum((one - cos_half) * spot_blend, dtype.type(1e-12))
     t = np.clip((cos_angle - cos_half) / width, 0, 1)

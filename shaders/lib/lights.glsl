@@ -95,7 +95,7 @@ void spot_light_sg(vec3 shading_position, vec3 light_position, vec3 spot_directi
 float light_emission_factor(vec3 axis, vec3 direction, float spot_size, float spot_blend, bool area,
                             float tan_half_spread, float spread_normalization)
 {
-  float cos_angle = dot(-axis, safe_normalize(direction));
+  float cos_angle = clamp(dot(-axis, safe_normalize(direction)), -1.0, 1.0);
   if (area) {
     float facing = max(cos_angle, 0.0);
     if (spread_normalization <= 0.0) {

@@ -177,7 +177,7 @@ def test_area_lights_count_their_patches_against_the_limit():
     data = scene_state.light_data(lights)
     assert len(data.point_radius) == 16 * fitting
     assert np.all(data.point_emitter[:, 0] == 1) and np.all(data.spot_size < 0)
-    assert np.allclose(data.point_intensity.sum(axis=0), sum(101.0 + i for i in range(2, fitting + 2)) / np.pi,
+    assert np.allclose(data.point_intensity.sum(axis=0), sum(100.0 + i for i in range(2, fitting + 2)) / np.pi,
                        rtol=1e-5)                       # each light's patches carry P / pi along its normal
     state = scene_state.SceneState()
     state.lights = lights

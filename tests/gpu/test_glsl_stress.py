@@ -8,6 +8,8 @@ tiny axes; safe_normalize also gets huge ones.
 import numpy as np
 import pytest
 
+from sg_prt_addon.lighting import lights
+
 ROWS = 1 << 20
 
 
@@ -147,6 +149,24 @@ def test_lights_stress(glsl, fuzz):
         out = glsl(["sg.glsl", "lights.glsl"], body, inputs, 3)
         _assert_finite(out, name)
         assert out[:, 1].min() > 0 and out[:, 2].min() >= 0, name
+
+
+def test_light_emission_stress(glsl, fuzz):
+    """light_emission_factor on any axis and direction (zero, 1e30-sized), spot sizes and blends out of range,
+    area patches with spreads from none to 1e-3 rad (normalization 3 / h^3 = 2.4e10): finite, within [0, peak]."""
+    axis = fuzz.stress_vectors(ROWS)
+    direction = fuzz.stress_vectors(ROWS)
+    size = fuzz.uniform(-1.0, 7.0, ROWS)
+    blend = fuzz.uniform(-0.5, 1.5, ROWS)
+    spread = np.where(fuzz.rng.integers(0, 4, ROWS) == 0, np.pi, fuzz.log_uniform(1e-3, np.pi, ROWS))
+    tan_half, normalization = np.array([lights.spread_parameters(s) for s in spread]).T
+    area = (fuzz.rng.integers(0, 2, ROWS) == 0).astype(np.float64)
+    inputs = {"a": np.c_[axis, size], "d": np.c_[direction, blend], "s": np.c_[area, tan_half, normalization]}
+    body = "result = vec4(light_emission_factor(a.xyz, d.xyz, a.w, d.w, s.x > 0.5, s.y, s.z));"
+    out = glsl(["sg.glsl", "lights.glsl"], body, inputs, 1).ravel()
+    _assert_finite(out, "light_emission_factor")
+    peak = np.where(area > 0.5, np.where(normalization > 0, tan_half * normalization, 1.0), 1.0)
+    assert out.min() >= 0 and np.all(out <= peak * (1 + 1e-5)), "light_emission_factor"
 
 
 def test_clamped_cosine_stress(glsl, fuzz):
@@ -891,6 +911,7 @@ COVERED = {
                        "ggx_ndf_lobe", "ggx_anisotropic_ndf", "ggx_anisotropic_smith_lambda",
                        "ggx_anisotropic_m_factor"],
     test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "spot_light_sg", "directional_light_sg"],
+    test_light_emission_stress: ["light_emission_factor"],
     test_clamped_cosine_stress: ["sg_clamped_cosine_integral", "sg_clamped_cosine_integral_paper",
                                  "clamped_cosine_from_cosine", "clamped_cosine_lobe_evaluate"],
     test_clamped_cosine_table_stress: ["sg_clamped_cosine_integral_tabulated", "clamped_cosine_tabulated"],
