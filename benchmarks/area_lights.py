@@ -97,36 +97,14 @@ def build(name, size, patches):
 
 
 def score(name, size, samples, patches, log=print):
-    """One scene's row: SG-PRT against the two-seed Cycles truth."""
-    import tempfile
+    """One scene's row: SG-PRT against the two-seed Cycles truth (benchmarks/cycles_truth.py)."""
+    from benchmarks import cycles_truth
 
-    import numpy as np
-    from scipy import ndimage
-
-    from benchmarks import error_vs_time, matched_materials, node_materials
-    from validation import image_error
-
-    scene = build(name, size, patches)
-    seconds, image, alpha, warnings = node_materials.render_engine_image(scene)
-    mask = ndimage.binary_erosion(alpha > 0.999, iterations=1)
-    seeds = []
-    with tempfile.TemporaryDirectory() as folder:
-        import bpy
-        for seed in node_materials.SEEDS:
-            matched_materials.configure_cycles(scene, samples, seed)
-            start = time.perf_counter()
-            bpy.ops.render.render()
-            seeds.append((time.perf_counter() - start, error_vs_time._read_render_result(scene, folder)))
-    truth = 0.5 * (seeds[0][1] + seeds[1][1])
-    row = {"scene": name, "size": size, "cycles_samples": samples, "patches": patches, "engine_seconds": seconds,
-           "cycles_seconds": seeds[0][0], "pixels": int(mask.sum()), "warnings": warnings,
-           "largest": float(np.max(image[mask])), "truth_largest": float(np.max(truth[mask]))}
-    if name not in DARK_SCENES:
-        row.update(relative_rmse=image_error.relative_rmse(image, truth, mask),
-                   relative_bias=image_error.relative_mean_bias(image, truth, mask),
-                   noise_floor=image_error.relative_rmse(seeds[0][1], seeds[1][1], mask) / 2)
+    row = {"scene": name, "size": size, "patches": patches,
+           **cycles_truth.score(build(name, size, patches), samples, scores=name not in DARK_SCENES)}
+    if "relative_rmse" in row:
         log(f"{name:26s} rmse {row['relative_rmse']:.3f}  bias {row['relative_bias']:+.3f}  noise floor "
-            f"{row['noise_floor']:.3f}  SG-PRT {seconds:.2f} s  Cycles {seeds[0][0]:.1f} s")
+            f"{row['noise_floor']:.3f}  SG-PRT {row['engine_seconds']:.2f} s  Cycles {row['cycles_seconds']:.1f} s")
     else:
         log(f"{name:26s} largest pixel {row['largest']:.3g} (Cycles {row['truth_largest']:.3g})")
     return row

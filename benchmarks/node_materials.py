@@ -10,7 +10,6 @@ Scores over the sphere's pixels (one pixel in from its silhouette): relative RMS
 """
 import argparse
 import json
-import tempfile
 import time
 from pathlib import Path
 
@@ -18,7 +17,6 @@ ROOT = Path(__file__).resolve().parents[1]
 JSON_PATH = ROOT / "docs" / "node_materials.json"
 DOC_PATH = ROOT / "docs" / "ACCURACY.md"
 SECTION_TITLE = "## Blender node materials against Cycles"
-SEEDS = (1, 2)
 GOLD = (1.0, 0.766, 0.336, 1.0)
 
 
@@ -180,46 +178,13 @@ def build(name, size):
     return scene
 
 
-def render_engine_image(scene):
-    """(seconds of the second render, RGB (H, W, 3) row 0 at the top, alpha, warnings)."""
-    from benchmarks import engine_vs_eevee
-    from sg_prt_addon.engine import render_engine
-
-    scene.render.engine = "SG_PRT"
-    engine_vs_eevee.render_seconds()                # warm-up: compile, prefilter, upload
-    seconds = engine_vs_eevee.render_seconds()
-    combined = render_engine.last_render["passes"]["Combined"][::-1].astype("float64")
-    warnings = list(render_engine.last_render["state"].warnings)
-    return seconds, combined[..., :3], combined[..., 3], warnings
-
-
 def score(name, size, samples, log=print):
-    """One scene's row: SG-PRT against the two-seed Cycles truth."""
-    from scipy import ndimage
+    """One scene's row: SG-PRT against the two-seed Cycles truth (benchmarks/cycles_truth.py)."""
+    from benchmarks import cycles_truth
 
-    from benchmarks import error_vs_time, matched_materials
-    from validation import image_error
-
-    scene = build(name, size)
-    seconds, image, alpha, warnings = render_engine_image(scene)
-    mask = ndimage.binary_erosion(alpha > 0.999, iterations=1)
-    seeds = []
-    with tempfile.TemporaryDirectory() as folder:
-        import bpy
-        for seed in SEEDS:
-            matched_materials.configure_cycles(scene, samples, seed)
-            start = time.perf_counter()
-            bpy.ops.render.render()
-            seeds.append((time.perf_counter() - start, error_vs_time._read_render_result(scene, folder)))
-    truth = 0.5 * (seeds[0][1] + seeds[1][1])
-    row = {"scene": name, "size": size, "cycles_samples": samples, "engine_seconds": seconds,
-           "cycles_seconds": seeds[0][0], "pixels": int(mask.sum()),
-           "relative_rmse": image_error.relative_rmse(image, truth, mask),
-           "relative_bias": image_error.relative_mean_bias(image, truth, mask),
-           "noise_floor": image_error.relative_rmse(seeds[0][1], seeds[1][1], mask) / 2,
-           "warnings": warnings}
+    row = {"scene": name, "size": size, **cycles_truth.score(build(name, size), samples)}
     log(f"{name:24s} rmse {row['relative_rmse']:.3f}  bias {row['relative_bias']:+.3f}  noise floor "
-        f"{row['noise_floor']:.3f}  SG-PRT {seconds:.2f} s  Cycles {seeds[0][0]:.1f} s")
+        f"{row['noise_floor']:.3f}  SG-PRT {row['engine_seconds']:.2f} s  Cycles {row['cycles_seconds']:.1f} s")
     return row
 
 

@@ -1,0 +1,51 @@
+"""One scene scored against Cycles with direct light only: SG-PRT's render against the mean of two Cycles seeds,
+the noise floor rmse(seed 1 - seed 2) / 2, over the rendered surfaces' pixels one pixel in from their
+silhouettes (film_transparent).  Shared by the benchmarks that build their own small scenes (node materials,
+area lights, flat shading); the truth suite (benchmarks/truth_suite.py) has its own, fuller harness."""
+import tempfile
+import time
+
+SEEDS = (1, 2)
+
+
+def render_engine_image(scene):
+    """(seconds of the second render, RGB (H, W, 3) row 0 at the top, alpha, warnings)."""
+    from benchmarks import engine_vs_eevee
+    from sg_prt_addon.engine import render_engine
+
+    scene.render.engine = "SG_PRT"
+    engine_vs_eevee.render_seconds()                # warm-up: compile, prefilter, upload
+    seconds = engine_vs_eevee.render_seconds()
+    combined = render_engine.last_render["passes"]["Combined"][::-1].astype("float64")
+    warnings = list(render_engine.last_render["state"].warnings)
+    return seconds, combined[..., :3], combined[..., 3], warnings
+
+
+def score(scene, samples, scores=True):
+    """A row: engine_seconds, cycles_seconds, pixels, warnings, largest (SG-PRT's and the truth's largest
+    value) and, with `scores`, relative_rmse, relative_bias and noise_floor."""
+    import bpy
+    import numpy as np
+    from scipy import ndimage
+
+    from benchmarks import error_vs_time, matched_materials
+    from validation import image_error
+
+    seconds, image, alpha, warnings = render_engine_image(scene)
+    mask = ndimage.binary_erosion(alpha > 0.999, iterations=1)
+    seeds = []
+    with tempfile.TemporaryDirectory() as folder:
+        for seed in SEEDS:
+            matched_materials.configure_cycles(scene, samples, seed)
+            start = time.perf_counter()
+            bpy.ops.render.render()
+            seeds.append((time.perf_counter() - start, error_vs_time._read_render_result(scene, folder)))
+    truth = 0.5 * (seeds[0][1] + seeds[1][1])
+    row = {"cycles_samples": samples, "engine_seconds": seconds, "cycles_seconds": seeds[0][0],
+           "pixels": int(mask.sum()), "warnings": warnings,
+           "largest": float(np.max(image[mask])), "truth_largest": float(np.max(truth[mask]))}
+    if scores:
+        row.update(relative_rmse=image_error.relative_rmse(image, truth, mask),
+                   relative_bias=image_error.relative_mean_bias(image, truth, mask),
+                   noise_floor=image_error.relative_rmse(seeds[0][1], seeds[1][1], mask) / 2)
+    return row
