@@ -257,6 +257,18 @@ def _any_perpendicular(normals):
 MAX_COORDINATE = 1e30
 
 
+def mesh_corner_normals(mesh, vertex_index, name=None):
+    """(C, 3) float32 unit corner (split) normals of a bpy Mesh, object space, degenerate ones repaired (the
+    shading's normals, and the local frames of per-corner bakes); vertex_index: the corners' vertices."""
+    normals = np.empty(len(mesh.loops) * 3, np.float32)
+    if hasattr(mesh, "corner_normals"):            # Blender 4.1+
+        mesh.corner_normals.foreach_get("vector", normals)
+    else:
+        mesh.calc_normals_split()
+        mesh.loops.foreach_get("normal", normals)
+    return _usable_normals(normals.reshape(-1, 3), vertex_index, mesh, name or mesh.name)
+
+
 def export_mesh_data(mesh, name=None):
     """MeshExport of a bpy Mesh (already evaluated), object space; `name` (the object's) in warnings."""
     export_counter["meshes"] += 1
@@ -269,13 +281,7 @@ def export_mesh_data(mesh, name=None):
     mesh.loops.foreach_get("vertex_index", vertex_index)
     positions = vertex_co.reshape(-1, 3)[vertex_index] if loop_count else np.zeros((0, 3), np.float32)
 
-    normals = np.empty(loop_count * 3, np.float32)
-    if hasattr(mesh, "corner_normals"):            # Blender 4.1+
-        mesh.corner_normals.foreach_get("vector", normals)
-    else:
-        mesh.calc_normals_split()
-        mesh.loops.foreach_get("normal", normals)
-    normals = _usable_normals(normals.reshape(-1, 3), vertex_index, mesh, name or mesh.name)
+    normals = mesh_corner_normals(mesh, vertex_index, name)
 
     triangles = np.empty(triangle_count * 3, np.int64)
     mesh.loop_triangles.foreach_get("loops", triangles)

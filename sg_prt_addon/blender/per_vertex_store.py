@@ -2,11 +2,13 @@
 
 A record of kind K (an SSDF bake is kind "ssdf"; blender/visibility_bake.py documents its fields):
 
-- ``sgprt_K_00`` .. ``sgprt_K_{L-1}``: POINT-domain FLOAT_COLOR attributes (4 float32 a vertex; saved,
-  reloaded and propagated through modifiers by 4.2 and 5.x alike), together the rows, L <= MAX_ROWS;
+- ``sgprt_K_00`` .. ``sgprt_K_{L-1}``: FLOAT_COLOR attributes (4 float32 a vertex, or a corner where the
+  record's ``domain`` is CORNER: visibility.per_vertex; saved, reloaded and propagated through modifiers by 4.2
+  and 5.x alike), together the rows, L <= MAX_ROWS;
 - ``mesh["sgprt_K"]``: an ID property group.  ``format_version``, ``layers`` L, ``vertex_count``,
   ``topology_hash`` (visibility.pipeline.topology_hash of the vertex count and the loop triangles' vertex
-  indices: mesh_topology_hash), ``face_hash`` (of its faces' corners: mesh_face_hash) and ``occluders`` (the
+  indices: mesh_topology_hash), ``face_hash`` (of its faces' corners: mesh_face_hash), ``domain`` (POINT, or
+  CORNER; records made before it are POINT) and ``occluders`` (the
   fingerprints of what the bake traced, blender/occluders.py, as JSON; optional) are this module's; the kind
   adds its own fields.
 
@@ -73,8 +75,9 @@ class StoredRecord:
     layers: int = 0
     vertex_count: int = 0
     topology_hash: str = ""
-    rows: Optional[np.ndarray] = None   # (V, 4 L) float32
+    rows: Optional[np.ndarray] = None   # (V, 4 L) float32, or (C, 4 L) with domain CORNER
     occluders: Optional[dict] = None    # the fingerprints of what the bake traced (blender/occluders.py)
+    domain: str = "POINT"
 
 
 def has_record(mesh, kind):
@@ -94,22 +97,49 @@ def clear_record(mesh, kind):
     return found
 
 
-def store_record(mesh, kind, rows, format_version, vertex_topology_hash, metadata, occluders=None):
-    """Write rows (V, 4 L) and the kind's metadata to a mesh datablock, replacing any record of that kind;
-    occluders: the fingerprints of what the bake traced (blender/occluders.py), or None."""
+def domain_of(corner_point):
+    """The attribute domain of a bake's rows: CORNER where it was made per point (corner_point), else POINT."""
+    return "POINT" if corner_point is None else "CORNER"
+
+
+def _domain_size(mesh, domain):
+    return len(mesh.loops) if domain == "CORNER" else len(mesh.vertices)
+
+
+def rows_for_mesh(mesh, rows, corner_point, what):
+    """A bake's rows as stored: per vertex as baked (corner_point None), or a point's row for each of its
+    corners; ValueError where they do not fit the mesh."""
+    rows = np.asarray(rows, np.float32)
+    if corner_point is None:
+        if rows.shape[0] != len(mesh.vertices):
+            raise ValueError(f"{what} of {rows.shape[0]} vertices does not fit '{mesh.name}' "
+                             f"({len(mesh.vertices)} vertices)")
+        return rows
+    corner_point = np.asarray(corner_point, np.int64)
+    if len(corner_point) != len(mesh.loops) or (len(corner_point) and corner_point.max() >= rows.shape[0]):
+        raise ValueError(f"{what} of {rows.shape[0]} points does not fit the {len(mesh.loops)} corners of "
+                         f"'{mesh.name}'")
+    return rows[corner_point]
+
+
+def store_record(mesh, kind, rows, format_version, metadata, occluders=None, domain="POINT"):
+    """Write rows (V, 4 L), or (C, 4 L) for domain CORNER, and the kind's metadata to a mesh datablock,
+    replacing any record of that kind; occluders: the fingerprints of what the bake traced
+    (blender/occluders.py), or None."""
     rows = np.asarray(rows, np.float32)
     layers = rows.shape[1] // 4
-    if rows.shape[0] != len(mesh.vertices):
-        raise ValueError(f"{rows.shape[0]} vertices do not fit '{mesh.name}' ({len(mesh.vertices)} vertices)")
+    if rows.shape[0] != _domain_size(mesh, domain):
+        raise ValueError(f"{rows.shape[0]} rows do not fit the {_domain_size(mesh, domain)} "
+                         f"{'corners' if domain == 'CORNER' else 'vertices'} of '{mesh.name}'")
     if rows.shape[1] != 4 * layers or not 0 < layers <= MAX_ROWS:
         raise ValueError(f"{rows.shape[1]} values a vertex need {-(-rows.shape[1] // 4)} attributes, at most {MAX_ROWS}")
     clear_record(mesh, kind)
     for layer in range(layers):
-        attribute = mesh.attributes.new(attribute_name(kind, layer), "FLOAT_COLOR", "POINT")
+        attribute = mesh.attributes.new(attribute_name(kind, layer), "FLOAT_COLOR", domain)
         attribute.data.foreach_set("color", np.ascontiguousarray(rows[:, 4 * layer:4 * layer + 4]).ravel())
     mesh[property_name(kind)] = {"format_version": int(format_version), "layers": int(layers),
-                                 "vertex_count": int(rows.shape[0]), "topology_hash": str(vertex_topology_hash),
-                                 "face_hash": mesh_face_hash(mesh), **metadata,
+                                 "vertex_count": len(mesh.vertices), "topology_hash": mesh_topology_hash(mesh),
+                                 "face_hash": mesh_face_hash(mesh), "domain": domain, **metadata,
                                  **({"occluders": json.dumps(occluders)} if occluders is not None else {})}
 
 
@@ -126,9 +156,12 @@ def load_record(mesh, kind, format_version, evaluated_mesh=None, read_rows=True,
     try:
         record = StoredRecord("VALID", "", group, format_version=int(group.get("format_version", 0)),
                               layers=int(group["layers"]), vertex_count=int(group["vertex_count"]),
-                              topology_hash=str(group["topology_hash"]))
+                              topology_hash=str(group["topology_hash"]), domain=str(group.get("domain", "POINT")))
     except (KeyError, TypeError, ValueError) as error:
         return StoredRecord("INVALID", f"bake metadata damaged ({error}): re-bake")
+    if record.domain not in ("POINT", "CORNER"):
+        record.status, record.message = "INVALID", f"bake metadata damaged (domain {record.domain!r}): re-bake"
+        return record
     if record.format_version != format_version:
         record.status, record.message = "INVALID", (f"bake format {record.format_version}, this add-on reads "
                                                     f"{format_version}: re-bake")
@@ -153,16 +186,17 @@ def load_record(mesh, kind, format_version, evaluated_mesh=None, read_rows=True,
         record.occluders = json.loads(group["occluders"]) if "occluders" in group else None
     except (TypeError, ValueError):
         record.occluders = None             # unreadable: the render cannot say what moved, the bake still shades
+    row_count = _domain_size(mesh, record.domain)
     for layer in range(record.layers):
         attribute = mesh.attributes.get(attribute_name(kind, layer))
-        if (attribute is None or attribute.data_type != "FLOAT_COLOR" or attribute.domain != "POINT"
-                or len(attribute.data) != record.vertex_count):
+        if (attribute is None or attribute.data_type != "FLOAT_COLOR" or attribute.domain != record.domain
+                or len(attribute.data) != row_count):
             record.status = "INVALID"
             record.message = f"attribute {attribute_name(kind, layer)} missing or damaged: re-bake"
             return record
     if read_rows:
-        rows = np.empty((record.vertex_count, 4 * record.layers), np.float32)
-        column = np.empty(record.vertex_count * 4, np.float32)
+        rows = np.empty((row_count, 4 * record.layers), np.float32)
+        column = np.empty(row_count * 4, np.float32)
         for layer in range(record.layers):
             mesh.attributes[attribute_name(kind, layer)].data.foreach_get("color", column)
             rows[:, 4 * layer:4 * layer + 4] = column.reshape(-1, 4)

@@ -64,6 +64,7 @@ class StoredTransfer:
     mean: Optional[np.ndarray] = None                  # (D,) float32
     basis: Optional[np.ndarray] = None                 # (K, D) float32
     occluders: Optional[dict] = None                   # what it traced (blender/occluders.py fingerprints)
+    domain: str = "POINT"                              # rows per vertex, or per corner (CORNER)
 
     @property
     def usable(self):
@@ -82,14 +83,12 @@ def clear_transfer_bake(mesh):
     return per_vertex_store.clear_record(mesh, KIND)
 
 
-def store_transfer_bake(mesh, result, options, occluder_fingerprints=None):
+def store_transfer_bake(mesh, result, options, occluder_fingerprints=None, corner_point=None):
     """Write a finished visibility.transfer.TransferResult to a mesh datablock, replacing any previous one
-    (occluder_fingerprints: see visibility_bake.store_visibility_bake)."""
-    if result.vertex_count != len(mesh.vertices):
-        raise ValueError(f"transfer of {result.vertex_count} vertices does not fit '{mesh.name}' "
-                         f"({len(mesh.vertices)} vertices)")
-    packed = decode.pack_coefficients(result.coefficients)
-    per_vertex_store.store_record(mesh, KIND, packed, FORMAT_VERSION, result.topology_hash, {
+    (occluder_fingerprints, corner_point: see visibility_bake.store_visibility_bake)."""
+    packed = per_vertex_store.rows_for_mesh(mesh, decode.pack_coefficients(result.coefficients), corner_point,
+                                            "transfer")
+    per_vertex_store.store_record(mesh, KIND, packed, FORMAT_VERSION, {
         "order": int(result.order), "terms": int(result.terms), "relative_error": float(result.relative_error),
         "directions": int(options.directions), "rays_traced": int(result.rays_traced),
         "error_target": float(options.error_target) if options.terms is None else -1.0,
@@ -97,7 +96,7 @@ def store_transfer_bake(mesh, result, options, occluder_fingerprints=None):
         "seconds": float(result.seconds),
         "mean": np.asarray(result.mean, np.float32).astype(np.float64).tolist(),
         "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
-    }, occluder_fingerprints)
+    }, occluder_fingerprints, per_vertex_store.domain_of(corner_point))
 
 
 def _check_layers(group, layers):
@@ -122,7 +121,7 @@ def load_transfer_bake(mesh, evaluated_mesh=None, read_arrays=True):
         stored = StoredTransfer(record.status, record.message, order=int(group["order"]), terms=int(group["terms"]),
                                 layers=record.layers, relative_error=float(group["relative_error"]),
                                 vertex_count=record.vertex_count, date=str(group.get("date", "")),
-                                occluders=record.occluders)
+                                occluders=record.occluders, domain=record.domain)
     except (KeyError, TypeError, ValueError) as error:
         return StoredTransfer("INVALID", f"transfer metadata damaged ({error}): re-bake")
     if not stored.usable:
@@ -170,7 +169,7 @@ class TransferJob(BackgroundJob):
         results = {}
         count = len(self.receivers)
         try:
-            for index, (key, label, vertices, normals, triangles) in enumerate(self.receivers):
+            for index, (key, label, vertices, normals, triangles, _) in enumerate(self.receivers):
                 def progress(fraction, message, index=index, label=label):
                     overall = (index + min(max(fraction, 0.0), 1.0)) / count
                     return self.record_progress(overall, f"{label}: {message}", always_print=fraction >= 1.0)
@@ -256,8 +255,8 @@ class SGPRT_OT_bake_transfer(SceneJobOperator, bpy.types.Operator):
                            hook=progress_hook)
 
     def _finish(self, context, job):
-        def store(mesh, result):
-            store_transfer_bake(mesh, result, job.options, self._occluders)
+        def store(mesh, result, corner_point):
+            store_transfer_bake(mesh, result, job.options, self._occluders, corner_point)
             return (f"order {result.order}, {result.terms} terms, error {result.relative_error:.3f}, "
                     f"{result.seconds:.1f} s")
 

@@ -1,14 +1,18 @@
 """Visibility bake operators and its storage in the .blend (wang2009 section 5; numerics in ../visibility).
 
-Which vertices are baked
-------------------------
-The Blender mesh vertices (``mesh.vertices``, one SSDF per vertex), in world
-space, with their smooth vertex normals (``MeshVertex.normal``, also on
-flat-shaded meshes) and the default local frame of
-``visibility.hemisphere_map.local_frame`` (no tangents).  The geometry is the
-evaluated object's (deform modifiers apply), but a modifier that changes the
-topology (subdivision, mirror...) is refused: the coefficients live on the
-original mesh datablock, which must index the same vertices.
+Which points are baked
+----------------------
+Where every vertex has one corner normal (smooth meshes, flat planes), the Blender
+mesh vertices (``mesh.vertices``, one SSDF per vertex), in world space, with
+their vertex normals (``MeshVertex.normal``); where a vertex has corners of
+several normals (flat-shaded faces, sharp edges), one point per vertex and
+normal (``visibility.per_vertex.split_points``), moved a little into its faces
+(``inset_points``), with that normal: its rows are stored per corner (domain
+CORNER), so a flat face's corners read its own hemisphere.  The local frame is
+``visibility.hemisphere_map.local_frame`` of the normal (no tangents).  The
+geometry is the evaluated object's (deform modifiers apply), but a modifier
+that changes the faces (subdivision, mirror...) is refused: the coefficients
+live on the original mesh datablock, which must index the same vertices.
 
 The engine exports one vertex per face corner (blender/export.py).  To upload
 per-corner data it maps corner -> vertex with the loop's ``vertex_index``::
@@ -67,7 +71,7 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from ..visibility import decode
+from ..visibility import decode, per_vertex
 from ..visibility.per_vertex import MAX_ROWS, MAX_TERMS
 from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
 from . import export, occluders, per_vertex_store
@@ -106,9 +110,20 @@ def _to_world(points, matrix):
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
 
+def _corner_face_centres(mesh):
+    """(C, 3) the centre of each corner's face, object space."""
+    centres = np.empty(len(mesh.polygons) * 3, np.float32)
+    mesh.polygons.foreach_get("center", centres)
+    sizes = np.empty(len(mesh.polygons), np.int64)
+    mesh.polygons.foreach_get("loop_total", sizes)
+    return np.repeat(centres.reshape(-1, 3).astype(np.float64), sizes, axis=0)
+
+
 def receiver_arrays(obj, depsgraph):
-    """World-space (vertices, normals, triangles) of a mesh object's vertices, from its evaluated
-    geometry; ValueError with a message for the user when it cannot be baked."""
+    """World-space (points, normals, triangles, corner_point) where a mesh object is baked, from its evaluated
+    geometry: its vertices (corner_point None) where every vertex has one normal, else one point a vertex and
+    normal (visibility.per_vertex.split_points: flat faces and sharp edges get their faces' hemispheres) and
+    the point each corner reads; ValueError with a message for the user when it cannot be baked."""
     if obj.type != "MESH":
         raise ValueError(f"'{obj.name}' is not a mesh")
     if obj.data.library is not None or getattr(obj.data, "override_library", None) is not None:
@@ -121,10 +136,20 @@ def receiver_arrays(obj, depsgraph):
     if len(mesh.vertices) != len(obj.data.vertices) or mesh_face_hash(mesh) != mesh_face_hash(obj.data):
         raise ValueError(f"'{obj.name}': its modifiers change the topology; apply them before baking")
     matrix = _matrix(obj.evaluated_get(depsgraph).matrix_world)
-    vertices = _to_world(_vertex_array(mesh, "co"), matrix)
-    normals = _vertex_array(mesh, "normal") @ np.linalg.inv(matrix[:3, :3])   # inverse transpose
+    vertices = _vertex_array(mesh, "co")
+    normals = _vertex_array(mesh, "normal")
+    corner_vertex = np.empty(len(mesh.loops), np.int64)
+    mesh.loops.foreach_get("vertex_index", corner_vertex)
+    corner_point, point_vertex, point_normal = per_vertex.split_points(
+        corner_vertex, export.mesh_corner_normals(mesh, corner_vertex, obj.name))
+    if len(point_vertex) == len(np.unique(corner_vertex)):
+        corner_point = None                  # one normal a vertex: rows per vertex, as smooth meshes always had
+    else:
+        vertices = per_vertex.inset_points(vertices[point_vertex], corner_point, _corner_face_centres(mesh))
+        normals = point_normal
+    normals = normals @ np.linalg.inv(matrix[:3, :3])   # inverse transpose
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
-    return vertices, normals, mesh_triangles(mesh)
+    return _to_world(vertices, matrix), normals, mesh_triangles(mesh), corner_point
 
 
 # --------------------------------------------------------------------------- storage
@@ -148,6 +173,7 @@ class StoredBake:
     basis: Optional[np.ndarray] = None                 # (N, R, R) float32
     mean: Optional[np.ndarray] = None                  # (R, R) float32
     occluders: Optional[dict] = None                   # what it traced (blender/occluders.py fingerprints)
+    domain: str = "POINT"                              # rows per vertex, or per corner (CORNER)
 
     @property
     def usable(self):
@@ -163,10 +189,15 @@ class StoredBake:
         return decode.pack_basis_texture(self.mean, self.basis)
 
     def corner_coefficients(self, vertex_index):
-        """Per-corner (C, 4 L) rows from the loops' vertex indices; IndexError if any is out of range."""
+        """Per-corner (C, 4 L) rows from the loops' vertex indices; IndexError if any is out of range (or,
+        for a bake per corner, if there are not as many corners as were baked)."""
         vertex_index = np.asarray(vertex_index, np.int64)
         if self.packed_coefficients is None:
             raise ValueError(f"no usable bake: {self.message}")
+        if self.domain == "CORNER":
+            if len(vertex_index) != len(self.packed_coefficients):
+                raise IndexError(f"{len(vertex_index)} corners, the bake has {len(self.packed_coefficients)}")
+            return self.packed_coefficients
         if vertex_index.size and (vertex_index.min() < 0 or vertex_index.max() >= self.vertex_count):
             raise IndexError(f"vertex index out of the baked range 0..{self.vertex_count - 1}")
         return self.packed_coefficients[vertex_index]
@@ -181,18 +212,17 @@ def clear_visibility_bake(mesh):
     return per_vertex_store.clear_record(mesh, KIND)
 
 
-def store_visibility_bake(mesh, result, options=None, occluder_fingerprints=None):
+def store_visibility_bake(mesh, result, options=None, occluder_fingerprints=None, corner_point=None):
     """Write a finished ``BakeResult`` to a mesh datablock, replacing any previous bake; with the fingerprints
-    of the occluders it traced (occluders.fingerprints), a render can name what moved since."""
-    if result.vertex_count != len(mesh.vertices):
-        raise ValueError(f"bake of {result.vertex_count} vertices does not fit '{mesh.name}' "
-                         f"({len(mesh.vertices)} vertices)")
-    packed = decode.pack_coefficients(result.coefficients)
+    of the occluders it traced (occluders.fingerprints), a render can name what moved since.  corner_point:
+    the point of each corner where the bake is per point (receiver_arrays), None where per vertex."""
+    packed = per_vertex_store.rows_for_mesh(mesh, decode.pack_coefficients(result.coefficients), corner_point,
+                                            "bake")
     layers = packed.shape[1] // 4
     if layers > MAX_LAYERS:
         raise ValueError(f"{result.terms} terms need {layers} attributes, more than {MAX_LAYERS}")
     options = options or BakeOptions(resolution=result.resolution)
-    per_vertex_store.store_record(mesh, KIND, packed, FORMAT_VERSION, result.topology_hash, {
+    per_vertex_store.store_record(mesh, KIND, packed, FORMAT_VERSION, {
         "resolution": int(result.resolution),
         "terms": int(result.terms),
         "rms_error": float(result.rms_error),
@@ -204,7 +234,7 @@ def store_visibility_bake(mesh, result, options=None, occluder_fingerprints=None
         "rays_traced": int(result.rays_traced),
         "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
         "mean": np.asarray(result.mean, np.float32).ravel().astype(np.float64).tolist(),
-    }, occluder_fingerprints)
+    }, occluder_fingerprints, per_vertex_store.domain_of(corner_point))
 
 
 def float_array(value):
@@ -241,13 +271,15 @@ def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
             resolution=int(group["resolution"]), terms=int(group["terms"]), layers=record.layers,
             rms_error=float(group["rms_error"]), vertex_count=record.vertex_count,
             topology_hash=record.topology_hash, frame_reference_axis=float_array(group["frame_reference_axis"]),
-            date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)), occluders=record.occluders)
+            date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)), occluders=record.occluders,
+            domain=record.domain)
     except (KeyError, TypeError, ValueError) as error:
         return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
     if not stored.usable:
         return stored
     stored.message = (f"{stored.terms} terms, RMS error {np.degrees(stored.rms_error):.2f} deg, "
-                      f"{stored.vertex_count} vertices, baked {stored.date}")
+                      f"{stored.vertex_count} vertices{' (per corner)' if stored.domain == 'CORNER' else ''}, "
+                      f"baked {stored.date}")
     if not read_arrays:
         return stored
     resolution = stored.resolution
@@ -288,7 +320,8 @@ def unusable_bakes(scene, depsgraph):
 class BakeJob(BackgroundJob):
     """Bakes receivers one after another; run() synchronously or start() a thread.  Never touches bpy.
 
-    receivers: [(key, label, vertices, normals, triangles)], world space.  results: {key: BakeResult}
+    receivers: [(key, label, points, normals, triangles, corner_point)] (receiver_arrays), world space.
+    results: {key: BakeResult} (a row a point)
     once every receiver finished; cancelled / error otherwise (results then empty).
     """
 
@@ -314,7 +347,7 @@ class BakeJob(BackgroundJob):
     def run(self):
         results = {}
         try:
-            for index, (key, label, vertices, normals, triangles) in enumerate(self.receivers):
+            for index, (key, label, vertices, normals, triangles, _) in enumerate(self.receivers):
                 results[key] = bake_visibility(vertices, triangles, normals, self.occluder_vertices,
                                                self.occluder_triangles, self.options,
                                                progress=self._progress_for(index, label))
@@ -384,7 +417,8 @@ def mesh_objects(context, target):
 
 
 def bake_inputs(operator, context, objects, what):
-    """(receivers [(mesh key, object name, vertices, normals, triangles)], occluder vertices, occluder
+    """(receivers [(mesh key, object name, points, normals, triangles, corner_point)] (receiver_arrays),
+    occluder vertices, occluder
     triangles, {mesh key: topology hash}, the occluders' fingerprints (occluders.fingerprints, stored with
     the bake)) of the objects a per-vertex bake writes to, world space; None after the operator reported why
     not.  what: the bake's name in messages ("bake", "transfer bake")."""
@@ -400,12 +434,12 @@ def bake_inputs(operator, context, objects, what):
                                          f"the {what} is stored once per mesh")
             continue
         try:
-            vertices, normals, triangles = receiver_arrays(obj, depsgraph)
+            vertices, normals, triangles, corner_point = receiver_arrays(obj, depsgraph)
         except ValueError as error:
             operator.report({"WARNING"}, f"SG-PRT {what} skips {error}")
             continue
         seen.add(obj.data.name)
-        receivers.append((obj.data.name, obj.name, vertices, normals, triangles))
+        receivers.append((obj.data.name, obj.name, vertices, normals, triangles, corner_point))
     if not receivers:
         operator.report({"ERROR"}, f"SG-PRT {what}: none of the objects can be baked (see the warnings)")
         return None
@@ -417,8 +451,8 @@ def bake_inputs(operator, context, objects, what):
 
 def store_results(operator, job, topology, store, what, done):
     """The operator's outcome of a finished per-vertex bake job: nothing written when it was cancelled or
-    failed; else store(mesh, result) -> a summary for every mesh whose topology is what was baked, reported
-    after `done`."""
+    failed; else store(mesh, result, corner_point) -> a summary for every mesh whose topology is what was
+    baked, reported after `done`."""
     if job.cancelled:
         operator.report({"WARNING"}, f"SG-PRT {what} cancelled: nothing written, previous bakes kept")
         return {"CANCELLED"}
@@ -431,7 +465,8 @@ def store_results(operator, job, topology, store, what, done):
         if mesh is None or mesh_topology_hash(mesh) != topology[key]:
             operator.report({"WARNING"}, f"mesh '{key}' changed during the {what}: not stored")
             continue
-        summary = store(mesh, result)
+        corner_point = next(receiver[5] for receiver in job.receivers if receiver[0] == key)
+        summary = store(mesh, result, corner_point)
         mesh.update()
         label = next(label for k, label, *_ in job.receivers if k == key)
         written.append(f"{label} ({summary})")
@@ -472,8 +507,8 @@ class SGPRT_OT_bake_visibility(SceneJobOperator, bpy.types.Operator):
                        hook=progress_hook)
 
     def _finish(self, context, job):
-        def store(mesh, result):
-            store_visibility_bake(mesh, result, job.options, self._occluders)
+        def store(mesh, result, corner_point):
+            store_visibility_bake(mesh, result, job.options, self._occluders, corner_point)
             return f"{result.terms} terms, {np.degrees(result.rms_error):.2f} deg, {result.seconds:.1f} s"
 
         outcome = store_results(self, job, self._topology, store, "bake", "SG-PRT baked")

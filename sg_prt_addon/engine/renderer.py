@@ -156,10 +156,18 @@ def per_vertex_texture(values, texels_per_vertex, per_row):
 def per_vertex_fits(mesh, data):
     """Whether visibility.per_vertex data can be uploaded for a MeshExport: scene_state checked it when it was
     read; checked again right before the upload, since texelFetch must never read past the rows uploaded."""
-    return not (mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions)
-                or data.rows.shape[0] != mesh.vertex_count
-                or (len(mesh.corner_vertex) and int(mesh.corner_vertex.max()) >= data.rows.shape[0])
+    if mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions):
+        return False
+    rows = data.corner_rows(mesh.corner_vertex)
+    expected = len(mesh.positions) if data.domain == "CORNER" else mesh.vertex_count
+    return not (data.rows.shape[0] != expected or (len(rows) and int(rows.max()) >= data.rows.shape[0])
                 or per_vertex_texture_shape(data.rows.shape[0], data.layers)[0] > MAX_TEXTURE_SIZE)
+
+
+def row_normals(mesh, data):
+    """(rows, 3) the local frames' normals of per-vertex data's rows: the vertex normals, or for rows per
+    corner the corners' (split) normals (visibility.per_vertex)."""
+    return mesh.normals if data.domain == "CORNER" else mesh.vertex_normals
 
 
 class PerVertexBuffers:
@@ -172,7 +180,7 @@ class PerVertexBuffers:
         self.vertices_per_row = vertices_per_row(data.layers)
         self.rows_texture = _texture_2d(per_vertex_texture(data.rows, data.layers, self.vertices_per_row))
         normals = np.zeros((data.rows.shape[0], 4), np.float32)
-        normals[:, :3] = mesh.vertex_normals
+        normals[:, :3] = row_normals(mesh, data)
         self.normal_texture = _texture_2d(per_vertex_texture(normals, 1, self.vertices_per_row))
         self.basis_texture = _texture_2d_array(data.basis_texture)
 
@@ -192,6 +200,11 @@ class MeshBuffers:
             return
         self.bounds = np.stack([mesh.positions.min(axis=0), mesh.positions.max(axis=0)])
         usable = {kind: data for kind, data in (per_vertex or {}).items() if per_vertex_fits(mesh, data)}
+        if len({data.domain for data in usable.values()}) > 1:
+            # the corners read every kind's rows by one index: the kinds must agree on vertices or corners
+            # (scene_state warns of the kind left out); the visibility bake wins
+            first = "ssdf" if "ssdf" in usable else next(iter(usable))
+            usable = {kind: data for kind, data in usable.items() if data.domain == usable[first].domain}
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="normal", comp_type="F32", len=3, fetch_mode="FLOAT")
@@ -206,9 +219,10 @@ class MeshBuffers:
         vertices.attr_fill("tangent", mesh.tangents)
         vertices.attr_fill("uv", mesh.uvs)
         if usable:
-            vertices.attr_fill("vertex_index", np.ascontiguousarray(mesh.corner_vertex, np.int32))
-            vertices.attr_fill("vertex_normal", np.ascontiguousarray(
-                mesh.vertex_normals[mesh.corner_vertex.astype(np.int64)], np.float32))
+            data = next(iter(usable.values()))
+            rows = data.corner_rows(mesh.corner_vertex)
+            vertices.attr_fill("vertex_index", np.ascontiguousarray(rows, np.int32))
+            vertices.attr_fill("vertex_normal", np.ascontiguousarray(row_normals(mesh, data)[rows], np.float32))
             self.per_vertex = {kind: PerVertexBuffers(mesh, data) for kind, data in usable.items()}
         for material_index, first, count in mesh.material_ranges:
             indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])

@@ -64,7 +64,7 @@ def ssdf_data(bake, mesh):
         basis_texture = decode.pack_basis_texture(bake.mean, bake.basis)
     layers = np.shape(packed)[1] // 4 if np.ndim(packed) == 2 else 0
     return per_vertex.check(SSDF, packed, basis_texture, getattr(bake, "terms", 4 * layers - 1),
-                            mesh.vertex_count, mesh.corner_vertex)
+                            mesh.vertex_count, mesh.corner_vertex, getattr(bake, "domain", "POINT"))
 
 
 def transfer_for(object_eval):
@@ -83,7 +83,7 @@ def transfer_data(stored, mesh):
     if not stored.usable:
         return None, stored.message
     return per_vertex.check(TRANSFER, stored.packed_coefficients, stored.basis_texture(), stored.terms,
-                            mesh.vertex_count, mesh.corner_vertex)
+                            mesh.vertex_count, mesh.corner_vertex, stored.domain)
 
 
 # Per-vertex kinds the scene state looks up for each mesh: kind -> (source(object_eval), to data(record, mesh))
@@ -217,6 +217,15 @@ class SceneState:
                 if getattr(record, "occluders", None):
                     traced[kind] = record.occluders
             status[kind] = message
+        if SSDF in found and any(data.domain != found[SSDF].domain for data in found.values()):
+            # the corners read every kind's rows by one index (engine/renderer.py): the visibility bake's wins
+            def unit(data):
+                return "corner" if data.domain == "CORNER" else "vertex"
+            for kind in [kind for kind, data in found.items() if data.domain != found[SSDF].domain]:
+                status[kind] = (f"made per {unit(found[kind])}, the visibility bake per {unit(found[SSDF])} "
+                                f"(one of them older): re-bake it")
+                del found[kind]
+                traced.pop(kind, None)
         self.per_vertex[mesh_key] = found
         self.per_vertex_status[mesh_key] = status
         self.bake_occluders[mesh_key] = traced

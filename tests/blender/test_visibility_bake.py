@@ -60,13 +60,16 @@ def test_operator_bakes_floor_and_suzanne_and_stores_attributes(scene, capfd, tm
     printed = capfd.readouterr().out
     assert "[sg-prt] bake" in printed and "100%" in printed
 
-    for obj in (floor, suzanne):
+    # the flat floor has one normal a vertex: rows per vertex; flat-shaded Suzanne's corners differ: per corner
+    for obj, domain, rows in ((floor, "POINT", len(floor.data.vertices)), (suzanne, "CORNER", len(suzanne.data.loops))):
         mesh = obj.data
         layers = -(-(SMALL["terms"] + 1) // 4)
         names = [a.name for a in mesh.attributes if a.name.startswith(vb.ATTRIBUTE_PREFIX)]
         assert names == [vb.attribute_name(k) for k in range(layers)]
         for name in names:
-            assert mesh.attributes[name].data_type == "FLOAT_COLOR" and mesh.attributes[name].domain == "POINT"
+            attribute = mesh.attributes[name]
+            assert attribute.data_type == "FLOAT_COLOR" and attribute.domain == domain and len(attribute.data) == rows
+        assert vb.load_visibility_bake(mesh).domain == domain
         meta = mesh[vb.PROPERTY]
         assert meta["vertex_count"] == len(mesh.vertices) and meta["terms"] == SMALL["terms"]
         assert meta["resolution"] == SMALL["resolution"] and meta["format_version"] == vb.FORMAT_VERSION
@@ -106,17 +109,18 @@ def test_operator_bakes_floor_and_suzanne_and_stores_attributes(scene, capfd, tm
 def test_store_is_bit_exact_against_the_bake_result(scene, tmp_path):
     _, floor, suzanne = scene
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    vertices, normals, triangles = vb.receiver_arrays(suzanne, depsgraph)
+    vertices, normals, triangles, corner_point = vb.receiver_arrays(suzanne, depsgraph)
+    assert corner_point is not None and len(corner_point) == len(suzanne.data.loops)       # flat-shaded
     occluder_vertices, occluder_triangles = vb.occluder_arrays(depsgraph)
     assert len(occluder_triangles) == len(floor.data.loop_triangles) + len(suzanne.data.loop_triangles)
     result = bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_triangles,
                              BakeOptions(resolution=8, refinement=1, terms=None, error_target=0.05, max_terms=9))
-    vb.store_visibility_bake(suzanne.data, result)
-    assert result.topology_hash == vb.mesh_topology_hash(suzanne.data)
+    vb.store_visibility_bake(suzanne.data, result, corner_point=corner_point)
+    assert vb.load_visibility_bake(suzanne.data).topology_hash == vb.mesh_topology_hash(suzanne.data)
     _reopen(tmp_path / "direct.blend")
     stored = vb.load_visibility_bake(bpy.data.objects["Suzanne"].data)
     assert stored.usable and stored.terms == result.terms
-    assert np.array_equal(_bits(stored.coefficients), _bits(result.coefficients))
+    assert np.array_equal(_bits(stored.coefficients), _bits(result.coefficients[corner_point]))
     assert np.array_equal(_bits(stored.basis), _bits(result.basis))
     assert np.array_equal(_bits(stored.mean), _bits(result.mean))
     assert stored.rms_error == pytest.approx(result.rms_error, rel=1e-12)
@@ -188,13 +192,14 @@ def test_cancelled_rebake_keeps_the_previous_bake(scene, tmp_path):
 def test_threaded_job_cancels_and_writes_nothing(scene):
     _, floor, suzanne = scene
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    vertices, normals, triangles = vb.receiver_arrays(floor, depsgraph)
-    job = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles)], *vb.occluder_arrays(depsgraph),
+    vertices, normals, triangles, corner_point = vb.receiver_arrays(floor, depsgraph)
+    assert corner_point is None                         # a flat grid: one normal a vertex
+    job = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles, None)], *vb.occluder_arrays(depsgraph),
                      BakeOptions(resolution=8, refinement=1, terms=2), hook=lambda f, m: f > 0.0)
     job.start()
     job.join(30)
     assert not job.running and job.cancelled and job.results == {} and job.error is None
-    done = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles)], *vb.occluder_arrays(depsgraph),
+    done = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles, None)], *vb.occluder_arrays(depsgraph),
                       BakeOptions(resolution=8, refinement=1, terms=2))
     done.start()
     done.join(30)
