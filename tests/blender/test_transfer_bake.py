@@ -156,3 +156,29 @@ def test_both_bake_panels_draw_their_settings_buttons_and_status(scene):
     assert bpy.ops.sgprt.bake_transfer(target="ALL") == {"FINISHED"}
     calls = recording_layout.draw(tb.SGPRT_PT_transfer_bake, bpy.context)
     assert any(call[0] == "label" and call[1].startswith("Suzanne: order 4, 6 terms") for call in calls)
+
+
+def test_a_transfer_bake_per_vertex_beside_a_visibility_bake_per_corner_is_named(scene):
+    """The corners read every kind's rows by one index: a transfer bake made per vertex (an older bake of a
+    flat mesh) beside a visibility bake made per corner is left out of the render, and named with why."""
+    from sg_prt_addon.blender import per_vertex_store
+    from sg_prt_addon.blender import visibility_bake as vb
+
+    _, floor, suzanne = scene
+    scene[0].sgprt_bake.resolution, scene[0].sgprt_bake.terms, scene[0].sgprt_bake.term_mode = 8, 3, "FIXED"
+    assert bpy.ops.sgprt.bake_visibility(target="ALL") == {"FINISHED"}
+    assert bpy.ops.sgprt.bake_transfer(target="ALL") == {"FINISHED"}
+    stored = tb.load_transfer_bake(suzanne.data)
+    group = suzanne.data[per_vertex_store.property_name(tb.KIND)].to_dict()
+    rows = np.zeros((len(suzanne.data.vertices), stored.packed_coefficients.shape[1]), np.float32)
+    rows[:, 0] = 1.0
+    metadata = {key: value for key, value in group.items() if key not in (
+        "format_version", "layers", "vertex_count", "topology_hash", "face_hash", "domain", "occluders")}
+    per_vertex_store.store_record(suzanne.data, tb.KIND, rows, tb.FORMAT_VERSION, metadata)    # per vertex
+    assert tb.load_transfer_bake(suzanne.data).usable and vb.load_visibility_bake(suzanne.data).domain == "CORNER"
+    state = scene_state.SceneState()
+    state.sync(bpy.context.evaluated_depsgraph_get())
+    key = next(entry.mesh_key for entry in state.objects.values() if entry.name == "Suzanne")
+    assert set(state.per_vertex[key]) == {scene_state.SSDF}
+    assert any("Suzanne" in line and "made per vertex, the visibility bake per corner" in line
+               for line in state.unshadowed_warnings())
