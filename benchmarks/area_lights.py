@@ -30,22 +30,16 @@ def area(shape, size, size_y=None, location=(0.0, 0.0, 3.6), target=SPHERE_CENTR
     """An area light aimed at target; energy defaults to 60 W per square metre of the light's area (so
     every size lights the sphere about equally)."""
     def build(scene):
-        import bpy
-        from mathutils import Vector
+        from benchmarks import truth_suite
 
-        light = bpy.data.objects.new("Area Light", bpy.data.lights.new("Area Light", "AREA"))
-        light.data.shape = shape
-        light.data.size = size
-        light.data.size_y = size if size_y is None else size_y
-        area_m2 = size * light.data.size_y * (math.pi / 4 if shape in ("DISK", "ELLIPSE") else 1.0)
-        light.data.energy = 60.0 * max(area_m2, 1.0) if energy is None else energy
+        area_m2 = size * (size if size_y is None else size_y) * (math.pi / 4 if shape in ("DISK", "ELLIPSE") else 1.0)
+        light = truth_suite._light(scene, "AREA", location, 60.0 * max(area_m2, 1.0) if energy is None else energy,
+                                   target=target).data
+        light.shape, light.size, light.size_y = shape, size, size if size_y is None else size_y
         if spread is not None:
-            light.data.spread = spread
-        if hasattr(light.data, "normalize"):
-            light.data.normalize = normalize
-        light.location = location
-        light.rotation_euler = (Vector(target) - Vector(location)).to_track_quat("-Z", "Y").to_euler()
-        scene.collection.objects.link(light)
+            light.spread = spread
+        if hasattr(light, "normalize"):
+            light.normalize = normalize
     return build
 
 
