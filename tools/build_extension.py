@@ -1,12 +1,16 @@
 """Build the SG-PRT extension zip with its wheels, and validate it with Blender's own tool.
 
-    .venv/bin/python tools/build_extension.py                  # every platform and Python
-    .venv/bin/python tools/build_extension.py --local-only     # this machine's platform only (tests)
+    .venv/bin/python tools/build_extension.py                  # a zip per platform, each for both Pythons
+    .venv/bin/python tools/build_extension.py --local-only     # this machine's platform and Python (tests)
+    .venv/bin/python tools/build_extension.py --local-only --python 3.13    # ... for another Python
 
 Stages the add-on package, the shaders and the manifest under build/extension/,
 downloads binary wheels of the runtime dependencies Blender does not ship
 (never numpy: Blender has its own), writes their paths into the staged
-manifest, then runs `blender_ext.py build` and `validate` from the bpy wheel.
+manifest, then runs `blender_ext.py build --split-platforms` and `validate` from
+the bpy wheel.  A platform's zip carries the wheels of both Pythons Blender
+embeds (3.11 in 4.2-5.0, 3.13 from 5.1, and in Linux distributions' builds such
+as Debian's 4.3): about 50 MB each, of which scipy is 35 MB.
 """
 import argparse
 import re
@@ -95,29 +99,37 @@ def local_platform():
     sys.exit(f"build_extension: no wheels are known for platform {machine}")
 
 
-def build(local_only=False, output_dir=None):
-    """Build and validate the zip; returns its path."""
+def build(local_only=False, output_dir=None, python_version=None):
+    """Build and validate the zips, one a platform (this machine's alone with local_only, for the running
+    Python's version or `python_version`); returns their paths."""
     platforms = [local_platform()] if local_only else list(PLATFORM_TAGS)
-    python_versions = [f"{sys.version_info.major}.{sys.version_info.minor}"] if local_only else PYTHON_VERSIONS
+    if local_only:
+        python_versions = [python_version or f"{sys.version_info.major}.{sys.version_info.minor}"]
+    else:
+        python_versions = PYTHON_VERSIONS
     wheels = download_wheels(BUILD / "wheels", platforms, python_versions)
     stage_dir = BUILD / "extension" / "sg_prt"
     stage(stage_dir, wheels, platforms)
     output_dir = Path(output_dir or BUILD / "dist")
     output_dir.mkdir(parents=True, exist_ok=True)
+    for old in output_dir.glob("sg_prt-*.zip"):
+        old.unlink()
     tool = blender_ext_tool()
     subprocess.run([sys.executable, str(tool), "build", "--source-dir", str(stage_dir),
-                    "--output-dir", str(output_dir)], check=True)
-    zips = sorted(output_dir.glob("sg_prt-*.zip"), key=lambda p: p.stat().st_mtime)
-    if not zips:
-        sys.exit("build_extension: blender_ext.py build wrote no zip")
-    subprocess.run([sys.executable, str(tool), "validate", str(zips[-1])], check=True)
-    print(f"build_extension: {zips[-1]} ({zips[-1].stat().st_size / 2**20:.1f} MiB) validated", flush=True)
-    return zips[-1]
+                    "--output-dir", str(output_dir), "--split-platforms"], check=True)
+    zips = sorted(output_dir.glob("sg_prt-*.zip"))
+    if len(zips) != len(platforms):
+        sys.exit(f"build_extension: blender_ext.py build wrote {len(zips)} zips for {len(platforms)} platforms")
+    for path in zips:
+        subprocess.run([sys.executable, str(tool), "validate", str(path)], check=True)
+        print(f"build_extension: {path} ({path.stat().st_size / 2**20:.1f} MiB) validated", flush=True)
+    return zips
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--local-only", action="store_true", help="wheels for this platform and Python only")
-    parser.add_argument("--output-dir", help="where to write the zip (default build/dist)")
+    parser.add_argument("--python", help="with --local-only: the Python version of the wheels (default this one's)")
+    parser.add_argument("--output-dir", help="where to write the zips (default build/dist)")
     arguments = parser.parse_args()
-    build(arguments.local_only, arguments.output_dir)
+    build(arguments.local_only, arguments.output_dir, arguments.python)

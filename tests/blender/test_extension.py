@@ -48,7 +48,8 @@ def test_extension_builds_validates_installs_and_renders(tmp_path):
         import build_extension
     finally:
         sys.path.pop(0)
-    zip_path = build_extension.build(local_only=True, output_dir=tmp_path / "dist")  # raises unless validated
+    [zip_path] = build_extension.build(local_only=True, output_dir=tmp_path / "dist")  # raises unless validated
+    assert zip_path.name.endswith("-linux_x64.zip")             # one zip a platform
     _check_contents(zip_path)
 
     environment = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
