@@ -1,6 +1,8 @@
 """Build the example scenes from Blender's own primitives and bundled HDRIs.
 
     .venv/bin/python examples/build_scenes.py out/scenes      # writes one .blend per scene
+    .venv/bin/python examples/build_scenes.py out/scenes suzanne_courtyard     # that one only
+    blender -b --python examples/build_scenes.py -- out/scenes                 # with a Blender binary
 
 Each builder starts from an empty file and returns the scene; `save_scene`
 writes it with every image packed, so the .blend is self-contained.
@@ -25,7 +27,9 @@ def bundled_hdri(name):
 
 
 def _empty_file():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    # the home file, not the factory settings: those would turn off the add-ons of a Blender that has SG-PRT
+    # installed as an extension
+    bpy.ops.wm.read_homefile(use_empty=True)
     return bpy.context.scene
 
 
@@ -249,11 +253,12 @@ def save_scene(path):
     return path
 
 
-def main(output_dir):
-    import sg_prt_addon
-    sg_prt_addon.register()
-    for name, build in SCENES.items():
-        build()
+def main(output_dir, names=()):
+    """Write the scenes `names` (default every one) into output_dir."""
+    from sg_prt_addon import render
+    render.ensure_registered()          # a Blender with the extension installed has it registered already
+    for name in names or SCENES:
+        SCENES[name]()
         print(f"wrote {save_scene(Path(output_dir) / f'{name}.blend')}", flush=True)
 
 
@@ -269,4 +274,4 @@ def script_arguments(argv):
 if __name__ == "__main__":
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     arguments = script_arguments(sys.argv)
-    main(arguments[0] if arguments else "out/scenes")
+    main(arguments[0] if arguments else "out/scenes", arguments[1:])

@@ -1,0 +1,150 @@
+"""Drives a real Blender window (run by tests/ui/test_real_blender.py inside the chroot, under Xvfb, with
+--enable-event-simulate) as a user would, one step a timer tick: the viewport in Rendered shading, a material
+edit, the render panels, the Bake button (modal, with progress) and a second bake cancelled with Esc.  Takes a
+screenshot of the screen at each step (ImageMagick's `import`: Blender's own screenshot is black under Xvfb)
+and writes what it saw to OUT/result.json, with the areas' places for the test's pixel checks.
+
+    blender scene.blend --enable-event-simulate --python drive_window.py -- OUT
+"""
+import json
+import subprocess
+import sys
+import time
+
+import bpy
+
+OUT = sys.argv[sys.argv.index("--") + 1]
+result = {"steps": [], "errors": []}
+state = {"step": 0, "since": time.monotonic(), "shots": 0}
+
+
+def screenshot(name):
+    path = f"{OUT}/{name}.png"
+    subprocess.run(["import", "-window", "root", path], check=True, timeout=60)
+    return path
+
+
+def colours(path):
+    done = subprocess.run(["convert", path, "-format", "%k", "info:"], capture_output=True, text=True, timeout=60)
+    return int(done.stdout.strip() or 0)
+
+
+def area(kind):
+    window = bpy.context.window_manager.windows[0]
+    found = max((a for a in window.screen.areas if a.type == kind), key=lambda a: a.width * a.height)
+    return window, found, next(r for r in found.regions if r.type == "WINDOW")
+
+
+def place(kind):
+    window, found, region = area(kind)
+    return {"x": region.x, "y": region.y, "width": region.width, "height": region.height,
+            "window_height": window.height}
+
+
+def bake_record():
+    mesh = bpy.data.objects["Suzanne"].data
+    record = mesh.get("sgprt_ssdf")
+    return None if record is None else str(record.get("date", "")) + "/" + str(record.get("face_hash", ""))
+
+
+def elapsed():
+    return time.monotonic() - state["since"]
+
+
+def next_step(name, **seen):
+    result["steps"].append({"name": name, "seconds": round(elapsed(), 2), **seen})
+    state["step"] += 1
+    state["since"] = time.monotonic()
+
+
+def wait_for_ui():
+    # Blender needs seconds to draw its first frame on llvmpipe: poll the screen, not a fixed sleep
+    if colours(screenshot("first")) > 100:
+        next_step("ui drawn")
+    elif elapsed() > 90:
+        raise RuntimeError("the window never drew its UI")
+
+
+def rendered_viewport():
+    window, view, _ = area("VIEW_3D")
+    view.spaces[0].shading.type = "RENDERED"
+    view.spaces[0].region_3d.view_perspective = "CAMERA"
+    window, properties, _ = area("PROPERTIES")
+    bpy.context.view_layer.objects.active = bpy.data.objects["Suzanne"]
+    properties.spaces[0].context = "MATERIAL"
+    next_step("rendered shading", view=place("VIEW_3D"), properties=place("PROPERTIES"))
+
+
+def settle(name, seconds):
+    def step():
+        if elapsed() > seconds:
+            screenshot(name)
+            next_step(name)
+    return step
+
+
+def edit_material():
+    material = bpy.data.objects["Suzanne"].active_material
+    material.sgprt.diffuse_color = (0.9, 0.05, 0.02)
+    material.sgprt.specular_color = (0.02, 0.02, 0.02)
+    next_step("material edited", material=material.name)
+
+
+def render_panels():
+    area("PROPERTIES")[1].spaces[0].context = "RENDER"
+    next_step("render context")
+
+
+def invoke_bake(name):
+    def step():
+        window, properties, region = area("PROPERTIES")
+        before = bake_record()
+        with bpy.context.temp_override(window=window, area=properties, region=region):
+            returned = bpy.ops.sgprt.bake_visibility("INVOKE_DEFAULT", target="ALL")
+        next_step(name, returned=sorted(returned), record_before=before)
+    return step
+
+
+def progress_shot():
+    if elapsed() > 1.0:
+        screenshot("bake_progress")
+        next_step("bake progress")
+
+
+def wait_bake(name):
+    def step():
+        if bpy.ops.sgprt.bake_visibility.poll():            # one bake at a time: it polls False while one runs
+            next_step(name, record=bake_record())
+        elif elapsed() > 300:
+            raise RuntimeError(f"{name}: the bake did not end")
+    return step
+
+
+def press_escape():
+    if elapsed() > 0.5:
+        window = bpy.context.window_manager.windows[0]
+        window.event_simulate("ESC", "PRESS")
+        window.event_simulate("ESC", "RELEASE")
+        next_step("escape pressed")
+
+
+STEPS = [wait_for_ui, rendered_viewport, settle("viewport_rendered", 20), edit_material,
+         settle("viewport_edited", 15), render_panels, settle("render_panels", 3),
+         invoke_bake("bake invoked"), progress_shot, wait_bake("bake finished"),
+         invoke_bake("second bake invoked"), press_escape, wait_bake("second bake ended")]
+
+
+def tick():
+    try:
+        if state["step"] < len(STEPS):
+            STEPS[state["step"]]()
+            return 0.25
+    except Exception as error:              # report, then quit: the test reads result.json
+        result["errors"].append(f"{STEPS[state['step']].__name__}: {type(error).__name__}: {error}")
+    with open(f"{OUT}/result.json", "w") as handle:
+        json.dump(result, handle, indent=1)
+    bpy.ops.wm.quit_blender()
+    return None
+
+
+bpy.app.timers.register(tick, first_interval=1.0)
