@@ -8,6 +8,7 @@ file (the lobe fit, the BRDF factorization).
 """
 import os
 import threading
+import time
 
 import bpy
 
@@ -30,6 +31,7 @@ class BackgroundJob:
         self._lock = threading.Lock()
         self._printed_decile = -1
         self._thread = None
+        self._started = None            # time.monotonic() of the first progress, for seconds_left
 
     def cancel(self):
         self._cancel.set()
@@ -55,6 +57,8 @@ class BackgroundJob:
         fraction = min(max(float(fraction), 0.0), 1.0)
         with self._lock:
             self.fraction, self.message = fraction, message
+            if self._started is None:
+                self._started = time.monotonic()
         decile = int(fraction * 10)
         if self.verbose and (decile > self._printed_decile or always_print):
             self._printed_decile = decile
@@ -63,8 +67,34 @@ class BackgroundJob:
             self._cancel.set()
         return self._cancel.is_set()
 
+    def seconds_left(self):
+        """An estimate of the time left from the pace so far, once there is one (2% done and 2 s gone), else
+        None."""
+        if self._started is None:
+            return None
+        elapsed = time.monotonic() - self._started
+        if self.fraction < 0.02 or elapsed < 2.0:
+            return None
+        return elapsed * (1.0 - self.fraction) / self.fraction
+
+    def progress_text(self):
+        """'40%: <message>, about 12 s left' for status bars."""
+        left = self.seconds_left()
+        estimate = "" if left is None else f", about {time_text(left)} left"
+        return f"{self.fraction * 100:.0f}%: {self.message}{estimate}"
+
     def run(self):
         raise NotImplementedError
+
+
+def time_text(seconds):
+    """A duration as people read it: '8 s', '2 min 10 s', '1 h 5 min'."""
+    seconds = int(round(seconds))
+    if seconds < 60:
+        return f"{seconds} s"
+    if seconds < 3600:
+        return f"{seconds // 60} min {seconds % 60} s" if seconds < 600 else f"{round(seconds / 60)} min"
+    return f"{seconds // 3600} h {(seconds % 3600) // 60} min"
 
 
 class ModalJobOperator:
@@ -115,7 +145,7 @@ class ModalJobOperator:
             if event.type == "TIMER":
                 context.window_manager.progress_update(int(job.fraction * 100))
                 if not job.cancelling:
-                    self._status(context, f"{self.job_label} {job.fraction * 100:.0f}%: {job.message} (Esc cancels)")
+                    self._status(context, f"{self.job_label} {job.progress_text()} (Esc cancels)")
                 if not job.running:
                     job.join()
                     self._cleanup(context)
