@@ -140,11 +140,17 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
                 print(error)
                 self.viewport_error = str(error)
             return
+        border = viewport_border_rect(context, depsgraph.scene, width, height)
+        if border is not None:          # the render region: the frame is shown inside it only
+            gpu.state.scissor_test_set(True)
+            gpu.state.scissor_set(border[0], border[1], border[2] - border[0], border[3] - border[1])
         gpu.state.blend_set("ALPHA_PREMULT")
         self.bind_display_space_shader(depsgraph.scene)
         draw_texture_2d(self.viewport_frame.texture, width, height)
         self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
+        if border is not None:
+            gpu.state.scissor_test_set(False)
 
 
 class ViewportFrame:
@@ -224,6 +230,35 @@ def border_rect(render_settings, width, height):
     y0, y1 = int(render_settings.border_min_y * height), int(render_settings.border_max_y * height)
     x0, y0 = min(max(x0, 0), width), min(max(y0, 0), height)
     return x0, y0, max(min(x1, width), x0), max(min(y1, height), y0)
+
+
+def viewport_border_rect(context, scene, width, height):
+    """(x0, y0, x1, y1) region pixels, y from the bottom, of a 3D view's render region (View > Render Region),
+    or None without one: in camera view the scene's render border placed on the camera's frame as the view
+    shows it, else the view's own region border."""
+    space, region_3d = context.space_data, context.region_data
+    if region_3d.view_perspective == "CAMERA":
+        if not scene.render.use_border or scene.camera is None or scene.camera.type != "CAMERA":
+            return None
+        from bpy_extras.view3d_utils import location_3d_to_region_2d
+
+        corners = [location_3d_to_region_2d(context.region, region_3d, scene.camera.matrix_world @ corner)
+                   for corner in scene.camera.data.view_frame(scene=scene)]
+        if any(corner is None for corner in corners):
+            return None
+        xs, ys = [corner.x for corner in corners], [corner.y for corner in corners]
+        left, bottom, frame_width, frame_height = min(xs), min(ys), max(xs) - min(xs), max(ys) - min(ys)
+        render = scene.render
+        box = (left + render.border_min_x * frame_width, bottom + render.border_min_y * frame_height,
+               left + render.border_max_x * frame_width, bottom + render.border_max_y * frame_height)
+    else:
+        if not getattr(space, "use_render_border", False):
+            return None
+        box = (space.render_border_min_x * width, space.render_border_min_y * height,
+               space.render_border_max_x * width, space.render_border_max_y * height)
+    x0, y0 = (min(max(int(round(v)), 0), size) for v, size in zip(box[:2], (width, height)))
+    x1, y1 = (min(max(int(round(v)), 0), size) for v, size in zip(box[2:], (width, height)))
+    return x0, y0, max(x1, x0), max(y1, y0)
 
 
 def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1):

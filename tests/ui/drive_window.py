@@ -1,6 +1,6 @@
 """Drives a real Blender window (run by tests/ui/test_real_blender.py inside the chroot, under Xvfb, with
 --enable-event-simulate) as a user would, one step a timer tick: the viewport in Rendered shading, a material
-edit, the render panels, the Bake button (modal, with progress) and a second bake cancelled with Esc.  Takes a
+edit, a render border, the render panels, the Bake button (modal, with progress) and a second bake cancelled with Esc.  Takes a
 screenshot of the screen at each step (ImageMagick's `import`: Blender's own screenshot is black under Xvfb)
 and writes what it saw to OUT/result.json, with the areas' places for the test's pixel checks.
 
@@ -90,6 +90,23 @@ def edit_material():
     next_step("material edited", material=material.name)
 
 
+def render_border():
+    """The scene's render border over the middle of the camera frame: the viewport shows it alone."""
+    render = bpy.context.scene.render
+    render.use_border = True
+    render.border_min_x, render.border_max_x, render.border_min_y, render.border_max_y = 0.3, 0.7, 0.35, 0.75
+    window, view, region = area("VIEW_3D")
+    with bpy.context.temp_override(window=window, area=view, region=region):
+        engine = sys.modules[next(name for name in sys.modules if name.endswith("sg_prt.engine.render_engine"))]
+        rect = engine.viewport_border_rect(bpy.context, bpy.context.scene, region.width, region.height)
+    next_step("render border", rect=list(rect))
+
+
+def no_render_border():
+    bpy.context.scene.render.use_border = False
+    next_step("render border off")
+
+
 def render_panels():
     area("PROPERTIES")[1].spaces[0].context = "RENDER"
     next_step("render context")
@@ -129,7 +146,8 @@ def press_escape():
 
 
 STEPS = [wait_for_ui, rendered_viewport, settle("viewport_rendered", 20), edit_material,
-         settle("viewport_edited", 15), render_panels, settle("render_panels", 3),
+         settle("viewport_edited", 15), render_border, settle("viewport_border", 10), no_render_border,
+         render_panels, settle("render_panels", 8),
          invoke_bake("bake invoked"), progress_shot, wait_bake("bake finished"),
          invoke_bake("second bake invoked"), press_escape, wait_bake("second bake ended")]
 

@@ -73,8 +73,8 @@ def _region(image, place):
 
 
 def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
-    """In a window under Xvfb: the 3D view in Rendered shading shows the scene and follows a material edit;
-    the render panels draw; Bake Visibility runs modal with progress and writes a bake; a second bake
+    """In a window under Xvfb: the 3D view in Rendered shading shows the scene and follows a material edit,
+    and with a render border shows it inside the border only; the render panels draw; Bake Visibility runs modal with progress and writes a bake; a second bake
     cancelled with Esc writes nothing and keeps the first."""
     out = real_blender.work / "window"
     out.mkdir()
@@ -96,6 +96,13 @@ def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     assert 0.01 < changed.mean() < 0.5, changed.mean()
     red_gain = (change[changed][:, 0] - change[changed][:, 1]).mean()
     assert red_gain > 0.05, red_gain                               # the viewport followed the edit to red
+    # a render border: the frame shows inside it as before, and outside it the view is empty
+    x0, y0, x1, y1 = steps["render border"]["rect"]
+    bordered = _region(_png(out / "viewport_border.png"), places["view"])
+    rows = slice(places["view"]["height"] - y1 + 3, places["view"]["height"] - y0 - 3)     # 3 px in
+    inside = np.abs(bordered[rows, x0 + 3:x1 - 3] - edited[rows, x0 + 3:x1 - 3]).mean()
+    outside = np.abs(bordered[:, :max(x0 - 3, 1)] - edited[:, :max(x0 - 3, 1)]).mean()
+    assert inside < 0.01 and outside > 0.05, (inside, outside)
     panels = _region(_png(out / "render_panels.png"), places["properties"])
     material_panels = _region(_png(out / "viewport_edited.png"), places["properties"])
     assert np.abs(panels - material_panels).mean() > 0.005         # the properties editor switched and drew
