@@ -1,10 +1,11 @@
 """Drives a real Blender window (run by tests/ui/test_real_blender.py inside the chroot, under Xvfb, with
 --enable-event-simulate) as a user would, one step a timer tick: the viewport in Rendered shading, a material
-edit, a render border, the render panels, the Bake button (modal, with progress) and a second bake cancelled with Esc.  Takes a
+edit, a render border, the render panels, the Bake button (modal, with progress), a second bake cancelled with
+Esc, and Fit Lobes on a MERL file.  Takes a
 screenshot of the screen at each step (ImageMagick's `import`: Blender's own screenshot is black under Xvfb)
 and writes what it saw to OUT/result.json, with the areas' places for the test's pixel checks.
 
-    blender scene.blend --enable-event-simulate --python drive_window.py -- OUT
+    blender scene.blend --enable-event-simulate --python drive_window.py -- OUT MERL_FILE
 """
 import json
 import subprocess
@@ -13,7 +14,7 @@ import time
 
 import bpy
 
-OUT = sys.argv[sys.argv.index("--") + 1]
+OUT, MERL = sys.argv[sys.argv.index("--") + 1:][:2]
 result = {"steps": [], "errors": []}
 state = {"step": 0, "since": time.monotonic(), "shots": 0}
 
@@ -128,13 +129,30 @@ def progress_shot():
         next_step("bake progress")
 
 
-def wait_bake(name):
+def wait_job(name, operator_class, seen=bake_record):
     def step():
-        if bpy.ops.sgprt.bake_visibility.poll():            # one bake at a time: it polls False while one runs
-            next_step(name, record=bake_record())
+        if not getattr(bpy.types, operator_class)._running:     # one job of a kind at a time: the flag
+            next_step(name, record=seen())
         elif elapsed() > 300:
-            raise RuntimeError(f"{name}: the bake did not end")
+            raise RuntimeError(f"{name}: the job did not end")
     return step
+
+
+def lobe_fit():
+    fit = bpy.data.objects["Suzanne"].active_material.sgprt.lobe_fit
+    return f"{fit.lobe_count} lobes, error {fit.fit_error:.3f}, {fit.date}" if fit.date else None
+
+
+def material_panels():
+    area("PROPERTIES")[1].spaces[0].context = "MATERIAL"
+    next_step("material context")
+
+
+def invoke_fit():
+    window, properties, region = area("PROPERTIES")
+    with bpy.context.temp_override(window=window, area=properties, region=region):
+        returned = bpy.ops.sgprt.fit_lobes("INVOKE_DEFAULT", filepath=MERL, lobe_count=1)
+    next_step("fit invoked", returned=sorted(returned))
 
 
 def press_escape():
@@ -148,8 +166,11 @@ def press_escape():
 STEPS = [wait_for_ui, rendered_viewport, settle("viewport_rendered", 20), edit_material,
          settle("viewport_edited", 15), render_border, settle("viewport_border", 10), no_render_border,
          render_panels, settle("render_panels", 8),
-         invoke_bake("bake invoked"), progress_shot, wait_bake("bake finished"),
-         invoke_bake("second bake invoked"), press_escape, wait_bake("second bake ended")]
+         invoke_bake("bake invoked"), progress_shot, wait_job("bake finished", "SGPRT_OT_bake_visibility"),
+         invoke_bake("second bake invoked"), press_escape,
+         wait_job("second bake ended", "SGPRT_OT_bake_visibility"),
+         material_panels, settle("material_panels", 3), invoke_fit,
+         wait_job("fit finished", "SGPRT_OT_fit_lobes", lobe_fit)]
 
 
 def tick():

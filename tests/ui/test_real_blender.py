@@ -75,12 +75,17 @@ def _region(image, place):
 def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     """In a window under Xvfb: the 3D view in Rendered shading shows the scene and follows a material edit,
     and with a render border shows it inside the border only; the render panels draw; Bake Visibility runs modal with progress and writes a bake; a second bake
-    cancelled with Esc writes nothing and keeps the first."""
+    cancelled with Esc writes nothing and keeps the first; the material panels draw and Fit Lobes fits a MERL
+    file."""
+    from validation import brdf_generators
+
     out = real_blender.work / "window"
     out.mkdir()
+    merl = real_blender.work / "analytic.binary"
+    brdf_generators.generate_merl(str(merl))
     command = (f"Xvfb :99 -screen 0 1280x800x24 -nolisten tcp & sleep 2; DISPLAY=:99 blender "
                f"{real_blender.guest(scene_file)} --enable-event-simulate "
-               f"--python {GUEST_REPO}/tests/ui/drive_window.py -- {real_blender.guest(out)}")
+               f"--python {GUEST_REPO}/tests/ui/drive_window.py -- {real_blender.guest(out)} {real_blender.guest(merl)}")
     completed = real_blender.run("bash", "-c", command, timeout=900, check=False)
     assert (out / "result.json").is_file(), completed.stdout[-3000:] + completed.stderr[-3000:]
     result = json.loads((out / "result.json").read_text())
@@ -114,6 +119,10 @@ def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     # it ended on Esc, well before a bake's time (the first: about 17 s on a quiet machine)
     assert steps["second bake ended"]["seconds"] < 0.5 * steps["bake finished"]["seconds"], steps
     status_bar = slice(-24, None)                                  # the progress line: "SG-PRT bake 8%: ..."
+    assert steps["fit invoked"]["returned"] == ["RUNNING_MODAL"]
+    assert steps["fit finished"]["record"] is not None and steps["fit finished"]["record"].startswith("1 lobes")
+    material = _region(_png(out / "material_panels.png"), places["properties"])
+    assert np.abs(material - panels).mean() > 0.005                # the material's panels, not the render's
     progress = _png(out / "bake_progress.png")[status_bar]
     assert np.abs(progress - _png(out / "render_panels.png")[status_bar]).mean() > 0.002
     shots = ROOT / "out" / "ui"                                    # for the README's pictures (not committed)
