@@ -226,6 +226,10 @@ class SceneState:
                                 f"(one of them older): re-bake it")
                 del found[kind]
                 traced.pop(kind, None)
+        if SSDF in found and found[SSDF].domain == "POINT" and per_vertex.has_split_normals(
+                mesh.normals, mesh.vertex_normals, mesh.corner_vertex):
+            export.warn(f"object '{obj.name}': its visibility bake is per vertex, made before flat faces and sharp "
+                        "edges were baked per corner: re-bake for their shadows")
         self.per_vertex[mesh_key] = found
         self.per_vertex_status[mesh_key] = status
         self.bake_occluders[mesh_key] = traced

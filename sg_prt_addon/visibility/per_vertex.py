@@ -58,6 +58,15 @@ def split_points(corner_vertex, corner_normals, tolerance=1e-5):
     return corner_point.ravel(), corner_vertex[first], corner_normals[first]
 
 
+def has_split_normals(corner_normals, vertex_normals, corner_vertex, tolerance=1e-3):
+    """Whether any corner's normal differs from its vertex's (flat faces, sharp edges): where split_points
+    makes more points than vertices."""
+    if vertex_normals is None or not len(corner_vertex):
+        return False
+    difference = np.asarray(corner_normals, np.float64) - np.asarray(vertex_normals, np.float64)[corner_vertex]
+    return bool(np.any(np.einsum("ij,ij->i", difference, difference) > tolerance * tolerance))
+
+
 # How far a point baked for its corners moves toward their faces' centres: a corner on a contact edge (a box's
 # bottom corner on a floor) lies on the other surface's plane, where rays along that plane hit it at t = 0
 CORNER_INSET = 1e-3

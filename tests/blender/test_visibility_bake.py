@@ -454,3 +454,25 @@ def test_render_names_what_moved_since_the_bake(scene):
     assert len(warnings) == 2 and all("'Cube' appeared" in warning for warning in warnings), warnings
     bpy.context.active_object.hide_render = True            # left out of renders: it shadows nothing
     assert _render_warnings() == []
+
+
+def test_a_bake_per_vertex_of_a_flat_mesh_asks_for_a_rebake(scene):
+    """A visibility bake made per vertex before flat faces were baked per corner still renders, and the render
+    says to re-bake; a smooth mesh's bake per vertex says nothing."""
+    from sg_prt_addon.engine import scene_state
+
+    _, floor, suzanne = scene
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    matrix = np.array(suzanne.matrix_world)
+    vertices = np.array([matrix[:3, :3] @ v.co + matrix[:3, 3] for v in suzanne.data.vertices])
+    normals = np.array([matrix[:3, :3] @ v.normal for v in suzanne.data.vertices])      # as bakes were made
+    result = bake_visibility(vertices, vb.mesh_triangles(suzanne.data), normals, *vb.occluder_arrays(depsgraph),
+                             BakeOptions(resolution=8, refinement=1, terms=3))
+    vb.store_visibility_bake(suzanne.data, result)
+    _select(floor)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    state = scene_state.SceneState()
+    state.sync(bpy.context.evaluated_depsgraph_get())
+    asked = [warning for warning in state.warnings if "made before flat faces" in warning]
+    assert len(asked) == 1 and "'Suzanne'" in asked[0], state.warnings
+    assert len(state.visibility) == 2                           # it still shades

@@ -54,3 +54,11 @@ def test_inset_moves_points_into_their_faces():
     side = CUBE_FACES.index((0, 4, 5, 1))          # the face of y = -1
     points = moved[corner_point[4 * side:4 * side + 4]]
     assert np.all(points[:, 1] == -1.0) and np.all(points[:, 2] > -1.0)    # in its plane, off the floor z = -1
+
+
+def test_split_normals_are_found():
+    smooth_vertex, smooth_normals = _cube_corners(flat=False)
+    vertex_normals = CUBE_VERTICES / np.sqrt(3.0)
+    assert not per_vertex.has_split_normals(smooth_normals, vertex_normals, smooth_vertex)
+    flat_vertex, flat_normals = _cube_corners(flat=True)
+    assert per_vertex.has_split_normals(flat_normals, vertex_normals, flat_vertex)
