@@ -9,19 +9,7 @@ import numpy as np
 import pytest
 from real_blender_harness import GUEST_REPO, ROOT
 
-
-def _png(path):
-    """(H, W, 3) float pixels of a PNG (ImageMagick-free: the pip bpy reads it)."""
-    import bpy
-
-    image = bpy.data.images.load(str(path))
-    try:
-        width, height = image.size
-        pixels = np.empty(width * height * 4, np.float32)
-        image.pixels.foreach_get(pixels)
-    finally:
-        bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[::-1, :, :3]
+from sg_prt_addon.render import read_float_image
 
 
 @pytest.fixture(scope="module")
@@ -55,13 +43,13 @@ def test_command_line_renders_a_frame_and_an_animation_like_the_pip_module(real_
     real_blender.run("blender", "-b", blend, "--python-expr", quarter, "-E", "SG_PRT",
                      "-o", real_blender.guest(out) + "/anim_", "-F", "PNG", "-s", "1", "-e", "2", "-a")
     assert sorted(path.name for path in out.glob("anim_*.png")) == ["anim_0001.png", "anim_0002.png"]
-    still = _png(out / "still_0001.png")
+    still = read_float_image(out / "still_0001.png")
     assert still.shape == (128, 128, 3) and still.std() > 0.05          # a picture, not a flat colour
 
     pip_png = tmp_path / "pip.png"
     subprocess.run([sys.executable, "-m", "sg_prt_addon.render", str(scene_file), "-o", str(pip_png),
                     "--width", "128", "--height", "128"], cwd=ROOT, check=True, capture_output=True, timeout=600)
-    difference = np.abs(_png(pip_png) - still)
+    difference = np.abs(read_float_image(pip_png) - still)
     assert difference.mean() < 2 / 255 and np.percentile(difference, 99) < 8 / 255, \
         (difference.mean(), np.percentile(difference, 99), difference.max())
 
@@ -93,8 +81,8 @@ def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     steps = {step["name"]: step for step in result["steps"]}
 
     places = steps["rendered shading"]
-    rendered = _region(_png(out / "viewport_rendered.png"), places["view"])
-    edited = _region(_png(out / "viewport_edited.png"), places["view"])
+    rendered = _region(read_float_image(out / "viewport_rendered.png"), places["view"])
+    edited = _region(read_float_image(out / "viewport_edited.png"), places["view"])
     assert rendered.std() > 0.05                                   # the scene, not an empty or flat view
     change = edited - rendered
     changed = np.abs(change).max(axis=-1) > 0.05                   # Suzanne: the pixels the edit reached
@@ -103,13 +91,13 @@ def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     assert red_gain > 0.05, red_gain                               # the viewport followed the edit to red
     # a render border: the frame shows inside it as before, and outside it the view is empty
     x0, y0, x1, y1 = steps["render border"]["rect"]
-    bordered = _region(_png(out / "viewport_border.png"), places["view"])
+    bordered = _region(read_float_image(out / "viewport_border.png"), places["view"])
     rows = slice(places["view"]["height"] - y1 + 3, places["view"]["height"] - y0 - 3)     # 3 px in
     inside = np.abs(bordered[rows, x0 + 3:x1 - 3] - edited[rows, x0 + 3:x1 - 3]).mean()
     outside = np.abs(bordered[:, :max(x0 - 3, 1)] - edited[:, :max(x0 - 3, 1)]).mean()
     assert inside < 0.01 and outside > 0.05, (inside, outside)
-    panels = _region(_png(out / "render_panels.png"), places["properties"])
-    material_panels = _region(_png(out / "viewport_edited.png"), places["properties"])
+    panels = _region(read_float_image(out / "render_panels.png"), places["properties"])
+    material_panels = _region(read_float_image(out / "viewport_edited.png"), places["properties"])
     assert np.abs(panels - material_panels).mean() > 0.005         # the properties editor switched and drew
 
     assert steps["bake invoked"]["returned"] == ["RUNNING_MODAL"]
@@ -121,10 +109,10 @@ def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     status_bar = slice(-24, None)                                  # the progress line: "SG-PRT bake 8%: ..."
     assert steps["fit invoked"]["returned"] == ["RUNNING_MODAL"]
     assert steps["fit finished"]["record"] is not None and steps["fit finished"]["record"].startswith("1 lobes")
-    material = _region(_png(out / "material_panels.png"), places["properties"])
+    material = _region(read_float_image(out / "material_panels.png"), places["properties"])
     assert np.abs(material - panels).mean() > 0.005                # the material's panels, not the render's
-    progress = _png(out / "bake_progress.png")[status_bar]
-    assert np.abs(progress - _png(out / "render_panels.png")[status_bar]).mean() > 0.002
+    progress = read_float_image(out / "bake_progress.png")[status_bar]
+    assert np.abs(progress - read_float_image(out / "render_panels.png")[status_bar]).mean() > 0.002
     shots = ROOT / "out" / "ui"                                    # for the README's pictures (not committed)
     shots.mkdir(parents=True, exist_ok=True)
     for path in out.glob("*.png"):
