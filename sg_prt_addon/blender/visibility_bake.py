@@ -121,9 +121,10 @@ def _corner_face_centres(mesh):
 
 def receiver_arrays(obj, depsgraph):
     """World-space (points, normals, triangles, corner_point) where a mesh object is baked, from its evaluated
-    geometry: its vertices (corner_point None) where every vertex has one normal, else one point a vertex and
-    normal (visibility.per_vertex.split_points: flat faces and sharp edges get their faces' hemispheres) and
-    the point each corner reads; ValueError with a message for the user when it cannot be baked."""
+    geometry: its vertices (corner_point None) where every corner has its vertex's normal, else one point a
+    vertex and normal (visibility.per_vertex.split_points: flat faces and sharp edges get their faces'
+    hemispheres) and the point each corner reads; ValueError with a message for the user when it cannot be
+    baked."""
     if obj.type != "MESH":
         raise ValueError(f"'{obj.name}' is not a mesh")
     if obj.data.library is not None or getattr(obj.data, "override_library", None) is not None:
@@ -140,13 +141,13 @@ def receiver_arrays(obj, depsgraph):
     normals = _vertex_array(mesh, "normal")
     corner_vertex = np.empty(len(mesh.loops), np.int64)
     mesh.loops.foreach_get("vertex_index", corner_vertex)
-    corner_point, point_vertex, point_normal = per_vertex.split_points(
-        corner_vertex, export.mesh_corner_normals(mesh, corner_vertex, obj.name))
-    if len(point_vertex) == len(np.unique(corner_vertex)):
+    corner_normals = export.mesh_corner_normals(mesh, corner_vertex, obj.name)
+    # the render asks the same question of the exported mesh (scene_state): a bake per vertex must not look stale
+    if not per_vertex.has_split_normals(corner_normals, normals, corner_vertex):
         corner_point = None                  # one normal a vertex: rows per vertex, as smooth meshes always had
     else:
+        corner_point, point_vertex, normals = per_vertex.split_points(corner_vertex, corner_normals)
         vertices = per_vertex.inset_points(vertices[point_vertex], corner_point, _corner_face_centres(mesh))
-        normals = point_normal
     normals = normals @ np.linalg.inv(matrix[:3, :3])   # inverse transpose
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
     return _to_world(vertices, matrix), normals, mesh_triangles(mesh), corner_point
