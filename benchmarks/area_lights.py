@@ -31,8 +31,9 @@ def area(shape, size, size_y=None, location=(0.0, 0.0, 3.6), target=SPHERE_CENTR
     every size lights the sphere about equally)."""
     def build(scene):
         from benchmarks import truth_suite
+        from sg_prt_addon.lighting import lights
 
-        area_m2 = size * (size if size_y is None else size_y) * (math.pi / 4 if shape in ("DISK", "ELLIPSE") else 1.0)
+        area_m2 = lights.area_light_area(shape, size, size if size_y is None else size_y)
         light = truth_suite._light(scene, "AREA", location, 60.0 * max(area_m2, 1.0) if energy is None else energy,
                                    target=target).data
         light.shape, light.size, light.size_y = shape, size, size if size_y is None else size_y

@@ -148,8 +148,8 @@ def directional_light_sg(direction, angular_radius, irradiance, model="energy"):
 # --------------------------------------------------------------------------- area lights
 
 AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
-# the grid's default patches a side: irradiance within 1.6% relative L2 of Lambert's formula from half the
-# light's size away (docs/ACCURACY.md, "area lights")
+# the grid's default patches a side: irradiance within 1.2% relative L2 of Lambert's formula from half the
+# light's size away (docs/ACCURACY.md, "area_lights")
 AREA_PATCHES_PER_SIDE = 4
 # Cycles turns a spread of 0 into a delta beam; below this a beam from each patch centre is all a patch can
 # give (blender/export.py warns where the shaft's edge is then approximate)
