@@ -75,19 +75,6 @@ void point_light_sg(vec3 shading_position, vec3 light_position, float intensity,
   sphere_light_sg(shading_position, light_position, radius, intensity, axis, sharpness, amplitude);
 }
 
-/* Point light times the cone falloff smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) blend)). */
-void spot_light_sg(vec3 shading_position, vec3 light_position, vec3 spot_direction, float spot_size,
-                   float spot_blend, float intensity, float radius,
-                   out vec3 axis, out float sharpness, out float amplitude)
-{
-  sphere_light_sg(shading_position, light_position, radius, intensity, axis, sharpness, amplitude);
-  float cos_angle = dot(-axis, safe_normalize(spot_direction));
-  float cos_half = cos(0.5 * spot_size);
-  float width = max((1.0 - cos_half) * spot_blend, 1.0e-12);
-  float t = clamp((cos_angle - cos_half) / width, 0.0, 1.0);
-  amplitude *= t * t * (3.0 - 2.0 * t);
-}
-
 /* The factor on a point-like light's intensity toward the shading point, seen along axis (from the point to the
  * light): an area light's patch (area) emits one-sided along direction with the cosine, times Cycles' soft-box
  * spread attenuation max((tan_half_spread - tan a) normalization, 0) where normalization > 0; a spot
@@ -111,6 +98,15 @@ float light_emission_factor(vec3 axis, vec3 direction, float spot_size, float sp
   float width = max((1.0 - cos_half) * spot_blend, 1.0e-12);
   float t = clamp((cos_angle - cos_half) / width, 0.0, 1.0);
   return t * t * (3.0 - 2.0 * t);
+}
+
+/* Point light times the cone falloff smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) blend)). */
+void spot_light_sg(vec3 shading_position, vec3 light_position, vec3 spot_direction, float spot_size,
+                   float spot_blend, float intensity, float radius,
+                   out vec3 axis, out float sharpness, out float amplitude)
+{
+  sphere_light_sg(shading_position, light_position, radius, intensity, axis, sharpness, amplitude);
+  amplitude *= light_emission_factor(axis, spot_direction, spot_size, spot_blend, false, 0.0, 0.0);
 }
 
 /* Distant disc light (eq. 33), e.g. Blender's sun: angular_radius = sun.angle / 2,
