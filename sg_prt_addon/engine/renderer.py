@@ -15,7 +15,7 @@ from ..blender.export import COLOUR_SLOTS, slot_pixels, texture_sources
 from ..spherical import clamped_cosine
 from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
-from . import shader_cache
+from . import disk_cache, shader_cache
 
 PASS_NAMES = ("Combined", "Diffuse", "Specular")
 
@@ -292,8 +292,17 @@ class _DrawContext(techniques.DrawContext):
     def table(self, name, build):
         tables = self.renderer.tables
         if name not in tables:
-            tables[name] = _texture(build())
+            # of the code alone, so the same in every process: kept on disk for the next one's first frame
+            array = disk_cache.load_or_build("table", (name,), lambda: {"table": build()})["table"]
+            tables[name] = _texture(array)
         return tables[name]
+
+    def environment_table(self, name, build):
+        environment = self.inputs.environment
+        entry = self.renderer.environment_tables.get(name)
+        if entry is None or entry[0] is not environment:
+            entry = self.renderer.environment_tables[name] = (environment, _texture(build()))
+        return entry[1]
 
     def material_table(self, name, build):
         tables = self.renderer.material_tables.setdefault(self.params.name or self.material_name, {})
@@ -349,6 +358,7 @@ class Renderer:
         self.material_ids = {}          # material name -> id written to the G-buffer (uv.z)
         self.textures = {}              # (image name, slot is a colour) -> GPUTexture
         self.tables = {}                # a technique's tables (DrawContext.table): name -> GPUTexture
+        self.environment_tables = {}    # name -> (EnvironmentData, GPUTexture) (DrawContext.environment_table)
         self.material_tables = {}       # material name -> {name: GPUTexture} (DrawContext.material_table)
         self.object_targets = {}        # object key -> {name: (GPUTexture, GPUFrameBuffer)} of techniques' passes
         self.object_tables = {}         # object key -> {name: (sources, GPUTexture)} (DrawContext.object_table)
@@ -565,6 +575,7 @@ class Renderer:
         self.material_buffers.clear()
         self.textures.clear()
         self.tables.clear()
+        self.environment_tables.clear()
         self.material_tables.clear()
         self.object_targets.clear()
         self.object_tables.clear()

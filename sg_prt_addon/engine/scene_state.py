@@ -7,6 +7,7 @@ a transform update only replaces its matrix, a material edit only re-reads the
 material, lights and world are re-read when they changed.  `dirty` tells the
 GPU side (renderer.py) what to re-upload.
 """
+import dataclasses
 import hashlib
 from dataclasses import dataclass, field
 
@@ -17,6 +18,7 @@ from ..lighting import lights as core_lights
 from ..lighting.scene_lighting import EnvironmentData, LightData
 from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility import decode, per_vertex
+from . import disk_cache
 
 # Prefiltered environments and SG fits by pixel content (prefiltering takes seconds); the most
 # recently used few only, since an artist editing the world makes a new one each edit.
@@ -516,15 +518,30 @@ def environment_data(world, layer_size=None):
            layer_size)
     cached = _environment_cache.pop(key, None)
     if cached is None:
-        from ..lighting import env_prefilter
-        prefiltered = env_prefilter.prefilter_environment(image, size=layer_size)
-        lobes = _fit_environment(image)
-        cached = EnvironmentData(colour=colour, prefiltered=prefiltered, lobe_axis=lobes[0],
-                                         lobe_sharpness=lobes[1], lobe_amplitude=lobes[2], radiance=image)
+        arrays = disk_cache.load_or_build("environment", key, lambda: _prefilter_and_fit(image, layer_size))
+        cached = EnvironmentData(colour=colour, prefiltered=_prefiltered_of(arrays), lobe_axis=arrays["lobe_axis"],
+                                 lobe_sharpness=arrays["lobe_sharpness"], lobe_amplitude=arrays["lobe_amplitude"],
+                                 radiance=image)
     _environment_cache[key] = cached                 # (re)inserted last: the most recent
     while len(_environment_cache) > ENVIRONMENT_CACHE_SIZE:
         del _environment_cache[next(iter(_environment_cache))]
     return cached
+
+
+def _prefilter_and_fit(image, layer_size):
+    """The environment's prefiltered layers and diffuse SG fit as named arrays (what the disk cache stores)."""
+    from ..lighting import env_prefilter
+    prefiltered = env_prefilter.prefilter_environment(image, size=layer_size)
+    arrays = dataclasses.asdict(prefiltered)
+    arrays["lobe_axis"], arrays["lobe_sharpness"], arrays["lobe_amplitude"] = _fit_environment(image)
+    return arrays
+
+
+def _prefiltered_of(arrays):
+    from ..lighting import env_prefilter
+    fields = {item.name: arrays[item.name] for item in dataclasses.fields(env_prefilter.PrefilteredEnvironment)}
+    fields["levels_per_octave"] = float(fields["levels_per_octave"])          # stored as a 0-d array
+    return env_prefilter.PrefilteredEnvironment(**fields)
 
 
 def _fit_environment(image):

@@ -58,7 +58,9 @@ class DrawContext:
     per_vertex(kind): the object's engine.per_vertex.PerVertexBuffers of that kind;
     environment_textures(): (prefiltered layers, equirect map) GPU textures of the scene's environment;
     table(name, build): a GPU texture of build()'s float32 array ((H, W, 4) or (L, H, W, 4)), made once
-      for the renderer; material_table(name, build): the same, remade when the material changes;
+      for the renderer and kept on disk (engine/disk_cache): build() must depend on the code alone, and
+      name say which table it is; material_table(name, build): the same in memory only, remade when the
+      material changes; environment_table(name, build): remade when the scene's environment changes;
     image(slot): the material's image texture of a texture slot;
     object_table(name, sources, build): a GPU texture of build()'s array for the object, remade when any of
       the objects in the tuple `sources` is not the one it was made from, dropped with the object;

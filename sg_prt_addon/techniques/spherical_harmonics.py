@@ -228,7 +228,7 @@ class SphericalHarmonics(Technique):
             row[0, :, :3] = coefficients
             return row
 
-        shader.uniform_sampler("sh_environment", context.table(f"sh_environment_{id(environment)}", environment_row))
+        shader.uniform_sampler("sh_environment", context.environment_table("sh_environment", environment_row))
         if key.transfer_layers:
             buffers = context.per_vertex(TRANSFER_KIND)
             data = buffers.data
