@@ -33,8 +33,9 @@ def test_the_zip_installs_and_registers(real_blender):
 
 
 def test_command_line_renders_a_frame_and_an_animation_like_the_pip_module(real_blender, scene_file, tmp_path):
-    """`blender -b scene.blend -E SG_PRT -o ... -f 1` and `-a` over two frames write the frames; the frame is
-    the pip module's render of the same file (python -m sg_prt_addon.render) to 8-bit rounding."""
+    """`blender -b scene.blend -E SG_PRT -o ... -f 1` and `-a` over two frames write the frames, and leave the
+    disk cache in the extension's user folder; the frame is the pip module's render of the same file (python -m
+    sg_prt_addon.render) to 8-bit rounding."""
     quarter = "import bpy; bpy.context.scene.render.resolution_percentage = 25"         # 128 x 128
     out = real_blender.work / "frames"
     blend = real_blender.guest(scene_file)
@@ -43,6 +44,13 @@ def test_command_line_renders_a_frame_and_an_animation_like_the_pip_module(real_
     real_blender.run("blender", "-b", blend, "--python-expr", quarter, "-E", "SG_PRT",
                      "-o", real_blender.guest(out) + "/anim_", "-F", "PNG", "-s", "1", "-e", "2", "-a")
     assert sorted(path.name for path in out.glob("anim_*.png")) == ["anim_0001.png", "anim_0002.png"]
+    # the first job left its environment and tables in the extension's user folder for the next ones
+    probe = ("import bpy, json, os; folder = bpy.utils.extension_path_user('bl_ext.user_default.sg_prt', "
+             "path='cache'); print('RESULT ' + json.dumps(sorted(os.listdir(folder)) if os.path.isdir(folder) else []))")
+    completed = real_blender.run("blender", "-b", "--python-expr", probe)
+    entries = json.loads(next(line for line in completed.stdout.splitlines() if line.startswith("RESULT "))[7:])
+    assert any(name.startswith("environment-") for name in entries), entries
+    assert any(name.startswith("table-") for name in entries), entries
     still = read_float_image(out / "still_0001.png")
     assert still.shape == (128, 128, 3) and still.std() > 0.05          # a picture, not a flat colour
 
