@@ -17,6 +17,8 @@ mismatch (0 texels of 25600 on the sphere-over-floor scene, at ~3.7k rays a vert
 Grids are (B, F, F) bool, True = visible, indexed [vertex, b index, a index]
 as in ``hemisphere_map``.
 """
+import functools
+
 import numpy as np
 from scipy import ndimage
 
@@ -28,14 +30,27 @@ def world_directions(local_directions, frames):
     return np.matmul(local_directions, frames)
 
 
+@functools.lru_cache(maxsize=8)
+def _local_directions32(resolution):
+    """hemisphere_map.texel_directions as float32 (what the tracer takes), read-only, made once."""
+    directions = hemisphere_map.texel_directions(resolution).astype(np.float32)
+    directions.flags.writeable = False
+    return directions
+
+
+def _occluded(tracer, origins, local, frames):
+    """(B, K) occlusion of rays from origins (B, 3) along local directions (K, 3), or (B, K, 3) a vertex, in
+    frames (B, 3, 3).  Built in float32, the tracer's precision, so no float64 copy is made and converted."""
+    directions = world_directions(local, np.asarray(frames, np.float32))
+    count, per_vertex = directions.shape[:2]
+    ray_origins = np.repeat(np.asarray(origins, np.float32), per_vertex, axis=0)
+    return tracer.occluded(ray_origins, directions.reshape(-1, 3)).reshape(count, per_vertex)
+
+
 def dense_visibility(tracer, origins, frames, resolution):
     """(B, R, R) visibility from one ray per texel centre (the reference for the adaptive scheme)."""
-    local = hemisphere_map.texel_directions(resolution).reshape(-1, 3)
-    count = len(origins)
-    directions = world_directions(np.broadcast_to(local, (count,) + local.shape), frames)
-    ray_origins = np.broadcast_to(np.asarray(origins, np.float64)[:, None, :], directions.shape)
-    occluded = tracer.occluded(ray_origins.reshape(-1, 3), directions.reshape(-1, 3))
-    return ~occluded.reshape(count, resolution, resolution)
+    occluded = _occluded(tracer, origins, _local_directions32(resolution).reshape(-1, 3), frames)
+    return ~occluded.reshape(len(occluded), resolution, resolution)
 
 
 def cells_to_refine(coarse_visible):
@@ -65,11 +80,8 @@ def _horizon_probe(tracer, origins, frames, coarse, refinement):
         rows.append(fine_row)
         cols.append(fine_col)
     cells, rows, cols = np.concatenate(cells), np.concatenate(rows), np.concatenate(cols)   # (E, 2), (E, f)
-    local = hemisphere_map.texel_directions(fine_resolution)[rows, cols].reshape(-1, 3)
-    directions = world_directions(np.broadcast_to(local, (count,) + local.shape), frames)
-    ray_origins = np.broadcast_to(np.asarray(origins, np.float64)[:, None, :], directions.shape)
-    visible = ~tracer.occluded(ray_origins.reshape(-1, 3), directions.reshape(-1, 3))
-    visible = visible.reshape(count, len(cells), refinement)
+    local = _local_directions32(fine_resolution)[rows, cols].reshape(-1, 3)
+    visible = ~_occluded(tracer, origins, local, frames).reshape(count, len(cells), refinement)
     centre = coarse[:, cells[:, 0], cells[:, 1]]
     disagree = np.any(visible != centre[:, :, None], axis=2)
     flagged = np.zeros_like(coarse)
@@ -97,14 +109,12 @@ def adaptive_visibility(tracer, origins, frames, coarse_resolution, refinement):
     if len(cell_vertex) == 0:
         return fine, rays
     fine_resolution = coarse_resolution * refinement
-    fine_local = hemisphere_map.texel_directions(fine_resolution)
     offset_row, offset_col = np.divmod(np.arange(refinement * refinement), refinement)
     not_centre = (offset_row != refinement // 2) | (offset_col != refinement // 2)
     offset_row, offset_col = offset_row[not_centre], offset_col[not_centre]
     rows = cell_row[:, None] * refinement + offset_row            # (M, f^2 - 1)
     cols = cell_col[:, None] * refinement + offset_col
-    directions = world_directions(fine_local[rows, cols], frames[cell_vertex])
-    ray_origins = np.broadcast_to(np.asarray(origins, np.float64)[cell_vertex][:, None, :], directions.shape)
-    occluded = tracer.occluded(ray_origins.reshape(-1, 3), directions.reshape(-1, 3)).reshape(rows.shape)
+    local = _local_directions32(fine_resolution)[rows, cols]       # (M, f^2 - 1, 3): a cell's own directions
+    occluded = _occluded(tracer, np.asarray(origins)[cell_vertex], local, np.asarray(frames)[cell_vertex])
     fine[cell_vertex[:, None], rows, cols] = ~occluded
     return fine, rays + occluded.size

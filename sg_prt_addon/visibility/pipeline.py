@@ -82,22 +82,24 @@ def bake_ssdf(vertices, normals, tracer, options, progress=None, tangents=None):
     resolution = options.resolution
     out = np.empty((count, resolution * resolution), np.float16)
 
-    def distances(part, fine):
+    def bake_batch(part):
+        fine, _ = binary_visibility.adaptive_visibility(tracer, origins[part], frames[part], resolution,
+                                                        options.refinement)
         out[part] = ssdf.ssdf_from_fine(fine, resolution).reshape(fine.shape[0], -1)
 
-    # Pipelined: the SSDF of one batch (BLAS, GIL released) overlaps the rays of the next.
-    with ThreadPoolExecutor(1) as pool:
-        pending = None
-        for start in range(0, count, options.batch_vertices):
-            part = slice(start, min(start + options.batch_vertices, count))
-            fine, _ = binary_visibility.adaptive_visibility(tracer, origins[part], frames[part], resolution,
-                                                     options.refinement)
-            if pending is not None:
-                pending.result()
-            pending = pool.submit(distances, part, fine)
+    # Each worker bakes whole batches (coarse rays, refinement, distances): the numpy steps of one batch run
+    # while another's rays are traced (embreex and numpy release the GIL), where one batch at a time left the
+    # cores idle between its steps.  Batches write disjoint rows, in any order; progress follows the first ones.
+    parts = [slice(start, min(start + options.batch_vertices, count))
+             for start in range(0, count, options.batch_vertices)]
+    pool = ThreadPoolExecutor(max(1, options.threads))
+    try:
+        futures = [pool.submit(bake_batch, part) for part in parts]
+        for part, future in zip(parts, futures):
+            future.result()
             _report(progress, 0.9 * part.stop / max(count, 1), f"visibility {part.stop}/{count} vertices")
-        if pending is not None:
-            pending.result()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)      # a cancel or an error: no batch keeps running
     return out
 
 
@@ -123,8 +125,9 @@ def bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_tr
     if normals.shape != vertices.shape:
         raise ValueError(f"normals {normals.shape} do not match vertices {vertices.shape}")
     _report(progress, 0.0, "building the ray tracer")
-    tracer = RayTracer(occluder_vertices, occluder_triangles, threads=options.threads,
-                       chunk_rays=1 << 15, relative_offset=options.relative_offset)
+    # one thread a tracer call: bake_ssdf runs options.threads batches at once
+    tracer = RayTracer(occluder_vertices, occluder_triangles, threads=1, chunk_rays=1 << 15,
+                       relative_offset=options.relative_offset)
     try:
         samples = bake_ssdf(vertices, normals, tracer, options, progress, tangents)
         rays = tracer.rays_traced

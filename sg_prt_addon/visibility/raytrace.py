@@ -8,6 +8,7 @@ threads over ray chunks use both cores.  Its rays start at tnear = 0: callers
 must move ray origins off the surface (``offset_origins``), or a ray leaving a
 triangle can hit that same triangle.
 """
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
@@ -72,6 +73,7 @@ class RayTracer:
             self._scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32), query="OCCLUDED")
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
         self.rays_traced = 0   # running count of rays queried, for throughput figures
+        self._count_lock = threading.Lock()     # queries may come from several threads at once
 
     def close(self):
         if getattr(self, "_pool", None) is not None:
@@ -93,6 +95,10 @@ class RayTracer:
             far = np.ascontiguousarray(np.clip(np.nan_to_num(far, nan=0.0, posinf=_EMBREE_FAR), 0, _EMBREE_FAR))
         return origins, directions, far
 
+    def _count(self, rays):
+        with self._count_lock:
+            self.rays_traced += rays
+
     def _map_chunks(self, work, count):
         starts = range(0, count, self.chunk_rays)
         slices = [slice(s, min(s + self.chunk_rays, count)) for s in starts]
@@ -107,7 +113,7 @@ class RayTracer:
         None means unbounded.
         """
         origins, directions, far = self._prepare(origins, directions, max_distance)
-        self.rays_traced += len(origins)
+        self._count(len(origins))
         result = np.zeros(len(origins), bool)
         if self._empty or len(origins) == 0:
             return result
@@ -124,7 +130,7 @@ class RayTracer:
         """First hit of each ray: a RayHits of (N,) arrays."""
         origins, directions, far = self._prepare(origins, directions, max_distance)
         count = len(origins)
-        self.rays_traced += count
+        self._count(count)
         distance = np.full(count, np.inf)
         triangle = np.full(count, -1, np.int64)
         u = np.zeros(count)

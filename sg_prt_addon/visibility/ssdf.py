@@ -49,8 +49,9 @@ def boundary_points(visible, directions):
     """
     horizontal = visible[:, :, 1:] != visible[:, :, :-1]
     vertical = visible[:, 1:, :] != visible[:, :-1, :]
-    v_h, r_h, c_h = np.nonzero(horizontal)
-    v_v, r_v, c_v = np.nonzero(vertical)
+    # flatnonzero and unravel: an order of magnitude faster than nonzero's three index arrays of a 3-d array
+    v_h, r_h, c_h = np.unravel_index(np.flatnonzero(horizontal), horizontal.shape)
+    v_v, r_v, c_v = np.unravel_index(np.flatnonzero(vertical), vertical.shape)
     sums = np.concatenate([directions[r_h, c_h] + directions[r_h, c_h + 1],
                            directions[r_v, c_v] + directions[r_v + 1, c_v]])
     points = sums / np.linalg.norm(sums, axis=-1, keepdims=True)
@@ -83,12 +84,16 @@ def signed_distance(visible, fine_directions, query_visible, query_directions):
     starts = np.searchsorted(vertex[order], np.arange(count + 1))
     query_directions = np.asarray(query_directions, np.float64)
     queries32 = query_directions.astype(np.float32)
-    nearest = np.full(query_visible.shape, np.inf)
-    for index in np.nonzero(starts[1:] > starts[:-1])[0]:
+    has_boundary = starts[1:] > starts[:-1]
+    # the loop does only what must be per vertex (a product and its argmax); the angles are taken for all at once
+    best = np.zeros(query_visible.shape, np.intp)
+    for index in np.flatnonzero(has_boundary):
         first, stop = starts[index], starts[index + 1]
-        best = first + np.argmax(queries32 @ points32[first:stop].T, axis=1)
-        chord = np.linalg.norm(query_directions - points[best], axis=1)
-        nearest[index] = _chord_to_angle(chord)
+        best[index] = first + np.argmax(queries32 @ points32[first:stop].T, axis=1)
+    nearest = np.full(query_visible.shape, np.inf)
+    if len(points):
+        chord = np.linalg.norm(query_directions - points[best], axis=-1)
+        nearest = np.where(has_boundary[:, None], _chord_to_angle(chord), np.inf)
     return _assemble(nearest, query_visible, np.broadcast_to(query_directions, query_visible.shape + (3,)))
 
 
