@@ -28,8 +28,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse
-import scipy.sparse.linalg
 
 from ..spherical.lattice import hemisphere_points
 from . import merl
@@ -46,6 +44,14 @@ FORM_LABELS = {"pqp": "p(o) q(h) p(i)", "pq": "p(o) q(h)", "pqpr": "p(o) q(h) p(
 ONE_DIMENSIONAL = {"r"}         # factors of o.h: a (1, R) map over u = o.h
 DEFAULT_FORM = "pqp"
 DEFAULT_MAPPING = "parabolic"
+
+
+def _sparse():
+    """scipy.sparse with its linalg, imported when a factorization runs: rendering never factors, and the
+    import costs every process (a batch job is one a frame) about 0.1 s."""
+    import scipy.sparse
+    import scipy.sparse.linalg
+    return scipy.sparse
 
 
 @dataclass
@@ -150,8 +156,8 @@ def grid_laplacian(width, height=None):
         rows += [a.ravel(), b.ravel()]
         cols += [b.ravel(), a.ravel()]
     rows, cols = np.concatenate(rows), np.concatenate(cols)
-    adjacency = scipy.sparse.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
-    return scipy.sparse.diags(np.asarray(adjacency.sum(axis=1)).ravel()) - adjacency
+    adjacency = _sparse().csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    return _sparse().diags(np.asarray(adjacency.sum(axis=1)).ravel()) - adjacency
 
 
 def sample_brdf(brdf, view_count=256, light_count=256):
@@ -202,7 +208,7 @@ def _system(form, wo, wi, resolution, mapping):
         rows.append(np.repeat(sample, 4))
         cols.append((index + offsets[names.index(name)]).ravel())
         vals.append(weight.ravel())
-    matrix = scipy.sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+    matrix = _sparse().csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                                      shape=(len(wo), offsets[-1]))      # duplicates add (eq. 14)
     return matrix, names, offsets
 
@@ -240,7 +246,7 @@ def factorize(wo, wi, values, form=DEFAULT_FORM, resolution=32, smoothness=0.02,
         shapes = [map_shape(name, size) for name in names]
         weight = smoothness * np.sqrt(len(wo) / (size * size))
         laplacians = [grid_laplacian(shape[1], shape[0]) * weight for shape in shapes]
-        system = scipy.sparse.vstack([matrix, scipy.sparse.block_diag(laplacians)]).tocsr()
+        system = _sparse().vstack([matrix, _sparse().block_diag(laplacians)]).tocsr()
         if log_maps is None:        # the paper's averaged-projection start: log f / factors, everywhere
             guess = np.tile(target.mean(axis=0) / factor_count, (offsets[-1], 1))
         else:
@@ -251,11 +257,11 @@ def factorize(wo, wi, values, form=DEFAULT_FORM, resolution=32, smoothness=0.02,
         # centre, few on p's rim); equalised, LSMR converges in far fewer iterations
         column_norm = np.sqrt(np.asarray(system.multiply(system).sum(axis=0)).ravel())
         column_scale = 1.0 / np.maximum(column_norm, 1e-12)
-        scaled = system @ scipy.sparse.diags(column_scale)
+        scaled = system @ _sparse().diags(column_scale)
         solution = np.empty_like(guess)
         for c in range(channels):
             residual = right[:, c] - system @ guess[:, c]
-            step = scipy.sparse.linalg.lsmr(scaled, residual, atol=1e-10, btol=1e-10, maxiter=iterations)[0]
+            step = _sparse().linalg.lsmr(scaled, residual, atol=1e-10, btol=1e-10, maxiter=iterations)[0]
             solution[:, c] = guess[:, c] + column_scale * step
         log_maps = {name: solution[offsets[k]:offsets[k + 1]].reshape(shapes[k] + (channels,))
                     for k, name in enumerate(names)}

@@ -41,12 +41,18 @@ import functools
 import itertools
 
 import numpy as np
-from scipy.optimize import least_squares, minimize, nnls
 
 HALF_PI = 0.5 * np.pi
 ANISOTROPY_RATIO_MIN = 1.0 / 64.0
 ANISOTROPY_RATIO_COUNT = 25
 MAX_LOBES = 8
+
+
+def _optimize():
+    """scipy.optimize, imported when a fit runs: rendering never fits, and the import costs every process
+    (a batch job is one a frame) about 0.15 s."""
+    import scipy.optimize
+    return scipy.optimize
 
 
 # ----------------------------------------------------------------------------- quadrature
@@ -146,7 +152,7 @@ def fit_isotropic(ndf_values, theta, weights, lobe_count=1, initial=None):
             d_log_sharpness = -(lobes * sharpness[:, None] * one_minus_cos[None, :])
             return (root_w[:, None] * np.concatenate([d_log_sharpness, lobes]).T) / scale
 
-        result = least_squares(residual, start, jac=jacobian, method="lm", xtol=1e-12, ftol=1e-12)
+        result = _optimize().least_squares(residual, start, jac=jacobian, method="lm", xtol=1e-12, ftol=1e-12)
         sharpness, amplitude, _ = _isotropic_model(result.x, one_minus_cos)
         order = np.argsort(sharpness)
         out_sharpness[row], out_amplitude[row] = sharpness[order], amplitude[order]
@@ -374,7 +380,7 @@ def fit_anisotropic(ndf_values, directions, weights, lobe_count, initial=None, m
 
     def optimize(start, count):
         options = {"maxiter": max_iterations} if method == "L-BFGS-B" else {"maxfun": 10 * max_iterations}
-        result = minimize(_anisotropic_objective, start.ravel(), jac=True, method=method,
+        result = _optimize().minimize(_anisotropic_objective, start.ravel(), jac=True, method=method,
                           args=(count, directions, weights, target, scale2),
                           bounds=([(None, None)] * 3 + [(-10, 16), (-60, 60)]) * count, options=options)
         return result.x.reshape(count, 5), result.fun
@@ -501,7 +507,7 @@ def _plane_fit(params, ratio, lobe_count):
     overlap_u = membership @ overlap
     gram_u = membership @ gram @ membership.T + 1e-12 * np.eye(unique) * np.trace(gram) / lobe_count
     cholesky = np.linalg.cholesky(gram_u)
-    mu_u, _ = nnls(cholesky.T, np.linalg.solve(cholesky, overlap_u))
+    mu_u, _ = _optimize().nnls(cholesky.T, np.linalg.solve(cholesky, overlap_u))
     mu = mu_u[group]
     error2 = target_norm - 2 * mu @ overlap + mu @ gram @ mu
     # derivatives of E = |T|^2 - 2 mu.I + mu' J mu with respect to each lobe's p and b
@@ -519,7 +525,7 @@ def _fit_row(ratio, lobe_count, start):
     bounds = [(0.0, 4.0)] * pairs + [(-8.0, 14.0)] * unique
     # bounded truncated Newton: scipy's L-BFGS-B calls multi-threaded BLAS on tiny arrays and
     # runs 10x slower than TNC on a busy machine for these <= 8 parameters
-    result = minimize(lambda x: _plane_fit(x, ratio, lobe_count)[:2], start, jac=True, method="TNC",
+    result = _optimize().minimize(lambda x: _plane_fit(x, ratio, lobe_count)[:2], start, jac=True, method="TNC",
                       bounds=bounds, options={"maxfun": 2000})
     return result.x, np.sqrt(result.fun)
 

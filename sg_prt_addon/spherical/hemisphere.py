@@ -43,7 +43,6 @@ over-counts by 1 + e^-lambda).  Either is exact only when applied to the lobe
 that is integrated last (the product of all SG factors).
 """
 import numpy as np
-from scipy import integrate, special
 
 from . import sg
 
@@ -153,6 +152,10 @@ def _hemisphere_quadrature(sine_theta_d, sharpness, cosine_weighted):
     with width ~ 1/sqrt(lambda); the integration is restricted to where the
     exponent is within 60 of its maximum, whose value is factored out.
     """
+    # scipy here and in derive_fast_constants (references and derivations only): every process that renders
+    # would otherwise import scipy.integrate and scipy.optimize, about 0.2 s
+    from scipy import integrate, special
+
     x = float(np.clip(sine_theta_d, -1.0, 1.0))
     lam = float(max(sharpness, 0.0))
     t = np.arcsin(x)
@@ -260,7 +263,7 @@ def derive_fast_constants(n_sharpness=43, seed_constants=None):
     (3) least squares of the rational k^2 to those; (4) Nelder-Mead minimax of all of
     fh_hat's error over the grid, starting from (3).
     """
-    from scipy import optimize
+    from scipy import optimize, special
 
     y = np.linspace(0, 6, 20001)
 

@@ -20,7 +20,6 @@ as in ``hemisphere_map``.
 import functools
 
 import numpy as np
-from scipy import ndimage
 
 from . import hemisphere_map
 
@@ -55,9 +54,12 @@ def dense_visibility(tracer, origins, frames, resolution):
 
 def cells_to_refine(coarse_visible):
     """(B, C, C) bool: cells whose 3 x 3 neighbourhood (clamped at the square's edge) is mixed."""
-    footprint = np.ones((1, 3, 3), bool)
-    any_visible = ndimage.maximum_filter(coarse_visible, footprint=footprint, mode="nearest")
-    all_visible = ndimage.minimum_filter(coarse_visible, footprint=footprint, mode="nearest")
+    padded = np.pad(coarse_visible, ((0, 0), (1, 1), (1, 1)), mode="edge")
+    # separable: OR and AND over the three rows, then over the three columns
+    rows_any = padded[:, :-2] | padded[:, 1:-1] | padded[:, 2:]
+    rows_all = padded[:, :-2] & padded[:, 1:-1] & padded[:, 2:]
+    any_visible = rows_any[:, :, :-2] | rows_any[:, :, 1:-1] | rows_any[:, :, 2:]
+    all_visible = rows_all[:, :, :-2] & rows_all[:, :, 1:-1] & rows_all[:, :, 2:]
     return any_visible != all_visible
 
 

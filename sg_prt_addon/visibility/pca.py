@@ -10,7 +10,6 @@ eigenvalues) / D), the RMS over all vertices and texels, in radians.
 from typing import NamedTuple
 
 import numpy as np
-from scipy import linalg
 
 CHUNK_ROWS = 4096
 # Full eigendecomposition (LAPACK syevd, faster here than the subset driver) up to 48 x 48 texels.
@@ -61,6 +60,8 @@ def fit(samples, terms=None, error_target=0.02, max_terms=48):
         values, vectors = np.linalg.eigh(covariance)
         values, vectors = values[dims - max_terms:], vectors[:, dims - max_terms:]
     else:
+        # imported here: only a bake needs it, and an import at the top costs every process
+        from scipy import linalg
         values, vectors = linalg.eigh(covariance, subset_by_index=[dims - max_terms, dims - 1])
     values = np.maximum(values[::-1], 0.0)
     vectors = vectors[:, ::-1].T
