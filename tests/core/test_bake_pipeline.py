@@ -114,3 +114,15 @@ def test_no_occluders_gives_the_open_plane():
                              BakeOptions(resolution=8, refinement=3, terms=2))
     elevation = np.arcsin(hemisphere_map.sample_directions(8)[..., 2])
     assert np.abs(result.ssdf() - elevation).max() < 1e-3
+
+
+@pytest.mark.parametrize("visible_fraction", [0.02, 0.5, 0.98])
+def test_mixed_cells_are_those_of_a_3x3_max_and_min_filter(visible_fraction):
+    """cells_to_refine's ORs and ANDs against scipy's max/min filters with the edge clamped (what it replaced)."""
+    from scipy import ndimage
+
+    coarse = np.random.default_rng(1).random((40, 32, 32)) < visible_fraction
+    footprint = np.ones((1, 3, 3), bool)
+    expected = (ndimage.maximum_filter(coarse, footprint=footprint, mode="nearest")
+                != ndimage.minimum_filter(coarse, footprint=footprint, mode="nearest"))
+    np.testing.assert_array_equal(binary_visibility.cells_to_refine(coarse), expected)
