@@ -1,22 +1,26 @@
-"""Visibility bake speed and PCA error vs terms (sg_prt_addon/visibility).
+"""Visibility bake speed and error, and the PCA's error vs terms (sg_prt_addon/visibility).
 
 Procedural scenes (numpy only): a subdivided icosphere resting over a
-subdivided floor grid, about 5k, 20k (and 80k) vertices; every vertex is
+subdivided floor grid, about 5k, 20k and 100k vertices; every vertex is
 baked and the whole scene occludes.  Prints, per size: bake time (rays + SSDF
 + PCA), rays per vertex, rays/s of the bake, and the raw occlusion rate of
 RayTracer.occluded on the same scene (one big batch of random hemisphere rays
-from the same vertices) in the same run, and their ratio; then the PCA's RMS
+from the same vertices, both cores) in the same run, and their ratio; the
+bake's SSDF error at 64 vertices against the SSDF of a dense 160 x 160 ray grid
+(adaptive rays and PCA together); the process's peak memory; then the PCA's RMS
 angular error against the number of terms (plot: benchmarks/ssdf_pca_error.png).
 
-    .venv/bin/python -m benchmarks.bake_speed            # 5k and 20k
-    .venv/bin/python -m benchmarks.bake_speed 5000 20000 80000
+    .venv/bin/python -m benchmarks.bake_speed [5000 20000 100000] [--update-doc]
 """
+import os
+import resource
 import sys
+import textwrap
 import time
 
 import numpy as np
 
-from sg_prt_addon.visibility import BakeOptions, bake_visibility, hemisphere_map
+from sg_prt_addon.visibility import BakeOptions, bake_visibility, binary_visibility, hemisphere_map, ssdf
 from sg_prt_addon.visibility.raytrace import RayTracer
 
 
@@ -83,17 +87,35 @@ def raw_rate(vertices, triangles, normals, rays=2_000_000, seed=0):
     return rays / seconds
 
 
+def dense_ssdf_error(result, vertices, triangles, normals, count=64, seed=0):
+    """RMS (rad) of the bake's decompressed SSDF at `count` vertices against the SSDF of a dense 160 x 160 ray
+    grid there: what the adaptive rays and the PCA cost together."""
+    pick = np.random.default_rng(seed).choice(len(vertices), min(count, len(vertices)), replace=False)
+    tracer = RayTracer(vertices, triangles, threads=2)
+    frames = hemisphere_map.local_frame(normals[pick])
+    dense = binary_visibility.dense_visibility(tracer, vertices[pick] + tracer.offset * frames[:, 2], frames,
+                                               result.resolution * BakeOptions().refinement)
+    tracer.close()
+    reference = ssdf.ssdf_from_fine(dense, result.resolution)
+    return float(np.sqrt(np.mean(np.square(result.ssdf(pick) - reference))))
+
+
 def run(target_vertices, options=None):
     vertices, triangles, normals = sphere_over_floor(target_vertices)
     options = options or BakeOptions()
     raw = raw_rate(vertices, triangles, normals)
     result = bake_visibility(vertices, triangles, normals, vertices, triangles, options)
-    bake_rate = result.rays_traced / result.seconds
-    print(f"{len(vertices):6d} vertices, {len(triangles):6d} triangles: bake {result.seconds:6.1f} s, "
-          f"{result.rays_traced / len(vertices):6.0f} rays/vertex, {bake_rate / 1e6:5.2f} M rays/s "
-          f"(raw RayTracer.occluded {raw / 1e6:5.2f} M rays/s, bake/raw {bake_rate / raw:4.2f}); "
-          f"PCA {result.terms} terms, RMS {result.rms_error:.4f} rad", flush=True)
-    return result
+    figures = {"vertices": len(vertices), "triangles": len(triangles), "seconds": result.seconds,
+               "rays_per_vertex": result.rays_traced / len(vertices), "bake_rate": result.rays_traced / result.seconds,
+               "raw_rate": raw, "terms": result.terms, "pca_rms": result.rms_error,
+               "dense_rms": dense_ssdf_error(result, vertices, triangles, normals),
+               "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, "load": os.getloadavg()[0]}
+    print(f"{figures['vertices']:6d} vertices, {figures['triangles']:6d} triangles: bake {result.seconds:6.1f} s, "
+          f"{figures['rays_per_vertex']:6.0f} rays/vertex, {figures['bake_rate'] / 1e6:5.2f} M rays/s "
+          f"(raw RayTracer.occluded {raw / 1e6:5.2f} M rays/s, bake/raw {figures['bake_rate'] / raw:4.2f}); "
+          f"PCA {result.terms} terms, RMS {result.rms_error:.4f} rad; against dense rays {figures['dense_rms']:.4f} rad; "
+          f"peak memory {figures['peak_mib']:.0f} MiB", flush=True)
+    return result, figures
 
 
 def plot_pca_error(result, path="benchmarks/ssdf_pca_error.png"):
@@ -112,15 +134,50 @@ def plot_pca_error(result, path="benchmarks/ssdf_pca_error.png"):
     figure.savefig(path, dpi=100)
 
 
-def main(sizes):
-    last = None
+SECTION_TITLE = "## Visibility bake"
+
+
+def section(sizes, rows, errors):
+    intro = (f"`.venv/bin/python -m benchmarks.bake_speed {' '.join(map(str, sizes))} --update-doc` "
+             f"({time.strftime('%Y-%m-%d')}; written by the benchmark): an icosphere over a floor grid, every vertex "
+             "baked, the whole scene occludes, operator defaults (resolution 32, refinement 5, PCA error target "
+             "0.02 rad).  Raw rate: RayTracer.occluded on 2M random hemisphere rays from the same vertices, both "
+             "cores, in the same run.  SSDF error: the bake's decompressed SSDF at 64 vertices against the SSDF of "
+             "a dense 160 x 160 ray grid there.  Peak memory: the process's (it grows with the largest size run).")
+    lines = [SECTION_TITLE, "", textwrap.fill(intro, 110), "",
+             "| vertices | bake (rays + SSDF + PCA) | rays/vertex | bake rays/s | raw rays/s | bake / raw | PCA terms, "
+             "RMS | SSDF error vs dense rays | peak memory | load |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['vertices']:,} | {r['seconds']:.1f} s | {r['rays_per_vertex']:,.0f} | "
+                     f"{r['bake_rate'] / 1e6:.2f} M | {r['raw_rate'] / 1e6:.2f} M | {r['bake_rate'] / r['raw_rate']:.2f} | "
+                     f"{r['terms']}, {r['pca_rms']:.4f} rad | {r['dense_rms']:.4f} rad | {r['peak_mib']:.0f} MiB | "
+                     f"{r['load']:.1f} |")
+    lines += ["", "PCA RMS angular error by terms (largest size): " + ", ".join(
+        f"{n}: {errors[n]:.3f}" for n in (0, 4, 8, 16, 24, 32) if n < len(errors))
+        + " rad (plot: benchmarks/ssdf_pca_error.png).", ""]
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    arguments = sys.argv[1:] if argv is None else argv
+    sizes = [int(a) for a in arguments if not a.startswith("--")] or [5000, 20000, 100000]
+    rows, last = [], None
     for size in sizes:
-        last = run(size)
+        last, figures = run(size)
+        rows.append(figures)
     errors = last.rms_error_by_terms
     print("PCA RMS error (rad) by terms: " + ", ".join(f"{n}:{errors[n]:.4f}" for n in
                                                       (0, 1, 2, 4, 8, 12, 16, 24, 32, 48) if n < len(errors)))
     plot_pca_error(last)
+    text = section(sizes, rows, errors)
+    print(text)
+    if "--update-doc" in arguments:
+        from benchmarks import markdown_sections
+        markdown_sections.update_file(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                                   "docs", "PERFORMANCE.md"), SECTION_TITLE, text)
+    return rows
 
 
 if __name__ == "__main__":
-    main([int(a) for a in sys.argv[1:]] or [5000, 20000])
+    main()
