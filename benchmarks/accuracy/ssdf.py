@@ -98,7 +98,7 @@ def measure():
     origins = vertices[pick] + tracer.offset * normals[pick]
     adaptive, rays = binary_visibility.adaptive_visibility(tracer, origins, frames, 32, 5)
     dense = binary_visibility.dense_visibility(tracer, origins, frames, 160)
-    rows.append(_row("adaptive visibility (32^2 coarse, x5 in mixed cells)", np.mean(adaptive != dense, axis=(1, 2)),
+    rows.append(_row("adaptive visibility (32^2 coarse, x5 where the coarse centres around a fine texel disagree)", np.mean(adaptive != dense, axis=(1, 2)),
                      "dense 160^2 rays", "fraction of mismatched texels per vertex", paper="512^2 rays",
                      note=f"{rays / len(pick):.0f} rays/vertex vs 25600; sphere over floor"))
     samples = bake_ssdf(vertices, normals, tracer, BakeOptions())

@@ -2,17 +2,17 @@
 
 wang2009 section 5.2 casts 512 x 512 rays a vertex and downsamples to 128 x 128:
 far too many rays for 20k vertices on a CPU.  ``adaptive_visibility`` casts a
-coarse C x C grid of texel-centre rays (C = the stored resolution) and supersamples, at ``refinement``^2
-rays (odd, so a coarse centre is also a fine centre), only the coarse cells
-whose 3 x 3 neighbourhood holds both visible and occluded samples.  Along the
-horizon, where a visible wedge between an occluder and the horizon thins to
-nothing (a tilted plane, an object on a floor), the cells of the square's edge
-are also probed at their outermost fine row (refinement rays a cell, ~4 C
-refinement in all) and refined when a probe disagrees.  It matches
-the dense fine grid except where a feature fits between coarse samples
-(thinner than a coarse cell, 0.078 rad = 4.5 degrees across at 32 x 32);
-tests/core/test_bake_pipeline.py and benchmarks/accuracy/ssdf.py measure the
-mismatch (0 texels of 25600 on the sphere-over-floor scene, at ~3.7k rays a vertex).
+coarse C x C grid of texel-centre rays (C = the stored resolution) and supersamples it ``refinement`` times
+(odd, so a coarse centre is also a fine centre) only where the boundary can pass: a fine texel is traced when
+the coarse centres around it (its cell's and its side's neighbours') disagree, and copies its cell otherwise
+(``_texels_to_trace``; refining every cell of a mixed 3 x 3 neighbourhood whole, as before, cast 1.45x the
+rays for the same error).  Along the horizon, where a visible wedge between an occluder and the horizon thins
+to nothing (a tilted plane, an object on a floor), the cells of the square's edge are also probed at their
+outermost fine row (refinement rays a cell, ~4 C refinement in all) and traced whole when a probe disagrees.
+It matches the dense fine grid except where a feature fits between coarse samples (thinner than a coarse
+cell, 0.078 rad = 4.5 degrees across at 32 x 32); tests/core/test_bake_pipeline.py and
+benchmarks/accuracy/ssdf.py measure the mismatch (34 texels of 7.68 million at 300 vertices of the
+sphere-over-floor scene, at ~2.6k rays a vertex; 6 with whole cells at ~3.7k).
 
 Grids are (B, F, F) bool, True = visible, indexed [vertex, b index, a index]
 as in ``hemisphere_map``.
@@ -52,17 +52,6 @@ def dense_visibility(tracer, origins, frames, resolution):
     return ~occluded.reshape(len(occluded), resolution, resolution)
 
 
-def cells_to_refine(coarse_visible):
-    """(B, C, C) bool: cells whose 3 x 3 neighbourhood (clamped at the square's edge) is mixed."""
-    padded = np.pad(coarse_visible, ((0, 0), (1, 1), (1, 1)), mode="edge")
-    # separable: OR and AND over the three rows, then over the three columns
-    rows_any = padded[:, :-2] | padded[:, 1:-1] | padded[:, 2:]
-    rows_all = padded[:, :-2] & padded[:, 1:-1] & padded[:, 2:]
-    any_visible = rows_any[:, :, :-2] | rows_any[:, :, 1:-1] | rows_any[:, :, 2:]
-    all_visible = rows_all[:, :, :-2] & rows_all[:, :, 1:-1] & rows_all[:, :, 2:]
-    return any_visible != all_visible
-
-
 def _horizon_probe(tracer, origins, frames, coarse, refinement):
     """(B, C, C) bool: edge cells whose outermost fine row (towards the horizon) holds a sample
     of the other visibility than the cell's centre."""
@@ -91,32 +80,59 @@ def _horizon_probe(tracer, origins, frames, coarse, refinement):
     return flagged
 
 
+def _texels_to_trace(coarse, probe_flagged, refinement):
+    """(vertex, fine row, fine col) of the fine texels to trace.  A fine texel lies between its cell's centre
+    and the centres of the neighbours on its side (the row's, the column's and the diagonal one; its cell's
+    own for an offset of 0, clamped at the square's edge): it is traced when those disagree, since the boundary
+    then passes between them, and copies its cell otherwise.  A cell the horizon probe flagged is traced whole.
+    Against refining every cell of a mixed 3 x 3 neighbourhood whole, a straight boundary costs about 2 / 5 of
+    the rays, and a texel is copied only where the coarse centres around it agree (as before, a feature
+    thinner than a cell can pass between them)."""
+    count, resolution, _ = coarse.shape
+    padded = np.pad(coarse, ((0, 0), (1, 1), (1, 1)), mode="edge")
+
+    def shifted(row, col):
+        return padded[:, 1 + row:resolution + 1 + row, 1 + col:resolution + 1 + col]
+
+    half = refinement // 2
+    vertex, fine_row, fine_col = [], [], []
+    for offset_row in range(refinement):
+        for offset_col in range(refinement):
+            if offset_row == half and offset_col == half:
+                continue                                    # the coarse ray itself
+            side_row, side_col = np.sign(offset_row - half), np.sign(offset_col - half)
+            corners = (coarse, shifted(side_row, 0), shifted(0, side_col), shifted(side_row, side_col))
+            mixed = np.logical_or.reduce(corners) != np.logical_and.reduce(corners)
+            cell_vertex, cell_row, cell_col = np.unravel_index(np.flatnonzero(mixed | probe_flagged), mixed.shape)
+            vertex.append(cell_vertex)
+            fine_row.append(cell_row * refinement + offset_row)
+            fine_col.append(cell_col * refinement + offset_col)
+    return np.concatenate(vertex), np.concatenate(fine_row), np.concatenate(fine_col)
+
+
 def adaptive_visibility(tracer, origins, frames, coarse_resolution, refinement):
     """(B, F, F) visibility with F = coarse_resolution * refinement, and the number of rays cast.
 
-    Coarse rays at the coarse texel centres; in mixed cells (``cells_to_refine``)
-    the other refinement^2 - 1 fine texels are traced; elsewhere fine texels copy
-    their coarse cell.
+    Coarse rays at the coarse texel centres; fine texels whose surrounding coarse centres disagree
+    (``_texels_to_trace``), and every fine texel of edge cells the horizon probe flags, are traced; the others
+    copy their coarse cell.
     """
     if refinement % 2 != 1:
         raise ValueError("refinement must be odd (coarse texel centres must be fine texel centres)")
     coarse = dense_visibility(tracer, origins, frames, coarse_resolution)
     rays = coarse.size
-    fine = np.repeat(np.repeat(coarse, refinement, axis=1), refinement, axis=2)
+    count = len(coarse)
+    fine_resolution = coarse_resolution * refinement
+    fine = np.broadcast_to(coarse[:, :, None, :, None], (count, coarse_resolution, refinement, coarse_resolution,
+                                                         refinement)).reshape(count, fine_resolution, fine_resolution)
     if refinement == 1:
         return fine, rays
-    refine = cells_to_refine(coarse) | _horizon_probe(tracer, origins, frames, coarse, refinement)
-    rays += len(origins) * 4 * (coarse_resolution - 1) * refinement
-    cell_vertex, cell_row, cell_col = np.nonzero(refine)
-    if len(cell_vertex) == 0:
+    probe_flagged = _horizon_probe(tracer, origins, frames, coarse, refinement)
+    rays += count * 4 * (coarse_resolution - 1) * refinement
+    vertex, rows, cols = _texels_to_trace(coarse, probe_flagged, refinement)
+    if len(vertex) == 0:
         return fine, rays
-    fine_resolution = coarse_resolution * refinement
-    offset_row, offset_col = np.divmod(np.arange(refinement * refinement), refinement)
-    not_centre = (offset_row != refinement // 2) | (offset_col != refinement // 2)
-    offset_row, offset_col = offset_row[not_centre], offset_col[not_centre]
-    rows = cell_row[:, None] * refinement + offset_row            # (M, f^2 - 1)
-    cols = cell_col[:, None] * refinement + offset_col
-    local = _local_directions32(fine_resolution)[rows, cols]       # (M, f^2 - 1, 3): a cell's own directions
-    occluded = _occluded(tracer, np.asarray(origins)[cell_vertex], local, np.asarray(frames)[cell_vertex])
-    fine[cell_vertex[:, None], rows, cols] = ~occluded
-    return fine, rays + occluded.size
+    local = _local_directions32(fine_resolution)[rows, cols][:, None, :]       # (M, 1, 3): one ray a texel
+    occluded = _occluded(tracer, np.asarray(origins)[vertex], local, np.asarray(frames)[vertex])
+    fine[vertex, rows, cols] = ~occluded[:, 0]
+    return fine, rays + len(vertex)

@@ -116,13 +116,33 @@ def test_no_occluders_gives_the_open_plane():
     assert np.abs(result.ssdf() - elevation).max() < 1e-3
 
 
-@pytest.mark.parametrize("visible_fraction", [0.02, 0.5, 0.98])
-def test_mixed_cells_are_those_of_a_3x3_max_and_min_filter(visible_fraction):
-    """cells_to_refine's ORs and ANDs against scipy's max/min filters with the edge clamped (what it replaced)."""
-    from scipy import ndimage
+@pytest.mark.parametrize("visible_fraction", [0.05, 0.5, 0.95])
+def test_a_fine_texel_is_traced_exactly_when_the_coarse_centres_around_it_disagree(visible_fraction):
+    """_texels_to_trace against a plain loop over every fine texel: traced where its cell's centre and its
+    side's neighbouring centres (edge clamped) disagree or the horizon probe flagged the cell, else copied."""
+    rng = np.random.default_rng(2)
+    count, resolution, refinement = 3, 8, 5
+    coarse = rng.random((count, resolution, resolution)) < visible_fraction
+    flagged = rng.random(coarse.shape) < 0.05
+    traced = set(zip(*(axis.tolist() for axis in binary_visibility._texels_to_trace(coarse, flagged, refinement))))
+    expected, half = set(), refinement // 2
+    for vertex in range(count):
+        for row in range(resolution * refinement):
+            for col in range(resolution * refinement):
+                cell_row, offset_row = divmod(row, refinement)
+                cell_col, offset_col = divmod(col, refinement)
+                if offset_row == half and offset_col == half:
+                    continue
+                rows = {cell_row, min(max(cell_row + int(np.sign(offset_row - half)), 0), resolution - 1)}
+                cols = {cell_col, min(max(cell_col + int(np.sign(offset_col - half)), 0), resolution - 1)}
+                values = {bool(coarse[vertex, r, c]) for r in rows for c in cols}
+                if len(values) > 1 or flagged[vertex, cell_row, cell_col]:
+                    expected.add((vertex, row, col))
+    assert traced == expected
 
-    coarse = np.random.default_rng(1).random((40, 32, 32)) < visible_fraction
-    footprint = np.ones((1, 3, 3), bool)
-    expected = (ndimage.maximum_filter(coarse, footprint=footprint, mode="nearest")
-                != ndimage.minimum_filter(coarse, footprint=footprint, mode="nearest"))
-    np.testing.assert_array_equal(binary_visibility.cells_to_refine(coarse), expected)
+
+def test_a_straight_boundary_traces_two_fifths_of_the_cells_it_crosses():
+    coarse = np.zeros((1, 8, 8), bool)
+    coarse[:, :, 4:] = True                   # a boundary between columns 3 and 4
+    vertex, _, _ = binary_visibility._texels_to_trace(coarse, np.zeros_like(coarse), 5)
+    assert len(vertex) == 8 * 2 * 10          # 10 of the 24 other texels of each cell on either side
