@@ -2,9 +2,9 @@
 ../visibility/transfer.py), its operators, panel and storage in the .blend.
 
 The same vertices, geometry rules, occluders and safety as the visibility bake (blender/visibility_bake.py:
-evaluated geometry, topology-changing modifiers refused, a cancelled or failed bake leaves the previous
-ones, the bake thread never touches bpy), stored through the one per-vertex path (per_vertex_store), kind
-``transfer`` (format version 1):
+geometry evaluated as final renders evaluate it, the rows of objects whose modifiers change the topology on a
+companion mesh, a cancelled or failed bake leaves the previous ones, the bake thread never touches bpy), stored
+through the one per-vertex path (per_vertex_store), kind ``transfer`` (format version 1):
 
 - ``sgprt_transfer_00`` .. : the rows [1, w_0, ..., w_{K-1}] (visibility.decode.pack_coefficients);
 - ``mesh["sgprt_transfer"]``: the store's fields and ``order`` N, ``terms`` K, ``relative_error``,
@@ -83,9 +83,9 @@ def clear_transfer_bake(mesh):
     return per_vertex_store.clear_record(mesh, KIND)
 
 
-def store_transfer_bake(mesh, result, options, occluder_fingerprints=None, corner_point=None):
+def store_transfer_bake(mesh, result, options, occluder_fingerprints=None, corner_point=None, evaluation=None):
     """Write a finished visibility.transfer.TransferResult to a mesh datablock, replacing any previous one
-    (occluder_fingerprints, corner_point: see visibility_bake.store_visibility_bake)."""
+    (occluder_fingerprints, corner_point, evaluation: see visibility_bake.store_visibility_bake)."""
     packed = per_vertex_store.rows_for_mesh(mesh, decode.pack_coefficients(result.coefficients), corner_point,
                                             "transfer")
     per_vertex_store.store_record(mesh, KIND, packed, FORMAT_VERSION, {
@@ -96,7 +96,7 @@ def store_transfer_bake(mesh, result, options, occluder_fingerprints=None, corne
         "seconds": float(result.seconds),
         "mean": np.asarray(result.mean, np.float32).astype(np.float64).tolist(),
         "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
-    }, occluder_fingerprints, per_vertex_store.domain_of(corner_point))
+    }, occluder_fingerprints, per_vertex_store.domain_of(corner_point), evaluation)
 
 
 def _check_layers(group, layers):
@@ -107,11 +107,11 @@ def _check_layers(group, layers):
     return None
 
 
-def load_transfer_bake(mesh, evaluated_mesh=None, read_arrays=True):
+def load_transfer_bake(mesh, evaluated_mesh=None, read_arrays=True, obj=None):
     """The transfer bake stored on a mesh datablock, or None without one (see load_visibility_bake)."""
     try:
         record = per_vertex_store.load_record(mesh, KIND, FORMAT_VERSION, evaluated_mesh, read_arrays,
-                                              check_layers=_check_layers)
+                                              check_layers=_check_layers, obj=obj)
     except (KeyError, TypeError, ValueError) as error:
         return StoredTransfer("INVALID", f"transfer metadata damaged ({error}): re-bake")
     if record is None:
@@ -127,7 +127,8 @@ def load_transfer_bake(mesh, evaluated_mesh=None, read_arrays=True):
     if not stored.usable:
         return stored
     stored.message = (f"order {stored.order}, {stored.terms} terms, error {stored.relative_error:.3f}, "
-                      f"{stored.vertex_count} vertices, baked {stored.date}")
+                      f"{stored.vertex_count} vertices{' with its modifiers' if record.evaluated else ''}, "
+                      f"baked {stored.date}")
     if not read_arrays:
         return stored
     size = transfer.vector_size(stored.order)
@@ -146,8 +147,8 @@ def transfer_for_object(object_eval, read_arrays=True):
     """The engine's entry: the transfer bake of an evaluated object's mesh, checked against what it draws."""
     if object_eval.type != "MESH":
         return None
-    original = getattr(object_eval, "original", None) or object_eval
-    return load_transfer_bake(original.data, evaluated_mesh=object_eval.data, read_arrays=read_arrays)
+    return per_vertex_store.record_for_object(object_eval, KIND, lambda mesh, obj: load_transfer_bake(
+        mesh, evaluated_mesh=object_eval.data, read_arrays=read_arrays, obj=obj))
 
 
 # --------------------------------------------------------------------------- the job (no bpy)
@@ -250,17 +251,18 @@ class SGPRT_OT_bake_transfer(SceneJobOperator, bpy.types.Operator):
         inputs = bake_inputs(self, context, mesh_objects(context, self.target), "transfer bake")
         if inputs is None:
             return None
-        receivers, occluder_vertices, occluder_triangles, self._topology, self._occluders = inputs
+        receivers, occluder_vertices, occluder_triangles, self._targets, self._occluders = inputs
         return TransferJob(receivers, occluder_vertices, occluder_triangles, _transfer_options(self),
                            hook=progress_hook)
 
     def _finish(self, context, job):
-        def store(mesh, result, corner_point):
-            store_transfer_bake(mesh, result, job.options, self._occluders, corner_point)
+        def store(mesh, result, corner_point, evaluation):
+            store_transfer_bake(mesh, result, job.options, self._occluders, corner_point, evaluation)
             return (f"order {result.order}, {result.terms} terms, error {result.relative_error:.3f}, "
                     f"{result.seconds:.1f} s")
 
-        return store_results(self, job, self._topology, store, "transfer bake", "SG-PRT baked the transfer of")
+        return store_results(self, job, self._targets, KIND, store, "transfer bake",
+                             "SG-PRT baked the transfer of")
 
 
 class SGPRT_OT_clear_transfer(bpy.types.Operator):
@@ -272,7 +274,7 @@ class SGPRT_OT_clear_transfer(bpy.types.Operator):
     target: EnumProperty(name="Target", items=TARGETS, default="SELECTED")
 
     def execute(self, context):
-        return clear_bakes(self, context, clear_transfer_bake, "transfer bake(s)")
+        return clear_bakes(self, context, KIND, "transfer bake(s)")
 
 
 class SGPRT_PT_transfer_bake(RenderPanel, bpy.types.Panel):

@@ -10,9 +10,15 @@ normal (``visibility.per_vertex.split_points``), moved a little into its faces
 (``inset_points``), with that normal: its rows are stored per corner (domain
 CORNER), so a flat face's corners read its own hemisphere.  The local frame is
 ``visibility.hemisphere_map.local_frame`` of the normal (no tangents).  The
-geometry is the evaluated object's (deform modifiers apply), but a modifier
-that changes the faces (subdivision, mirror...) is refused: the coefficients
-live on the original mesh datablock, which must index the same vertices.
+geometry is the evaluated object's, as a final render evaluates it
+(modifier_stack.as_rendered: the render's subdivision levels, the modifiers
+shown in renders).  Where the modifiers keep the faces (deform only, or none)
+the rows live on the mesh datablock, as they always did; where they change
+them (Subdivision Surface, Mirror, Array, Geometry Nodes...) on a companion
+mesh of the evaluated faces, with the modifier stack's fingerprint
+(per_vertex_store's module docstring: the mesh datablock stays as it is; a
+render whose modifiers changed since, or the viewport where it evaluates them
+otherwise, draws the object unshadowed and says why).
 
 The engine exports one vertex per face corner (blender/export.py).  To upload
 per-corner data it maps corner -> vertex with the loop's ``vertex_index``::
@@ -42,7 +48,8 @@ per-vertex kind):
 - ``mesh["sgprt_ssdf"]``, an ID property group: the store's ``format_version``,
   ``layers`` L, ``vertex_count``, ``topology_hash`` (``visibility.pipeline.topology_hash`` of the
   vertex count and the loop triangles' vertex indices: ``mesh_topology_hash``), ``face_hash``,
-  ``occluders`` (per_vertex_store's), and the bake's
+  ``occluders`` (per_vertex_store's; on a companion mesh also ``modifiers``,
+  ``base_face_hash`` and ``viewport_face_hash``), and the bake's
   ``resolution`` R, ``terms`` N, ``rms_error`` (radians),
   ``frame_reference_axis`` (3), ``date`` (ISO 8601 UTC), ``seconds``,
   ``refinement``, ``error_target`` (-1 for fixed terms), ``rays_traced``, and the
@@ -74,7 +81,7 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 from ..visibility import decode, per_vertex
 from ..visibility.per_vertex import MAX_ROWS, MAX_TERMS
 from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
-from . import export, occluders, per_vertex_store
+from . import export, modifier_stack, occluders, per_vertex_store
 from .background_job import BackgroundJob, SceneJobOperator
 from .occluders import occluder_arrays
 from .panels import RenderPanel
@@ -119,23 +126,25 @@ def _corner_face_centres(mesh):
     return np.repeat(centres.reshape(-1, 3).astype(np.float64), sizes, axis=0)
 
 
+def _evaluated_mesh(obj, depsgraph):
+    """The evaluated mesh of an object a bake can take; ValueError with a message for the user if none."""
+    if obj.type != "MESH":
+        raise ValueError(f"'{obj.name}' is not a mesh")
+    if obj.mode == "EDIT":
+        raise ValueError(f"'{obj.name}' is in Edit Mode: leave it before baking")
+    mesh = obj.evaluated_get(depsgraph).data
+    if len(mesh.polygons) == 0:
+        raise ValueError(f"'{obj.name}' has no faces: nothing to bake")
+    return mesh
+
+
 def receiver_arrays(obj, depsgraph):
     """World-space (points, normals, triangles, corner_point) where a mesh object is baked, from its evaluated
     geometry: its vertices (corner_point None) where every corner has its vertex's normal, else one point a
     vertex and normal (visibility.per_vertex.split_points: flat faces and sharp edges get their faces'
     hemispheres) and the point each corner reads; ValueError with a message for the user when it cannot be
     baked."""
-    if obj.type != "MESH":
-        raise ValueError(f"'{obj.name}' is not a mesh")
-    if obj.data.library is not None or getattr(obj.data, "override_library", None) is not None:
-        raise ValueError(f"'{obj.name}' uses a linked mesh, which cannot store a bake")
-    if obj.mode == "EDIT":
-        raise ValueError(f"'{obj.name}' is in Edit Mode: leave it before baking")
-    if len(obj.data.polygons) == 0:
-        raise ValueError(f"'{obj.name}' has no faces: nothing to bake")
-    mesh = obj.evaluated_get(depsgraph).data
-    if len(mesh.vertices) != len(obj.data.vertices) or mesh_face_hash(mesh) != mesh_face_hash(obj.data):
-        raise ValueError(f"'{obj.name}': its modifiers change the topology; apply them before baking")
+    mesh = _evaluated_mesh(obj, depsgraph)
     matrix = _matrix(obj.evaluated_get(depsgraph).matrix_world)
     vertices = _vertex_array(mesh, "co")
     normals = _vertex_array(mesh, "normal")
@@ -151,6 +160,64 @@ def receiver_arrays(obj, depsgraph):
     normals = normals @ np.linalg.inv(matrix[:3, :3])   # inverse transpose
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
     return _to_world(vertices, matrix), normals, mesh_triangles(mesh), corner_point
+
+
+@dataclass
+class BakeTarget:
+    """Where a receiver's rows are stored: on its mesh datablock (`evaluated` None: its modifiers keep the faces),
+    or on a companion mesh of its evaluated faces (per_vertex_store), with what the bake saw of the object."""
+    key: tuple                          # ("MESH", mesh name) or ("OBJECT", object name): one bake each
+    object_name: str
+    mesh_name: str
+    topology_hash: str                  # the mesh datablock's at the bake: an edit during the bake is not stored
+    evaluated: Optional[per_vertex_store.EvaluatedTopology] = None
+    modifiers: Optional[list] = None    # modifier_stack.fingerprint at the bake (companions)
+    evaluation: Optional[dict] = None   # per_vertex_store.evaluation_fields (companions)
+
+    def changed_since(self):
+        """Why the object can no longer take what was baked (gone, its mesh or modifiers edited), or None."""
+        obj = bpy.data.objects.get(self.object_name)
+        mesh = bpy.data.meshes.get(self.mesh_name)
+        if obj is None or mesh is None or obj.data != mesh:
+            return "went or changed its mesh"
+        if mesh_topology_hash(mesh) != self.topology_hash:
+            return "had its mesh edited"
+        if self.evaluated is not None and modifier_stack.changes(self.modifiers, modifier_stack.fingerprint(obj)):
+            return "had its modifiers changed"
+        return None
+
+    def write(self, kind, store):
+        """store(mesh, evaluation) writes the record of `kind` to `mesh`: here the mesh datablock (and the
+        object's older companion goes), or a new companion replacing the object's (per_vertex_store.write_companion).
+        Returns what store returned."""
+        obj = bpy.data.objects[self.object_name]
+        if self.evaluated is None:
+            written = store(obj.data, None)
+            obj.data.update()
+            per_vertex_store.remove_companion(obj, kind)
+        else:
+            written = per_vertex_store.write_companion(obj, kind, self.evaluated,
+                                                       lambda mesh: store(mesh, self.evaluation))
+        obj.update_tag(refresh={"DATA"})        # the viewport re-reads the object's bake
+        return written
+
+
+def bake_target(obj, depsgraph, viewport_face_hash):
+    """The BakeTarget of a mesh object evaluated as a render does (`depsgraph`, inside modifier_stack.as_rendered);
+    viewport_face_hash: of its viewport evaluation.  ValueError with a message for the user when it cannot be
+    baked."""
+    mesh = _evaluated_mesh(obj, depsgraph)
+    base_face_hash = mesh_face_hash(obj.data)
+    if len(mesh.vertices) == len(obj.data.vertices) and mesh_face_hash(mesh) == base_face_hash:
+        if obj.data.library is not None or getattr(obj.data, "override_library", None) is not None:
+            raise ValueError(f"'{obj.name}' uses a linked mesh, which cannot store a bake")
+        return BakeTarget(("MESH", obj.data.name), obj.name, obj.data.name, mesh_topology_hash(obj.data))
+    if obj.library is not None:
+        raise ValueError(f"'{obj.name}' is linked from a library, which cannot store a bake of its modifiers' mesh")
+    modifiers = modifier_stack.fingerprint(obj)
+    return BakeTarget(("OBJECT", obj.name), obj.name, obj.data.name, mesh_topology_hash(obj.data),
+                      per_vertex_store.EvaluatedTopology.of(mesh), modifiers,
+                      per_vertex_store.evaluation_fields(modifiers, base_face_hash, viewport_face_hash))
 
 
 # --------------------------------------------------------------------------- storage
@@ -175,6 +242,7 @@ class StoredBake:
     mean: Optional[np.ndarray] = None                  # (R, R) float32
     occluders: Optional[dict] = None                   # what it traced (blender/occluders.py fingerprints)
     domain: str = "POINT"                              # rows per vertex, or per corner (CORNER)
+    renders_only: bool = False                         # stale here, for the viewport only (per_vertex_store)
 
     @property
     def usable(self):
@@ -213,10 +281,12 @@ def clear_visibility_bake(mesh):
     return per_vertex_store.clear_record(mesh, KIND)
 
 
-def store_visibility_bake(mesh, result, options=None, occluder_fingerprints=None, corner_point=None):
+def store_visibility_bake(mesh, result, options=None, occluder_fingerprints=None, corner_point=None,
+                          evaluation=None):
     """Write a finished ``BakeResult`` to a mesh datablock, replacing any previous bake; with the fingerprints
     of the occluders it traced (occluders.fingerprints), a render can name what moved since.  corner_point:
-    the point of each corner where the bake is per point (receiver_arrays), None where per vertex."""
+    the point of each corner where the bake is per point (receiver_arrays), None where per vertex;
+    evaluation: per_vertex_store.evaluation_fields on a companion mesh (BakeTarget), else None."""
     packed = per_vertex_store.rows_for_mesh(mesh, decode.pack_coefficients(result.coefficients), corner_point,
                                             "bake")
     layers = packed.shape[1] // 4
@@ -235,7 +305,7 @@ def store_visibility_bake(mesh, result, options=None, occluder_fingerprints=None
         "rays_traced": int(result.rays_traced),
         "basis": np.asarray(result.basis, np.float32).ravel().astype(np.float64).tolist(),
         "mean": np.asarray(result.mean, np.float32).ravel().astype(np.float64).tolist(),
-    }, occluder_fingerprints, per_vertex_store.domain_of(corner_point))
+    }, occluder_fingerprints, per_vertex_store.domain_of(corner_point), evaluation)
 
 
 def float_array(value):
@@ -252,15 +322,16 @@ def _terms_fill_layers(group, layers):
     return None
 
 
-def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
+def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True, obj=None):
     """The bake stored on a mesh datablock, or None if it has none.
 
     evaluated_mesh: the mesh the engine draws (an object's evaluated data), checked for staleness
-    instead of ``mesh`` itself.  read_arrays=False skips the arrays (cheap status for panels).
+    instead of ``mesh`` itself.  read_arrays=False skips the arrays (cheap status for panels).  obj: the object
+    whose companion ``mesh`` is (per_vertex_store.load_record).
     """
     try:
         record = per_vertex_store.load_record(mesh, KIND, FORMAT_VERSION, evaluated_mesh, read_arrays,
-                                              check_layers=_terms_fill_layers)
+                                              check_layers=_terms_fill_layers, obj=obj)
     except (KeyError, TypeError, ValueError) as error:
         return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
     if record is None:
@@ -273,14 +344,14 @@ def load_visibility_bake(mesh, evaluated_mesh=None, read_arrays=True):
             rms_error=float(group["rms_error"]), vertex_count=record.vertex_count,
             topology_hash=record.topology_hash, frame_reference_axis=float_array(group["frame_reference_axis"]),
             date=str(group.get("date", "")), seconds=float(group.get("seconds", 0.0)), occluders=record.occluders,
-            domain=record.domain)
+            domain=record.domain, renders_only=record.renders_only)
     except (KeyError, TypeError, ValueError) as error:
         return StoredBake("INVALID", f"bake metadata damaged ({error}): re-bake")
     if not stored.usable:
         return stored
     stored.message = (f"{stored.terms} terms, RMS error {np.degrees(stored.rms_error):.2f} deg, "
-                      f"{stored.vertex_count} vertices{' (per corner)' if stored.domain == 'CORNER' else ''}, "
-                      f"baked {stored.date}")
+                      f"{stored.vertex_count} vertices{' (per corner)' if stored.domain == 'CORNER' else ''}"
+                      f"{' with its modifiers' if record.evaluated else ''}, baked {stored.date}")
     if not read_arrays:
         return stored
     resolution = stored.resolution
@@ -300,8 +371,8 @@ def visibility_for_object(object_eval, read_arrays=True):
     draws; None without a bake or for non-mesh objects."""
     if object_eval.type != "MESH":
         return None
-    original = getattr(object_eval, "original", None) or object_eval
-    return load_visibility_bake(original.data, evaluated_mesh=object_eval.data, read_arrays=read_arrays)
+    return per_vertex_store.record_for_object(object_eval, KIND, lambda mesh, obj: load_visibility_bake(
+        mesh, evaluated_mesh=object_eval.data, read_arrays=read_arrays, obj=obj))
 
 
 def unusable_bakes(scene, depsgraph):
@@ -309,7 +380,7 @@ def unusable_bakes(scene, depsgraph):
     (they render unshadowed): what the operator and the panel warn about."""
     found = []
     for obj in scene.objects:
-        if obj.type == "MESH" and obj.visible_get() and PROPERTY in obj.data.keys():
+        if obj.type == "MESH" and obj.visible_get() and per_vertex_store.object_has_record(obj, KIND):
             stored = visibility_for_object(obj.evaluated_get(depsgraph), read_arrays=False)
             if stored is not None and not stored.usable:
                 found.append((obj.name, stored.message))
@@ -418,42 +489,46 @@ def mesh_objects(context, target):
 
 
 def bake_inputs(operator, context, objects, what):
-    """(receivers [(mesh key, object name, points, normals, triangles, corner_point)] (receiver_arrays),
-    occluder vertices, occluder
-    triangles, {mesh key: topology hash}, the occluders' fingerprints (occluders.fingerprints, stored with
-    the bake)) of the objects a per-vertex bake writes to, world space; None after the operator reported why
-    not.  what: the bake's name in messages ("bake", "transfer bake")."""
+    """(receivers [(target key, object name, points, normals, triangles, corner_point)] (receiver_arrays),
+    occluder vertices, occluder triangles, {target key: BakeTarget}, the occluders' fingerprints
+    (occluders.fingerprints, stored with the bake)) of the objects a per-vertex bake writes to, world space, as
+    a final render evaluates the scene (modifier_stack.as_rendered); None after the operator reported why not.
+    what: the bake's name in messages ("bake", "transfer bake")."""
     if not objects:
         operator.report({"ERROR"}, f"SG-PRT {what}: no mesh object selected" if operator.target == "SELECTED"
                         else f"SG-PRT {what}: no visible mesh object")
         return None
     depsgraph = context.evaluated_depsgraph_get()
-    receivers, seen = [], set()
-    for obj in objects:
-        if obj.data.name in seen:
-            operator.report({"WARNING"}, f"'{obj.name}' shares its mesh with an object baked already; "
-                                         f"the {what} is stored once per mesh")
-            continue
-        try:
-            vertices, normals, triangles, corner_point = receiver_arrays(obj, depsgraph)
-        except ValueError as error:
-            operator.report({"WARNING"}, f"SG-PRT {what} skips {error}")
-            continue
-        seen.add(obj.data.name)
-        receivers.append((obj.data.name, obj.name, vertices, normals, triangles, corner_point))
-    if not receivers:
-        operator.report({"ERROR"}, f"SG-PRT {what}: none of the objects can be baked (see the warnings)")
-        return None
-    geometry = occluders.scene_geometry(depsgraph)
-    occluder_vertices, occluder_triangles = occluder_arrays(depsgraph, geometry)
-    topology = {key: mesh_topology_hash(bpy.data.meshes[key]) for key, *_ in receivers}
-    return receivers, occluder_vertices, occluder_triangles, topology, occluders.fingerprints(geometry)
+    viewport_faces = {obj.name: mesh_face_hash(obj.evaluated_get(depsgraph).data) for obj in objects
+                      if obj.type == "MESH"}
+    receivers, targets = [], {}
+    with modifier_stack.as_rendered(context.scene):
+        depsgraph = context.evaluated_depsgraph_get()
+        for obj in objects:
+            try:
+                target = bake_target(obj, depsgraph, viewport_faces.get(obj.name))
+                if target.key in targets:
+                    operator.report({"WARNING"}, f"'{obj.name}' shares its mesh with an object baked already; "
+                                                 f"the {what} is stored once per mesh")
+                    continue
+                vertices, normals, triangles, corner_point = receiver_arrays(obj, depsgraph)
+            except ValueError as error:
+                operator.report({"WARNING"}, f"SG-PRT {what} skips {error}")
+                continue
+            targets[target.key] = target
+            receivers.append((target.key, obj.name, vertices, normals, triangles, corner_point))
+        if not receivers:
+            operator.report({"ERROR"}, f"SG-PRT {what}: none of the objects can be baked (see the warnings)")
+            return None
+        geometry = occluders.scene_geometry(depsgraph)
+        occluder_vertices, occluder_triangles = occluder_arrays(depsgraph, geometry)
+    return receivers, occluder_vertices, occluder_triangles, targets, occluders.fingerprints(geometry)
 
 
-def store_results(operator, job, topology, store, what, done):
+def store_results(operator, job, targets, kind, store, what, done):
     """The operator's outcome of a finished per-vertex bake job: nothing written when it was cancelled or
-    failed; else store(mesh, result, corner_point) -> a summary for every mesh whose topology is what was
-    baked, reported after `done`."""
+    failed; else store(mesh, result, corner_point, evaluation) -> a summary, for every target (BakeTarget) of
+    `kind` whose object is as it was baked, reported after `done`."""
     if job.cancelled:
         operator.report({"WARNING"}, f"SG-PRT {what} cancelled: nothing written, previous bakes kept")
         return {"CANCELLED"}
@@ -462,15 +537,14 @@ def store_results(operator, job, topology, store, what, done):
         return {"CANCELLED"}
     written = []
     for key, result in job.results.items():
-        mesh = bpy.data.meshes.get(key)
-        if mesh is None or mesh_topology_hash(mesh) != topology[key]:
-            operator.report({"WARNING"}, f"mesh '{key}' changed during the {what}: not stored")
+        target = targets[key]
+        problem = target.changed_since()
+        if problem is not None:
+            operator.report({"WARNING"}, f"'{target.object_name}' {problem} during the {what}: not stored")
             continue
         corner_point = next(receiver[5] for receiver in job.receivers if receiver[0] == key)
-        summary = store(mesh, result, corner_point)
-        mesh.update()
-        label = next(label for k, label, *_ in job.receivers if k == key)
-        written.append(f"{label} ({summary})")
+        summary = target.write(kind, lambda mesh, evaluation: store(mesh, result, corner_point, evaluation))
+        written.append(f"{target.object_name} ({summary})")
     if not written:
         return {"CANCELLED"}
     operator.report({"INFO"}, f"{done} " + ", ".join(written))
@@ -503,33 +577,37 @@ class SGPRT_OT_bake_visibility(SceneJobOperator, bpy.types.Operator):
         inputs = bake_inputs(self, context, mesh_objects(context, self.target), "bake")
         if inputs is None:
             return None
-        receivers, occluder_vertices, occluder_triangles, self._topology, self._occluders = inputs
+        receivers, occluder_vertices, occluder_triangles, self._targets, self._occluders = inputs
         return BakeJob(receivers, occluder_vertices, occluder_triangles, _bake_options(self),
                        hook=progress_hook)
 
     def _finish(self, context, job):
-        def store(mesh, result, corner_point):
-            store_visibility_bake(mesh, result, job.options, self._occluders, corner_point)
+        def store(mesh, result, corner_point, evaluation):
+            store_visibility_bake(mesh, result, job.options, self._occluders, corner_point, evaluation)
             return f"{result.terms} terms, {np.degrees(result.rms_error):.2f} deg, {result.seconds:.1f} s"
 
-        outcome = store_results(self, job, self._topology, store, "bake", "SG-PRT baked")
+        outcome = store_results(self, job, self._targets, KIND, store, "bake", "SG-PRT baked")
         if not job.cancelled and job.error is None:
-            for name, message in unusable_bakes(context.scene, context.evaluated_depsgraph_get()):
+            with modifier_stack.as_rendered(context.scene):     # what final renders say, as the bake was made
+                unusable = unusable_bakes(context.scene, context.evaluated_depsgraph_get())
+            for name, message in unusable:
                 self.report({"WARNING"}, f"SG-PRT: '{name}' renders unshadowed, its bake is {message}")
         return outcome
 
 
-def clear_bakes(operator, context, clear, what):
-    """A clear operator's execute: clear(mesh) -> bool on the target's meshes (else the active mesh object)."""
+def clear_bakes(operator, context, kind, what):
+    """A clear operator's execute: the records of `kind` of the target's mesh objects (else the active one), on
+    their meshes and companions (per_vertex_store.clear_object_record)."""
     objects = mesh_objects(context, operator.target)
     if not objects and context.active_object is not None and context.active_object.type == "MESH":
         objects = [context.active_object]
     if not objects:
         operator.report({"ERROR"}, "SG-PRT: no mesh object selected")
         return {"CANCELLED"}
-    cleared = [obj.data.name for obj in objects if clear(obj.data)]
-    for name in cleared:
-        bpy.data.meshes[name].update()
+    cleared = [obj for obj in objects if per_vertex_store.clear_object_record(obj, kind)]
+    for obj in cleared:
+        obj.data.update()
+        obj.update_tag(refresh={"DATA"})
     operator.report({"INFO"}, f"SG-PRT cleared {len(cleared)} {what}")
     return {"FINISHED"}
 
@@ -543,7 +621,7 @@ class SGPRT_OT_clear_visibility(bpy.types.Operator):
     target: EnumProperty(name="Target", items=TARGETS, default="SELECTED")
 
     def execute(self, context):
-        return clear_bakes(self, context, clear_visibility_bake, "bake(s)")
+        return clear_bakes(self, context, KIND, "bake(s)")
 
 
 def draw_bake_controls(layout, settings, option_names, bake_idname, clear_idname):
@@ -595,7 +673,8 @@ class SGPRT_PT_visibility_bake(RenderPanel, bpy.types.Panel):
         else:
             column.alert = True
             column.label(text=f"{obj.name}: {stored.message}", icon="ERROR")
-            column.label(text="Renders unshadowed until re-baked")
+            if not stored.renders_only:         # else its message says final renders are shadowed
+                column.label(text="Renders unshadowed until re-baked")
 
 
 classes = (SGPRT_PG_bake, SGPRT_OT_bake_visibility, SGPRT_OT_clear_visibility, SGPRT_PT_visibility_bake)

@@ -129,14 +129,36 @@ def test_a_changed_mesh_makes_the_bake_stale_and_the_render_says_so(scene):
     assert any(data.get("transfer") is not None for data in state.per_vertex.values())    # the floor's is kept
 
 
-def test_topology_changing_modifiers_are_refused(scene):
+def test_a_subdivided_object_bakes_its_transfer_on_a_companion(scene):
+    """The transfer of Suzanne under a Subdivision Surface is baked on her evaluated mesh, as renders evaluate it
+    (per_vertex_store's companion, as the visibility bake's), and shades the render; another render level makes it
+    stale and the render says why.  Her mesh datablock keeps no transfer."""
+    from sg_prt_addon.blender import modifier_stack, per_vertex_store
+
     _, floor, suzanne = scene
-    suzanne.modifiers.new("subdivision", "SUBSURF")
+    subdivision = suzanne.modifiers.new("Subdivision", "SUBSURF")
+    subdivision.levels, subdivision.render_levels = 0, 1
     bpy.ops.object.select_all(action="DESELECT")
     suzanne.select_set(True)
-    with pytest.raises(RuntimeError, match="none of the objects can be baked"):
-        bpy.ops.sgprt.bake_transfer(target="SELECTED")
-    assert not tb.has_transfer_bake(suzanne.data)
+    assert bpy.ops.sgprt.bake_transfer(target="SELECTED") == {"FINISHED"}
+    assert not tb.has_transfer_bake(suzanne.data) and per_vertex_store.companion_mesh(suzanne, tb.KIND) is not None
+
+    def render_state():
+        with modifier_stack.as_rendered(bpy.context.scene):
+            state = scene_state.SceneState()
+            state.sync(bpy.context.evaluated_depsgraph_get())
+        key = next(entry.mesh_key for entry in state.objects.values() if entry.name == "Suzanne")
+        return state, key
+
+    state, key = render_state()
+    data = state.per_vertex[key].get(scene_state.TRANSFER)
+    assert data is not None and data.rows.shape[0] == len(state.meshes[key].corner_vertex) == 4 * len(suzanne.data.loops)
+    subdivision.render_levels = 2
+    state, key = render_state()
+    assert scene_state.TRANSFER not in state.per_vertex[key]
+    assert any(line.startswith("object 'Suzanne' renders without its transfer bake: stale: its modifiers changed "
+                               "since the bake ('Subdivision' render levels 1 -> 2)") for line in
+               state.unshadowed_warnings()), state.unshadowed_warnings()
 
 
 def test_both_bake_panels_draw_their_settings_buttons_and_status(scene):

@@ -6,6 +6,7 @@ import bmesh
 import bpy
 import numpy as np
 import pytest
+import recording_layout
 
 from sg_prt_addon.blender import export
 from sg_prt_addon.blender import visibility_bake as vb
@@ -254,9 +255,6 @@ def test_topology_edits_make_the_bake_stale(scene, tmp_path, capfd):
     obj_eval = suzanne.evaluated_get(bpy.context.evaluated_depsgraph_get())
     assert vb.visibility_for_object(obj_eval).status == "STALE"
     assert vb.load_visibility_bake(suzanne.data).usable          # the datablock itself is intact
-    # ...and baking through that modifier is refused with a report
-    with pytest.raises(RuntimeError, match="can be baked"):
-        bpy.ops.sgprt.bake_visibility()
 
     assert bpy.ops.sgprt.clear_visibility() == {"FINISHED"}
     assert vb.load_visibility_bake(suzanne.data) is None
@@ -418,6 +416,8 @@ def test_moved_vertices_keep_the_faces_and_the_bake(scene):
     assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
     obj_eval = floor.evaluated_get(bpy.context.evaluated_depsgraph_get())
     assert vb.visibility_for_object(obj_eval).usable
+    # a deform modifier keeps the faces: the rows stay on the mesh, no companion
+    assert vb.load_visibility_bake(floor.data).usable and per_vertex_store.companion_mesh(floor, vb.KIND) is None
 
 
 def _render_warnings():
@@ -476,3 +476,208 @@ def test_a_bake_per_vertex_of_a_flat_mesh_asks_for_a_rebake(scene):
     asked = [warning for warning in state.warnings if "made before flat faces" in warning]
     assert len(asked) == 1 and "'Suzanne'" in asked[0], state.warnings
     assert len(state.visibility) == 2                           # it still shades
+
+
+# --------------------------------------------------------------------------- objects whose modifiers change the faces
+
+def _mesh_snapshot(mesh):
+    """A mesh datablock's positions, faces and attribute names: what a bake through modifiers must not touch."""
+    from sg_prt_addon.blender import per_vertex_store
+
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return _bits(co).tobytes(), per_vertex_store.mesh_face_hash(mesh), sorted(a.name for a in mesh.attributes)
+
+
+def _as_rendered(obj, load=vb.visibility_for_object):
+    """An object's record as a final render reads it: its modifiers evaluated at their render settings."""
+    from sg_prt_addon.blender import modifier_stack
+
+    with modifier_stack.as_rendered(bpy.context.scene):
+        return load(obj.evaluated_get(bpy.context.evaluated_depsgraph_get()))
+
+
+def _in_viewport(obj, load=vb.visibility_for_object):
+    return load(obj.evaluated_get(bpy.context.evaluated_depsgraph_get()))
+
+
+def test_a_subdivided_object_bakes_its_evaluated_mesh_on_a_companion(scene, tmp_path, capfd):
+    """Suzanne under a Subdivision Surface (levels 1 in the viewport, 2 in renders: Blender's defaults) bakes the
+    mesh a render evaluates, onto a companion mesh; her mesh datablock stays as it was.  The viewport, at another
+    level, says why it shows no shadows; another render level makes the bake stale, naming the change; the bake
+    survives save and reopen; Clear removes the companion."""
+    from sg_prt_addon.blender import per_vertex_store
+    from sg_prt_addon.engine import scene_state
+
+    _, floor, suzanne = scene
+    subdivision = suzanne.modifiers.new("Subdivision", "SUBSURF")
+    subdivision.levels, subdivision.render_levels = 1, 2
+    untouched = _mesh_snapshot(suzanne.data)
+    _select(suzanne)
+    viewport_state = scene_state.SceneState()               # a viewport's, fed its updates as view_update does
+    bpy.context.view_layer.update()
+    viewport_state.sync(bpy.context.view_layer.depsgraph)
+
+    def on_update(updated_scene, depsgraph):
+        viewport_state.update(depsgraph)
+    bpy.app.handlers.depsgraph_update_post.append(on_update)
+    try:
+        capfd.readouterr()
+        assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+        assert "renders unshadowed" not in "".join(capfd.readouterr())     # the operator asks as renders do
+        bpy.context.view_layer.update()
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(on_update)
+    assert _mesh_snapshot(suzanne.data) == untouched and not vb.has_visibility_bake(suzanne.data)
+    companion = per_vertex_store.companion_mesh(suzanne, vb.KIND)
+    stored = _as_rendered(suzanne)
+    assert stored.usable and "with its modifiers" in stored.message, stored.message
+    with per_vertex_store.modifier_stack.as_rendered(bpy.context.scene):
+        evaluated = suzanne.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+        assert stored.vertex_count == len(evaluated.vertices) == len(companion.vertices) > 8 * len(suzanne.data.vertices)
+        assert stored.domain == "CORNER" and stored.packed_coefficients.shape[0] == len(evaluated.loops)
+    rows = stored.packed_coefficients.copy()
+
+    # the viewport evaluates level 1: no shadows there, and why (the operator's update reached its state)
+    viewport = _in_viewport(suzanne)
+    assert viewport.status == "STALE" and viewport.packed_coefficients is None
+    assert "'Subdivision' levels 1 in the viewport, 2 in renders" in viewport.message, viewport.message
+    assert "final renders are shadowed" in viewport.message
+    key = next(entry.mesh_key for entry in viewport_state.objects.values() if entry.name == "Suzanne")
+    assert viewport_state.visibility_status[key] == viewport.message
+    assert f"object 'Suzanne' renders unshadowed: {viewport.message}" in viewport_state.unshadowed_warnings()
+    drawn = recording_layout.draw(vb.SGPRT_PT_visibility_bake, bpy.context)          # the panel's status line
+    assert ("label", f"Suzanne: {viewport.message}") in drawn
+    assert ("label", "Renders unshadowed until re-baked") not in drawn
+
+    subdivision.render_levels = 3
+    stale = _as_rendered(suzanne)
+    assert stale.status == "STALE" and stale.packed_coefficients is None
+    assert "its modifiers changed since the bake ('Subdivision' render levels 2 -> 3): re-bake" in stale.message
+    subdivision.render_levels = 2
+    assert _as_rendered(suzanne).usable                     # as baked again
+    subdivision.levels = 2                                  # the viewport at the render's level: shadowed there too
+    assert _in_viewport(suzanne).usable
+
+    _reopen(tmp_path / "subdivided.blend")
+    suzanne = bpy.data.objects["Suzanne"]
+    reopened = _as_rendered(suzanne)
+    assert reopened.usable and np.array_equal(_bits(reopened.packed_coefficients), _bits(rows))
+    assert _mesh_snapshot(suzanne.data) == untouched
+
+    assert bpy.ops.sgprt.clear_visibility(target="ALL") == {"FINISHED"}
+    assert per_vertex_store.companion_mesh(suzanne, vb.KIND) is None and _as_rendered(suzanne) is None
+    assert not [mesh.name for mesh in bpy.data.meshes if mesh.name.startswith("SG-PRT")]
+    assert _mesh_snapshot(suzanne.data) == untouched
+
+
+def test_a_bake_on_the_mesh_and_one_on_a_companion_take_turns(scene):
+    """A bake made on the mesh (no modifiers) still shades where the object's modifiers keep its faces, beside the
+    object's bake through a Subdivision; a companion whose modifier went says so; a bake on the mesh again drops
+    the companion."""
+    from sg_prt_addon.blender import per_vertex_store
+
+    _, floor, suzanne = scene
+    _select(suzanne)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    on_mesh = vb.load_visibility_bake(suzanne.data)
+    subdivision = suzanne.modifiers.new("Subdivision", "SUBSURF")
+    subdivision.levels = subdivision.render_levels = 1
+    assert _in_viewport(suzanne).status == "STALE"
+    assert bpy.ops.sgprt.bake_visibility(resolution=8) == {"FINISHED"}
+    assert _in_viewport(suzanne).usable and _in_viewport(suzanne).resolution == 8
+    assert vb.load_visibility_bake(suzanne.data).date == on_mesh.date          # kept for the mesh's other users
+
+    subdivision.show_viewport = subdivision.show_render = False               # the faces are the mesh's again
+    assert _in_viewport(suzanne).usable and _in_viewport(suzanne).resolution == SMALL["resolution"]
+    subdivision.show_viewport = subdivision.show_render = True
+    vb.clear_visibility_bake(suzanne.data)
+    suzanne.modifiers.remove(subdivision)
+    gone = _in_viewport(suzanne)
+    assert gone.status == "STALE" and "its modifiers changed since the bake ('Subdivision' removed)" in gone.message
+
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    assert per_vertex_store.companion_mesh(suzanne, vb.KIND) is None
+    assert not [mesh.name for mesh in bpy.data.meshes if mesh.name.startswith("SG-PRT")]
+    assert _in_viewport(suzanne).usable and vb.load_visibility_bake(suzanne.data).usable
+
+
+def _subdivide_nodes():
+    """A Geometry Nodes group subdividing its geometry by its input "Level"."""
+    group = bpy.data.node_groups.new("Subdivide", "GeometryNodeTree")
+    group.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    level = group.interface.new_socket("Level", in_out="INPUT", socket_type="NodeSocketInt")
+    group.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    inputs, outputs = group.nodes.new("NodeGroupInput"), group.nodes.new("NodeGroupOutput")
+    subdivide = group.nodes.new("GeometryNodeSubdivideMesh")
+    group.links.new(inputs.outputs["Geometry"], subdivide.inputs["Mesh"])
+    group.links.new(inputs.outputs["Level"], subdivide.inputs["Level"])
+    group.links.new(subdivide.outputs["Mesh"], outputs.inputs["Geometry"])
+    return group, level.identifier
+
+
+def test_mirror_array_and_geometry_nodes_bake_their_evaluated_meshes(scene):
+    """Cubes under a Mirror (about the floor's origin), an Array and a Geometry Nodes subdivision bake their
+    evaluated meshes; a changed setting, node input or node group makes the bake stale and says which; moving a
+    node in the editor does not."""
+    from sg_prt_addon.blender import per_vertex_store
+
+    _, floor, suzanne = scene
+    cubes = {}
+    for name, location in (("Mirrored", (1.4, 0.0, 0.4)), ("Arrayed", (-1.8, 1.2, 0.4)), ("Noded", (0.0, -1.6, 0.4))):
+        bpy.ops.mesh.primitive_cube_add(size=0.5, location=location)
+        cubes[name] = bpy.context.active_object
+        cubes[name].name = name
+    mirror = cubes["Mirrored"].modifiers.new("Mirror", "MIRROR")
+    mirror.mirror_object = floor
+    array = cubes["Arrayed"].modifiers.new("Array", "ARRAY")
+    array.count = 3
+    nodes = cubes["Noded"].modifiers.new("GeometryNodes", "NODES")
+    group, level = _subdivide_nodes()
+    nodes.node_group = group
+    nodes[level] = 1
+    _select(*cubes.values())
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    for name, vertex_count in (("Mirrored", 16), ("Arrayed", 24), ("Noded", 26)):
+        stored = _as_rendered(cubes[name])
+        assert stored.usable and stored.vertex_count == vertex_count, (name, stored.message)
+        assert per_vertex_store.companion_mesh(cubes[name], vb.KIND) is not None
+        assert len(cubes[name].data.vertices) == 8 and not vb.has_visibility_bake(cubes[name].data)
+
+    array.count = 4
+    assert "('Array' count 3 -> 4)" in _as_rendered(cubes["Arrayed"]).message
+    nodes[level] = 2
+    cubes["Noded"].update_tag()
+    assert "('GeometryNodes' inputs changed)" in _as_rendered(cubes["Noded"]).message
+    nodes[level] = 1
+    cubes["Noded"].update_tag()
+    group.nodes["Group Output"].location.x += 100.0
+    assert _as_rendered(cubes["Noded"]).usable
+    group.nodes.new("GeometryNodeSetShadeSmooth")            # the group's content changed (unlinked: same faces)
+    assert "('GeometryNodes' node group 'Subdivide' edited)" in _as_rendered(cubes["Noded"]).message
+
+
+def test_a_cancelled_or_failed_rebake_keeps_the_previous_companion(scene):
+    from sg_prt_addon.blender import per_vertex_store
+
+    _, floor, suzanne = scene
+    suzanne.modifiers.new("Subdivision", "SUBSURF").render_levels = 1
+    _select(suzanne)
+    assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
+    companion = per_vertex_store.companion_mesh(suzanne, vb.KIND)
+    previous = _as_rendered(suzanne)
+    vb.progress_hook = lambda fraction, message: fraction > 0.2
+    assert bpy.ops.sgprt.bake_visibility(resolution=8, terms=3) == {"CANCELLED"}
+    vb.progress_hook = None
+    meshes = sorted(bpy.data.meshes.keys())
+
+    def fails(mesh):
+        raise ValueError("disk full")
+    with pytest.raises(ValueError, match="disk full"):
+        per_vertex_store.write_companion(suzanne, vb.KIND, per_vertex_store.EvaluatedTopology.of(suzanne.data), fails)
+    assert sorted(bpy.data.meshes.keys()) == meshes                 # the half-made companion went
+    assert per_vertex_store.companion_mesh(suzanne, vb.KIND) == companion
+    kept = _as_rendered(suzanne)
+    assert kept.usable and kept.resolution == SMALL["resolution"] and kept.date == previous.date
+    for field in ("packed_coefficients", "basis", "mean"):
+        assert np.array_equal(_bits(getattr(kept, field)), _bits(getattr(previous, field))), field

@@ -148,3 +148,48 @@ def test_bake_operator_to_render(engine):
     assert {data.terms for data in result["state"].visibility.values()} == {8}
     shadowed = result["passes"]["Combined"]
     assert (shadowed[..., 0] < 0.5 * unshadowed[..., 0]).mean() > 0.03
+
+
+def test_a_subdivided_floor_bakes_and_renders_shadowed_until_its_level_changes(engine):
+    """End to end through a modifier: a floor under a Subdivision Surface (level 0 in the viewport, 1 in renders)
+    baked by the operator (on a companion mesh of the render's faces) renders the sphere's shadow; at render level
+    2 its bake is stale: the report names the floor and the change, and the image is exactly the one without the
+    floor's bake."""
+    import bpy
+
+    from sg_prt_addon.blender import per_vertex_store, visibility_bake
+
+    scene, sphere, floor = _scene("subdivided_floor")
+    subdivision = floor.modifiers.new("Subdivision", "SUBSURF")
+    subdivision.levels, subdivision.render_levels = 0, 1
+    view_layer = scene.view_layers[0]
+
+    def bake(obj):
+        with bpy.context.temp_override(scene=scene, view_layer=view_layer, selected_objects=[obj]):
+            return bpy.ops.sgprt.bake_visibility(target="SELECTED", resolution=8, term_mode="FIXED", terms=8)
+
+    def render():
+        result = fx.render(scene)
+        assert "error" not in result, result.get("error")
+        return result["passes"]["Combined"].copy(), result["state"]
+
+    assert bake(sphere) == {"FINISHED"}                     # on its mesh: the same in every render below
+    sphere_only, _ = render()
+    assert bake(floor) == {"FINISHED"}
+    assert per_vertex_store.companion_mesh(floor, visibility_bake.KIND) is not None
+    assert not visibility_bake.has_visibility_bake(floor.data) and len(floor.data.polygons) == 16 * 16
+    shadowed, state = render()
+    floor_key = next(key for key in state.meshes if key.startswith(floor.name))
+    assert floor_key in state.visibility and state.meshes[floor_key].vertex_count == 33 * 33, state.visibility_status
+    darker = shadowed[..., 0] < 0.5 * sphere_only[..., 0]
+    assert darker.mean() > 0.02                             # the sphere's shadow on the floor
+    assert np.all(shadowed[..., :3] <= sphere_only[..., :3] * 1.001 + 1e-6)
+
+    subdivision.render_levels = 2
+    stale, state = render()
+    assert floor_key not in state.visibility and state.meshes[floor_key].vertex_count == 65 * 65
+    assert (f"object '{floor.name}' renders unshadowed: stale: its modifiers changed since the bake ('Subdivision' "
+            "render levels 1 -> 2): re-bake") in state.unshadowed_warnings(), state.unshadowed_warnings()
+    per_vertex_store.clear_object_record(floor, visibility_bake.KIND)
+    unbaked, _ = render()
+    np.testing.assert_array_equal(stale, unbaked)
