@@ -250,16 +250,18 @@ class SceneState:
         shade it (stale, unusable...) naming it and why; the objects with no bake at all in one line, when
         the scene has bakes (a scene never baked renders unshadowed by design)."""
         lines, unbaked, seen = [], [], set()
+        # both read once: each property builds a dict over every mesh (a read per object: quadratic)
+        visibility, visibility_status = self.visibility, self.visibility_status
         for entry in self.objects.values():
-            if entry.mesh_key in seen or entry.mesh_key in self.visibility:
+            if entry.mesh_key in seen or entry.mesh_key in visibility:
                 continue
             seen.add(entry.mesh_key)
-            status = self.visibility_status.get(entry.mesh_key, "no visibility bake")
+            status = visibility_status.get(entry.mesh_key, "no visibility bake")
             if status == "no visibility bake":
                 unbaked.append(entry.name)
             else:
                 lines.append(f"object '{entry.name}' renders unshadowed: {status}")
-        if unbaked and (self.visibility or lines):
+        if unbaked and (visibility or lines):
             names = ", ".join(f"'{name}'" for name in unbaked[:5]) + (" ..." if len(unbaked) > 5 else "")
             lines.append(f"{len(unbaked)} object(s) without a visibility bake render unshadowed: {names}")
         seen = set()
