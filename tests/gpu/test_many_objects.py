@@ -1,5 +1,5 @@
 """Many objects (issue 20's scaling): linked duplicates of a plain mesh share one export and one GPU copy,
-without changing the image."""
+and the draw loop binds a run of objects with one variant and material once; neither changes the image."""
 import engine_fixtures as fx
 import numpy as np
 import pytest
@@ -71,3 +71,48 @@ def test_linked_duplicates_share_one_export(engine, monkeypatch):
             if isinstance(image, np.ndarray):
                 assert np.array_equal(image, separate_result["passes"][name]), name
     assert (shared[0]["passes"]["gbuffer_normal"][..., 3] > 0).sum() > 100
+
+
+def test_objects_of_one_mesh_and_material_share_key_and_bindings(engine, monkeypatch):
+    """The draw loop makes a variant key once for the objects drawing one mesh and material (unless making it
+    read the object's transform) and binds a run of objects with one variant and material once (unless the
+    technique's bind reads the object's own): the image (passes and G-buffer, whose object ids are set per
+    object) equals the one made with a key and a bind for each object."""
+    from sg_prt_addon.techniques import sg_parametric
+
+    technique = sg_parametric.TECHNIQUE
+    scene, objects, baked = _spheres("runs")
+    keys, binds = [], []
+    variant_key, bind = technique.variant_key, technique.bind
+
+    def counted_key(params, inputs):
+        keys.append(params.name)
+        return variant_key(params, inputs)
+
+    def counted_bind(shader, key, context):
+        binds.append(key.visibility_layers)
+        return bind(shader, key, context)
+
+    monkeypatch.setattr(technique, "variant_key", counted_key)
+    monkeypatch.setattr(technique, "bind", counted_bind)
+    shared, bake = _render(scene, baked)
+    # each of the two renders: a key for each material of the linked spheres and one for the baked sphere
+    # (whose key reads its transform: shared light visibility); three runs of two unbaked spheres (the
+    # materials alternate in pairs) and the baked one, whose bind reads its rows
+    assert len(keys) == 2 * 3
+    assert binds.count(0) == 2 * 3 and len(binds) == 2 * 4
+
+    def key_reading_the_transform(params, inputs):
+        assert inputs.matrix_world.shape == (4, 4)
+        return counted_key(params, inputs)
+
+    monkeypatch.setattr(technique, "variant_key", key_reading_the_transform)
+    monkeypatch.setattr(technique, "bind_reads_object", lambda key: True)
+    keys.clear()
+    binds.clear()
+    every, _ = _render(scene, baked, bake)
+    assert len(keys) == len(binds) == 2 * (len(objects) + 1)
+    for shared_result, every_result in zip(shared, every):
+        for name, image in shared_result["passes"].items():
+            if isinstance(image, np.ndarray):
+                assert np.array_equal(image, every_result["passes"][name]), name
