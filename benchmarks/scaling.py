@@ -196,22 +196,38 @@ TIMES = (("render", "SG-PRT render()"), ("frame", "SG-PRT frame"), ("eevee", "EE
 
 
 def summarize(results):
-    """axis -> {what: log-log slope}, plus seconds per extra object on the objects' axes."""
+    """axis -> {what: log-log slope over every size, and over the two largest (fixed costs weigh on the small
+    sizes)}, plus seconds per extra object on the objects' axes."""
     summary = {}
     for axis, points in results.items():
         sizes = [point["size"] for point in points]
         entry = {f"slope_{key}": log_log_slope(sizes, [point[key] for point in points]) for key, _ in TIMES}
+        entry.update({f"end_slope_{key}": log_log_slope(sizes[-2:], [point[key] for point in points[-2:]])
+                      for key, _ in TIMES})
         if axis in ("objects", "instances"):
-            entry.update({f"per_object_{key}": linear_slope(sizes, [point[key] for point in points])
-                          for key, _ in TIMES})
+            parts = {key: [point[key] for point in points] for key, _ in TIMES}
+            parts["prepared"] = [point["export"] + point["upload"] for point in points]
+            parts["draw_and_read"] = [point["draw_and_read"] for point in points]
+            parts["rest"] = [point["render"] - prepared - point["draw_and_read"]
+                             for point, prepared in zip(points, parts["prepared"])]
+            entry.update({f"per_object_{key}": linear_slope(sizes, seconds) for key, seconds in parts.items()})
         summary[axis] = entry
     return summary
+
+
+def _compact(number):
+    """1000 -> 1k, 2000000 -> 2M: a tick's label."""
+    for scale, suffix in ((1_000_000, "M"), (1_000, "k")):
+        if number >= scale and number % (scale // 10) == 0:
+            return f"{number / scale:g}{suffix}"
+    return str(number)
 
 
 def plot(results, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     figure, axes = plt.subplots(1, len(results), figsize=(3.6 * len(results), 3.4), squeeze=False)
     for subplot, (axis, points) in zip(axes[0], results.items()):
@@ -220,6 +236,8 @@ def plot(results, path):
             subplot.plot(sizes, [point[key] for point in points], marker=marker, label=label)
         subplot.set_xscale("log")
         subplot.set_yscale("log")
+        subplot.set_xticks(sizes, [_compact(size) for size in sizes], fontsize=7)
+        subplot.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         subplot.set_xlabel(AXES[axis][0], fontsize=8)
         subplot.set_ylabel("seconds")
         subplot.set_title(axis)
@@ -241,10 +259,11 @@ def section(results, summary, command, plot_name):
              "scene state's export and the upload; the draw and read back; the rest is Blender's own, its "
              "depsgraph for the render and the result, and the render's report); frame: draw + read back 3 "
              "passes; EEVEE: 1 sample, matched node materials, after a warm-up. "
-             "Slopes: least-squares fit of log seconds against log size.")
+             "Slopes: least-squares fit of log seconds against log size (on the resolution axis, the image's side: "
+             "2 is linear in pixels).")
     lines = [SECTION_TITLE, "", textwrap.fill(intro, 100), "", f"![scaling]({plot_name})", ""]
     for axis, points in results.items():
-        lines += [f"| {AXES[axis][0]} | triangles | render() s | of which export + upload | draw + read back | "
+        lines += [f"| {AXES[axis][0]} | triangles drawn | render() s | of which export + upload | draw + read back | "
                   "the rest | frame s | EEVEE s | render() / EEVEE |", "|---|---|---|---|---|---|---|---|---|"]
         for point in points:
             prepared = point["export"] + point["upload"]
@@ -252,10 +271,15 @@ def section(results, summary, command, plot_name):
                          f"{point['draw_and_read']:.4f} | {point['render'] - prepared - point['draw_and_read']:.4f} | "
                          f"{point['frame']:.4f} | {point['eevee']:.3f} | {point['render'] / point['eevee']:.3f} |")
         slopes = summary[axis]
-        text = f"{axis}: log-log slope " + ", ".join(f"{label} {slopes['slope_' + key]:.2f}" for key, label in TIMES)
+        text = f"{axis}: log-log slope " + ", ".join(
+            f"{label} {slopes['slope_' + key]:.2f} ({slopes['end_slope_' + key]:.2f} between the two largest)"
+            for key, label in TIMES)
         if "per_object_render" in slopes:
             text += "; per extra object " + ", ".join(f"{label} {1e3 * slopes['per_object_' + key]:.3f} ms"
                                                       for key, label in TIMES)
+            text += (f" (render()'s export + upload {1e3 * slopes['per_object_prepared']:.3f} ms, draw + read back "
+                     f"{1e3 * slopes['per_object_draw_and_read']:.3f} ms, the rest "
+                     f"{1e3 * slopes['per_object_rest']:.3f} ms)")
             goal = "met" if slopes["per_object_render"] < OBJECT_COST_GOAL else "not met"
             text += f" (goal: render() under {1e3 * OBJECT_COST_GOAL:.1f} ms, {goal})"
         lines += ["", textwrap.fill(text + ".", 100), ""]
