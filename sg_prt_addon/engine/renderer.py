@@ -444,6 +444,9 @@ class Renderer:
         object of the state: the G-buffer's object id)."""
         light_data = state.light_data()
         draws = []
+        # (technique name, material, MeshBuffers) -> a variant key made without reading the object's transform:
+        # the same for every object drawing that mesh and material (ObjectInputs.matrix_world_read)
+        shared_keys = {}
         for object_index, (object_key, entry) in enumerate(state.objects.items()):
             buffers = self.mesh_buffers.get(entry.mesh_key)
             if buffers is None:
@@ -457,7 +460,13 @@ class Renderer:
                 if name not in self.material_buffers:
                     name = ""
                 technique = techniques.for_material(params)
-                slots.append((first_triangle, batch, name, params, technique, technique.variant_key(params, inputs)))
+                shared = (technique.name, name, id(params), buffers)       # params: the state's, alive all frame
+                key = shared_keys.get(shared)
+                if key is None:
+                    key = technique.variant_key(params, inputs)
+                    if not inputs.matrix_world_read:
+                        shared_keys[shared] = key
+                slots.append((first_triangle, batch, name, params, technique, key))
             draws.append((object_index, object_key, entry, _DrawContext(self, object_key, entry, buffers, inputs),
                           slots))
         return draws
@@ -476,26 +485,37 @@ class Renderer:
             gpu.state.face_culling_set("NONE")
             gpu.state.blend_set("NONE")
             if self.depth_prepass:
-                self._draw_depth(state)
+                self._draw_depth(draws)
                 gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
             else:       # holdouts shade nothing but occlude: their depth alone, first
-                self._draw_depth(state, holdouts_only=True)
-            for object_index, _object_key, entry, context, slots in draws:
-                if entry.holdout:       # a holdout's pixels keep the clear: (0, 0, 0, 0)
-                    continue
-                for first_triangle, batch, name, params, technique, key in slots:
-                    shader = shader_cache.get_shader(technique, key)
-                    shader.bind()
-                    shader.uniform_float("model_matrix", context.model_matrix)
-                    if self.gbuffer:
-                        shader.uniform_int("gbuffer_object_index", object_index)
-                        shader.uniform_int("gbuffer_triangle_offset", first_triangle)
-                    technique.bind(shader, key, context.for_material(name, params))
-                    batch.draw(shader)
+                self._draw_depth(draws, holdouts_only=True)
+            self._draw_surfaces(draws)
             if not self.gbuffer:
                 self._draw_background(camera, state.environment.prefiltered is not None, background_alpha)
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
+
+    def _draw_surfaces(self, draws):
+        """The shading pass.  A run of draws with one variant and material binds the shader and the
+        technique's resources once (a uniform block and texture binding per run, not per object), unless
+        the technique's bind reads the object's own (Technique.bind_reads_object): then per object."""
+        bound = None        # (shader, variant key, material name) of the bindings in place
+        for object_index, _object_key, entry, context, slots in draws:
+            if entry.holdout:       # a holdout's pixels keep the clear: (0, 0, 0, 0)
+                continue
+            for first_triangle, batch, name, params, technique, key in slots:
+                shader = shader_cache.get_shader(technique, key)
+                in_place = bound is not None and shader is bound[0] and name == bound[2] and (
+                    key is bound[1] or key == bound[1])
+                if not in_place or technique.bind_reads_object(key):
+                    shader.bind()
+                    technique.bind(shader, key, context.for_material(name, params))
+                    bound = (shader, key, name)
+                shader.uniform_float("model_matrix", context.model_matrix)
+                if self.gbuffer:
+                    shader.uniform_int("gbuffer_object_index", object_index)
+                    shader.uniform_int("gbuffer_triangle_offset", first_triangle)
+                batch.draw(shader)
 
     def _prepare_objects(self, draws):
         """Each technique's own passes for the objects that use it (Technique.prepare_object), before the
@@ -514,22 +534,22 @@ class Renderer:
             for technique, keys in by_technique.values():
                 technique.prepare_object(keys, context)
 
-    def _draw_depth(self, state, holdouts_only=False):
-        """Depth of every surface, no colour: the surface shaders then shade each pixel once instead of
-        every surface drawn over it (they are the frame's whole cost; the pre-pass is vertex work).
-        holdouts_only: the holdouts' depth alone (without the pre-pass the shading pass writes the rest)."""
+    def _draw_depth(self, draws, holdouts_only=False):
+        """Depth of every surface of object_draws' `draws`, no colour: the surface shaders then shade each
+        pixel once instead of every surface drawn over it (they are the frame's whole cost; the pre-pass is
+        vertex work).  holdouts_only: the holdouts' depth alone (without the pre-pass the shading pass writes
+        the rest)."""
         import gpu
 
         shader = shader_cache.get_depth_shader()
         shader.bind()
         shader.uniform_block("scene", self.scene_buffer)
         gpu.state.color_mask_set(False, False, False, False)
-        for entry in state.objects.values():
-            buffers = self.mesh_buffers.get(entry.mesh_key)
-            if buffers is None or (holdouts_only and not entry.holdout):
+        for _index, _object_key, entry, context, _slots in draws:
+            if holdouts_only and not entry.holdout:
                 continue
-            shader.uniform_float("model_matrix", _column_major(entry.matrix_world))
-            for _slot, _first_triangle, batch in buffers.batches:
+            shader.uniform_float("model_matrix", context.model_matrix)
+            for _slot, _first_triangle, batch in context.buffers.batches:
                 batch.draw(shader)
         gpu.state.color_mask_set(True, True, True, True)
 

@@ -134,6 +134,7 @@ class SceneState:
         # bad input met while exporting (NaN texels, degenerate normals...): said once a render/redraw
         self.warnings = []
         self._edited_meshes = None  # names of the meshes the update being applied edited (update())
+        self._exported_in_update = set()    # mesh keys exported by the update being applied (update())
         self._roles = export.RenderRoles(set(), set(), set())  # the view layer's, as of the last update()
 
     # ----------------------------------------------------------------- full sync
@@ -252,16 +253,18 @@ class SceneState:
         shade it (stale, unusable...) naming it and why; the objects with no bake at all in one line, when
         the scene has bakes (a scene never baked renders unshadowed by design)."""
         lines, unbaked, seen = [], [], set()
+        # both read once: each property builds a dict over every mesh (a read per object: quadratic)
+        visibility, visibility_status = self.visibility, self.visibility_status
         for entry in self.objects.values():
-            if entry.mesh_key in seen or entry.mesh_key in self.visibility:
+            if entry.mesh_key in seen or entry.mesh_key in visibility:
                 continue
             seen.add(entry.mesh_key)
-            status = self.visibility_status.get(entry.mesh_key, "no visibility bake")
+            status = visibility_status.get(entry.mesh_key, "no visibility bake")
             if status == "no visibility bake":
                 unbaked.append(entry.name)
             else:
                 lines.append(f"object '{entry.name}' renders unshadowed: {status}")
-        if unbaked and (self.visibility or lines):
+        if unbaked and (visibility or lines):
             names = ", ".join(f"'{name}'" for name in unbaked[:5]) + (" ..." if len(unbaked) > 5 else "")
             lines.append(f"{len(unbaked)} object(s) without a visibility bake render unshadowed: {names}")
         seen = set()
@@ -275,7 +278,11 @@ class SceneState:
 
     @staticmethod
     def _mesh_key(obj):
-        # evaluated data of modified objects is per object; plain meshes can be shared
+        """The key of the export an object draws: linked duplicates of a plain mesh (_is_plain_mesh) draw the
+        same evaluated mesh and its bakes (stored on the mesh), so they share one export and one GPU copy
+        (":mesh name", no object name can be empty); anything else evaluates per object ("object:mesh")."""
+        if _is_plain_mesh(obj):
+            return f":{obj.original.data.name_full}"
         data = obj.data
         return f"{obj.name}:{data.name if data is not None else ''}"
 
@@ -303,6 +310,7 @@ class SceneState:
         # material changed, so a plain mesh object re-exports only when its mesh is among these
         self._edited_meshes = {update.id.name for update in depsgraph.updates
                                if isinstance(update.id, bpy.types.Mesh) and update.is_updated_geometry}
+        self._exported_in_update = set()    # a shared mesh edited is exported once, not once per object
         self._roles = export.render_roles(depsgraph.view_layer)
         changed_sources = set()         # datablocks materials are computed from (export.MaterialParams.reads)
         for update in depsgraph.updates:
@@ -372,8 +380,10 @@ class SceneState:
                     dirty.lights = True
             elif obj.type in ("MESH", "CURVE", "SURFACE", "META", "FONT") and name not in self.objects:
                 mesh_key = self._mesh_key(obj)
-                self._export_mesh(obj, mesh_key)
-                dirty.meshes.add(mesh_key)
+                if mesh_key not in self._exported_in_update:
+                    self._export_mesh(obj, mesh_key)
+                    self._exported_in_update.add(mesh_key)
+                    dirty.meshes.add(mesh_key)
                 self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
                                                  self._read_materials(obj), obj.original.name in roles.holdout)
                 dirty.objects = True
@@ -393,9 +403,10 @@ class SceneState:
                 dirty.objects = True
             return
         mesh_key = self._mesh_key(obj)
-        if entry is None or mesh_key not in self.meshes or (update.is_updated_geometry and _geometry_may_differ(
-                obj, self._edited_meshes)):
+        if mesh_key not in self._exported_in_update and (entry is None or mesh_key not in self.meshes or (
+                update.is_updated_geometry and _geometry_may_differ(obj, self._edited_meshes))):
             self._export_mesh(obj, mesh_key)
+            self._exported_in_update.add(mesh_key)
             dirty.meshes.add(mesh_key)
         self.objects[obj.name] = ObjectEntry(obj.name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
                                              self._read_materials(obj), obj.original.name in self._roles.holdout)
@@ -494,16 +505,20 @@ def light_data(light_exports, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
     return data
 
 
+def _is_plain_mesh(obj):
+    """Whether an (evaluated) object draws its mesh as stored: a mesh object without modifiers or shape keys
+    (those, and other object types, evaluate from more than the mesh)."""
+    original = obj.original
+    return (original.type == "MESH" and not len(original.modifiers) and original.data is not None
+            and getattr(original.data, "shape_keys", None) is None)
+
+
 def _geometry_may_differ(obj, edited_meshes):
     """Whether an object whose update flags its geometry can shade differently: anything but a plain mesh
-    object (modifiers, shape keys and other types evaluate from more than the mesh) does; a plain mesh only
-    when its mesh itself was edited (edited_meshes; None: not known, so it may)."""
-    original = obj.original
-    if edited_meshes is None or original.type != "MESH" or len(original.modifiers) or original.data is None:
+    object does; a plain mesh only when its mesh itself was edited (edited_meshes; None: not known, so it may)."""
+    if edited_meshes is None or not _is_plain_mesh(obj):
         return True
-    if getattr(original.data, "shape_keys", None) is not None:
-        return True
-    return original.data.name in edited_meshes
+    return obj.original.data.name in edited_meshes
 
 
 def environment_data(world, layer_size=None):

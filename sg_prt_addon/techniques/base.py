@@ -28,7 +28,9 @@ class ObjectInputs:
     writes the G-buffer outputs; per_vertex: per-vertex kind ("ssdf", "transfer") -> vec4 rows a vertex of
     the object's usable precomputation (absent: none), per_vertex_data: kind -> its
     visibility.per_vertex.PerVertexData (numpy); bounds: (2, 3) local box or None; matrix_world (4, 4).
-    Derived values a technique computes once per object go in ``memo``."""
+    Derived values a technique computes once per object go in ``memo``.  Everything but matrix_world is the
+    frame's or the mesh's: reading matrix_world sets ``matrix_world_read``, and the engine reuses a variant key
+    for the other objects drawing the same mesh and material only when it was made without reading it."""
 
     def __init__(self, light_data, environment, gbuffer=False, per_vertex=None, bounds=None, matrix_world=None,
                  per_vertex_data=None):
@@ -38,8 +40,14 @@ class ObjectInputs:
         self.per_vertex = dict(per_vertex or {})
         self.per_vertex_data = dict(per_vertex_data or {})
         self.bounds = bounds
-        self.matrix_world = np.eye(4) if matrix_world is None else np.asarray(matrix_world)
+        self._matrix_world = np.eye(4) if matrix_world is None else np.asarray(matrix_world)
+        self.matrix_world_read = False
         self.memo = {}
+
+    @property
+    def matrix_world(self):
+        self.matrix_world_read = True
+        return self._matrix_world
 
     @functools.cached_property
     def has_lights(self):
@@ -89,6 +97,13 @@ class Technique:
 
     def bind(self, shader, key, context):
         raise NotImplementedError
+
+    def bind_reads_object(self, key):
+        """Whether bind(shader, key, context) binds anything of the object's own (context.per_vertex,
+        object_table, object_texture, inputs' bounds or matrix): the draw loop then calls it for every
+        object; otherwise once for a run of objects drawn with the same variant and material (what it
+        binds stays bound).  Default: True."""
+        return True
 
     def prepare_object(self, keys, context):
         """GPU work of the technique's own for one object before its surfaces are drawn (keys: the

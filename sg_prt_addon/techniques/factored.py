@@ -215,6 +215,9 @@ class Factored(Technique):
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
                                             per_vertex, push_constants=(("VEC4", "factor_scale"),))
 
+    def bind_reads_object(self, key):
+        return key.visibility_layers > 0        # the bake's rows, the mesh's
+
     def bind(self, shader, key, context):
         tables = tables_for(context.params)
         shader.uniform_block("scene", context.scene_buffer)

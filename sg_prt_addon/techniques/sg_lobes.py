@@ -276,6 +276,11 @@ class SGLobes(Technique):
 
     # ------------------------------------------------------------- drawing
 
+    def bind_reads_object(self, key):
+        # the bake's rows (the mesh's) and the per-vertex pass's target (the object's); the model hooks bind
+        # the material's tables only
+        return key.visibility_layers > 0
+
     def bind(self, shader, key, context):
         if key.visibility_layers:
             buffers = context.per_vertex(VISIBILITY_KIND)

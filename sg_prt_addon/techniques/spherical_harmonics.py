@@ -212,6 +212,10 @@ class SphericalHarmonics(Technique):
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
                                             per_vertex, push_constants=(("VEC4", "sh_axis"),))
 
+    def bind_reads_object(self, key):
+        # the transfer bake's rows and radiance table (the mesh's); the environment's row is the scene's
+        return key.transfer_layers > 0
+
     def bind(self, shader, key, context):
         table = table_for(context.params, key.order)
         environment = context.inputs.environment

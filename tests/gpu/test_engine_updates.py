@@ -89,6 +89,31 @@ def test_light_edit_and_removed_object(tracked_scene):
 
 
 
+def test_linked_duplicates_export_their_mesh_once(tracked_scene):
+    """Linked duplicates of a plain mesh share its export: added, the mesh is exported once for all of them;
+    an edit of the mesh re-exports it once, not once per object; a modifier gives an object its own export."""
+    bpy, scene, view_layer, state, material, first, second = tracked_scene
+    before = _exports()
+    duplicates = []
+    for index in range(3):
+        duplicate = fx.add_object(scene, bpy.data.objects.new(f"updates_duplicate{index}", first.data))
+        duplicate.location = (-2.0 * (index + 1), 0.0, 1.0)
+        duplicates.append(duplicate)
+    view_layer.update()
+    key = state.objects[first.name].mesh_key
+    assert all(state.objects[duplicate.name].mesh_key == key for duplicate in duplicates)
+    assert state.objects[second.name].mesh_key != key and _exports() == before + 1
+    state.consume_dirty()
+    first.data.vertices[0].co.x += 0.25
+    first.data.update()
+    view_layer.update()
+    assert _exports() == before + 2 and state.consume_dirty().meshes == {key}
+    duplicates[0].modifiers.new("updates_bevel", "BEVEL")
+    view_layer.update()
+    assert state.objects[duplicates[0].name].mesh_key != key
+    assert state.objects[duplicates[1].name].mesh_key == key
+
+
 def test_world_space_export_matches_blender(tracked_scene):
     """export.to_world against Blender's own evaluated world-space vertex positions and normals."""
     from sg_prt_addon.blender import export

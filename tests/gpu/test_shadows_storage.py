@@ -55,7 +55,7 @@ def test_stored_bakes_shadow_and_stale_bakes_do_not(engine):
     result = fx.render(scene)
     assert "error" not in result, result.get("error")
     state = result["state"]
-    floor_key = next(key for key in state.meshes if key.startswith(floor.name))
+    floor_key = state.objects[floor.name].mesh_key
     assert floor_key not in state.visibility
     assert "stale" in state.visibility_status[floor_key]
     assert len(state.visibility) == 1                      # the sphere keeps its shadows
@@ -119,7 +119,7 @@ def test_viewport_update_picks_up_a_new_bake_and_its_removal(blender):
             visibility_bake.store_visibility_bake(floor.data, bakes[floor.name])
             floor.data.update()                 # as the operator does after storing
             view_layer.update()
-            floor_key = next(key for key in state.meshes if key.startswith(floor.name))
+            floor_key = state.objects[floor.name].mesh_key
             assert floor_key in state.visibility, state.visibility_status
             assert floor_key in state.dirty.meshes
             state.consume_dirty()
