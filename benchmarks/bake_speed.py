@@ -108,11 +108,16 @@ def run(target_vertices, options=None):
     figures = {"vertices": len(vertices), "triangles": len(triangles), "seconds": result.seconds,
                "rays_per_vertex": result.rays_traced / len(vertices), "bake_rate": result.rays_traced / result.seconds,
                "raw_rate": raw, "terms": result.terms, "pca_rms": result.rms_error,
+               # Embree's own rate inside the bake: its rays over its thread-seconds, times the bake's threads
+               "casting_rate": result.rays_traced / result.seconds_tracing * options.threads,
+               "tracing_share": result.seconds_tracing / (options.threads * result.seconds),
                "dense_rms": dense_ssdf_error(result, vertices, triangles, normals),
                "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, "load": os.getloadavg()[0]}
     print(f"{figures['vertices']:6d} vertices, {figures['triangles']:6d} triangles: bake {result.seconds:6.1f} s, "
           f"{figures['rays_per_vertex']:6.0f} rays/vertex, {figures['bake_rate'] / 1e6:5.2f} M rays/s "
-          f"(raw RayTracer.occluded {raw / 1e6:5.2f} M rays/s, bake/raw {figures['bake_rate'] / raw:4.2f}); "
+          f"(raw RayTracer.occluded {raw / 1e6:5.2f} M rays/s, bake/raw {figures['bake_rate'] / raw:4.2f}; casting "
+          f"inside the bake {figures['casting_rate'] / 1e6:5.2f} M rays/s, {figures['casting_rate'] / raw:4.2f} of raw, "
+          f"{figures['tracing_share']:.0%} of the cores' time); "
           f"PCA {result.terms} terms, RMS {result.rms_error:.4f} rad; against dense rays {figures['dense_rms']:.4f} rad; "
           f"peak memory {figures['peak_mib']:.0f} MiB", flush=True)
     return result, figures
@@ -143,14 +148,19 @@ def section(sizes, rows, errors):
              "baked, the whole scene occludes, operator defaults (resolution 32, refinement 5, PCA error target "
              "0.02 rad).  Raw rate: RayTracer.occluded on 2M random hemisphere rays from the same vertices, both "
              "cores, in the same run.  SSDF error: the bake's decompressed SSDF at 64 vertices against the SSDF of "
-             "a dense 160 x 160 ray grid there.  Peak memory: the process's (it grows with the largest size run).")
+             "a dense 160 x 160 ray grid there.  Casting: Embree's rate inside the bake (its rays over the "
+             "thread-seconds spent in its queries, times the 2 threads) and the share of the two cores' bake time "
+             "spent there (the rest is the SSDF's boundary search, the PCA and numpy).  Peak memory: the "
+             "process's (it grows with the largest size run).")
     lines = [SECTION_TITLE, "", textwrap.fill(intro, 110), "",
-             "| vertices | bake (rays + SSDF + PCA) | rays/vertex | bake rays/s | raw rays/s | bake / raw | PCA terms, "
-             "RMS | SSDF error vs dense rays | peak memory | load |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "| vertices | bake (rays + SSDF + PCA) | rays/vertex | bake rays/s | raw rays/s | bake / raw | casting "
+             "rays/s (/ raw) | time in Embree | PCA terms, RMS | SSDF error vs dense rays | peak memory | load |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['vertices']:,} | {r['seconds']:.1f} s | {r['rays_per_vertex']:,.0f} | "
                      f"{r['bake_rate'] / 1e6:.2f} M | {r['raw_rate'] / 1e6:.2f} M | {r['bake_rate'] / r['raw_rate']:.2f} | "
+                     f"{r['casting_rate'] / 1e6:.2f} M ({r['casting_rate'] / r['raw_rate']:.2f}) | "
+                     f"{r['tracing_share']:.0%} | "
                      f"{r['terms']}, {r['pca_rms']:.4f} rad | {r['dense_rms']:.4f} rad | {r['peak_mib']:.0f} MiB | "
                      f"{r['load']:.1f} |")
     lines += ["", "PCA RMS angular error by terms (largest size): " + ", ".join(

@@ -48,6 +48,7 @@ class BakeResult:
     topology_hash: str              # of the baked mesh (vertex count + triangles): detects stale bakes
     frame_reference_axis: np.ndarray = field(default_factory=lambda: hemisphere_map.FRAME_REFERENCE_AXIS.copy())
     rays_traced: int = 0
+    seconds_tracing: float = 0.0    # inside Embree's queries, summed over threads (the rest is SSDF, PCA, numpy)
     seconds: float = 0.0
 
     def ssdf(self, vertex_index=slice(None)):
@@ -130,7 +131,7 @@ def bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_tr
                        relative_offset=options.relative_offset)
     try:
         samples = bake_ssdf(vertices, normals, tracer, options, progress, tangents)
-        rays = tracer.rays_traced
+        rays, seconds_tracing = tracer.rays_traced, tracer.seconds_tracing
     finally:
         tracer.close()
     _report(progress, 0.9, "PCA")
@@ -143,7 +144,7 @@ def bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_tr
         mean=model.mean.reshape(resolution, resolution).astype(np.float32),
         resolution=resolution, terms=model.terms, rms_error=model.rms_error,
         rms_error_by_terms=model.rms_error_by_terms, vertex_count=len(vertices),
-        topology_hash=topology_hash(len(vertices), triangles), rays_traced=rays,
+        topology_hash=topology_hash(len(vertices), triangles), rays_traced=rays, seconds_tracing=seconds_tracing,
         seconds=time.perf_counter() - started)
     if progress is not None:
         progress(1.0, "done")  # finished: a late cancel request no longer discards the result

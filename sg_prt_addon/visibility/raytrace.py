@@ -9,6 +9,7 @@ must move ray origins off the surface (``offset_origins``), or a ray leaving a
 triangle can hit that same triangle.
 """
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
@@ -73,6 +74,7 @@ class RayTracer:
             self._scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32), query="OCCLUDED")
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
         self.rays_traced = 0   # running count of rays queried, for throughput figures
+        self.seconds_tracing = 0.0      # summed over threads: the time inside Embree's occlusion queries
         self._count_lock = threading.Lock()     # queries may come from several threads at once
 
     def close(self):
@@ -95,9 +97,10 @@ class RayTracer:
             far = np.ascontiguousarray(np.clip(np.nan_to_num(far, nan=0.0, posinf=_EMBREE_FAR), 0, _EMBREE_FAR))
         return origins, directions, far
 
-    def _count(self, rays):
+    def _count(self, rays, seconds=0.0):
         with self._count_lock:
             self.rays_traced += rays
+            self.seconds_tracing += seconds
 
     def _map_chunks(self, work, count):
         starts = range(0, count, self.chunk_rays)
@@ -120,7 +123,9 @@ class RayTracer:
 
         def work(part):
             # tfar is copied per chunk: embreex may write into the array it is given.
+            started = time.perf_counter()
             ids = self._scene.run(origins[part], directions[part], dists=far[part].copy(), query="OCCLUDED")
+            self._count(0, time.perf_counter() - started)
             result[part] = ids != -1
 
         self._map_chunks(work, len(origins))
