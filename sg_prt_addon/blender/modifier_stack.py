@@ -92,6 +92,17 @@ def _node_tree_digest(tree, memo):
     return hashlib.blake2b(_dump([nodes, links]).encode(), digest_size=8).hexdigest()
 
 
+def _node_inputs(modifier, memo):
+    """A Geometry Nodes modifier's inputs by identifier: RNA structs (value, type, attribute name) under
+    ``properties.inputs`` from Blender 5.2, the modifier's ID properties before."""
+    interface = getattr(modifier, "properties", None)
+    if interface is not None:
+        inputs = interface.inputs
+        return {prop.identifier: _settings(getattr(inputs, prop.identifier), {"rna_type", "name"}, memo)
+                for prop in inputs.bl_rna.properties if prop.identifier not in ("rna_type", "name")}
+    return {key: _plain(modifier[key], memo) for key in modifier.keys()}
+
+
 def fingerprint(obj):
     """[[name, type, {setting: value}]] of an object's modifiers in order (JSON-ready): what a render evaluates.
     A Geometry Nodes modifier's inputs (its ID properties) are the setting "inputs"."""
@@ -99,8 +110,8 @@ def fingerprint(obj):
     stack = []
     for modifier in obj.modifiers:
         settings = _settings(modifier, NOT_RENDERED.union(VIEWPORT_LEVELS.get(modifier.type, ())), memo)
-        if modifier.type == "NODES":                    # the only modifier with ID properties: its inputs
-            settings["inputs"] = {key: _plain(modifier[key], memo) for key in modifier.keys()}
+        if modifier.type == "NODES":
+            settings["inputs"] = _node_inputs(modifier, memo)
         stack.append([modifier.name, modifier.type, settings])
     return json.loads(_dump(stack))                     # as it reads back from the record
 

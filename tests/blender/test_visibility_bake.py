@@ -616,6 +616,14 @@ def _subdivide_nodes():
     return group, level.identifier
 
 
+def _set_node_input(modifier, identifier, value):
+    """A Geometry Nodes modifier's input: an RNA struct's value from Blender 5.2, an ID property before."""
+    if hasattr(modifier, "properties"):
+        getattr(modifier.properties.inputs, identifier).value = value
+    else:
+        modifier[identifier] = value
+
+
 def test_mirror_array_and_geometry_nodes_bake_their_evaluated_meshes(scene):
     """Cubes under a Mirror (about the floor's origin), an Array and a Geometry Nodes subdivision bake their
     evaluated meshes; a changed setting, node input or node group makes the bake stale and says which; moving a
@@ -635,7 +643,7 @@ def test_mirror_array_and_geometry_nodes_bake_their_evaluated_meshes(scene):
     nodes = cubes["Noded"].modifiers.new("GeometryNodes", "NODES")
     group, level = _subdivide_nodes()
     nodes.node_group = group
-    nodes[level] = 1
+    _set_node_input(nodes, level, 1)
     _select(*cubes.values())
     assert bpy.ops.sgprt.bake_visibility() == {"FINISHED"}
     for name, vertex_count in (("Mirrored", 16), ("Arrayed", 24), ("Noded", 26)):
@@ -646,10 +654,10 @@ def test_mirror_array_and_geometry_nodes_bake_their_evaluated_meshes(scene):
 
     array.count = 4
     assert "('Array' count 3 -> 4)" in _as_rendered(cubes["Arrayed"]).message
-    nodes[level] = 2
+    _set_node_input(nodes, level, 2)
     cubes["Noded"].update_tag()
     assert "('GeometryNodes' inputs changed)" in _as_rendered(cubes["Noded"]).message
-    nodes[level] = 1
+    _set_node_input(nodes, level, 1)
     cubes["Noded"].update_tag()
     group.nodes["Group Output"].location.x += 100.0
     assert _as_rendered(cubes["Noded"]).usable
