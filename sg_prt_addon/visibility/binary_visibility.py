@@ -95,15 +95,18 @@ def _texels_to_trace(coarse, probe_flagged, refinement):
         return padded[:, 1 + row:resolution + 1 + row, 1 + col:resolution + 1 + col]
 
     half = refinement // 2
+    mixed_by_side = {}          # (side_row, side_col) -> (B, C, C): the texels of one side share their corners
     vertex, fine_row, fine_col = [], [], []
     for offset_row in range(refinement):
         for offset_col in range(refinement):
             if offset_row == half and offset_col == half:
                 continue                                    # the coarse ray itself
-            side_row, side_col = np.sign(offset_row - half), np.sign(offset_col - half)
-            corners = (coarse, shifted(side_row, 0), shifted(0, side_col), shifted(side_row, side_col))
-            mixed = np.logical_or.reduce(corners) != np.logical_and.reduce(corners)
-            cell_vertex, cell_row, cell_col = np.unravel_index(np.flatnonzero(mixed | probe_flagged), mixed.shape)
+            side = (int(np.sign(offset_row - half)), int(np.sign(offset_col - half)))
+            if side not in mixed_by_side:
+                a, b, c, d = coarse, shifted(side[0], 0), shifted(0, side[1]), shifted(*side)
+                mixed_by_side[side] = ((a | b | c | d) != (a & b & c & d)) | probe_flagged
+            mixed = mixed_by_side[side]
+            cell_vertex, cell_row, cell_col = np.unravel_index(np.flatnonzero(mixed), mixed.shape)
             vertex.append(cell_vertex)
             fine_row.append(cell_row * refinement + offset_row)
             fine_col.append(cell_col * refinement + offset_col)
@@ -132,7 +135,11 @@ def adaptive_visibility(tracer, origins, frames, coarse_resolution, refinement):
     vertex, rows, cols = _texels_to_trace(coarse, probe_flagged, refinement)
     if len(vertex) == 0:
         return fine, rays
-    local = _local_directions32(fine_resolution)[rows, cols][:, None, :]       # (M, 1, 3): one ray a texel
-    occluded = _occluded(tracer, np.asarray(origins)[vertex], local, np.asarray(frames)[vertex])
-    fine[vertex, rows, cols] = ~occluded[:, 0]
+    local = _local_directions32(fine_resolution)[rows, cols]                   # (M, 3): one ray a texel
+    frames32 = np.asarray(frames, np.float32)[vertex]                           # (M, 3, 3), rows t, b, n
+    # t x + b y + n z written out: a stack of M (1 x 3) @ (3 x 3) products is far slower in numpy
+    directions = (local[:, 0, None] * frames32[:, 0] + local[:, 1, None] * frames32[:, 1]
+                  + local[:, 2, None] * frames32[:, 2])
+    occluded = tracer.occluded(np.asarray(origins, np.float32)[vertex], directions)
+    fine[vertex, rows, cols] = ~occluded
     return fine, rays + len(vertex)
