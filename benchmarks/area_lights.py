@@ -71,7 +71,7 @@ FLOOR_SCENES = ("square_2_floor_baked",)     # a floor the sphere shadows: the v
 
 
 def build(name, size, patches):
-    from benchmarks import matched_materials, node_materials, truth_suite
+    from benchmarks import engine_vs_eevee, matched_materials, node_materials, truth_suite
 
     scene = truth_suite._start(size)
     truth_suite._black_world(scene)
@@ -80,12 +80,9 @@ def build(name, size, patches):
     truth_suite._sphere_camera(scene)
     scene.render.film_transparent = True
     if name in FLOOR_SCENES:
-        import bpy
-
         floor = truth_suite._floor()
         matched_materials.match_material(floor.data.materials[0])     # Cycles' node tree of its SG-PRT settings
-        if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
-            raise RuntimeError(f"{name}: the visibility bake did not finish")
+        engine_vs_eevee.bake_all(name)
     if hasattr(scene.sgprt, "area_light_patches"):     # (a before-run on an older commit has none)
         scene.sgprt.area_light_patches = patches
     return scene

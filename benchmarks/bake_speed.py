@@ -184,8 +184,7 @@ def main(argv=None):
     print(text)
     if "--update-doc" in arguments:
         from benchmarks import markdown_sections
-        markdown_sections.update_file(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
-                                                   "docs", "PERFORMANCE.md"), SECTION_TITLE, text)
+        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, SECTION_TITLE, text)
     return rows
 
 

@@ -33,14 +33,13 @@ def prepare(name, size, folder):
     """Build and bake scene `name`; save it for SG-PRT and for EEVEE; returns (sgprt .blend, eevee .blend)."""
     import bpy
 
-    from benchmarks import matched_materials
+    from benchmarks import engine_vs_eevee, matched_materials
     from examples import build_scenes
     from sg_prt_addon import render
 
     render.ensure_registered()
     scene = build_scenes.SCENES[name](size)
-    if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
-        raise RuntimeError(f"{name}: the visibility bake did not finish")
+    engine_vs_eevee.bake_all(name)
     paths = os.path.join(folder, f"{name}_sgprt.blend"), os.path.join(folder, f"{name}_eevee.blend")
     bpy.ops.wm.save_as_mainfile(filepath=paths[0])
     matched_materials.match_scene(scene)
@@ -148,7 +147,7 @@ def main(argv=None):
     print(text)
     if args.update_doc:
         from benchmarks import markdown_sections
-        markdown_sections.update_file(os.path.join(REPO_ROOT, "docs", "PERFORMANCE.md"), SECTION_TITLE, text)
+        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, SECTION_TITLE, text)
     return results
 
 

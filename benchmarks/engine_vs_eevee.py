@@ -43,6 +43,15 @@ def render_seconds():
     return seconds
 
 
+def bake_all(name, **options):
+    """Bake the visibility of every mesh of the context's scene (the operator, with `options`); raises if it did
+    not finish (`name`: the scene's, in the message)."""
+    import bpy
+
+    if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL", **options) != {"FINISHED"}:
+        raise RuntimeError(f"{name}: the visibility bake did not finish")
+
+
 def steady_frame(redraws, depth_prepass=True):
     """Median steady-state SG-PRT frame (draw + read back 3 passes) of one render's redraws."""
     from sg_prt_addon.engine import render_engine, renderer
@@ -93,8 +102,7 @@ def measure_scene(name, size, renders, redraws, eevee_samples):
     triangles = sum(len(obj.evaluated_get(depsgraph).data.loop_triangles)
                     for obj in scene.objects if obj.type == "MESH")
     start = time.perf_counter()
-    if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
-        raise RuntimeError(f"{name}: the visibility bake did not finish")
+    bake_all(name)
     figures = {"scene": name, "triangles": triangles, "bake": time.perf_counter() - start,
                "load_start": os.getloadavg()[0]}
     figures["first_render"] = render_seconds()
@@ -175,7 +183,7 @@ def main(argv=None):
     print(text)
     if args.update_doc:
         from benchmarks import markdown_sections
-        markdown_sections.update_file(os.path.join(REPO_ROOT, "docs", "PERFORMANCE.md"), SECTION_TITLE, text)
+        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, SECTION_TITLE, text)
     return results
 
 

@@ -56,9 +56,7 @@ SCENES = {"cube_8_vertices": _cube(), "cube_8x8_quads": _cube(3), "cylinder_flat
 
 
 def build(name, size):
-    import bpy
-
-    from benchmarks import matched_materials, truth_suite
+    from benchmarks import engine_vs_eevee, matched_materials, truth_suite
 
     scene = truth_suite._start(size)
     truth_suite._hdri(scene)
@@ -69,8 +67,7 @@ def build(name, size):
         matched_materials.match_material(material)      # Cycles' node tree of its SG-PRT settings
     truth_suite._sphere_camera(scene)
     scene.render.film_transparent = True
-    if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
-        raise RuntimeError(f"{name}: the visibility bake did not finish")
+    engine_vs_eevee.bake_all(name)
     return scene
 
 

@@ -100,13 +100,11 @@ def paired(rounds, new, old):
 
 
 def measure_scene(name, size, rounds):
-    import bpy
-
+    from benchmarks.engine_vs_eevee import bake_all
     from examples import build_scenes
 
     build_scenes.SCENES[name](size)
-    if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL") != {"FINISHED"}:
-        raise RuntimeError(f"{name}: the visibility bake did not finish")
+    bake_all(name)
     render_seconds(True)                       # compiles, prefilters
     rows = {}
     images = {}

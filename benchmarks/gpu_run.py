@@ -61,17 +61,14 @@ def platform():
 def example_scene(name, image_size, scenes_dir, bake_resolution, renders, redraws):
     """{scene, kind, triangles, objects, bake, render, frame, eevee} of an example scene, built, baked and
     saved into scenes_dir."""
-    import bpy
-
-    from benchmarks import scaling
+    from benchmarks import engine_vs_eevee, scaling
     from examples import build_scenes
 
     scene = build_scenes.SCENES[name]()
     scene.render.resolution_x, scene.render.resolution_y = image_size
     options = {"resolution": bake_resolution} if bake_resolution else {}
     start = time.perf_counter()
-    if bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL", **options) != {"FINISHED"}:
-        raise RuntimeError(f"{name}: the visibility bake did not finish")
+    engine_vs_eevee.bake_all(name, **options)
     bake = time.perf_counter() - start
     build_scenes.save_scene(Path(scenes_dir) / f"{name}.blend")
     row = {"scene": name, "kind": "example", "triangles": scaling.scene_triangles(scene),

@@ -1,4 +1,7 @@
 """Benchmarks write their own sections of docs/*.md, so the figures there are regenerated, never typed."""
+from pathlib import Path
+
+PERFORMANCE_DOC = Path(__file__).resolve().parents[1] / "docs" / "PERFORMANCE.md"
 
 
 def replace_section(text, title, section):

@@ -312,7 +312,7 @@ def main(argv=None):
         plot(results, PLOT_PATH)
         with open(JSON_PATH, "w", encoding="utf-8") as handle:
             json.dump({"results": results, "summary": summary}, handle, indent=1)
-        markdown_sections.update_file(os.path.join(REPO_ROOT, "docs", "PERFORMANCE.md"), SECTION_TITLE, text)
+        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, SECTION_TITLE, text)
     return results, summary
 
 
