@@ -49,11 +49,27 @@ def test_other_keys_and_other_code_are_misses(tmp_path, monkeypatch):
     assert build.calls == 5
 
 
-def test_the_code_digest_covers_the_package_sources():
-    digest = disk_cache.code_digest()
-    assert len(digest) == 32 and digest == disk_cache.code_digest()
-    assert "engine/disk_cache.py" in {str(path.relative_to(disk_cache._PACKAGE_ROOT))
-                                      for path in disk_cache._PACKAGE_ROOT.rglob("*.py")}
+def test_the_code_digest_changes_with_any_python_source(tmp_path, monkeypatch):
+    """An edit to any .py file of the add-on (not only the module that builds an entry) changes the digest;
+    other files do not."""
+    (tmp_path / "lighting").mkdir()
+    (tmp_path / "lighting" / "env_fit.py").write_text("LOBES = 8\n")
+    (tmp_path / "registration.py").write_text("")
+    monkeypatch.setattr(disk_cache, "_PACKAGE_ROOT", tmp_path)
+
+    def digest():
+        disk_cache.code_digest.cache_clear()
+        return disk_cache.code_digest()
+
+    try:
+        first = digest()
+        assert len(first) == 32 and digest() == first
+        (tmp_path / "README.md").write_text("notes")
+        assert digest() == first
+        (tmp_path / "lighting" / "env_fit.py").write_text("LOBES = 9\n")
+        assert digest() != first
+    finally:
+        disk_cache.code_digest.cache_clear()
 
 
 @pytest.mark.parametrize("damage", ["truncated", "garbage", "empty", "missing member"])
