@@ -471,8 +471,15 @@ def _usable_technique(material, params):
             warn(f"material '{material.name}': {factored.TECHNIQUE.label} factorizes the model with uniform "
                  f"parameters: the textures on {', '.join(ignored)} are not applied")
     if name == spherical_harmonics.NAME:
+        if material.sgprt.sh_brdf == "LOBE_FIT":
+            name = _usable_sh_lobe_fit(material, params)
+            if name != spherical_harmonics.NAME:
+                return name
         ignored = sorted(slot for slot in params.textures if slot not in spherical_harmonics.texture_slots(params))
-        if ignored:
+        if ignored and params.fitted is not None:
+            warn(f"material '{material.name}': {spherical_harmonics.TECHNIQUE.label} tabulates the lobe fit: the "
+                 f"textures on {', '.join(ignored)} are not applied")
+        elif ignored:
             warn(f"material '{material.name}': {spherical_harmonics.TECHNIQUE.label} tabulates the model with "
                  f"uniform {', '.join(ignored)}: those textures are not applied")
     if name == sg_biscale.NAME:
@@ -485,6 +492,28 @@ def _usable_technique(material, params):
                  "its model")
             return techniques.DEFAULT
     return name
+
+
+def _usable_sh_lobe_fit(material, params):
+    """SH with the material's stored lobe fit in params.fitted when it can tabulate it; else SH with the model
+    (no usable fit) or the fitted SG lobes (a fit SH cannot tabulate: free axes, too large), with the reason."""
+    from . import lobe_fit
+
+    label = spherical_harmonics.TECHNIQUE.label
+    fitted = export_fitted_lobes(material)
+    if fitted is None:
+        state, message = lobe_fit.fit_status(material)
+        warn(f"material '{material.name}': {label}: no usable lobe fit ({message or state.lower()}): its model is "
+             "tabulated")
+        return spherical_harmonics.NAME
+    reason = _lobe_tilt(fitted) or spherical_harmonics.fitted_refusal(fitted, params.sh_order)
+    if reason is not None:
+        params.fitted = fitted
+        warn(f"material '{material.name}': {label} cannot tabulate its lobe fit ({reason}): rendered with "
+             f"{sg_fitted.TECHNIQUE.label}")
+        return sg_fitted.NAME
+    params.fitted = fitted
+    return spherical_harmonics.NAME
 
 
 def _usable_biscale(material, params):
@@ -534,11 +563,18 @@ def _isotropic_lobe_fit(material):
     if fitted is None:
         state, message = lobe_fit.fit_status(material)
         return None, message or state.lower()
+    reason = _lobe_tilt(fitted)
+    if reason is not None:
+        return None, reason + " for an isotropic small-scale BRDF"
+    return fitted, None
+
+
+def _lobe_tilt(fitted):
+    """Why a FittedLobes is not isotropic (its lobes leave the normal: a free-axes fit), or None."""
     tilt, degrees = effective_brdf.axis_tilt(fitted.layers[1:1 + 2 * fitted.lobe_count:2, ..., :3])
     if tilt > effective_brdf.AXIS_TOLERANCE:
-        return None, (f"its lobes leave the normal by up to {degrees:.1f} degrees: fit with Axes Auto for an "
-                      "isotropic small-scale BRDF")
-    return fitted, None
+        return f"its lobes leave the normal by up to {degrees:.1f} degrees: fit with Axes Auto"
+    return None
 
 
 def export_material(material):

@@ -28,7 +28,8 @@ microfacet_fit.relative_rmse, mean / max over texels), ``ndf_error`` (mean relat
 of the SG fit of D), ``date`` (ISO 8601 UTC), ``seconds``, and ``images``: a collection of
 (``role``, ``image``).  A fit sets ``material.sgprt.technique`` to the fitted-lobes technique
 (techniques/sg_fitted.py): the engine then renders the fit instead of ``model``; clearing the fit sets
-the default technique back.
+the default technique back.  A bi-scale material keeps its technique and takes the fit as its small-scale
+BRDF; a spherical-harmonics material keeps its technique and tabulates the fit (``sh_brdf`` LOBE_FIT).
 
 Every image is a FLOAT RGBA image (32-bit float), packed into the .blend (OpenEXR,
 float32-exact through save and reopen on 4.2 and 5.0), colour space Non-Color,
@@ -68,7 +69,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from .. import techniques
 from ..measured import merl as merl_format
 from ..measured import microfacet_fit, svbrdf_table
-from ..techniques import sg_biscale, sg_fitted
+from ..techniques import sg_biscale, sg_fitted, spherical_harmonics
 from .background_job import BackgroundJob, MaterialFileJobOperator, active_material
 from .panels import MaterialPanel
 
@@ -335,8 +336,11 @@ def store_lobe_fit(material, result, path, free_axes=None):
     settings.date = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     settings.seconds = float(result["seconds"])
     settings.format_version = FORMAT_VERSION
-    if techniques.of_settings(material.sgprt) == sg_biscale.NAME:
+    technique = techniques.of_settings(material.sgprt)
+    if technique == sg_biscale.NAME:
         material.sgprt.biscale.small_scale = "LOBE_FIT"      # a bi-scale material's fit is its small-scale BRDF
+    elif technique == spherical_harmonics.NAME:
+        material.sgprt.sh_brdf = "LOBE_FIT"                  # an SH material tabulates the fit
     else:
         material.sgprt.technique = sg_fitted.NAME
     material.update_tag()
@@ -497,6 +501,14 @@ class SGPRT_PT_material_lobe_fit(MaterialPanel, bpy.types.Panel):
         technique = techniques.of_settings(material.sgprt)
         if technique == sg_biscale.NAME and material.sgprt.biscale.small_scale == "LOBE_FIT":
             column.label(text="The small-scale BRDF of the bi-scale material", icon="INFO")
+        elif technique == spherical_harmonics.NAME and material.sgprt.sh_brdf == "LOBE_FIT":
+            if settings.free_axes:
+                column.label(text="Free axes: SH tabulates lobes about the normal only: rendered as SG lobes",
+                             icon="INFO")
+            else:
+                column.label(text="Tabulated per texel by the SH technique", icon="INFO")
+        elif technique == spherical_harmonics.NAME:
+            column.label(text="Renders the model: set SH BRDF to Lobe Fit to render the fit", icon="INFO")
         elif technique != sg_fitted.NAME:
             column.label(text="Renders the model: pick the fitted technique above to render the fit", icon="INFO")
         if state == "INVALID":

@@ -25,6 +25,7 @@ def _draw_technique_settings(layout, settings):
     if techniques.of_settings(settings) == spherical_harmonics.NAME:
         layout.prop(settings, "sh_order")
         layout.prop(settings, "sh_window")
+        layout.prop(settings, "sh_brdf")
     else:
         layout.prop(settings, "view_warp")
 

@@ -24,6 +24,9 @@ from ..reflectance import models
 SH_WINDOWS = (("NONE", "None", "The bands as projected (sharpest; rings around small bright lights)"),
               ("HANNING", "Hanning", "(1 + cos(pi l / N)) / 2 per band: the least ringing, the most blur"),
               ("LANCZOS", "Lanczos", "sinc(l / N) per band: less blur than Hanning, more ringing"))
+SH_BRDFS = (("MODEL", "Material Model", "The material's model and parameters, tabulated over its parameter axis"),
+            ("LOBE_FIT", "Lobe Fit", "The material's stored lobe fit (Fit Lobes: a measured BRDF or SVBRDF, lobes "
+                                     "about the normal), tabulated per texel"))
 VIEW_WARPS = (
     ("SPLIT3", "3 Lobes", "Three warped lobes per NDF lobe (default): the most accurate at grazing views "
                           "(mean energy error 0.09 at 75 degrees)"),
@@ -248,6 +251,8 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                                       "Kautz 2002 used 5): higher follows sharper lights and glossier lobes")
     sh_window: EnumProperty(update=_tag_changed, name="SH Window", items=SH_WINDOWS, default="NONE",
                             description="Smoothing of the lighting's bands against ringing (it blurs)")
+    sh_brdf: EnumProperty(update=_tag_changed, name="SH BRDF", items=SH_BRDFS, default="MODEL",
+                          description="What the spherical-harmonic technique tabulates")
     fresnel: EnumProperty(update=_tag_changed, name="Fresnel", items=FRESNEL_MODES, default="NONE",
                           description="How the specular colour changes with angle (reflectance/layering.py)")
     multiscatter: BoolProperty(update=_tag_changed, name="Multiscatter", default=False,

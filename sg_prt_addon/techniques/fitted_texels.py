@@ -1,7 +1,8 @@
-"""Numpy mirror of sg_shading.glsl's fitted_* functions: a stored lobe fit (blender.lobe_fit, export.FittedLobes)
-read at each pixel's texel, its shadowing S and its M_o(i) = F_eta(i.h) S(o) S(i) / (pi (i.n)(o.n)).  Shared by the
-fitted-lobes technique's slice (sg_shading) and a bi-scale material whose small-scale BRDF is the fit
-(biscale_shading)."""
+"""Numpy mirror of shaders/techniques/common/fitted_texels.glsl and sg_shading.glsl's fitted_m_factor: a stored
+lobe fit (blender.lobe_fit, export.FittedLobes) read at each pixel's texel, its shadowing S and its
+M_o(i) = F_eta(i.h) S(o) S(i) / (pi (i.n)(o.n)).  Shared by the fitted-lobes technique's slice (sg_shading), a
+bi-scale material whose small-scale BRDF is the fit (biscale_shading) and the SH technique's tables of the fit
+(spherical_harmonics, sh_shading)."""
 import numpy as np
 
 from ..measured.microfacet_fit import decompress_shadowing
@@ -14,14 +15,31 @@ FITTED_MODEL = "FITTED"        # the variant's model with a stored fit (MODEL_FI
 
 
 def fitted_texel_values(fitted, uv):
-    """surface.frag.glsl's fitted_select_texel + fetches: the nearest texel of the UV (floor(uv * size),
+    """fitted_texels.glsl's fitted_select_texel + fetches: the nearest texel of the UV (floor(uv * size),
     clamped) in an export.FittedLobes; returns the shade() params of model FITTED and (kd (N, 3), eta (N,))."""
     layers = np.asarray(fitted.layers, FLOAT)                       # (L, H, W, 4), row 0 at t = 0
-    height, width = layers.shape[1:3]
+    texels = texel_indices(fitted, uv)
+    return _texel_values(fitted, layers.reshape(layers.shape[0], -1, 4)[:, texels])
+
+
+def texel_indices(fitted, uv):
+    """Row-major index y W + x of the UV's nearest texel (fitted_select_texel), (N,)."""
+    height, width = fitted.layers.shape[1:3]
     uv = np.asarray(uv, FLOAT)
     x = np.clip(np.floor(uv[:, 0] * FLOAT(width)).astype(np.int64), 0, width - 1)
     y = np.clip(np.floor(uv[:, 1] * FLOAT(height)).astype(np.int64), 0, height - 1)
-    texel = layers[:, y, x]                                         # (L, N, 4)
+    return y * width + x
+
+
+def every_texel(fitted):
+    """fitted_texel_values of every texel of an export.FittedLobes, row-major from row 0 (t = 0): texel
+    y W + x."""
+    layers = np.asarray(fitted.layers, FLOAT)
+    return _texel_values(fitted, layers.reshape(layers.shape[0], -1, 4))
+
+
+def _texel_values(fitted, texel):
+    """The shade() params and kd of texels' layers (L, N, 4)."""
     count = fitted.lobe_count
     lobes = np.stack([texel[1 + 2 * k] for k in range(count)], axis=1)        # (N, K, 4)
     colour = np.stack([texel[2 + 2 * k, :, :3] for k in range(count)], axis=1)

@@ -24,6 +24,7 @@ from ..reflectance import brdf
 from ..spherical import clamped_cosine_table, warp
 from . import sg_shading, shader_sources, surface_layering
 from .base import Technique
+from .fitted_texels import FITTED_MODEL
 from .shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
 
 GLSL_DIR = "sg"
@@ -32,7 +33,7 @@ LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_c
                  "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
 # (directory under shaders/techniques, file) in order: lobe_visibility is shared with other techniques
 TECHNIQUE_FILES = (("sg", "anisotropic_lobes.glsl"), ("sg", "ggx_two_lobes.glsl"), ("common", "lobe_visibility.glsl"),
-                   ("sg", "sg_shading.glsl"))
+                   ("common", "fitted_texels.glsl"), ("sg", "sg_shading.glsl"))
 # The per-vertex precomputation this technique reads (visibility.per_vertex kinds)
 VISIBILITY_KIND = "ssdf"
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
@@ -237,6 +238,8 @@ class SGLobes(Technique):
         wanted = set(self.model_files(key) if key.has_specular else ()) | {"sg_shading.glsl"}
         if key.visibility_layers:
             wanted.add("lobe_visibility.glsl")
+        if key.model == FITTED_MODEL:
+            wanted.add("fitted_texels.glsl")
         return [(folder, name) for folder, name in TECHNIQUE_FILES if name in wanted]
 
     def fragment_source(self, key):

@@ -1,9 +1,11 @@
 """The generated part of the SH technique's GLSL: the constants of an order and window (normalization,
-window factors, the clamped cosine's A_l) and the two fixed x rotations of the zyz method unrolled over
+window factors, the clamped cosine's A_l, the indices a lobe fit's table stores: harmonics.fitted_table) and
+the two fixed x rotations of the zyz method unrolled over
 their non-zero entries (harmonics.rotation.x90_blocks), so the shader does exactly the numpy's sums."""
 import math
 
-from ..harmonics import basis, projection, rotation
+from ..harmonics import basis, fitted_table, projection, rotation
+from ..reflectance import brdf
 
 
 def _floats(values):
@@ -28,10 +30,15 @@ def constants_source(order, window):
     normalization = [basis.normalization(band, m) * (math.sqrt(2.0) if m else 1.0)
                      for band in range(order) for m in range(band + 1)]
     cosine = projection.clamped_cosine_zonal(order) / [basis.normalization(band, 0) for band in range(order)]
+    stored = fitted_table.positive_m_indices(order)
     parts = [f"#define SH_ORDER {order}", f"#define SH_COUNT {order * order}",
              f"const float SH_NORMALIZATION[{len(normalization)}] = float[]({_floats(normalization)});",
              f"const float SH_WINDOW[SH_ORDER] = float[]({_floats(projection.window_factors(window, order))});",
              "/* A_l: the clamped cosine's bands (Ramamoorthi and Hanrahan 2001) */",
              f"const float SH_COSINE[SH_ORDER] = float[]({_floats(cosine)});",
+             f"#define SH_STORED {len(stored)}",
+             "/* a lobe fit's table stores the m >= 0 coefficients (l, then m = 0 .. l): their indices */",
+             f"const int SH_STORED_INDEX[SH_STORED] = int[]({', '.join(str(i) for i in stored)});",
+             f"const float SH_COSINE_EPSILON = {brdf.COSINE_EPSILON:.9e};      /* brdf.COSINE_EPSILON */",
              _x90_function("sh_rotate_x90", order, False), _x90_function("sh_rotate_x90_inverse", order, True)]
     return "\n".join(parts) + "\n"

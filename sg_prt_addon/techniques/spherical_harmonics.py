@@ -6,7 +6,11 @@ mirror).
 What it reads: the material's model and parameters; an isotropic model's table has its spatially varying
 parameter (roughness, exponent, alpha) as an axis, so that parameter's texture applies, as in the paper's
 Fig. 4; an anisotropic model's parameters are uniform over the material (their textures are warned and
-not applied).  Lighting: the environment's equirect map projected once per map (SH_ENVIRONMENT_ORDER
+not applied).  Or (SH BRDF: Lobe Fit, export puts it in params.fitted) the material's stored lobe fit, the
+measured BRDF SG_FITTED renders: a table per texel of the fit (harmonics/fitted_table.py, the texel as the
+axis, nearest texel as SG_FITTED reads it), kd from the fit, only a normal map of the textures; isotropic
+fits only (export refuses free axes and tables over fitted_table.MAX_TABLE_BYTES, rendering them with the
+fitted SG lobes).  Lighting: the environment's equirect map projected once per map (SH_ENVIRONMENT_ORDER
 bands, truncated to the material's order), or the world colour; point and spot lights as uniform caps,
 suns as their SG (both zonal about their direction).  The material's order (2-8) and window (none,
 Hanning, Lanczos: ringing against blur, docs/ACCURACY.md) pick the variant.
@@ -25,10 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..harmonics import brdf_table, projection
+from ..harmonics import brdf_table, fitted_table, projection
 from ..reflectance import models
 from ..visibility import transfer
-from . import sh_glsl, sh_shading, shader_sources, surface_layering
+from . import fitted_texels, sh_glsl, sh_shading, shader_sources, surface_layering
 from .base import Technique
 
 NAME = "SH"
@@ -57,11 +61,13 @@ class SHKey:
     gbuffer: bool = False
     transfer_layers: int = 0            # vec4 rows a vertex of the transfer bake (0: none)
     layering: tuple = ()            # surface_layering.flags of the material
+    fitted_lobes: int = 0           # a stored lobe fit's tables (SH_FITTED): its lobes (0: the model's table)
+    fitted_components: int = 0      # and its shadowing's PCA components
 
     def describe(self):
-        parts = [f"order {self.order}", f"window {self.window}",
-                 f"{self.parameter} axis" if self.isotropic else "anisotropic map",
-                 "lights" if self.has_lights else "no lights"]
+        table = (f"lobe fit ({self.fitted_lobes} lobes)" if self.fitted_lobes else
+                 f"{self.parameter} axis" if self.isotropic else "anisotropic map")
+        parts = [f"order {self.order}", f"window {self.window}", table, "lights" if self.has_lights else "no lights"]
         if self.textures:
             parts.append("textures: " + ", ".join(self.textures))
         if self.gbuffer:
@@ -75,22 +81,50 @@ class SHKey:
 
 def texture_slots(params):
     """The texture slots the technique applies for a material: the colours, the normal map, and the table
-    axis parameter's texture."""
+    axis parameter's texture; with a lobe fit the normal map alone (the fit holds the look)."""
+    if getattr(params, "fitted", None) is not None:
+        return ("normal_map",)
     axis = brdf_table.PARAMETER_AXES.get(params.model)
     return COLOUR_SLOTS + ((axis[0],) if axis else ())
 
 
 def table_for(params, order=None):
-    """The BrdfTable of a material (export.MaterialParams): its model at its order (or `order`, the variant's:
-    a transfer bake of a lower order lowers it) and fixed parameters."""
+    """The table of a material (export.MaterialParams) at its order (or `order`, the variant's: a transfer bake
+    of a lower order lowers it): its lobe fit's FittedTable when params.fitted, else its model's BrdfTable
+    with its fixed parameters."""
+    order = int(order or params.sh_order)
+    if getattr(params, "fitted", None) is not None:
+        return fitted_table_for(params.fitted, order)
     model = models.BY_NAME[params.model]
     values = {name: float(getattr(params, name)) for name in model.parameters}
-    return brdf_table.table_for(params.model, order=int(order or params.sh_order), **values)
+    return brdf_table.table_for(params.model, order=order, **values)
+
+
+def fitted_table_for(fitted, order):
+    """The harmonics.fitted_table.FittedTable of an export.FittedLobes: its texels as the SG_FITTED mirror reads
+    them (fitted_texels.every_texel), so both tabulate the same BRDF."""
+    values, _ = fitted_texels.every_texel(fitted)
+    return fitted_table.table_for(values["sharpness"], values["eta"], values["shadowing"], values["shadowing_theta"],
+                                  fitted.layers.shape[1:3], order)
+
+
+def fitted_refusal(fitted, order):
+    """Why the SH technique cannot tabulate an isotropic export.FittedLobes at an order (its table's size), or
+    None."""
+    height, width = fitted.layers.shape[1:3]
+    size = fitted_table.table_bytes(height * width, fitted.lobe_count, order)
+    if size > fitted_table.MAX_TABLE_BYTES:
+        return (f"its {width}x{height} texels' tables at order {order} would take {size / 2 ** 20:.3g} MB, more "
+                f"than {fitted_table.MAX_TABLE_BYTES / 2 ** 20:.3g}: a lower SH order or a smaller fit")
+    if width * fitted_table.DEFAULT_VIEWS > fitted_table.MAX_TEXTURE_WIDTH:
+        return (f"its {width} texels a row make a table texture wider than "
+                f"{fitted_table.MAX_TEXTURE_WIDTH} texels")
+    return None
 
 
 def axis_constants(table):
     """sh_axis of the shader (sh_shading.glsl): the parameter axis' scale, low end, log flag, node count."""
-    if table.layout != "theta":
+    if table.layout != "theta" or table.parameter is None:
         return [0.0, 1.0, 0.0, 1.0]
     _, spacing, low, high = brdf_table.PARAMETER_AXES[table.model]
     scale = 1.0 / math.log(high / low) if spacing == "log" else 1.0 / (high - low)
@@ -149,24 +183,30 @@ class SphericalHarmonics(Technique):
     mirror = staticmethod(sh_shading.shade_fragments)
 
     def variant_key(self, params, inputs):
-        axis = brdf_table.PARAMETER_AXES.get(params.model)
+        fitted = getattr(params, "fitted", None)
+        axis = brdf_table.PARAMETER_AXES.get(params.model) if fitted is None else None
         slots = texture_slots(params)
         textures = tuple(sorted(name for name in params.textures if name in slots))
         order = int(np.clip(int(getattr(params, "sh_order", DEFAULT_ORDER)), min(ORDERS), max(ORDERS)))
         data = inputs.per_vertex_data.get(TRANSFER_KIND)
         if data is not None:
             order = min(order, transfer_order(data))
-        return SHKey(order=order, window=getattr(params, "sh_window", "none"), isotropic=axis is not None,
-                     parameter=axis[0] if axis else None, textures=textures, has_lights=inputs.has_lights,
-                     gbuffer=inputs.gbuffer, transfer_layers=data.layers if data is not None else 0,
-                     layering=surface_layering.flags(params))
+        fit = dict(fitted_lobes=int(fitted.lobe_count), fitted_components=int(fitted.components),
+                   layering=()) if fitted is not None else dict(layering=surface_layering.flags(params))
+        return SHKey(order=order, window=getattr(params, "sh_window", "none"),
+                     isotropic=axis is not None or fitted is not None, parameter=axis[0] if axis else None,
+                     textures=textures, has_lights=inputs.has_lights, gbuffer=inputs.gbuffer,
+                     transfer_layers=data.layers if data is not None else 0, **fit)
 
     def defines(self, key):
-        out = {"SH_PARAMETER": PARAMETER_FIELDS[key.parameter] if key.isotropic else "0.0"}
+        out = {"SH_PARAMETER": PARAMETER_FIELDS[key.parameter] if key.parameter else "0.0"}
         if key.isotropic:
             out["SH_ISOTROPIC"] = 1
             if key.parameter in key.textures:
                 out["SH_PARAMETER_TEXTURE"] = "texture_" + key.parameter
+        if key.fitted_lobes:
+            out.update(SH_FITTED=1, FITTED_LOBES=key.fitted_lobes, FITTED_COMPONENTS=key.fitted_components,
+                       FITTED_SHADOWING_LAYERS=-(-key.fitted_components // 4))
         if key.has_lights:
             out["HAS_LIGHTS"] = 1
         for name in key.textures:
@@ -182,6 +222,8 @@ class SphericalHarmonics(Technique):
 
     def samplers(self, key):
         samplers = [("FLOAT_2D_ARRAY", "sh_table"), ("FLOAT_2D", "sh_environment")]
+        if key.fitted_lobes:           # texelFetch: the UV's nearest texel, as SG_FITTED reads it
+            samplers += [("FLOAT_2D_ARRAY", "fitted_layers"), ("FLOAT_2D", "fitted_shadowing")]
         if key.transfer_layers:
             samplers += [("FLOAT_2D", "transfer_coefficients"), ("FLOAT_2D", "sh_transfer_radiance")]
             if key.has_lights:
@@ -202,6 +244,8 @@ class SphericalHarmonics(Technique):
                                                                                  "surface_io.glsl")]
         if key.layering:
             sources.append(surface_layering.source())
+        if key.fitted_lobes:
+            sources.append(shader_sources.technique_source("common", "fitted_texels.glsl"))
         sources.append(sh_glsl.constants_source(key.order, key.window))
         per_vertex = self.per_vertex_inputs(key)
         if per_vertex:
@@ -217,14 +261,21 @@ class SphericalHarmonics(Technique):
         return key.transfer_layers > 0
 
     def bind(self, shader, key, context):
-        table = table_for(context.params, key.order)
         environment = context.inputs.environment
         shader.uniform_block("scene", context.scene_buffer)
         shader.uniform_block("material", context.material_buffer)
-        if key.isotropic:              # an anisotropic map has no parameter axis: the constant is compiled out
-            shader.uniform_float("sh_axis", axis_constants(table))
-        shader.uniform_sampler("sh_table", context.material_table(f"sh_table_{key.order}",
-                                                                  lambda: brdf_table.texture_layers(table)))
+        if key.fitted_lobes:           # built once a fit and order (seconds for 64 x 64 texels), then the GPU's copy
+            fitted = context.params.fitted
+            shader.uniform_sampler("sh_table", context.material_table(
+                f"sh_fitted_table_{key.order}", lambda: fitted_table.texture_layers(fitted_table_for(fitted, key.order))))
+            shader.uniform_sampler("fitted_layers", context.material_table("fitted_layers", lambda: fitted.layers))
+            shader.uniform_sampler("fitted_shadowing", context.material_table("fitted_shadowing", lambda: fitted.table))
+        else:
+            table = table_for(context.params, key.order)
+            if key.isotropic:          # an anisotropic map has no parameter axis: the constant is compiled out
+                shader.uniform_float("sh_axis", axis_constants(table))
+            shader.uniform_sampler("sh_table", context.material_table(f"sh_table_{key.order}",
+                                                                      lambda: brdf_table.texture_layers(table)))
 
         def environment_row():
             coefficients = environment_coefficients(environment)

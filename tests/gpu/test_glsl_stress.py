@@ -563,16 +563,16 @@ def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
 
 RESOURCE_KERNELS = {
     "../common/lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility"],
-    "sg_shading.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_layer",
-                        "fitted_select_texel", "fitted_node_theta", "fitted_node_value", "fitted_shadowing_at",
-                        "fitted_shadowing_of", "fitted_m_factor"],
+    "sg_shading.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_m_factor"],
+    "../common/fitted_texels.glsl": ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
+                                     "fitted_shadowing_at", "fitted_shadowing_of"],
     "anisotropic_lobes.glsl": ["anisotropic_lobes"],
     "ggx_two_lobes.glsl": ["ggx_two_lobes"],
     "../common/surface_common.glsl": ["shading_frame", "apply_normal_map", "rotate_tangent"],
     "../factored/factored_shading.glsl": ["parabolic_uv", "factored_brdf"],
     "../sh/sh_library.glsl": ["sh_basis", "sh_rotate_z", "sh_rotate", "sh_cap_factors", "sh_sg_factors",
                               "sh_zonal_sum"],
-    "../sh/sh_shading.glsl": ["sh_parameter_coordinate", "sh_table_lookup"],
+    "../sh/sh_shading.glsl": ["sh_parameter_coordinate", "sh_table_lookup", "sh_fitted_lookup", "sh_product"],
 }
 LIBRARY_ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl", "warp.glsl", "lights.glsl"]
 
@@ -759,6 +759,70 @@ def test_sh_table_lookup_stress(glsl, fuzz):
         np.testing.assert_allclose(out[ordinary, 2], expected[:, 0], atol=1e-5 * scale)
 
 
+def test_sh_fitted_product_stress(glsl, fuzz):
+    """sh_product of a lobe fit's table (SH_FITTED, sh_shading.glsl: sh_fitted_lookup of each lobe, rotated,
+    weighed by its colour and S(o) / (pi o.z)) with random layers and table, any UV (outside [0, 1] too), any
+    view (zero, tiny, huge, below the horizon: normalized as shade_sh's is) and random frames: finite, and the
+    mirror's (sh_shading._product) within 1e-5 of the sums' scale where o.z > 0.05."""
+    from scipy.spatial.transform import Rotation
+
+    from sg_prt_addon.blender.export import FittedLobes
+    from sg_prt_addon.harmonics import fitted_table
+    from sg_prt_addon.techniques import fitted_texels, sh_glsl, sh_shading
+
+    order, lobes, components, views, count = 5, 2, 5, 16, SMALL_ROWS // 8
+    rng = fuzz.rng
+    layers = _f32(rng.normal(size=(1 + 2 * lobes + 2, 8, 8, 4)))
+    table = np.zeros((components + 2, 16, 4), np.float32)
+    table[0, :, 0] = np.linspace(0.0, 1.4, 16)
+    table[1, :, 0] = np.linspace(1.0, 0.2, 16)
+    table[2:, :, 0] = rng.normal(size=(components, 16)) * 0.1
+    fitted = FittedLobes(lobes, components, layers, table)
+    stored = len(fitted_table.positive_m_indices(order))
+    sh_table = fitted_table.FittedTable(order, (8, 8), _f32(rng.normal(size=(64, lobes, views, stored))))
+    o = fuzz.stress_vectors(count)
+    frames = _f32(Rotation.random(count, random_state=5).as_matrix())
+    uv = _f32(rng.uniform(-0.5, 1.5, (count, 2)))
+    theta = _f32(rng.uniform(-0.2, 1.8, count))
+    weights = _sh_weights(order * order, 6)
+    shading = _resource("sh_shading.glsl", "sh")
+    source = (f"#define SH_FITTED 1\n#define SH_VALUE vec3\n#define FITTED_LOBES {lobes}\n"
+              f"#define FITTED_COMPONENTS {components}\n#define FITTED_SHADOWING_LAYERS 2\n"
+              + sh_glsl.constants_source(order, None) + _resource("sh_library.glsl", "sh")
+              + _resource("fitted_texels.glsl", "common")
+              + "const float W[SH_COUNT] = float[](" + ", ".join(f"{v:.9e}" for v in weights) + ");\n"
+              + "".join(_glsl_function(shading, name) for name in ("sh_fitted_lookup", "sh_product")))
+    body = """
+    fitted_select_texel(t.xy);
+    vec3 c[SH_COUNT];
+    sh_product(safe_normalize(o.xyz), 0.0, mat3(c0.xyz, c1.xyz, c2.xyz), c);
+    float lobe[SH_COUNT];
+    sh_fitted_lookup(t.z, 1, lobe);
+    vec3 a = vec3(0.0);
+    float b = 0.0;
+    for (int i = 0; i < SH_COUNT; i++) { a += W[i] * c[i]; b += W[i] * lobe[i]; }
+    result = vec4(a, b);
+    """
+    inputs = {"t": np.c_[uv, theta], "o": o, "c0": frames[:, :, 0], "c1": frames[:, :, 1], "c2": frames[:, :, 2]}
+    out = glsl(["sg.glsl", source], body, inputs, 4,
+               textures={"sh_table": fitted_table.texture_layers(sh_table), "fitted_layers": layers,
+                         "fitted_shadowing": table})
+    _assert_finite(out, "sh_product (SH_FITTED)")
+    texels = fitted_texels.texel_indices(fitted, uv)
+    scale = np.abs(sh_table.coefficients).max() * np.abs(weights).sum()
+    looked_up = fitted_table.lookup(sh_table, texels, theta)[:, 1] @ weights
+    np.testing.assert_allclose(out[:, 3], looked_up, atol=1e-5 * scale)
+    with np.errstate(all="ignore"):
+        length = np.linalg.norm(o, axis=1)
+        unit = _f32(o / length[:, None])
+    ordinary = (length > 1e-3) & (length < 1e3) & (unit[:, 2] > 0.05)
+    values, _ = fitted_texels.fitted_texel_values(fitted, uv[ordinary])
+    expected = np.einsum("nic,i->nc", sh_shading._product(sh_table, unit[ordinary], frames[ordinary],
+                                                          (texels[ordinary], values)), weights)
+    colour_scale = np.abs(layers[2::2, ..., :3]).max() * 20 / np.pi       # S <= 1.2 here, o.z > 0.05
+    np.testing.assert_allclose(out[ordinary, :3], expected, atol=1e-5 * scale * colour_scale)
+
+
 def test_shading_frame_stress(glsl, fuzz):
     """shading_frame, apply_normal_map and rotate_tangent with zero / parallel / huge tangents, zero
     normals, any normal-map sample (also outside [0, 1]) and strength 0..10."""
@@ -858,7 +922,7 @@ def test_table_lobes_stress(glsl, fuzz):
 
 
 def test_fitted_pieces_stress(glsl, fuzz):
-    """sg_shading.glsl's MODEL_FITTED pieces with a random 2-lobe, 5-component fit (shadowing nodes
+    """common/fitted_texels.glsl and sg_shading.glsl's fitted_m_factor with a random 2-lobe, 5-component fit (shadowing nodes
     stopping short of the horizon, so the appended S(pi/2) = 0 node is used): any UV (outside [0, 1]
     too), the numpy suite's directions, eta 0..4."""
     wo, wi, _, _, _, rng = _brdf_inputs()
@@ -871,13 +935,9 @@ def test_fitted_pieces_stress(glsl, fuzz):
     table[2:, :, 0] = rng.normal(size=(components, nodes)) * 0.1
     uv = _f32(rng.uniform(-0.5, 1.5, (SMALL_ROWS, 2)))
     eta = _f32(rng.uniform(0.0, 4.0, SMALL_ROWS))
-    shading = _resource("sg_shading.glsl")
     source = (f"#define NDF_LOBES {lobes}\n#define FITTED_LOBES {lobes}\n#define FITTED_COMPONENTS {components}\n"
-              f"#define FITTED_SHADOWING_LAYERS {shadowing_layers}\n"
-              "ivec2 fitted_texel;\nfloat fitted_coefficients[4 * FITTED_SHADOWING_LAYERS];\n"
-              + "".join(_glsl_function(shading, name) for name in (
-                  "fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
-                  "fitted_shadowing_at", "fitted_shadowing_of", "fitted_m_factor")))
+              f"#define FITTED_SHADOWING_LAYERS {shadowing_layers}\n" + _resource("fitted_texels.glsl", "common")
+              + _glsl_function(_resource("sg_shading.glsl"), "fitted_m_factor"))
     body = """
     fitted_select_texel(t.xy);
     vec4 lobe = fitted_layer(1);
@@ -938,6 +998,7 @@ COVERED = {
     test_sh_library_stress: ["sh_basis", "sh_rotate_z", "sh_rotate", "sh_cap_factors", "sh_sg_factors",
                              "sh_zonal_sum"],
     test_sh_table_lookup_stress: ["sh_parameter_coordinate", "sh_table_lookup"],
+    test_sh_fitted_product_stress: ["sh_fitted_lookup", "sh_product"],
     test_model_lobes_stress: ["model_ndf_lobe", "model_m_factor"],
     test_table_lobes_stress: ["ggx_two_lobes", "anisotropic_lobes"],
     test_fitted_pieces_stress: ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",

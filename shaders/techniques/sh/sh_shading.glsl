@@ -17,8 +17,21 @@
  * Needs sh_library.glsl and its generated constants, surface_common.glsl, (HAS_LIGHTS) lights.glsl, the
  * samplers sh_table (the BRDF product, ceil(SH_COUNT / 4) layers) and sh_environment (SH_COUNT x 1, rgb),
  * and the push constant sh_axis of the table's parameter axis (harmonics.brdf_table.BrdfTable.parameter_coordinate):
- * x 1 / (high - low) (a log axis: 1 / log(high / low)), y low, z 1 for a log axis, w the node count. */
+ * x 1 / (high - low) (a log axis: 1 / log(high / low)), y low, z 1 for a log axis, w the node count.
+ *
+ * SH_FITTED (with SH_ISOTROPIC: a stored lobe fit, harmonics/fitted_table.py): sh_table holds each lobe's
+ * coefficients with m >= 0 per texel and view node (texel (x, y)'s views in columns x V .. x V + V - 1 of row
+ * y, lobe k in layers k ceil(SH_STORED / 4) ..), read with texelFetch at the texel fitted_select_texel chose
+ * (common/fitted_texels.glsl) and interpolated between view nodes here; each lobe's vector is rotated, then
+ * weighed by its colour and the view's S(o) / (pi o.z): the product is RGB (SH_VALUE vec3). */
 
+#ifdef SH_FITTED
+#define SH_VALUE vec3
+#else
+#define SH_VALUE float
+#endif
+
+#ifndef SH_FITTED
 float sh_parameter_coordinate(float value)
 {
   float t = sh_axis.z > 0.5 ? log(max(value, sh_axis.y) / sh_axis.y) : value - sh_axis.y;
@@ -47,6 +60,60 @@ void sh_table_lookup(vec3 o, float p, out float c[SH_COUNT])
   }
 }
 
+#endif
+
+#ifdef SH_FITTED
+/* Lobe k's coefficients at view angle theta from the fit's table: linear between the two view nodes about it
+ * (clamped to the end nodes), m < 0 zero (harmonics.fitted_table.lookup). */
+void sh_fitted_lookup(float theta, int lobe, out float c[SH_COUNT])
+{
+  int views = textureSize(sh_table, 0).x / textureSize(fitted_layers, 0).x;
+  float x = clamp(theta * (2.0 / 3.14159265358979) * float(views) - 0.5, 0.0, float(views - 1));
+  int low = min(int(x), views - 2);
+  float t = x - float(low);
+  int column = fitted_texel.x * views + low;
+  for (int i = 0; i < SH_COUNT; i++) {
+    c[i] = 0.0;
+  }
+  const int layers = (SH_STORED + 3) / 4;
+  for (int k = 0; k < layers; k++) {
+    vec4 below = texelFetch(sh_table, ivec3(column, fitted_texel.y, lobe * layers + k), 0);
+    vec4 above = texelFetch(sh_table, ivec3(column + 1, fitted_texel.y, lobe * layers + k), 0);
+    vec4 value = below + (above - below) * t;
+    for (int j = 0; j < 4; j++) {
+      if (4 * k + j < SH_STORED) {
+        c[SH_STORED_INDEX[4 * k + j]] = value[j];
+      }
+    }
+  }
+}
+#endif
+
+/* The BRDF product at local view o in world coordinates: the table's vector rotated by frame (SH_FITTED: each
+ * lobe's, weighed by its colour and S(o) / (pi o.z)). */
+void sh_product(vec3 o, float parameter, mat3 frame, out SH_VALUE c[SH_COUNT])
+{
+#ifdef SH_FITTED
+  float theta = atan(max(length(o.xy), 1.0e-30), max(o.z, 0.0));
+  float view_factor = fitted_shadowing_at(theta) / (3.14159265358979 * max(o.z, SH_COSINE_EPSILON));
+  for (int i = 0; i < SH_COUNT; i++) {
+    c[i] = vec3(0.0);
+  }
+  for (int k = 0; k < FITTED_LOBES; k++) {
+    float lobe[SH_COUNT];
+    sh_fitted_lookup(theta, k, lobe);
+    sh_rotate(lobe, frame);
+    vec3 colour = fitted_layer(2 + 2 * k).rgb * view_factor;
+    for (int i = 0; i < SH_COUNT; i++) {
+      c[i] += colour * lobe[i];
+    }
+  }
+#else
+  sh_table_lookup(o, sh_parameter_coordinate(parameter), c);
+  sh_rotate(c, frame);                          /* the product in world coordinates */
+#endif
+}
+
 void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3 specular_color, float parameter,
               out vec3 diffuse, out vec3 specular)
 {
@@ -63,9 +130,8 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
 #endif
   mat3 frame = mat3(t, b, n);                   /* local -> world */
   vec3 o = view * frame;                        /* world -> local: the rows */
-  float c[SH_COUNT];
-  sh_table_lookup(o, sh_parameter_coordinate(parameter), c);
-  sh_rotate(c, frame);                          /* the product in world coordinates */
+  SH_VALUE c[SH_COUNT];
+  sh_product(o, parameter, frame, c);
   float y[SH_COUNT];
   sh_basis(n, y);
   vec3 radiance = vec3(0.0);
@@ -124,7 +190,7 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
     }
     float ya[SH_COUNT];
     sh_basis(axis, ya);
-    float glossy = 0.0;
+    SH_VALUE glossy = SH_VALUE(0.0);
     float zonal[SH_ORDER];
 #ifdef HAS_TRANSFER
     float shadowed = 0.0;

@@ -1,7 +1,7 @@
 /* Material colours and the table's parameter (property x texture), normal map and tangent frame
  * (common/surface_io.glsl), then shade_sh (sh_shading.glsl).  Writes the passes as the other techniques'
  * surfaces do.  SH_PARAMETER: the MaterialData field of the table's parameter axis
- * (techniques/spherical_harmonics.py). */
+ * (techniques/spherical_harmonics.py).  SH_FITTED: kd from the lobe fit's texel, the colours in its lobes. */
 void main()
 {
   vec3 normal = surface_facing_normal();
@@ -10,6 +10,11 @@ void main()
 #endif
   vec3 diffuse_color = material.diffuse_color.rgb;
   vec3 specular_color = material.specular_color.rgb;
+#ifdef SH_FITTED
+  fitted_select_texel(texcoord);
+  diffuse_color = fitted_layer(0).rgb;
+  specular_color = vec3(1.0);
+#endif
   surface_colour_textures(diffuse_color, specular_color);
   float parameter = SH_PARAMETER;
 #ifdef SH_PARAMETER_TEXTURE
