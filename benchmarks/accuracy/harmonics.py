@@ -1,7 +1,8 @@
 """Accuracy of the spherical-harmonic machinery (sg_prt_addon/harmonics, kautz2002): rotation by the
 recurrence and by the zyz method against projecting the rotated function (orders 2-8); projections of an
 equirect image, of caps, windows (ringing against blur); the BRDF product tables' quadrature against a
-dense one; the shading error of the SH method itself (eq. 1, per order 3-6 and per model) against
+dense one, the parametric models' and a stored lobe fit's (harmonics/fitted_table.py: per order, its view
+interpolation, a 64 x 64-texel fit's build time and size); the shading error of the SH method itself (eq. 1, per order 3-6 and per model) against
 direct quadrature of the shading integral, under courtyard.exr and under sphere lights of three sizes; and
 the transfer bake (visibility/transfer.py): its direction lattice against exact integrals where the
 visibility is known, and its PCA compression on a floor under a sphere."""
@@ -12,12 +13,14 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from benchmarks.accuracy.lighting import load_world
-from sg_prt_addon.harmonics import basis, brdf_table, projection, rotation
+from sg_prt_addon.harmonics import basis, brdf_table, fitted_table, projection, rotation
 from sg_prt_addon.lighting import equirect
+from sg_prt_addon.measured import microfacet_fit
 from sg_prt_addon.reflectance import brdf
 from sg_prt_addon.spherical.lattice import hemisphere_points
 from sg_prt_addon.visibility import transfer
 from sg_prt_addon.visibility.raytrace import RayTracer
+from validation import brdf_generators, fitted_sh_reference
 
 SHADING_ORDERS = (3, 4, 5, 6)
 TABLE_MODELS = [
@@ -32,7 +35,8 @@ CAP_SIZES = (0.05, 0.2, 0.5)            # sphere lights' angular radii (rad)
 
 
 def measure():
-    return _rotation_rows() + _projection_rows() + _table_rows() + _shading_rows() + _transfer_rows()
+    return (_rotation_rows() + _projection_rows() + _table_rows() + _fitted_table_rows() + _shading_rows()
+            + _transfer_rows())
 
 
 def _rotation_rows():
@@ -124,6 +128,69 @@ def _table_rows():
                          metric="max abs coefficient error / max coefficient, order 6", max_error=error,
                          mean_error=None, note=f"MIS 1024 + 1024 samples, {seconds * 1e3:.1f} ms a view; order-5 "
                                                f"table {table.coefficients.shape} in {table.seconds:.1f} s"))
+    return rows
+
+
+FITTED_ORDERS = (3, 4, 5, 6)
+FITTED_VIEWS = (1, 8, 13, 15)           # nodes of a 16-node table: theta_v 0.15, 0.83, 1.28, 1.52 rad
+
+
+def _fitted_table_rows():
+    """A 2-lobe fit of a generated 8 x 8 SVBRDF table (sharpness 3 to 15,000): every texel's entries at four view
+    nodes against the dense lattice; the shader's interpolation between the 64 view nodes; the build of a
+    64 x 64-texel fit."""
+    table, _ = brdf_generators.generate_svbrdf_table(size=8, seed=5)
+    fit = fitted_sh_reference.fit_arrays(microfacet_fit.fit_lobes(table, 2, shadowing_components=5))
+    texels = np.arange(len(fit["sharpness"]))
+    thetas = fitted_table.view_thetas(16)
+    reference = {view: fitted_sh_reference.dense_product(fit, texels, thetas[view], max(FITTED_ORDERS))
+                 for view in FITTED_VIEWS}
+    rows = []
+    for order in FITTED_ORDERS:
+        start = time.perf_counter()
+        sh_table = fitted_table.table_for(fit["sharpness"], fit["eta"], fit["shadowing"], fit["theta"], (8, 8),
+                                          order, views=16)
+        seconds = time.perf_counter() - start
+        count = order * order
+        scale = np.max(np.abs(np.stack([r[:, :count] for r in reference.values()])), axis=(0, 2, 3))    # (T,)
+        errors = np.max(np.stack([np.max(np.abs(fitted_sh_reference.table_product(fit, sh_table, texels, view)
+                                                - reference[view][:, :count]), axis=(1, 2)) / scale
+                                  for view in FITTED_VIEWS]), axis=0)                                      # (T,)
+        rows.append(dict(name=f"SH table of a lobe fit, order {order}: quadrature",
+                         reference="300,000-point uniform lattice of the fitted BRDF x cosine (the SG_FITTED "
+                                   "mirror's M x lobes)",
+                         metric="max abs coefficient error / the texel's max coefficient (mean: over texels), "
+                                "64 texels x 4 views to 87 degrees",
+                         max_error=float(errors.max()), mean_error=float(errors.mean()),
+                         note=f"half-vector Gauss rule shared by the texels; 64 texels x 16 views in {seconds:.2f} s"))
+    nodes = fitted_table.project_texels(fit["sharpness"], fit["eta"], fit["shadowing"], fit["theta"], 5,
+                                        fitted_table.view_thetas())
+    middles = (np.arange(fitted_table.DEFAULT_VIEWS - 1) + 1.0) / fitted_table.DEFAULT_VIEWS * (np.pi / 2)
+    sh_table = fitted_table.FittedTable(5, (8, 8), nodes)
+    looked_up = np.stack([fitted_table.lookup(sh_table, texels, np.full(len(texels), theta)) for theta in middles],
+                         2)[..., fitted_table.positive_m_indices(5)]
+    direct = fitted_table.project_texels(fit["sharpness"], fit["eta"], fit["shadowing"], fit["theta"], 5, middles)
+    error = np.abs(looked_up - direct) / np.max(np.abs(nodes), axis=(1, 2, 3))[:, None, None, None]
+    below = middles < np.radians(70)
+    rows.append(dict(name="SH table of a lobe fit: linear interpolation between its 64 view nodes",
+                     reference="the table's quadrature at the view itself (halfway between nodes)",
+                     metric="max abs coefficient error / the texel's max coefficient, order 5 (mean: below 70 degrees)",
+                     max_error=float(error.max()), mean_error=float(error[:, :, below].max()),
+                     note="S(o) / (pi o.z) left out of the table and applied per pixel: tabulated, its rise at "
+                          "grazing views made the error at the last nodes 0.09 that did not fall with more nodes"))
+    big, _ = brdf_generators.generate_svbrdf_table(size=64, seed=3)
+    big_fit = fitted_sh_reference.fit_arrays(microfacet_fit.fit_lobes(big, 2, shadowing_components=5))
+    notes = []
+    for order in (5, 8):
+        start = time.perf_counter()
+        fitted_table.table_for(big_fit["sharpness"], big_fit["eta"], big_fit["shadowing"], big_fit["theta"],
+                               (64, 64), order)
+        notes.append(f"order {order}: {time.perf_counter() - start:.1f} s, "
+                     f"{fitted_table.table_bytes(64 * 64, 2, order) / 2 ** 20:.0f} MB")
+    rows.append(dict(name="SH table of a lobe fit, 64 x 64 texels, 2 lobes: build", reference="-", metric="seconds, MB",
+                     max_error=None, mean_error=None,
+                     note="; ".join(notes) + f" (64 views; the engine builds at most "
+                                            f"{fitted_table.MAX_TABLE_BYTES / 2 ** 20:.0f} MB)"))
     return rows
 
 

@@ -20,8 +20,9 @@ Isotropic fits only: lobes about the normal (Fit Lobes' z+ axes, 1-2 lobes) make
 the frame turned until the view lies in its x-z plane, depend on theta_v alone and even in y, so only the
 N (N + 1) / 2 coefficients with m >= 0 are stored (the paper's Fig. 4 with the texel as the parameter axis).
 A free-axes fit is anisotropic per texel: a parabolic view map per texel (the paper's anisotropic layout) at
-even 16 x 16 views, order 5 and 4 lobes is 460 KB a texel, 1.9 GB for 64 x 64 texels, so the SH technique
-refuses it (blender/export.py renders it with the fitted SG lobes instead).
+even 16 x 16 views (the paper used 128 x 128), order 5 and 4 lobes is 115 KB a texel, 470 MB for 64 x 64
+texels, and its lobes, off the normal, would each need nodes about their own axis (no rule shared by the
+texels), so the SH technique refuses it (blender/export.py renders it with the fitted SG lobes instead).
 
 Layout and size: coefficients (T texels, K lobes, V views, M = N (N + 1) / 2) float32, V = 64 theta_v nodes at
 (j + 1/2) / V pi / 2; the GPU's copy (texture_layers) pads M to whole vec4s: T K V 4 ceil(M / 4) floats, e.g.

@@ -1,17 +1,14 @@
 """The SH tables of a stored lobe fit (harmonics/fitted_table.py): each texel's entries against a dense
 lattice's projection of the fitted BRDF x cosine, the very BRDF the SG_FITTED mirror evaluates
-(fitted_texels.fitted_m_factor times the lobes), per order; the view interpolation; the GPU layout; the cache."""
+(validation/fitted_sh_reference.py), per order; the view interpolation; the GPU layout; the cache."""
 import numpy as np
 import pytest
 
 from sg_prt_addon.harmonics import basis, fitted_table
 from sg_prt_addon.measured import microfacet_fit
 from sg_prt_addon.reflectance import brdf
-from sg_prt_addon.spherical.lattice import hemisphere_points
-from sg_prt_addon.techniques import fitted_texels
-from validation import brdf_generators
+from validation import brdf_generators, fitted_sh_reference
 
-DENSE = hemisphere_points(300000)      # against 4,000,000 points: within 1e-6 of the largest coefficient here
 ORDERS = (3, 4, 5, 6)
 VIEWS = 16                             # table nodes; the engine's tables have fitted_table.DEFAULT_VIEWS
 CHECKED_VIEWS = (1, 8, 13, 15)         # theta_v 0.15, 0.83, 1.28, 1.52 rad
@@ -21,11 +18,7 @@ CHECKED_VIEWS = (1, 8, 13, 15)         # theta_v 0.15, 0.83, 1.28, 1.52 rad
 def fit():
     """A 2-lobe fit (lobes about the normal) of a generated 8 x 8 SVBRDF table: sharpness 3 to 15,000."""
     table, _ = brdf_generators.generate_svbrdf_table(size=8, seed=5)
-    lobes = microfacet_fit.fit_lobes(table, 2, shadowing_components=5)
-    shadowing = microfacet_fit.decompress_shadowing(lobes.shadowing_mean, lobes.shadowing_basis,
-                                                    lobes.shadowing_coefficients)
-    return dict(sharpness=lobes.sharpness, eta=lobes.eta, shadowing=shadowing, theta=lobes.shadowing_theta,
-                colour=lobes.amplitude, axis=lobes.axis)
+    return fitted_sh_reference.fit_arrays(microfacet_fit.fit_lobes(table, 2, shadowing_components=5))
 
 
 def _texels(fit):
@@ -35,34 +28,6 @@ def _texels(fit):
                       int(np.argsort(sharpness.max(1))[len(sharpness) // 2])])
 
 
-def _dense_product(fit, texels, theta_v, order):
-    """(T, N^2, 3) SH projection of sum_k a_k G_k(h) M_o(i) cos(i) on the dense lattice, M_o(i) by the SG_FITTED
-    mirror's fitted_m_factor."""
-    wo = np.array([np.sin(theta_v), 0.0, np.cos(theta_v)])
-    params = {"eta": fit["eta"][texels], "shadowing": fit["shadowing"][texels], "shadowing_theta": fit["theta"]}
-    out = 0.0
-    for start in range(0, len(DENSE), 100000):
-        wi = DENSE[start:start + 100000]
-        h = brdf.half_vector(np.broadcast_to(wo, wi.shape), wi)
-        m = fitted_texels.fitted_m_factor(params, np.broadcast_to(wo, (len(wi), len(texels), 3)),
-                                          np.broadcast_to(wi[:, None], (len(wi), len(texels), 3)))   # (S, T)
-        lobes = np.exp(fit["sharpness"][texels][None] * (h[:, None, None, 2] - 1))                   # (S, T, K)
-        f = np.einsum("stk,tkc->stc", lobes, fit["colour"][texels]) * (m * wi[:, None, 2])[..., None]
-        out = out + np.einsum("stc,si->tic", f, basis.evaluate(wi, order)) * (2 * np.pi / len(DENSE))
-    return out
-
-
-def _table_product(fit, table, texels, view):
-    """(T, N^2, 3): the table's lobes weighed by their colours and the view's S(o) / (pi o.z)."""
-    theta_v = fitted_table.view_thetas(table.views)[view]
-    shadowing = fitted_texels.fitted_shadowing({"shadowing": fit["shadowing"][texels], "shadowing_theta": fit["theta"]},
-                                               np.broadcast_to([np.sin(theta_v), 0, np.cos(theta_v)], (len(texels), 1, 3)))
-    full = np.zeros(table.coefficients.shape[:3] + (table.order ** 2,))
-    full[..., fitted_table.positive_m_indices(table.order)] = table.coefficients
-    lobes = full[texels, :, view] * (shadowing / (np.pi * np.cos(theta_v)))[:, :, None]                    # (T, K, N^2)
-    return np.einsum("tki,tkc->tic", lobes, fit["colour"][texels])
-
-
 def test_entries_against_a_dense_lattice_per_order(fit):
     """Orders 3-6 at view nodes from the normal to 87 degrees: measured max 1.15e-3 of the texel's largest
     coefficient at every order (a coefficient's quadrature is the same at any order: the kinks of the
@@ -70,8 +35,8 @@ def test_entries_against_a_dense_lattice_per_order(fit):
     vanish (an isotropic product in the view-plane frame: 2.5e-7, the lattice's asymmetry), which the table
     leaves out."""
     texels = _texels(fit)
-    reference = {view: _dense_product(fit, texels, fitted_table.view_thetas(VIEWS)[view], max(ORDERS))
-                 for view in CHECKED_VIEWS}
+    reference = {view: fitted_sh_reference.dense_product(fit, texels, fitted_table.view_thetas(VIEWS)[view],
+                                                         max(ORDERS)) for view in CHECKED_VIEWS}
     _, m = basis.band_of(max(ORDERS) ** 2)
     for values in reference.values():
         assert np.max(np.abs(values[:, m < 0])) < 1e-5 * np.max(np.abs(values))
@@ -80,7 +45,7 @@ def test_entries_against_a_dense_lattice_per_order(fit):
         table = fitted_table.table_for(fit["sharpness"], fit["eta"], fit["shadowing"], fit["theta"], (8, 8), order,
                                        views=VIEWS)
         scale = np.max(np.abs(np.stack(list(reference.values()))[:, :, :order * order]), axis=(0, 2, 3))
-        errors[order] = max(float(np.max(np.abs(_table_product(fit, table, texels, view)
+        errors[order] = max(float(np.max(np.abs(fitted_sh_reference.table_product(fit, table, texels, view)
                                                 - reference[view][:, :order * order]) / scale[:, None, None]))
                             for view in CHECKED_VIEWS)
     print("max error / largest coefficient per order", errors)
