@@ -7,7 +7,7 @@ the steady frame (draw + read back 3 passes, median of --redraws) and render() (
 after a first render that factorizes, prefilters and compiles), then EEVEE at 1 sample with matched node
 materials.  Ratios against EEVEE measured in the same run.
 
-    .venv/bin/python -m benchmarks.technique_speed [--size 512] [--scenes NAME ...]
+    .venv/bin/python -m benchmarks.technique_speed [--size 512] [--scenes NAME ...] [--techniques NAME ...]
 """
 import argparse
 import os
@@ -31,7 +31,7 @@ def _set_technique(scene, technique):
                 slot.material.sgprt.technique = technique
 
 
-def measure_scene(name, size, renders, redraws):
+def measure_scene(name, size, renders, redraws, runs=RUNS):
     import bpy
 
     from benchmarks import matched_materials
@@ -42,7 +42,7 @@ def measure_scene(name, size, renders, redraws):
     figures = {}
     operators = {"visibility": bpy.ops.sgprt.bake_visibility, "transfer": bpy.ops.sgprt.bake_transfer}
     clears = {"visibility": bpy.ops.sgprt.clear_visibility, "transfer": bpy.ops.sgprt.clear_transfer}
-    for technique, baked in RUNS:
+    for technique, baked in runs:
         kind = BAKES[technique]
         for other in operators:          # only this run's bake present: "unshadowed" means no bake at all
             if other != kind or not baked:
@@ -72,17 +72,20 @@ def main(argv=None):
     parser.add_argument("--scenes", nargs="*", default=["suzanne_courtyard", "brushed_metal"])
     parser.add_argument("--renders", type=int, default=5)
     parser.add_argument("--redraws", type=int, default=7)
+    parser.add_argument("--techniques", nargs="*", default=sorted(BAKES), choices=sorted(BAKES),
+                        help="the techniques' rows to measure (default: all)")
     arguments = parser.parse_args(argv)
+    runs = tuple(run for run in RUNS if run[0] in arguments.techniques)
     import sg_prt_addon
     sg_prt_addon.register()
-    results = {name: measure_scene(name, arguments.size, arguments.renders, arguments.redraws)
+    results = {name: measure_scene(name, arguments.size, arguments.renders, arguments.redraws, runs)
                for name in arguments.scenes}
     print(f"\n{arguments.size}x{arguments.size}, seconds (ratio to EEVEE 1 sample, same run)")
     for name, figures in results.items():
         eevee = figures[("EEVEE 1 sample", "render")]
         print(f"\n{name}: EEVEE 1 sample render {eevee:.3f} s")
         print(f"{'technique':28s} {'first render':>14s} {'render()':>16s} {'steady frame':>16s}")
-        for technique, baked in RUNS:
+        for technique, baked in runs:
             label = technique + (" + bake" if baked else "")
             first, render, frame = (figures[(label, k)] for k in ("first", "render", "frame"))
             print(f"{label:28s} {first:14.3f} {render:9.3f} ({render / eevee:4.2f}) {frame:9.3f} ({frame / eevee:4.2f})")

@@ -297,6 +297,9 @@ class _DrawContext(techniques.DrawContext):
             tables[name] = _texture(array)
         return tables[name]
 
+    def cached_arrays(self, kind, key, build):
+        return disk_cache.load_or_build(kind, key, build)
+
     def environment_table(self, name, build):
         environment = self.inputs.environment
         entry = self.renderer.environment_tables.get(name)

@@ -140,9 +140,11 @@ _cache = collections.OrderedDict()
 
 
 def table_for(model_name, order=DEFAULT_ORDER, resolution=None, parameter_count=DEFAULT_PARAMETER_NODES,
-              samples=DEFAULT_SAMPLES, **params):
+              samples=DEFAULT_SAMPLES, store=None, **params):
     """The BrdfTable of a model (its name in reflectance.models) at the given order, cached in the process by
-    every input.  params: the model's parameters (the axis parameter of an isotropic model is ignored)."""
+    every input.  params: the model's parameters (the axis parameter of an isotropic model is ignored).
+    store: None, or a function (kind, key, build) -> build()'s dict of arrays that may keep them elsewhere
+    (the engine's disk cache; key: every input), asked on a miss in the process."""
     spec = models.BY_NAME[model_name]
     isotropic = model_name in PARAMETER_AXES
     axis = PARAMETER_AXES[model_name][0] if isotropic else None
@@ -153,19 +155,24 @@ def table_for(model_name, order=DEFAULT_ORDER, resolution=None, parameter_count=
     if table is not None:
         _cache.move_to_end(key)
         return table
-    start = time.perf_counter()
-    if isotropic:
-        nodes = parameter_nodes(model_name, parameter_count)
-        views = theta_directions(resolution)
-        coefficients = np.stack([project_product(brdf.model_from_name(model_name, **dict(fixed, **{axis: node})),
-                                                 views, order, samples) for node in nodes])
-        coefficients[..., basis.band_of(coefficients.shape[-1])[1] < 0] = 0.0   # zero by symmetry: lattice noise
-    else:
-        nodes = np.zeros(0)
-        views = parabolic_directions(resolution).reshape(-1, 3)
-        coefficients = project_product(brdf.model_from_name(model_name, **dict(fixed)), views, order, samples)[None]
+    nodes = parameter_nodes(model_name, parameter_count) if isotropic else np.zeros(0)
+
+    def build():
+        start = time.perf_counter()
+        if isotropic:
+            views = theta_directions(resolution)
+            coefficients = np.stack([project_product(brdf.model_from_name(model_name, **dict(fixed, **{axis: node})),
+                                                     views, order, samples) for node in nodes])
+            coefficients[..., basis.band_of(coefficients.shape[-1])[1] < 0] = 0.0   # zero by symmetry: lattice noise
+        else:
+            views = parabolic_directions(resolution).reshape(-1, 3)
+            coefficients = project_product(brdf.model_from_name(model_name, **dict(fixed)), views, order,
+                                           samples)[None]
+        return {"coefficients": coefficients.astype(np.float32), "seconds": np.float64(time.perf_counter() - start)}
+
+    arrays = build() if store is None else store("sh_brdf_table", key, build)
     table = BrdfTable(model_name, order, "theta" if isotropic else "parabolic", resolution, axis, nodes, fixed,
-                      coefficients.astype(np.float32), time.perf_counter() - start)
+                      arrays["coefficients"], float(arrays["seconds"]))
     _cache[key] = table
     while len(_cache) > CACHE_SIZE:
         _cache.popitem(last=False)

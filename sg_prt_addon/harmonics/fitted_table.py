@@ -222,21 +222,29 @@ def _content_key(*arrays):
 _cache = collections.OrderedDict()
 
 
-def table_for(sharpness, eta, shadowing, shadowing_theta, shape, order, views=DEFAULT_VIEWS):
+def table_for(sharpness, eta, shadowing, shadowing_theta, shape, order, views=DEFAULT_VIEWS, store=None):
     """The FittedTable of a fit's texels (project_texels' arrays, T = H W of shape), cached in the process by
-    their content; texels with equal rows are projected once."""
+    their content; texels with equal rows are projected once.  store: None, or a function (kind, key, build)
+    -> build()'s dict of arrays that may keep them elsewhere (the engine's disk cache; key: the content
+    digest, shape, order and views), asked on a miss in the process."""
     sharpness = np.asarray(sharpness, np.float64)
     key = (_content_key(sharpness, eta, shadowing, shadowing_theta), tuple(shape), int(order), int(views))
     table = _cache.get(key)
     if table is not None:
         _cache.move_to_end(key)
         return table
-    start = time.perf_counter()
-    rows = np.concatenate([sharpness, np.asarray(eta, np.float64)[:, None], np.asarray(shadowing, np.float64)], 1)
-    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
-    unique = project_texels(sharpness[first], np.asarray(eta)[first], np.asarray(shadowing)[first],
-                            shadowing_theta, order, view_thetas(views))
-    table = FittedTable(int(order), tuple(shape), unique[inverse.reshape(-1)], time.perf_counter() - start)
+
+    def build():
+        start = time.perf_counter()
+        rows = np.concatenate([sharpness, np.asarray(eta, np.float64)[:, None], np.asarray(shadowing, np.float64)],
+                              1)
+        _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        unique = project_texels(sharpness[first], np.asarray(eta)[first], np.asarray(shadowing)[first],
+                                shadowing_theta, order, view_thetas(views))
+        return {"coefficients": unique[inverse.reshape(-1)], "seconds": np.float64(time.perf_counter() - start)}
+
+    arrays = build() if store is None else store("sh_fitted_table", key, build)
+    table = FittedTable(int(order), tuple(shape), arrays["coefficients"], float(arrays["seconds"]))
     _cache[key] = table
     while len(_cache) > CACHE_SIZE:
         _cache.popitem(last=False)

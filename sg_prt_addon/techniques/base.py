@@ -69,6 +69,9 @@ class DrawContext:
       for the renderer and kept on disk (engine/disk_cache): build() must depend on the code alone, and
       name say which table it is; material_table(name, build): the same in memory only, remade when the
       material changes; environment_table(name, build): remade when the scene's environment changes;
+    cached_arrays(kind, key, build): build()'s dict of named numpy arrays, kept on disk for the next process
+      (engine/disk_cache) under kind (a word) and key (what they are made of, by content: parts that are
+      bytes or have a stable repr); the maths modules take it as their tables' `store`;
     image(slot): the material's image texture of a texture slot;
     object_table(name, sources, build): a GPU texture of build()'s array for the object, remade when any of
       the objects in the tuple `sources` is not the one it was made from, dropped with the object;

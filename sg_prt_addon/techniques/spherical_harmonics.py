@@ -88,24 +88,25 @@ def texture_slots(params):
     return COLOUR_SLOTS + ((axis[0],) if axis else ())
 
 
-def table_for(params, order=None):
+def table_for(params, order=None, store=None):
     """The table of a material (export.MaterialParams) at its order (or `order`, the variant's: a transfer bake
     of a lower order lowers it): its lobe fit's FittedTable when params.fitted, else its model's BrdfTable
-    with its fixed parameters."""
+    with its fixed parameters.  store: where a table built in another process may be kept (the engine's
+    DrawContext.cached_arrays), or None."""
     order = int(order or params.sh_order)
     if getattr(params, "fitted", None) is not None:
-        return fitted_table_for(params.fitted, order)
+        return fitted_table_for(params.fitted, order, store)
     model = models.BY_NAME[params.model]
     values = {name: float(getattr(params, name)) for name in model.parameters}
-    return brdf_table.table_for(params.model, order=order, **values)
+    return brdf_table.table_for(params.model, order=order, store=store, **values)
 
 
-def fitted_table_for(fitted, order):
+def fitted_table_for(fitted, order, store=None):
     """The harmonics.fitted_table.FittedTable of an export.FittedLobes: its texels as the SG_FITTED mirror reads
-    them (fitted_texels.every_texel), so both tabulate the same BRDF."""
+    them (fitted_texels.every_texel), so both tabulate the same BRDF; store as table_for's."""
     values, _ = fitted_texels.every_texel(fitted)
     return fitted_table.table_for(values["sharpness"], values["eta"], values["shadowing"], values["shadowing_theta"],
-                                  fitted.layers.shape[1:3], order)
+                                  fitted.layers.shape[1:3], order, store=store)
 
 
 def fitted_refusal(fitted, order):
@@ -267,11 +268,12 @@ class SphericalHarmonics(Technique):
         if key.fitted_lobes:           # built once a fit and order (seconds for 64 x 64 texels), then the GPU's copy
             fitted = context.params.fitted
             shader.uniform_sampler("sh_table", context.material_table(
-                f"sh_fitted_table_{key.order}", lambda: fitted_table.texture_layers(fitted_table_for(fitted, key.order))))
+                f"sh_fitted_table_{key.order}",
+                lambda: fitted_table.texture_layers(fitted_table_for(fitted, key.order, context.cached_arrays))))
             shader.uniform_sampler("fitted_layers", context.material_table("fitted_layers", lambda: fitted.layers))
             shader.uniform_sampler("fitted_shadowing", context.material_table("fitted_shadowing", lambda: fitted.table))
         else:
-            table = table_for(context.params, key.order)
+            table = table_for(context.params, key.order, context.cached_arrays)    # about 1 s to build
             if key.isotropic:          # an anisotropic map has no parameter axis: the constant is compiled out
                 shader.uniform_float("sh_axis", axis_constants(table))
             shader.uniform_sampler("sh_table", context.material_table(f"sh_table_{key.order}",
