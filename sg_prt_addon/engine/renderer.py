@@ -15,6 +15,8 @@ from ..blender.export import COLOUR_SLOTS, slot_pixels, texture_sources
 from ..spherical import clamped_cosine
 from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
+from ..visibility.per_vertex import texture_of as per_vertex_texture  # the layout of every per-vertex texture
+from ..visibility.per_vertex import vertices_per_row
 from . import disk_cache, shader_cache
 
 PASS_NAMES = ("Combined", "Diffuse", "Specular")
@@ -126,31 +128,13 @@ def material_block(params, material_id=0):
     ], np.float32)
 
 
-PER_VERTEX_TEXTURE_WIDTH = 4096     # texels a row of a per-vertex texture (a multiple of its rows is used)
 MAX_TEXTURE_SIZE = 16384            # GPUTexture side limit measured with llvmpipe (2D; 2048 array layers)
-
-
-def vertices_per_row(layers):
-    """Vertices a row of the per-vertex textures of data with `layers` vec4 a vertex (its rows texture,
-    and the normal and pass textures laid out in the same rows)."""
-    return max(1, PER_VERTEX_TEXTURE_WIDTH // layers)
 
 
 def per_vertex_texture_shape(vertex_count, layers):
     """(rows, texels a row) of the rows texture of vertex_count vertices."""
     per_row = vertices_per_row(layers)
     return max(1, -(-vertex_count // per_row)), per_row * layers
-
-
-def per_vertex_texture(values, texels_per_vertex, per_row):
-    """(rows, per_row * texels_per_vertex, 4) float32 texture of per-vertex values (V, 4 * texels_per_vertex):
-    vertex v's texel k at (column (v % per_row) * texels_per_vertex + k, row v // per_row)
-    (shader_sources.per_vertex_fetch_source reads it back with texelFetch)."""
-    count = values.shape[0]
-    rows = max(1, -(-count // per_row))
-    out = np.zeros((rows * per_row, texels_per_vertex, 4), np.float32)
-    out[:count] = np.asarray(values, np.float32).reshape(count, texels_per_vertex, 4)
-    return out.reshape(rows, per_row * texels_per_vertex, 4)
 
 
 def per_vertex_fits(mesh, data):

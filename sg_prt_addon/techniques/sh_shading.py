@@ -93,11 +93,23 @@ def _zonal_sum(weights, t):
                   * np.stack(p[:order], -1).astype(FLOAT), axis=-1)
 
 
+def transfer_sums(rows, products, terms, count):
+    """(T L (N, count, 3), t . L (N, 3), t (N, count)) float32 of rows (N, 4 L) [1, w_0, ...] of the transfer's
+    weights: sum_k w_k of products (4 L, count + 1, >= 3) spherical_harmonics.transfer_radiance_texture (row k:
+    T_k L, then t_k . L) and of terms (4 L, D) visibility.transfer.basis_terms.  The shader's per-pixel loop
+    of the interpolated weights, or (VERTEX_TRANSFER) at the vertices before the interpolation: by linearity
+    the same."""
+    rows, products, terms = (np.asarray(a, FLOAT) for a in (rows, products, terms))
+    # one matrix product (einsum's loop took 20x as long: 0.16 s for 8,000 vertices and 48 terms)
+    lit = (rows @ np.ascontiguousarray(products[:, :count + 1, :3]).reshape(len(products), -1)).reshape(
+        len(rows), count + 1, 3)
+    return lit[:, :count], lit[:, count], rows @ terms[:, :count]
+
+
 def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color, specular_color, parameter,
           light_data, environment, table, window="none", transfer=None):
-    """Diffuse and specular radiance (N, 3) float32 of pixels; transfer: None or (rows (N, 4 L) the pixels'
-    interpolated [1, w_0, ...], radiance (4 L, N^2 + 1, >= 3) spherical_harmonics.transfer_radiance_texture,
-    terms (4 L, D) visibility.transfer.basis_terms of the bake), the HAS_TRANSFER variant's inputs."""
+    """Diffuse and specular radiance (N, 3) float32 of pixels; transfer: None or the HAS_TRANSFER variant's
+    inputs at the pixels, transfer_sums' (T L (N, N^2, 3), t . L (N, 3), t (N, >= N^2))."""
     order = table.order
     count = order * order
     position = np.asarray(position, FLOAT)
@@ -121,11 +133,9 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
         radiance = np.einsum("nic,ic->nc", c, light)
         irradiance = (basis.evaluate(n, order).astype(FLOAT) * cosine[bands]) @ light
     else:
-        rows, products, terms = (np.asarray(a, FLOAT) for a in transfer)
-        lit = np.einsum("nk,kic->nic", rows, products[:, :count + 1, :3])          # (N, N^2 + 1, 3)
+        lit, irradiance, diffuse_transfer = (np.asarray(a, FLOAT) for a in transfer)
         radiance = np.einsum("nic,nic->nc", c, lit[:, :count])
-        irradiance = lit[:, count]
-        diffuse_transfer = rows @ terms[:, :count]                                 # (N, N^2): t(p)
+        diffuse_transfer = diffuse_transfer[:, :count]                             # (N, N^2): t(p)
     for axis, flux, g, sine in _light_sets(position, light_data, order):
         weight = window_factors * g                                       # (N, P, order)
         y = basis.evaluate(axis, order).astype(FLOAT)                     # (N, P, N^2)

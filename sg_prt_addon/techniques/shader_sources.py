@@ -36,6 +36,11 @@ LIMITS = {"SGPRT_MAX_POINT_LIGHTS": MAX_POINT_LIGHTS, "SGPRT_MAX_SUNS": MAX_SUNS
           "SGPRT_MAX_ENV_LOBES": MAX_ENV_LOBES, "SGPRT_MAX_LAYERS": MAX_LAYERS}
 
 GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
+# vec4 varyings a surface shader may use: llvmpipe gives 128 floats (gpu.capabilities.max_varying_floats_get
+# in a render, Mesa 22.3), as desktop GL drivers commonly do; the surface's own take 5 with per-vertex rows
+# (surface_calls' interface: position, normal, tangent, texcoord, vertex normal)
+MAX_VARYINGS = 32
+SURFACE_VARYINGS = 5
 
 
 def output_names(gbuffer):

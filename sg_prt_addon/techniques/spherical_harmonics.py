@@ -18,8 +18,11 @@ Hanning, Lanczos: ringing against blur, docs/ACCURACY.md) pick the variant.
 Shadows: with a transfer bake of the object (blender/transfer_bake.py, visibility/transfer.py) the
 environment reaches the surface through the vertex's transfer: the glossy term dots the BRDF product with
 T L and the diffuse term is t . L (the paper's section 5 after Sloan 2002), the products of L with the
-compressed transfer's terms computed once per frame per object (visibility.transfer.transferred_radiance)
-and weighed per pixel by the interpolated PCA weights.  A light's diffuse term is t . (its SH) and its
+compressed transfer's terms computed once per lighting per object (visibility.transfer.transferred_radiance)
+and weighed by the PCA weights: at the vertices, once per lighting (vertex_transfer_values), the pixels
+interpolating the sums, where the varyings hold them (vertex_transfer_rows: order 5 and below); else per
+pixel by the interpolated weights (up to 47 terms of N^2 + 1 fetches a pixel: 4-5x the unshadowed frame
+at order 5, the vertices' sums about 1x; docs/PERFORMANCE.md).  A light's diffuse term is t . (its SH) and its
 glossy term is scaled by the same visible fraction of the light (t . L_light over the unshadowed
 clamped-cosine integral); the shading order is at most the transfer's.
 """
@@ -32,6 +35,7 @@ import numpy as np
 from ..harmonics import brdf_table, fitted_table, projection
 from ..reflectance import models
 from ..visibility import transfer
+from ..visibility.per_vertex import texture_of as per_vertex_texture
 from . import fitted_texels, sh_glsl, sh_shading, shader_sources, surface_layering
 from .base import Technique
 
@@ -60,6 +64,7 @@ class SHKey:
     has_lights: bool = False
     gbuffer: bool = False
     transfer_layers: int = 0            # vec4 rows a vertex of the transfer bake (0: none)
+    vertex_transfer: int = 0            # vec4 a vertex of the transfer summed at the vertices (0: per pixel)
     layering: tuple = ()            # surface_layering.flags of the material
     fitted_lobes: int = 0           # a stored lobe fit's tables (SH_FITTED): its lobes (0: the model's table)
     fitted_components: int = 0      # and its shadowing's PCA components
@@ -73,7 +78,9 @@ class SHKey:
         if self.gbuffer:
             parts.append("G-buffer")
         if self.transfer_layers:
-            parts.append(f"transfer ({self.transfer_layers} weight vec4)")
+            parts.append(f"transfer ({self.transfer_layers} weight vec4, "
+                         + (f"summed at the vertices: {self.vertex_transfer} vec4)" if self.vertex_transfer
+                            else "summed per pixel)"))
         if self.layering:
             parts.append("layering: " + ", ".join(self.layering))
         return ", ".join(parts)
@@ -133,6 +140,7 @@ def axis_constants(table):
 
 
 TRANSFER_KIND = "transfer"       # the per-vertex kind of a transfer bake (engine/scene_state.py)
+VERTEX_TRANSFER = True           # False: the transfer's terms summed per pixel at every order (benchmarks compare)
 
 
 def transfer_order(data):
@@ -149,6 +157,33 @@ def transfer_radiance_texture(data, environment, order, window):
                                              transfer_order(data), order)
     out = np.zeros(products.shape[:2] + (4,), np.float32)
     out[..., :3] = products
+    return out
+
+
+def vertex_transfer_rows(order, has_lights):
+    """vec4 a vertex of the transfer summed at the vertices: T L (N^2 RGB), t . L (RGB) and, for the lights'
+    terms, t (N^2), packed 4 floats a vec4; 0 where they and the surface's own varyings would pass
+    shader_sources.MAX_VARYINGS (order 6 and above) or VERTEX_TRANSFER is off."""
+    count = order * order
+    rows = -(-(3 * (count + 1) + (count if has_lights else 0)) // 4)
+    fits = shader_sources.SURFACE_VARYINGS + rows <= shader_sources.MAX_VARYINGS
+    return rows if VERTEX_TRANSFER and fits else 0
+
+
+def vertex_transfer_values(data, environment, order, window, rows):
+    """(V, 4 rows) float32 of a transfer bake's PerVertexData under an environment: each row's
+    sh_shading.transfer_sums packed as the shader reads them (T L RGB by coefficient, t . L, then t if the
+    rows hold it, zero-padded)."""
+    count = order * order
+    lit, irradiance, diffuse_transfer = sh_shading.transfer_sums(
+        data.rows, transfer_radiance_texture(data, environment, order, window), transfer.basis_terms(
+            data.basis_texture), count)
+    parts = [lit.reshape(len(lit), -1), irradiance]
+    if 4 * rows >= 3 * (count + 1) + count:
+        parts.append(diffuse_transfer)
+    out = np.zeros((len(lit), 4 * rows), np.float32)
+    values = np.concatenate(parts, axis=1)
+    out[:, :values.shape[1]] = values
     return out
 
 
@@ -197,7 +232,8 @@ class SphericalHarmonics(Technique):
         return SHKey(order=order, window=getattr(params, "sh_window", "none"),
                      isotropic=axis is not None or fitted is not None, parameter=axis[0] if axis else None,
                      textures=textures, has_lights=inputs.has_lights, gbuffer=inputs.gbuffer,
-                     transfer_layers=data.layers if data is not None else 0, **fit)
+                     transfer_layers=data.layers if data is not None else 0,
+                     vertex_transfer=vertex_transfer_rows(order, inputs.has_lights) if data is not None else 0, **fit)
 
     def defines(self, key):
         out = {"SH_PARAMETER": PARAMETER_FIELDS[key.parameter] if key.parameter else "0.0"}
@@ -217,6 +253,8 @@ class SphericalHarmonics(Technique):
             out["GBUFFER"] = 1
         if key.transfer_layers:
             out.update(HAS_TRANSFER=1, TRANSFER_LAYERS=key.transfer_layers)
+        if key.vertex_transfer:
+            out["VERTEX_TRANSFER"] = key.vertex_transfer
         out.update(surface_layering.layering_defines(key.layering, key.parameter == "roughness"
                                                      and "roughness" in key.textures))
         return out
@@ -225,7 +263,9 @@ class SphericalHarmonics(Technique):
         samplers = [("FLOAT_2D_ARRAY", "sh_table"), ("FLOAT_2D", "sh_environment")]
         if key.fitted_lobes:           # texelFetch: the UV's nearest texel, as SG_FITTED reads it
             samplers += [("FLOAT_2D_ARRAY", "fitted_layers"), ("FLOAT_2D", "fitted_shadowing")]
-        if key.transfer_layers:
+        if key.vertex_transfer:
+            samplers.append(("FLOAT_2D", "sh_vertex_transfer"))
+        elif key.transfer_layers:
             samplers += [("FLOAT_2D", "transfer_coefficients"), ("FLOAT_2D", "sh_transfer_radiance")]
             if key.has_lights:
                 samplers.append(("FLOAT_2D_ARRAY", "transfer_basis"))
@@ -233,6 +273,9 @@ class SphericalHarmonics(Technique):
         return samplers + ([surface_layering.SAMPLER] if key.layering else [])
 
     def per_vertex_inputs(self, key):
+        if key.vertex_transfer:
+            return (shader_sources.PerVertexInput("sh_vertex_transfer", key.vertex_transfer, "transfer_varying",
+                                                  "transfer_rows"),)
         if not key.transfer_layers:
             return ()
         return (shader_sources.PerVertexInput("transfer_coefficients", key.transfer_layers, "transfer_varying",
@@ -250,7 +293,7 @@ class SphericalHarmonics(Technique):
         sources.append(sh_glsl.constants_source(key.order, key.window))
         per_vertex = self.per_vertex_inputs(key)
         if per_vertex:
-            sources.append(f"vec4 transfer_rows[{key.transfer_layers}];\n"
+            sources.append(f"vec4 transfer_rows[{per_vertex[0].rows}];\n"
                            + shader_sources.per_vertex_copy_source(per_vertex))
         sources += [shader_sources.technique_source(GLSL_DIR, name)
                     for name in ("sh_library.glsl", "sh_shading.glsl", "surface.frag.glsl")]
@@ -286,7 +329,13 @@ class SphericalHarmonics(Technique):
             return row
 
         shader.uniform_sampler("sh_environment", context.environment_table("sh_environment", environment_row))
-        if key.transfer_layers:
+        if key.vertex_transfer:          # remade when the bake or the lighting changes, not a frame
+            data = context.per_vertex(TRANSFER_KIND).data
+            shader.uniform_sampler("sh_vertex_transfer", context.object_table(
+                f"sh_vertex_transfer_{key.order}_{key.window}_{key.vertex_transfer}", (data, environment),
+                lambda: per_vertex_texture(vertex_transfer_values(data, environment, key.order, key.window,
+                                                                  key.vertex_transfer), key.vertex_transfer)))
+        elif key.transfer_layers:
             buffers = context.per_vertex(TRANSFER_KIND)
             data = buffers.data
             shader.uniform_sampler("transfer_coefficients", buffers.rows_texture)

@@ -18,6 +18,25 @@ import numpy as np
 MAX_ROWS = 12
 # PCA terms of an SSDF bake that fit them: the rows hold [1, w_0, ..., w_{N-1}] (the mean's weight first)
 MAX_TERMS = 4 * MAX_ROWS - 1
+TEXTURE_WIDTH = 4096        # texels a row of a per-vertex texture (a multiple of its vec4 a vertex is used)
+
+
+def vertices_per_row(texels_per_vertex):
+    """Vertices a row of a per-vertex texture of `texels_per_vertex` vec4 a vertex."""
+    return max(1, TEXTURE_WIDTH // texels_per_vertex)
+
+
+def texture_of(values, texels_per_vertex, per_row=None):
+    """(rows, per_row * texels_per_vertex, 4) float32 texture of per-vertex values (V, 4 * texels_per_vertex):
+    vertex v's texel k at (column (v % per_row) * texels_per_vertex + k, row v // per_row)
+    (techniques/shader_sources.py per_vertex_fetch_source reads it back with texelFetch); per_row: default
+    vertices_per_row(texels_per_vertex)."""
+    per_row = per_row or vertices_per_row(texels_per_vertex)
+    count = values.shape[0]
+    rows = max(1, -(-count // per_row))
+    out = np.zeros((rows * per_row, texels_per_vertex, 4), np.float32)
+    out[:count] = np.asarray(values, np.float32).reshape(count, texels_per_vertex, 4)
+    return out.reshape(rows, per_row * texels_per_vertex, 4)
 
 
 @dataclass

@@ -368,3 +368,26 @@ def pixel_visibility(result, mask):
     return sg_shading.Visibility(rows=rows.astype(np.float32), normal=normal.astype(np.float32),
                               basis_texture=data.basis_texture, diffuse=diffuse.astype(np.float32),
                               shared_light=shared_light)
+
+
+def pixel_sh_transfer(result, mask, params):
+    """(order, the SH mirror's transfer inputs (sh_shading.transfer_sums' at the pixels)) of the G-buffer pixels
+    `mask` (all of one object with a transfer bake), summed as the variant sums them: at the vertices and
+    interpolated (spherical_harmonics.vertex_transfer_rows), else of the interpolated weights."""
+    from sg_prt_addon.techniques import sh_shading, spherical_harmonics
+    from sg_prt_addon.visibility import transfer
+
+    state = result["state"]
+    entry, _mesh, vertex, weights = _pixel_corners(result, mask)
+    data = state.per_vertex[entry.mesh_key]["transfer"]
+    order = min(params.sh_order, spherical_harmonics.transfer_order(data))
+    count, has_lights = order * order, state.light_data().count > 0
+    rows = spherical_harmonics.vertex_transfer_rows(order, has_lights)
+    if not rows:
+        pixel_rows = np.einsum("nk,nkc->nc", weights, data.rows[vertex].astype(np.float64)).astype(np.float32)
+        return order, sh_shading.transfer_sums(pixel_rows, spherical_harmonics.transfer_radiance_texture(
+            data, state.environment, order, params.sh_window), transfer.basis_terms(data.basis_texture), count)
+    values = spherical_harmonics.vertex_transfer_values(data, state.environment, order, params.sh_window, rows)
+    pixel = np.einsum("nk,nkc->nc", weights, values[vertex].astype(np.float64)).astype(np.float32)
+    diffuse_transfer = pixel[:, 3 * count + 3:4 * count + 3] if has_lights else np.zeros((len(pixel), count))
+    return order, (pixel[:, :3 * count].reshape(-1, count, 3), pixel[:, 3 * count:3 * count + 3], diffuse_transfer)

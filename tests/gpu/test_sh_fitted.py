@@ -33,7 +33,6 @@ def fitted_material(blender, tmp_path_factory):
 def _mirror_errors(result, transfer=False):
     """{(material, pass): max relative error} of the GPU's passes against sh_shading.shade_fragments."""
     from sg_prt_addon.techniques import sh_shading, spherical_harmonics
-    from sg_prt_addon.visibility import transfer as transfer_module
 
     passes, state = result["passes"], result["state"]
     camera, uv = passes["camera"], passes["gbuffer_uv"]
@@ -47,11 +46,7 @@ def _mirror_errors(result, transfer=False):
         params = state.materials[material_of_id[int(np.rint(uv[mask][0, 2]))]]
         order, inputs = params.sh_order, None
         if transfer:
-            rows, data = fx.pixel_per_vertex(result, mask, "transfer")
-            order = min(order, spherical_harmonics.transfer_order(data))
-            inputs = (rows, spherical_harmonics.transfer_radiance_texture(data, state.environment, order,
-                                                                          params.sh_window),
-                      transfer_module.basis_terms(data.basis_texture))
+            order, inputs = fx.pixel_sh_transfer(result, mask, params)
         diffuse, specular = sh_shading.shade_fragments(
             params, {}, spherical_harmonics.table_for(params, order), environment,
             passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],

@@ -120,7 +120,6 @@ def transfer_scene(engine):
 
 def _transfer_mirror_errors(result):
     from sg_prt_addon.techniques import sh_shading, spherical_harmonics
-    from sg_prt_addon.visibility import transfer
 
     passes, state = result["passes"], result["state"]
     camera, uv = passes["camera"], passes["gbuffer_uv"]
@@ -132,15 +131,12 @@ def _transfer_mirror_errors(result):
         mask = covered & (objects == object_index)
         material_id = int(np.rint(uv[mask][0, 2]))
         params = state.materials[{i: n for n, i in passes["material_ids"].items()}[material_id]]
-        rows, data = fx.pixel_per_vertex(result, mask, "transfer")
-        assert data is not None
-        order = min(params.sh_order, spherical_harmonics.transfer_order(data))
-        products = spherical_harmonics.transfer_radiance_texture(data, state.environment, order, params.sh_window)
+        order, inputs = fx.pixel_sh_transfer(result, mask, params)
         diffuse, specular = sh_shading.shade_fragments(
             params, {}, spherical_harmonics.table_for(params, order), environment,
             passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
             passes["gbuffer_tangent"][mask], uv[mask][:, :2], camera.position, camera.is_perspective,
-            state.light_data(), transfer=(rows, products, transfer.basis_terms(data.basis_texture)))
+            state.light_data(), transfer=inputs)
         for name, expected in (("Diffuse", diffuse), ("Specular", specular)):
             actual = passes[name][mask][:, :3]
             assert np.all(np.isfinite(actual)) and expected.max() > 0
@@ -148,20 +144,28 @@ def _transfer_mirror_errors(result):
     return errors
 
 
-def test_transfer_shadows_match_the_mirror(transfer_scene):
-    """Both objects' transfer baked by the operator at order 4 (the materials' order 5 shades at 4): the GPU
-    as the mirror, and the floor under the sphere darker than without the transfer."""
+@pytest.mark.parametrize("bake_order, at_vertices", [(4, True), (4, False), (5, True)])
+def test_transfer_shadows_match_the_mirror(transfer_scene, monkeypatch, bake_order, at_vertices):
+    """Both objects' transfer baked by the operator (the materials' order 5 shades at min(5, the bake's)), its
+    terms summed at the vertices (order 5 with a light: 26 vec4 varyings, 31 with the surface's, within the
+    driver's 32) or per pixel (VERTEX_TRANSFER off, as at orders 6-8): the GPU as the mirror, and the floor
+    under the sphere darker than without the transfer."""
     import bpy
 
+    from sg_prt_addon.techniques import spherical_harmonics
+
+    monkeypatch.setattr(spherical_harmonics, "VERTEX_TRANSFER", at_vertices)
     scene, sphere, floor = transfer_scene
     unshadowed = fx.render(scene, gbuffer=True, environment_layer_size=32)["passes"]["Diffuse"].copy()
     with bpy.context.temp_override(scene=scene):
-        assert bpy.ops.sgprt.bake_transfer("EXEC_DEFAULT", target="ALL", order=4, directions=256,
+        assert bpy.ops.sgprt.bake_transfer("EXEC_DEFAULT", target="ALL", order=bake_order, directions=256,
                                            term_mode="FIXED", terms=6) == {"FINISHED"}
     with fx.recorded_variant_keys() as keys:
         result = fx.render(scene, gbuffer=True, environment_layer_size=32)
     assert "error" not in result, result.get("error")
-    assert {(key.order, key.transfer_layers) for key in keys} == {(4, 2)}
+    order = min(bake_order, 5)
+    rows = -(-(3 * (order * order + 1) + order * order) // 4) if at_vertices else 0
+    assert {(key.order, key.transfer_layers, key.vertex_transfer) for key in keys} == {(order, 2, rows)}
     errors = _transfer_mirror_errors(result)
     print("max relative error", errors)
     assert max(errors.values()) <= TOLERANCE

@@ -12,7 +12,10 @@
  * transfer, T L and t . L weighed from sh_transfer_radiance (row k: term k of the transfer times the
  * windowed lighting; columns 0 .. SH_COUNT - 1: T_k L, SH_COUNT: t_k . L) by transfer_rows; each light's
  * diffuse term t . L_light with t rebuilt from transfer_basis, its glossy term times the same visible
- * fraction of the light.
+ * fraction of the light.  VERTEX_TRANSFER (where the varyings hold them): the sums over the terms made per
+ * vertex once per lighting (spherical_harmonics.vertex_transfer_values), transfer_rows the pixel's
+ * interpolated T L (SH_COUNT RGB), t . L (RGB) and (HAS_LIGHTS) t, packed 4 floats a vec4: the per-pixel
+ * loop over up to 47 terms (26 fetches each) was most of the frame (docs/PERFORMANCE.md).
  *
  * Needs sh_library.glsl and its generated constants, surface_common.glsl, (HAS_LIGHTS) lights.glsl, the
  * samplers sh_table (the BRDF product, ceil(SH_COUNT / 4) layers) and sh_environment (SH_COUNT x 1, rgb),
@@ -114,6 +117,19 @@ void sh_product(vec3 o, float parameter, mat3 frame, out SH_VALUE c[SH_COUNT])
 #endif
 }
 
+#ifdef VERTEX_TRANSFER
+/* Value j of the pixel's transfer summed at the vertices (transfer_rows, packed 4 a vec4). */
+float sh_vertex_transfer_value(int j)
+{
+  return transfer_rows[j / 4][j % 4];
+}
+
+vec3 sh_vertex_transfer_rgb(int j)
+{
+  return vec3(sh_vertex_transfer_value(j), sh_vertex_transfer_value(j + 1), sh_vertex_transfer_value(j + 2));
+}
+#endif
+
 void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3 specular_color, float parameter,
               out vec3 diffuse, out vec3 specular)
 {
@@ -136,7 +152,19 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
   sh_basis(n, y);
   vec3 radiance = vec3(0.0);
   vec3 irradiance = vec3(0.0);
-#ifdef HAS_TRANSFER
+#if defined(HAS_TRANSFER) && defined(VERTEX_TRANSFER)
+  /* the terms summed at the vertices, interpolated (by linearity the same sum of the interpolated weights) */
+  for (int i = 0; i < SH_COUNT; i++) {
+    radiance += c[i] * sh_vertex_transfer_rgb(3 * i);
+  }
+  irradiance = sh_vertex_transfer_rgb(3 * SH_COUNT);
+#ifdef HAS_LIGHTS
+  float diffuse_transfer[SH_COUNT];             /* t(p) */
+  for (int i = 0; i < SH_COUNT; i++) {
+    diffuse_transfer[i] = sh_vertex_transfer_value(3 * SH_COUNT + 3 + i);
+  }
+#endif
+#elif defined(HAS_TRANSFER)
   for (int k = 0; k < 4 * TRANSFER_LAYERS; k++) {
     float weight = transfer_rows[k / 4][k % 4];
     for (int i = 0; i < SH_COUNT; i++) {
