@@ -891,6 +891,7 @@ class CameraExport:
     position: tuple
     forward: tuple                 # camera -Z in world
     is_perspective: bool = True
+    shading_footprint: float = 0.0  # pixels a side each pixel's specular averages over (anti_aliasing.specular_footprint)
 
 
 def camera_from_view(view_matrix, projection_matrix, is_perspective):

@@ -131,6 +131,7 @@ class SGPRT_PT_sampling(RenderPanel, bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         layout.prop(context.scene.sgprt, "render_samples")
+        layout.prop(context.scene.sgprt, "specular_anti_aliasing")
         layout.prop(context.scene.sgprt, "area_light_patches")
 
 

@@ -297,6 +297,12 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
                                             "offset: anti-aliasing with a 1-pixel box filter, as Cycles' Box "
                                             "filter (4 = a 2x2 grid per pixel); each sample costs one frame. The "
                                             "viewport draws one")
+    specular_anti_aliasing: BoolProperty(name="Specular Anti-Aliasing", default=True, update=_tag_changed,
+                                         description="Where the surface's normal turns by more than the "
+                                                     "highlight's width within a pixel, shade that pixel at up to "
+                                                     "4 x 4 points of its area instead of its centre: highlights "
+                                                     "narrower than a pixel neither flicker nor vanish, at the "
+                                                     "cost of shading those pixels again (SG techniques)")
     area_light_patches: IntProperty(name="Area Light Patches", default=AREA_PATCHES_PER_SIDE, min=1, max=8,
                                     update=_tag_changed,
                                     description="An area light is cut into about this many patches a side, each "

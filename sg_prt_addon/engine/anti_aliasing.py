@@ -1,5 +1,6 @@
 """Sub-pixel offsets of the frames a final render averages (Render Samples), and the projection moved by
-one: anti-aliasing with a 1-pixel box filter.  Pixels: x to the right, y DOWN, as validation/camera.py."""
+one: anti-aliasing with a 1-pixel box filter; and the footprint each frame's shading averages its
+specular over (Specular Anti-Aliasing).  Pixels: x to the right, y DOWN, as validation/camera.py."""
 import numpy as np
 
 
@@ -29,3 +30,11 @@ def jittered_projection(projection, offset, width, height):
     shift[0, 3] = 2.0 * float(offset[0]) / float(width)
     shift[1, 3] = -2.0 * float(offset[1]) / float(height)
     return shift @ np.asarray(projection, np.float64).reshape(4, 4)
+
+
+def specular_footprint(samples, enabled=True):
+    """The side, in pixels, of the square each pixel of one frame shades its specular over (the scene
+    block's shading_footprint, sg_shading.glsl shade_footprint): the whole pixel for one frame, a cell
+    of the 1 / sqrt(samples) grid for each of ``samples`` jittered frames, 0 (the centre alone) when
+    Specular Anti-Aliasing is off."""
+    return 1.0 / float(np.sqrt(max(int(samples), 1))) if enabled else 0.0

@@ -132,6 +132,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         region_3d = context.region_data
         camera = export.camera_from_view(region_3d.view_matrix, region_3d.window_matrix,
                                          region_3d.is_perspective)
+        camera.shading_footprint = anti_aliasing.specular_footprint(1, specular_anti_aliasing(depsgraph.scene))
         try:
             self.viewport_frame.update(self.viewport_state, camera, width, height,
                                        0.0 if depsgraph.scene.render.film_transparent else 1.0)
@@ -261,6 +262,11 @@ def viewport_border_rect(context, scene, width, height):
     return x0, y0, max(x1, x0), max(y1, y0)
 
 
+def specular_anti_aliasing(scene):
+    """The scene's Specular Anti-Aliasing setting (on where the add-on's settings are absent)."""
+    return bool(getattr(getattr(scene, "sgprt", None), "specular_anti_aliasing", True))
+
+
 def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1):
     """Export, upload, draw and read back one frame; with ``samples`` > 1 the average of that many draws,
     each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset (anti-aliasing).
@@ -276,6 +282,8 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     camera_object = scene.camera.evaluated_get(depsgraph)
     camera = export.export_camera(camera_object, depsgraph, width, height,
                                   scene.render.pixel_aspect_x, scene.render.pixel_aspect_y)
+    # the G-buffer the mirrors read is shaded at the pixels' centres
+    camera.shading_footprint = anti_aliasing.specular_footprint(samples, specular_anti_aliasing(scene) and not gbuffer)
     timings["export"] = time.perf_counter() - start
     renderer = renderer or renderer_module.Renderer(gbuffer=gbuffer)
     start = time.perf_counter()

@@ -108,6 +108,7 @@ def scene_block(camera, light_data, environment):
         vec4_array(2 * MAX_ENV_LOBES, clamped_cosine.sharpness_terms(environment.lobe_sharpness[:env_lobes], np.float32)
                    if env_lobes else []),
         np.asarray(_column_major(camera.projection @ camera.view), np.float32).reshape(4, 4),   # mat4 columns
+        np.array([[camera.shading_footprint, 0.0, 0.0, 0.0]], np.float32),
     ]
     return np.concatenate(parts, axis=0)
 

@@ -33,6 +33,9 @@ struct SceneData {
   vec4 env_cosine_terms[2 * SGPRT_MAX_ENV_LOBES];
   /* world -> clip of the surface draws (push constants stay within 128 bytes: model matrix + G-buffer ids) */
   mat4 view_projection;
+  /* x: the side, in pixels, of the square each pixel's shading averages its specular over (engine/
+   * anti_aliasing.py specular_footprint): 1 one frame, 1/m each of m x m jittered frames, 0 the centre alone */
+  vec4 shading_footprint;
 };
 
 struct MaterialData {

@@ -34,6 +34,8 @@ def new_scene(name, width=256, height=256):
     scene.render.resolution_x = width
     scene.render.resolution_y = height
     scene.render.resolution_percentage = 100
+    # the Monte Carlo references shade pixel centres; the tests of the footprint sampling turn it on
+    scene.sgprt.specular_anti_aliasing = False
     camera = bpy.data.objects.new(name + "_camera", bpy.data.cameras.new(name + "_camera"))
     scene.collection.objects.link(camera)
     camera.location = (0.0, -6.0, 1.0)

@@ -17,6 +17,14 @@ SIZE = 48
 PASSES = ("Combined", "Diffuse", "Specular")
 
 
+def _new_scene(name, width, height):
+    """fx.new_scene with the engine's default Specular Anti-Aliasing: the footprint's derivatives meet the
+    degenerate geometry and extreme materials too."""
+    scene = fx.new_scene(name, width, height)
+    scene.sgprt.specular_anti_aliasing = True
+    return scene
+
+
 @pytest.fixture(scope="module")
 def engine(blender):
     from sg_prt_addon.engine import render_engine
@@ -109,7 +117,7 @@ EXTREMES = {
 def test_extreme_materials(engine, model, world):
     """Each model at roughness 1e-4 and 1, exponents 1e-4 and 1e8, zero diffuse / specular / both,
     lit by a point, a spot, a sun and the world (a colour, or an HDRI with a 500x sun texel)."""
-    scene = fx.new_scene(f"stress_{model}_{world}", SIZE, SIZE)
+    scene = _new_scene(f"stress_{model}_{world}", SIZE, SIZE)
     if world == "hdri":
         _world_image(scene, _hdri("stress_hdri"))
     else:
@@ -139,7 +147,7 @@ def _height_image(name, heights):
 def test_extreme_bi_scale_materials(engine, model):
     """The bi-scale technique (SG_BISCALE) with the extreme settings above on a flat tile, a tile of near-vertical
     walls and a single spike, under the HDRI and the lights: every pass finite."""
-    scene = fx.new_scene(f"stress_biscale_{model}", SIZE, SIZE)
+    scene = _new_scene(f"stress_biscale_{model}", SIZE, SIZE)
     _world_image(scene, _hdri("stress_biscale_hdri"))
     fx.point_light(scene, f"{scene.name}_point", (1.0, -3.0, 3.0), 1000.0, radius=0.0)
     fx.point_light(scene, f"{scene.name}_sun", (0.0, 0.0, 5.0), 3.0, kind="SUN")
@@ -169,7 +177,7 @@ def test_extreme_bi_scale_materials(engine, model):
 
 def test_non_finite_material_settings(engine):
     """NaN / Inf settings stored by a script: the defaults are used, and said."""
-    scene = fx.new_scene("stress_nan_settings", 16, 16)
+    scene = _new_scene("stress_nan_settings", 16, 16)
     fx.world_colour(scene, (0.2, 0.2, 0.2))
     fx.point_light(scene, "stress_nan_settings_light", (1.0, -3.0, 3.0), 1000.0)
     material = fx.material("stress_nan_settings", model="WARD_ANISO", lobe_count=2)
@@ -201,7 +209,7 @@ def test_degenerate_geometry(engine):
     """Zero-area triangles (collapsed to a point and to a line), a fan whose vertices have zero
     normals (every face degenerate), custom split normals of zero length, vertices at NaN / Inf /
     1e30, objects scaled by 0 along one axis and along all three."""
-    scene = fx.new_scene("stress_degenerate", SIZE, SIZE)
+    scene = _new_scene("stress_degenerate", SIZE, SIZE)
     fx.world_colour(scene, (0.2, 0.2, 0.2))
     fx.point_light(scene, "stress_degenerate_light", (1.0, -3.0, 3.0), 1000.0)
     material = fx.material("stress_degenerate_material", model="WARD_ANISO", lobe_count=2)
@@ -251,7 +259,7 @@ def test_missing_uvs(engine):
     import bmesh
     import bpy
 
-    scene = fx.new_scene("stress_no_uv", SIZE, SIZE)
+    scene = _new_scene("stress_no_uv", SIZE, SIZE)
     fx.world_colour(scene, (0.2, 0.2, 0.2))
     fx.point_light(scene, "stress_no_uv_light", (1.0, -3.0, 3.0), 1000.0)
     pixels = np.ones((8, 8, 4), np.float32)
@@ -280,7 +288,7 @@ def test_missing_uvs(engine):
 # --------------------------------------------------------------------------- scales
 
 def _scaled_scene(scale):
-    scene = fx.new_scene(f"stress_scale_{scale:g}", SIZE, SIZE)
+    scene = _new_scene(f"stress_scale_{scale:g}", SIZE, SIZE)
     fx.world_colour(scene, (0.1, 0.1, 0.1))
     scene.camera.location = tuple(scale * c for c in scene.camera.location)
     scene.camera.data.clip_start = 0.1 * scale
@@ -336,7 +344,7 @@ def _poisoned(height, width, base, seed, count_nan, count_inf, channels=3):
 def test_nan_inf_texels(engine, model):
     """NaN and +-Inf texels in the diffuse colour, roughness (alpha_x) and normal map textures and in
     the world's HDRI: finite passes and a warning per image with its count."""
-    scene = fx.new_scene(f"stress_texels_{model}", SIZE, SIZE)
+    scene = _new_scene(f"stress_texels_{model}", SIZE, SIZE)
     world_pixels = _poisoned(16, 32, 0.5, 1, 5, 4)
     world_pixels[13, 5, :3] = 200.0
     world_pixels[2, 7:9, :3] = 3e38                 # finite, but two of them overflow the prefilter's sums
@@ -372,7 +380,7 @@ def test_nan_inf_texels(engine, model):
 def test_warnings_reset_per_render(engine):
     """A second render of a repaired scene does not keep the first one's warnings twice, and a
     clean scene has none."""
-    scene = fx.new_scene("stress_clean", 16, 16)
+    scene = _new_scene("stress_clean", 16, 16)
     fx.world_colour(scene, (0.2, 0.2, 0.2))
     _uv_sphere(scene, "stress_clean_sphere", (0.0, 0.0, 1.0), segments=8, rings=4)
     assert _warnings(_render(scene)) == []
@@ -389,7 +397,7 @@ def test_warnings_reset_per_render(engine):
 def test_light_extremes(engine):
     """Point, spot, area and sun lights of zero energy, huge energy (1e20 W) and zero size, one of them
     inside the sphere and one at the shading point of the floor."""
-    scene = fx.new_scene("stress_lights", SIZE, SIZE)
+    scene = _new_scene("stress_lights", SIZE, SIZE)
     fx.world_colour(scene, (0.0, 0.0, 0.0))
     lights = [
         ("zero_point", "POINT", (1.0, -3.0, 3.0), 0.0, 0.0),
@@ -431,7 +439,7 @@ def test_non_finite_light_and_world_settings(engine, world):
     location, a NaN world colour and strength (Blender stores what scripts set): finite, warned."""
     import bpy
 
-    scene = fx.new_scene(f"stress_nan_lights_{world}", 32, 32)
+    scene = _new_scene(f"stress_nan_lights_{world}", 32, 32)
     if world == "hdri":
         world_data = _world_image(scene, _hdri("stress_nan_lights_hdri"))
     else:

@@ -1,6 +1,6 @@
 /* Material parameters (property x texture over the active UV map), normal map, tangent
- * frame (common/surface_io.glsl), then shade_surface (sg_shading.glsl).  Writes Combined, Diffuse and
- * Specular; the GBUFFER variant writes Diffuse, Specular and the shading inputs for the numpy mirror. */
+ * frame (common/surface_io.glsl), then shade_surface over the pixel's footprint (sg_shading.glsl
+ * shade_footprint).  Writes Combined, Diffuse and Specular; the GBUFFER variant writes Diffuse, Specular and the shading inputs for the numpy mirror. */
 void main()
 {
   vec3 normal = surface_facing_normal();
@@ -49,7 +49,7 @@ void main()
   surface_layering(shading_normal, diffuse_color, specular_color);
 #endif
   vec3 diffuse, specular;
-  shade_surface(world_position, shading_normal, shading_tangent, p, q, diffuse_color, specular_color,
-                diffuse, specular);
+  shade_footprint(world_position, shading_normal, shading_tangent, p, q, diffuse_color, specular_color,
+                  diffuse, specular);
   surface_write(diffuse, specular, normal, tangent);
 }
