@@ -298,8 +298,8 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
                                             "filter (4 = a 2x2 grid per pixel); each sample costs one frame. The "
                                             "viewport draws one")
     specular_anti_aliasing: BoolProperty(name="Specular Anti-Aliasing", default=True, update=_tag_changed,
-                                         description="Where the surface's normal turns by more than the "
-                                                     "highlight's width within a pixel, shade that pixel at up to "
+                                         description="Where the surface's normal turns by more than twice "
+                                                     "the highlight's width within a pixel, shade that pixel at up to "
                                                      "4 x 4 points of its area instead of its centre: highlights "
                                                      "narrower than a pixel neither flicker nor vanish, at the "
                                                      "cost of shading those pixels again (SG techniques)")

@@ -86,7 +86,7 @@ def test_specular_anti_aliasing_comes_close_to_the_box_filter(engine):
     errors = {key: _surface_rmse(image, renders["reference"], mask) for key, image in renders.items()
               if key != "reference"}
     print("relative RMSE against 64 jittered frames: " + ", ".join(f"{k} {v:.3f}" for k, v in errors.items()))
-    # measured: centre 3.43, footprint 0.028; with 16 frames 0.041 (centre) and 0.130 (footprint: each frame
+    # measured: centre 3.43, footprint 0.031; with 16 frames 0.040 (centre) and 0.131 (footprint: each frame
     # shades its cell of the pixel): the highlight lies within 1/20 of one pixel, where the 8 x 8 reference
     # itself is uncertain by a few percent, which on its value of 16 (the surface's mean is 0.05) is the RMSE
     assert errors["centre"] > 1.0                               # the aliasing is there to remove

@@ -80,24 +80,32 @@ float fitted_m_factor(vec3 wo, vec3 wi, float eta, float shadowing_o)
 }
 #endif
 
-/* The NDF's angular width, as GGX's alpha: sqrt(2 / lambda) of its sharpest lobe (an SG of sharpness lambda
- * falls to 1/e at about that angle from its axis); the small-scale BRDF's for a bi-scale material. */
-float model_lobe_width(vec4 p, vec4 q)
+/* The NDF's angular widths along the tangent and the bitangent (radians, about the slopes' spread: GGX's and
+ * Beckmann's alpha, Blinn-Phong's and Ashikhmin-Shirley's sqrt(2 / (n + 2)) and sqrt(2 / (n + 1)), a fitted
+ * lobe's sqrt(2 / lambda), the sharpest); the small-scale BRDF's for a bi-scale material. */
+vec2 model_lobe_widths(vec4 p, vec4 q)
 {
+#if defined(MODEL_FITTED)
   float sharpest = 0.0;
-#ifdef MODEL_FITTED
   for (int k = 0; k < FITTED_LOBES; k++) {
     sharpest = max(sharpest, fitted_layer(1 + 2 * k).w);
   }
+  return vec2(sqrt(2.0 / max(sharpest, 1.0e-6)));
+#elif defined(MODEL_GGX)
+  return vec2(ggx_alpha(p.x));
+#elif defined(MODEL_COOK_TORRANCE)
+  return vec2(p.x);
+#elif defined(MODEL_BLINN_PHONG)
+  return vec2(sqrt(2.0 / (max(p.z, 0.0) + 2.0)));
+#elif defined(MODEL_WARD_ISO)
+  return vec2(p.w);
+#elif defined(MODEL_WARD_ANISO) || defined(MODEL_GGX_ANISO)
+  return vec2(p.w, q.x);
+#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
+  return sqrt(2.0 / (max(q.yz, vec2(0.0)) + 1.0));
 #else
-  for (int k = 0; k < NDF_LOBES; k++) {
-    vec3 axis;
-    float sharpness, amplitude;
-    model_ndf_lobe(p, q, k, axis, sharpness, amplitude);
-    sharpest = max(sharpest, sharpness);
-  }
+  return vec2(1.0);
 #endif
-  return sqrt(2.0 / max(sharpest, 1.0e-6));
 }
 
 /* M_o(i) of the model (brdf.glsl's <model>_m_factor). */
@@ -430,7 +438,8 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
 #else
   /* a constant world: the cosine lobe alone (a zero-sharpness G) */
-  irradiance += float(with_environment_diffuse) * SG_PI * scene.world_colour.rgb * DIFFUSE_VISIBILITY(0, n, 0.0) * BISCALE_ALBEDO;
+  irradiance += float(with_environment_diffuse) * SG_PI * scene.world_colour.rgb * DIFFUSE_VISIBILITY(0, n, 0.0) *
+                BISCALE_ALBEDO;
 #endif
 #endif
 
@@ -439,15 +448,15 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 }
 
 #ifdef HAS_SPECULAR
-/* shade_footprint's grid: a sample a side for each two NDF widths the normal turns across the footprint, at
- * most 4 (benchmarks/specular_aa.py on ggx030_point, relative RMSE against the box filter: 0.30; one a width
- * 0.29 at 1.2x the cost, at most 3 a side 0.33 at 0.65x) */
-#define SPECULAR_AA_RATE 0.5
+/* shade_footprint's grid: a sample a side for each 4/3 of an NDF width the normal turns across the footprint, at
+ * most 4 (benchmarks/specular_aa.py, relative RMSE against the box filter on ggx030_point: 0.29 at this rate,
+ * 0.46 at a sample for two widths, for 3.4x and 2.3x the frame) */
+#define SPECULAR_AA_RATE 0.75
 #define SPECULAR_AA_MAX_SIDE 4
 #endif
 
 /* shade_surface averaged over the pixel's footprint (scene.shading_footprint.x pixels a side): where the normal
- * turns across it by more than the NDF's width, a highlight narrower than the pixel would be caught or missed
+ * turns across it by more than two NDF widths, a highlight narrower than the pixel would be caught or missed
  * whole at its centre; the specular is shaded at the centres of a side x side grid instead, the position and
  * normal moved along their screen derivatives (exact inside a triangle, whose attributes are affine there).
  * Must be called in uniform control flow (the derivatives). */
@@ -462,8 +471,14 @@ void shade_footprint(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q, v
   int side = 1;
 #ifdef HAS_SPECULAR
   if (footprint > 0.0) {
-    float turn = sqrt(dot(dndx, dndx) + dot(dndy, dndy));
-    side = clamp(int(ceil(SPECULAR_AA_RATE * turn / model_lobe_width(p, q))), 1, SPECULAR_AA_MAX_SIDE);
+    /* the turn in NDF widths, each axis of the shading frame by its own (anisotropic lobes) */
+    vec3 n, t, b;
+    shading_frame(normal, tangent, n, t, b);
+    vec2 widths = max(model_lobe_widths(p, q), vec2(1.0e-4));
+    vec2 turn_x = vec2(dot(dndx, t), dot(dndx, b)) / widths;
+    vec2 turn_y = vec2(dot(dndy, t), dot(dndy, b)) / widths;
+    float turn = sqrt(dot(turn_x, turn_x) + dot(turn_y, turn_y));
+    side = clamp(int(ceil(SPECULAR_AA_RATE * turn)), 1, SPECULAR_AA_MAX_SIDE);
   }
 #endif
   shade_surface(position, normal, tangent, p, q, diffuse_color, specular_color, true, diffuse, specular);
