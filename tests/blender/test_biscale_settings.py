@@ -3,6 +3,7 @@ and the clear word when they cannot be rendered (blender/biscale_source.py)."""
 import numpy as np
 import pytest
 import recording_layout
+from exported_material import export_with_warnings
 
 bpy = pytest.importorskip("bpy")
 
@@ -24,16 +25,6 @@ def _biscale(name, **settings):
     return material
 
 
-def _export(material):
-    from sg_prt_addon.blender import export
-
-    warnings = export.collect_warnings([])
-    try:
-        return export.export_material(material), warnings
-    finally:
-        export.collect_warnings(None)
-
-
 def _drawn(panel, material):
     return recording_layout.draw(panel, type("Context", (), {"material": material})())
 
@@ -46,7 +37,7 @@ def test_panel_shows_the_tile_of_the_chosen_source(empty_file):
     calls = _drawn(panels.SGPRT_PT_material_biscale, material)
     assert ("template_ID", "height_image") in calls and ("prop", "height_scale") in calls
     assert ("prop", "tile_object") not in calls
-    _export(material)
+    export_with_warnings(material)
     assert any(kind == "label" and "lobes from 128 triangles" in text for kind, text in
                _drawn(panels.SGPRT_PT_material_biscale, material))
     material.sgprt.biscale.source = "OBJECT"
@@ -64,12 +55,12 @@ def test_export_gives_the_tables_and_what_it_reads(empty_file):
 
     material = _biscale("export_biscale", model="BLINN_PHONG", exponent=200.0)
     material.sgprt.biscale.height_image = _height_image("export_height", 0.05 * np.eye(8))
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert params.technique == "SG_BISCALE" and isinstance(params.biscale, bvndf.BVNDF) and not warnings
     assert params.reads == (("IMAGE", "export_height"),)
     assert params.biscale.lobe_count == 4 and params.biscale.resolution == 12
     # the same tile and settings: the cached tables
-    assert _export(material)[0].biscale is params.biscale
+    assert export_with_warnings(material)[0].biscale is params.biscale
 
 
 def test_a_mask_and_a_second_height_field_make_two_tiles(empty_file):
@@ -80,12 +71,12 @@ def test_a_mask_and_a_second_height_field_make_two_tiles(empty_file):
     settings = material.sgprt.biscale
     settings.height_image = _height_image("masked_first", 0.05 * np.eye(8))
     settings.mask = _height_image("masked_mask", np.tri(8))
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert any("no second height image: the mask is not applied" in warning for warning in warnings)
     assert isinstance(params.biscale, bvndf.BVNDF) and "biscale_mask" not in params.textures
     assert ("template_ID", "second_height_image") in _drawn(panels.SGPRT_PT_material_biscale, material)
     settings.second_height_image = _height_image("masked_second", np.zeros((8, 8)))
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert isinstance(params.biscale, bvndf.MaskedTiles) and params.biscale.lobe_count == 4 + 4
     assert params.textures["biscale_mask"] == "masked_mask" and not warnings
     assert ("IMAGE", "masked_second") in params.reads
@@ -106,6 +97,6 @@ def test_what_cannot_render_bi_scale_is_said(empty_file, case, expected):
         material.sgprt.biscale.height_image = _height_image(f"bad_{case}_height", heights)
     if case == "fresnel":
         material.sgprt.fresnel = "SCHLICK"
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert any(expected in warning for warning in warnings), warnings
     assert params.technique == ("SG_BISCALE" if case == "fresnel" else "SG_PARAMETRIC")

@@ -4,6 +4,7 @@ technique cannot tabulate is refused with its reason (blender/export.py)."""
 import numpy as np
 import pytest
 import recording_layout
+from exported_material import export_with_warnings
 
 from validation import brdf_generators
 
@@ -35,16 +36,6 @@ def _fit(material, path, **options):
         assert bpy.ops.sgprt.fit_lobes(filepath=path, **options) == {"FINISHED"}
 
 
-def _export(material):
-    from sg_prt_addon.blender import export
-
-    warnings = export.collect_warnings([])
-    try:
-        return export.export_material(material), warnings
-    finally:
-        export.collect_warnings(None)
-
-
 def _labels(material):
     panel = bpy.types.SGPRT_PT_material_lobe_fit
     return [text for kind, text in recording_layout.draw(panel, type("Context", (), {"material": material})())
@@ -59,7 +50,7 @@ def test_a_fit_on_an_sh_material_is_tabulated_and_the_choice_survives_reopening(
     assert _labels(material) == ["No fitted lobes: renders the model above"]
     _fit(material, table_path, lobe_count=2, shadowing_components=4)
     assert (material.sgprt.technique, material.sgprt.sh_brdf) == ("SH", "LOBE_FIT")
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert params.technique == "SH" and params.fitted is not None and not warnings
     assert params.fitted.layers.shape[1:3] == (8, 8)
     calls = recording_layout.draw(panels.SGPRT_PT_material, type("Context", (), {"material": material})())
@@ -74,12 +65,12 @@ def test_a_fit_on_an_sh_material_is_tabulated_and_the_choice_survives_reopening(
     bpy.ops.wm.open_mainfile(filepath=str(path))
     reopened = bpy.data.materials["sh_fit_saved"]
     assert (reopened.sgprt.technique, reopened.sgprt.sh_brdf, reopened.sgprt.sh_order) == ("SH", "LOBE_FIT", 6)
-    again, warnings = _export(reopened)
+    again, warnings = export_with_warnings(reopened)
     assert again.technique == "SH" and not warnings
     np.testing.assert_array_equal(again.fitted.layers, params.fitted.layers)
 
     reopened.sgprt.sh_brdf = "MODEL"            # the model again: the fit stays stored and unused
-    model, _ = _export(reopened)
+    model, _ = export_with_warnings(reopened)
     assert model.technique == "SH" and model.fitted is None
     assert any("set SH BRDF to Lobe Fit" in text for text in _labels(reopened))
 
@@ -89,13 +80,13 @@ def test_fits_it_cannot_tabulate_are_refused_with_the_reason(empty_file, table_p
     from sg_prt_addon.harmonics import fitted_table
 
     material = _sh_material("sh_fit_refused", sh_brdf="LOBE_FIT")
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert params.technique == "SH" and params.fitted is None
     assert any("no usable lobe fit (no fitted lobes): its model is tabulated" in w for w in warnings), warnings
 
     _fit(material, table_path, lobe_count=1, shadowing_components=3)
     monkeypatch.setattr(fitted_table, "MAX_TABLE_BYTES", 2 ** 17)
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert params.technique == "SG_FITTED" and params.fitted is not None
     assert any("cannot tabulate its lobe fit (its 8x8 texels' tables at order 5 would take 0.25 MB, more than 0.125" in w
                and "rendered with Fitted SG Lobes" in w for w in warnings), warnings
@@ -103,7 +94,7 @@ def test_fits_it_cannot_tabulate_are_refused_with_the_reason(empty_file, table_p
 
     _fit(material, table_path, lobe_count=3, axes="FREE", shadowing_components=3)
     assert material.sgprt.sh_brdf == "LOBE_FIT" and material.sgprt.lobe_fit.free_axes
-    params, warnings = _export(material)
+    params, warnings = export_with_warnings(material)
     assert params.technique == "SG_FITTED" and params.fitted is not None
     assert any("cannot tabulate its lobe fit (its lobes leave the normal by up to" in w for w in warnings), warnings
     assert any(text.startswith("Free axes: SH tabulates lobes about the normal only") for text in _labels(material))

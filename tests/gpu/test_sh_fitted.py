@@ -7,7 +7,7 @@ material; and with a transfer bake, the path the parametric tables take."""
 import engine_fixtures as fx
 import numpy as np
 import pytest
-from test_sh_technique import FLOOR_FRACTION, TOLERANCE
+from test_sh_technique import FLOOR_FRACTION, TOLERANCE, lit_scene
 
 
 @pytest.fixture(scope="module")
@@ -60,15 +60,7 @@ def _mirror_errors(result, transfer=False):
 
 
 def _scene(name, fitted_material, world, order, window):
-    scene = fx.new_scene(name, 96, 96)
-    if world == "colour":
-        fx.world_colour(scene, (0.15, 0.17, 0.2))
-    else:
-        fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
-    fx.point_light(scene, name + "_point", (1.5, -2.0, 3.0), 800.0, radius=0.5)
-    fx.point_light(scene, name + "_sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
-    spot = fx.point_light(scene, name + "_spot", (-2.0, -2.0, 2.5), 600.0, radius=0.1, kind="SPOT")
-    spot.rotation_euler = (0.9, 0.0, -0.8)
+    scene = lit_scene(name, world)
     fitted_material.sgprt.sh_order, fitted_material.sgprt.sh_window = order, window
     glossy = fx.material(name + "_ggx", technique="SH", sh_order=order, sh_window=window, model="GGX",
                          roughness=0.4, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6))

@@ -19,7 +19,6 @@ def engine(blender):
     return blender
 
 
-NO_TEXTURE = False
 ROUGHNESS = np.ones((8, 8, 4), np.float32)
 ROUGHNESS[..., 0] = np.linspace(0.3, 1.6, 8)[None, :]
 
@@ -49,7 +48,8 @@ def _mirror_errors(result):
     return errors, covered
 
 
-def _scene(name, world, order, window):
+def lit_scene(name, world):
+    """The SH mirror tests' scene: a world colour or courtyard.exr, a point, a sun and a spot light."""
     scene = fx.new_scene(name, 96, 96)
     if world == "colour":
         fx.world_colour(scene, (0.15, 0.17, 0.2))
@@ -59,10 +59,15 @@ def _scene(name, world, order, window):
     fx.point_light(scene, name + "_sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
     spot = fx.point_light(scene, name + "_spot", (-2.0, -2.0, 2.5), 600.0, radius=0.1, kind="SPOT")
     spot.rotation_euler = (0.9, 0.0, -0.8)
+    return scene
+
+
+def _scene(name, world, order, window):
+    scene = lit_scene(name, world)
     glossy = fx.material(name + "_ggx", technique="SH", sh_order=order, sh_window=window, model="GGX",
                          roughness=0.4, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6),
-                         fresnel="SCHLICK", multiscatter=True, layered_diffuse=True)     # the layer's roughness follows the texture
-    if not NO_TEXTURE: glossy.sgprt.roughness_texture = fx.image(name + "_rough", ROUGHNESS)
+                         fresnel="SCHLICK", multiscatter=True, layered_diffuse=True)
+    glossy.sgprt.roughness_texture = fx.image(name + "_rough", ROUGHNESS)    # the layer's roughness follows it
     brushed = fx.material(name + "_as", technique="SH", sh_order=order, sh_window=window, model="ASHIKHMIN_SHIRLEY",
                           nu=20.0, nv=200.0)
     fx.uv_sphere(scene, name + "_a", (-1.1, 0.0, 1.0), radius=0.9).data.materials.append(glossy)
