@@ -2,8 +2,9 @@
 # Set up and run the whole test suite: every tier on pip bpy 5.0 (the last for Python 3.11) and on the newest,
 # 5.3 (Python 3.13, through pyenv), then the Blender and GPU tiers on 5.2 LTS and on the oldest, 4.2 LTS, and
 # the real-Blender tier (tests/ui: Debian's Blender 4.3 in a chroot, scripts/real_blender.sh; needs root).  The
-# scores against the Monte Carlo reference (marker "reference", about 3 min a tier) run on 5.0 alone: the same
-# GLSL and maths on every Blender, and the suite stays within 30 minutes on 2 cores.
+# scores against the Monte Carlo reference (marker "reference", about 3 min a tier) and the GPU run's smoke run
+# (marker "one_tier", 15-40 s) run on 5.0 alone: the same GLSL, maths and script on every Blender, and the suite
+# stays within 30 minutes on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup_venv.sh .venv requirements.txt
@@ -20,14 +21,14 @@ echo "== lint (ruff, pyproject.toml)"
 echo "== all tiers, bpy $(version .venv)"
 .venv/bin/python -m pytest tests --ignore=tests/ui -q -p no:cacheprovider "$@"
 
-echo "== all tiers less the Monte Carlo scores, bpy $(version .venv-bpy53)"
-.venv-bpy53/bin/python -m pytest tests --ignore=tests/ui -q -p no:cacheprovider -m "not reference" "$@"
+echo "== all tiers less the Monte Carlo scores and the one-tier checks, bpy $(version .venv-bpy53)"
+.venv-bpy53/bin/python -m pytest tests --ignore=tests/ui -q -p no:cacheprovider -m "not reference and not one_tier" "$@"
 
 echo "== blender and gpu tiers, bpy $(version .venv-bpy52)"
-.venv-bpy52/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -m "not reference" "$@"
+.venv-bpy52/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -m "not reference and not one_tier" "$@"
 
 echo "== blender and gpu tiers, bpy $(version .venv-bpy42)"
-.venv-bpy42/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -m "not reference" "$@"
+.venv-bpy42/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -m "not reference and not one_tier" "$@"
 
 echo "== real-Blender tier (Debian's Blender in a chroot, the extension installed from its zip)"
 .venv/bin/python -m pytest tests/ui -q -p no:cacheprovider "$@"

@@ -9,6 +9,8 @@ import time
 
 import pytest
 
+pytestmark = pytest.mark.one_tier     # the script, not the Blender it drives: the bpy 5.0 tier runs it
+
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENE_FIELDS = {"scene", "kind", "triangles", "objects", "render", "frame", "eevee", "render_ratio", "frame_ratio"}
 
