@@ -36,11 +36,24 @@ LIMITS = {"SGPRT_MAX_POINT_LIGHTS": MAX_POINT_LIGHTS, "SGPRT_MAX_SUNS": MAX_SUNS
           "SGPRT_MAX_ENV_LOBES": MAX_ENV_LOBES, "SGPRT_MAX_LAYERS": MAX_LAYERS}
 
 GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
-# vec4 varyings a surface shader may use: llvmpipe gives 128 floats (gpu.capabilities.max_varying_floats_get
-# in a render, Mesa 22.3), as desktop GL drivers commonly do; the surface's own take 5 with per-vertex rows
+# vec4 varyings a surface shader may use where the driver cannot be asked (max_varyings): llvmpipe gives 128
+# floats (Mesa 22.3), as desktop GL drivers commonly do; the surface's own take 5 with per-vertex rows
 # (surface_calls' interface: position, normal, tangent, texcoord, vertex normal)
 MAX_VARYINGS = 32
 SURFACE_VARYINGS = 5
+_driver_varyings = []
+
+
+def max_varyings():
+    """vec4 varyings a surface shader may use: the driver's (gpu.capabilities, asked once inside a GPU context;
+    Metal and some GL drivers give fewer than 128 floats), else MAX_VARYINGS."""
+    if not _driver_varyings:
+        try:
+            from gpu import capabilities  # answers only in Blender's GPU context
+            _driver_varyings.append(int(capabilities.max_varying_floats_get()) // 4)
+        except (ImportError, SystemError):     # no GPU context: background without one, the maths' tests
+            return MAX_VARYINGS
+    return _driver_varyings[0]
 
 
 def output_names(gbuffer):

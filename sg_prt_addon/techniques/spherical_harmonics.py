@@ -163,10 +163,10 @@ def transfer_radiance_texture(data, environment, order, window):
 def vertex_transfer_rows(order, has_lights):
     """vec4 a vertex of the transfer summed at the vertices: T L (N^2 RGB), t . L (RGB) and, for the lights'
     terms, t (N^2), packed 4 floats a vec4; 0 where they and the surface's own varyings would pass
-    shader_sources.MAX_VARYINGS (order 6 and above) or VERTEX_TRANSFER is off."""
+    shader_sources.max_varyings() (order 6 and above on llvmpipe) or VERTEX_TRANSFER is off."""
     count = order * order
     rows = -(-(3 * (count + 1) + (count if has_lights else 0)) // 4)
-    fits = shader_sources.SURFACE_VARYINGS + rows <= shader_sources.MAX_VARYINGS
+    fits = shader_sources.SURFACE_VARYINGS + rows <= shader_sources.max_varyings()
     return rows if VERTEX_TRANSFER and fits else 0
 
 

@@ -22,6 +22,11 @@ def test_the_sums_go_to_the_vertices_up_to_order_5_and_within_the_varyings(monke
                 assert 4 * rows >= floats > 4 * rows - 4
                 assert rows + shader_sources.SURFACE_VARYINGS <= shader_sources.MAX_VARYINGS
     assert spherical_harmonics.vertex_transfer_rows(5, True) == 26
+    # a driver with fewer varyings (Metal's 124 floats less Blender's own, some GL drivers' 64) keeps the larger
+    # orders summed per pixel: 16 vec4 hold order 3 with lights (10 rows and the surface's 5), not order 4
+    monkeypatch.setattr(shader_sources, "_driver_varyings", [16])
+    assert spherical_harmonics.vertex_transfer_rows(3, True) == 10
+    assert spherical_harmonics.vertex_transfer_rows(4, False) == 0
     monkeypatch.setattr(spherical_harmonics, "VERTEX_TRANSFER", False)
     assert spherical_harmonics.vertex_transfer_rows(3, False) == 0
 
