@@ -51,7 +51,7 @@ def max_varyings():
         try:
             from gpu import capabilities  # answers only in Blender's GPU context
             _driver_varyings.append(int(capabilities.max_varying_floats_get()) // 4)
-        except (ImportError, SystemError):     # no GPU context: background without one, the maths' tests
+        except (ImportError, AttributeError, SystemError):  # no GPU context (background without one, the maths' tests)
             return MAX_VARYINGS
     return _driver_varyings[0]
 
