@@ -91,6 +91,26 @@ def material(name, **settings):
     return mat
 
 
+def svbrdf_table_file(folder):
+    """A generated 8 x 8 SVBRDF table (spatially varying kd, eta, roughness; seed 5), written to folder/table.npz:
+    what the fitted-lobe tests fit."""
+    from sg_prt_addon.measured import svbrdf_table
+    from validation import brdf_generators
+
+    path = str(folder / "table.npz")
+    table, _ = brdf_generators.generate_svbrdf_table(size=8, seed=5)
+    svbrdf_table.write_svbrdf_table(path, table)
+    return path
+
+
+def fit_lobes(material, path, **options):
+    """Fit Lobes (bpy.ops.sgprt.fit_lobes) of the file at path on material; it must finish."""
+    import bpy
+
+    with bpy.context.temp_override(material=material):
+        assert bpy.ops.sgprt.fit_lobes(filepath=path, **options) == {"FINISHED"}
+
+
 def image(name, pixels):
     """A float image from (H, W, 4) pixels in Blender's row order (row 0 at the bottom)."""
     import bpy

@@ -167,25 +167,16 @@ def test_saved_file_reopens_and_renders_the_same_image(blender, tmp_path):
 @pytest.fixture(scope="module")
 def fitted_table(blender, tmp_path_factory):
     """A generated 8 x 8 SVBRDF table (spatially varying kd, eta, roughness) to fit the small-scale BRDF to."""
-    from sg_prt_addon.measured import svbrdf_table
-    from validation import brdf_generators
-
-    path = str(tmp_path_factory.mktemp("biscale_fitted") / "table.npz")
-    table, _ = brdf_generators.generate_svbrdf_table(size=8, seed=5)
-    svbrdf_table.write_svbrdf_table(path, table)
-    return path
+    return fx.svbrdf_table_file(tmp_path_factory.mktemp("biscale_fitted"))
 
 
 def test_lobe_fit_small_scale_shader_matches_its_mirror(blender, fitted_table):
     """A measured small-scale BRDF (iwasaki2012 fig. 8): Fit Lobes on a bi-scale material makes the fit its
     small-scale BRDF (the technique stays); its per-texel lobes, colours and M (S(o) in each facet's frame)
     under the tile's lobes, the GLSL against the mirror."""
-    import bpy
-
     fx.ensure_registered()
     material = biscale_material("biscale_fitted", biscale_reference.egg_crate(32), model="GGX", roughness=0.35)
-    with bpy.context.temp_override(material=material):
-        assert bpy.ops.sgprt.fit_lobes(filepath=fitted_table, lobe_count=2, shadowing_components=5) == {"FINISHED"}
+    fx.fit_lobes(material, fitted_table, lobe_count=2, shadowing_components=5)
     assert (material.sgprt.technique, material.sgprt.biscale.small_scale) == ("SG_BISCALE", "LOBE_FIT")
     for world in ("texture", "colour"):
         result = fx.render(_scene(f"biscale_fitted_{world}", material, world), gbuffer=True)
@@ -203,8 +194,6 @@ def test_lobe_fit_small_scale_shader_matches_its_mirror(blender, fitted_table):
 def test_unusable_lobe_fit_renders_single_scale_with_a_reason(blender, fitted_table):
     """Lobe Fit chosen with no fit, or with a free-axes fit (not isotropic): the model, a single scale, and why;
     a usable fit with no tile: the fit, a single scale."""
-    import bpy
-
     fx.ensure_registered()
     material = biscale_material("biscale_no_fit", biscale_reference.egg_crate(16), model="GGX")
     material.sgprt.biscale.small_scale = "LOBE_FIT"
@@ -212,14 +201,11 @@ def test_unusable_lobe_fit_renders_single_scale_with_a_reason(blender, fitted_ta
     assert result["state"].materials[material.name].technique == "SG_PARAMETRIC"
     assert any("no usable small-scale lobe fit (no fitted lobes)" in w for w in result["state"].warnings), \
         result["state"].warnings
-    with bpy.context.temp_override(material=material):
-        assert bpy.ops.sgprt.fit_lobes(filepath=fitted_table, lobe_count=3, axes="FREE",
-                                       shadowing_components=3) == {"FINISHED"}
+    fx.fit_lobes(material, fitted_table, lobe_count=3, axes="FREE", shadowing_components=3)
     result = fx.render(_scene("biscale_free_scene", material, "colour"))
     assert result["state"].materials[material.name].technique == "SG_PARAMETRIC"
     assert any("its lobes leave the normal" in w for w in result["state"].warnings), result["state"].warnings
-    with bpy.context.temp_override(material=material):
-        assert bpy.ops.sgprt.fit_lobes(filepath=fitted_table, lobe_count=1) == {"FINISHED"}
+    fx.fit_lobes(material, fitted_table, lobe_count=1)
     material.sgprt.biscale.height_image = None
     result = fx.render(_scene("biscale_fit_no_tile_scene", material, "colour"))
     assert result["state"].materials[material.name].technique == "SG_FITTED"

@@ -16,19 +16,12 @@ TOLERANCE = 1e-3
 
 @pytest.fixture(scope="module")
 def fitted_material(blender, tmp_path_factory):
-    import bpy
-
     from sg_prt_addon.blender import lobe_fit
-    from sg_prt_addon.measured import svbrdf_table
-    from validation import brdf_generators
 
     fx.ensure_registered()
-    path = str(tmp_path_factory.mktemp("fitted") / "table.npz")
-    table, _ = brdf_generators.generate_svbrdf_table(size=8, seed=5)
-    svbrdf_table.write_svbrdf_table(path, table)
     material = fx.material("mat_fitted_table", model="GGX", roughness=0.4)
-    with bpy.context.temp_override(material=material):
-        assert bpy.ops.sgprt.fit_lobes(filepath=path, lobe_count=2, shadowing_components=5) == {"FINISHED"}
+    fx.fit_lobes(material, fx.svbrdf_table_file(tmp_path_factory.mktemp("fitted")), lobe_count=2,
+                 shadowing_components=5)
     assert lobe_fit.fit_status(material)[0] == "VALID" and material.sgprt.technique == "SG_FITTED"
     return material
 
