@@ -1,8 +1,8 @@
-"""Derived data a render would rebuild in every new process, kept on disk: the environment's prefiltered
-layers and SG fit (about 1 s for a 1024 x 512 HDRI), the engine's tables of the code alone (the clamped
-cosine, GGX albedo, layering: about 1 s together) and the SH technique's tables (techniques reach it through
-DrawContext.cached_arrays: a parametric model's, about 1 s; a lobe fit's, about 5 s for 64 x 64 texels).  A batch job (`blender -b -f 1`) is one process a frame,
-and without this each paid them on its first render.
+"""Derived data a render would rebuild in every new process, kept on disk: the environment's prefiltered layers
+and SG fit (about 1 s for a 1024 x 512 HDRI), the engine's tables of the code alone (the clamped cosine, GGX
+albedo, layering: about 1 s together) and the SH technique's tables (techniques reach it through
+DrawContext.cached_arrays: a parametric model's, about 1 s; a lobe fit's, about 5 s for 64 x 64 texels).  A
+batch job (`blender -b -f 1`) is one process a frame, and without this each paid them on its first render.
 
 Entries are .npz files (numpy arrays only, no pickle, and the list of their names) named by a digest of
 what they were made from: the caller's key (an image's pixels, a table's name) and this add-on's Python
