@@ -135,7 +135,21 @@ class SGPRT_PT_sampling(RenderPanel, bpy.types.Panel):
         layout.prop(context.scene.sgprt, "area_light_patches")
 
 
-classes = (SGPRT_PT_material, SGPRT_PT_material_biscale, SGPRT_PT_material_geometry, SGPRT_PT_sampling)
+class SGPRT_PT_shadows(RenderPanel, bpy.types.Panel):
+    bl_label = "Light Shadows"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        settings = context.scene.sgprt
+        layout.prop(settings, "light_shadows")
+        row = layout.row()
+        row.active = settings.light_shadows == "SHADOW_MAPS"
+        row.prop(settings, "shadow_map_size")
+
+
+classes = (SGPRT_PT_material, SGPRT_PT_material_biscale, SGPRT_PT_material_geometry, SGPRT_PT_sampling,
+           SGPRT_PT_shadows)
 
 # Built-in panels that work unchanged with this engine.
 COMPATIBLE_BUILTIN_PANELS = (

@@ -17,6 +17,7 @@ from bpy.props import (
 )
 
 from .. import techniques
+from ..lighting import shadow_maps
 from ..lighting.lights import AREA_PATCHES_PER_SIDE
 from ..reflectance import models
 
@@ -303,6 +304,20 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
                                                      "4 x 4 points of its area instead of its centre: highlights "
                                                      "narrower than a pixel neither flicker nor vanish, at the "
                                                      "cost of shading those pixels again (SG techniques)")
+    light_shadows: EnumProperty(
+        name="Light Shadows", default="SHADOW_MAPS", update=_tag_changed,
+        items=[("SHADOW_MAPS", "Shadow Maps",
+                "Point, spot and sun lights cast their shadows from a depth map drawn each frame: sharp edges, "
+                "penumbrae from the light's radius or angle (percentage-closer soft shadows), objects without a "
+                "visibility bake shadowed too.  Area lights keep the baked visibility", 0),
+               ("SSDF", "Baked Visibility",
+                "Every light's shadow from the visibility bake (wang2009's SSDF): smooth, its edges wider than "
+                "the light's; objects without a bake are unshadowed", 1)],
+        description="How lights (not the world) are shadowed")
+    shadow_map_size: IntProperty(name="Shadow Map Size", default=shadow_maps.DEFAULT_SIZE, min=64, max=8192,
+                                 soft_max=4096, update=_tag_changed,
+                                 description="Texels a side of each shadow map (a point or spot light draws six, "
+                                             "a sun one); fewer when the lights' maps would pass 256 MB")
     area_light_patches: IntProperty(name="Area Light Patches", default=AREA_PATCHES_PER_SIDE, min=1, max=8,
                                     update=_tag_changed,
                                     description="An area light is cut into about this many patches a side, each "

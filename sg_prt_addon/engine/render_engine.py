@@ -311,6 +311,8 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     if gbuffer:
         for name in GBUFFER_OUTPUTS:
             passes["gbuffer_" + name] = renderer.read_output(name)
+        if renderer.shadow_plan is not None:        # the mirror's shadow-map lookups read the same atlas
+            passes["shadow_atlas"], passes["shadow_plan"] = renderer.shadow_atlas.read(), renderer.shadow_plan
     timings["draw_and_read"] = time.perf_counter() - start
     # steady-state frame cost (shaders compiled and JIT-ed, data uploaded): draw + read the passes
     frame_times = []

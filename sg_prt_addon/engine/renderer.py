@@ -12,12 +12,13 @@ import numpy as np
 
 from .. import techniques
 from ..blender.export import COLOUR_SLOTS, slot_pixels, texture_sources
+from ..lighting import shadow_maps
 from ..spherical import clamped_cosine
 from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility.per_vertex import texture_of as per_vertex_texture  # the layout of every per-vertex texture
 from ..visibility.per_vertex import vertices_per_row
-from . import disk_cache, shader_cache
+from . import disk_cache, shader_cache, shadow_pass
 
 PASS_NAMES = ("Combined", "Diffuse", "Specular")
 
@@ -58,8 +59,9 @@ def _uniform_buffer(data):
     return gpu.types.GPUUniformBuf(gpu.types.Buffer("FLOAT", data.size, data.ravel()))
 
 
-def scene_block(camera, light_data, environment):
-    """SceneData (shaders/engine/scene_data.glsl) as float32 words, std140 (all vec4)."""
+def scene_block(camera, light_data, environment, shadow_plan=None):
+    """SceneData (shaders/engine/scene_data.glsl) as float32 words, std140 (all vec4); shadow_plan: the
+    lights' lighting.shadow_maps.ShadowPlan, or None (no maps)."""
     def vec4_array(count, rows):
         block = np.zeros((count, 4), np.float32)
         rows = np.asarray(rows, np.float32).reshape(-1, 4) if len(rows) else np.zeros((0, 4), np.float32)
@@ -109,6 +111,7 @@ def scene_block(camera, light_data, environment):
                    if env_lobes else []),
         np.asarray(_column_major(camera.projection @ camera.view), np.float32).reshape(4, 4),   # mat4 columns
         np.array([[camera.shading_footprint, 0.0, 0.0, 0.0]], np.float32),
+        shadow_pass.scene_rows(shadow_plan, light_data),
     ]
     return np.concatenate(parts, axis=0)
 
@@ -274,6 +277,9 @@ class _DrawContext(techniques.DrawContext):
     def environment_textures(self):
         return self.renderer.environment_texture, self.renderer.equirect_texture
 
+    def shadow_atlas(self):
+        return self.renderer.shadow_atlas.texture
+
     def table(self, name, build):
         tables = self.renderer.tables
         if name not in tables:
@@ -358,6 +364,8 @@ class Renderer:
         self.targets = []
         self.size = None
         self.uploads = {"meshes": 0, "materials": 0}
+        self.shadow_plan = None         # lighting.shadow_maps.ShadowPlan of the frame (None: no maps)
+        self.shadow_atlas = shadow_pass.ShadowAtlas()
         self._full_screen_batches = {}  # pass name -> GPUBatch of a full-screen triangle
 
     # ----------------------------------------------------------------- uploads
@@ -394,11 +402,21 @@ class Renderer:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)
             self.environment_source = state.environment
-        block = scene_block(camera, state.light_data(), state.environment)
+        light_data = state.light_data()
+        self.shadow_plan = self._plan_shadows(state, light_data)
+        block = scene_block(camera, light_data, state.environment, self.shadow_plan)
         if self.scene_buffer is None:
             self.scene_buffer = _uniform_buffer(block)
         else:
             self.scene_buffer.update(gpu_buffer(block))
+
+    def _plan_shadows(self, state, light_data):
+        """The frame's lighting.shadow_maps.ShadowPlan over the uploaded objects, or None (no maps)."""
+        if not state.shadow_map_size or not light_data.count:
+            return None
+        shadow_plan = shadow_maps.plan(light_data, shadow_pass.world_bounds(state.objects.values(), self.mesh_buffers),
+                                       state.shadow_map_size)
+        return shadow_plan if shadow_plan.active else None
 
     # ----------------------------------------------------------------- targets
 
@@ -441,7 +459,7 @@ class Renderer:
                 continue
             inputs = techniques.ObjectInputs(light_data, state.environment, self.gbuffer,
                                              buffers.per_vertex_layers(), buffers.bounds, entry.matrix_world,
-                                             buffers.per_vertex_data())
+                                             buffers.per_vertex_data(), self.shadow_plan is not None)
             slots = []
             for slot, first_triangle, batch in buffers.batches:
                 name, params = _slot_material(state, entry, slot)
@@ -466,6 +484,10 @@ class Renderer:
 
         draws = self.object_draws(state)
         self._prepare_objects(draws)
+        if self.shadow_plan is not None:        # every object casts, holdouts too (as in Cycles)
+            self.shadow_atlas.draw(self.shadow_plan, [(context.model_matrix, [batch for *_, batch in
+                                                                              context.buffers.batches])
+                                                      for _index, _key, _entry, context, _slots in draws])
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..blender import export
 from ..lighting import lights as core_lights
+from ..lighting import shadow_maps
 from ..lighting.scene_lighting import EnvironmentData, LightData
 from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility import decode, per_vertex
@@ -128,6 +129,7 @@ class SceneState:
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
         self.area_patches = core_lights.AREA_PATCHES_PER_SIDE   # scene.sgprt.area_light_patches
+        self.shadow_map_size = shadow_maps.DEFAULT_SIZE     # the lights' shadow maps' tile side (0: SSDF shadows)
         self.world = export.WorldExport()
         self.environment = EnvironmentData()
         self.dirty = Dirty()
@@ -151,6 +153,7 @@ class SceneState:
         self.materials = {"": export.MaterialParams()}
         self.lights = []
         self.area_patches = _area_patches(depsgraph.scene)
+        self.shadow_map_size = _shadow_map_size(depsgraph.scene)
         seen_meshes = set()
         unrendered = set()          # objects named once in the warnings
         roles = export.render_roles(depsgraph.view_layer)
@@ -331,8 +334,10 @@ class SceneState:
                 dirty.world = True
             elif isinstance(datablock, (bpy.types.Scene, bpy.types.Collection)):
                 membership_changed = True       # objects may have been added, removed or hidden
-                if _area_patches(depsgraph.scene) != self.area_patches:
+                if (_area_patches(depsgraph.scene), _shadow_map_size(depsgraph.scene)) != (
+                        self.area_patches, self.shadow_map_size):
                     self.area_patches = _area_patches(depsgraph.scene)
+                    self.shadow_map_size = _shadow_map_size(depsgraph.scene)
                     dirty.lights = True
             elif isinstance(datablock, bpy.types.Object):
                 self._update_object(depsgraph, datablock.evaluated_get(depsgraph), update, dirty)
@@ -447,6 +452,14 @@ def _area_patches(scene):
     return int(getattr(settings, "area_light_patches", core_lights.AREA_PATCHES_PER_SIDE))
 
 
+def _shadow_map_size(scene):
+    """The tile side of the lights' shadow maps (the scene's Light Shadows settings), 0 for the SSDF's."""
+    settings = getattr(scene, "sgprt", None)
+    if getattr(settings, "light_shadows", "SHADOW_MAPS") != "SHADOW_MAPS":
+        return 0
+    return int(getattr(settings, "shadow_map_size", shadow_maps.DEFAULT_SIZE))
+
+
 def _point_count(light, area_patches):
     """How many of the shader's point lights a light takes: an area light's patches, else one."""
     if light.kind != "AREA":
@@ -502,6 +515,7 @@ def light_data(light_exports, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
             0.5 * np.array([light.angle for light in suns]), np.array([light.colour_intensity for light in suns]))
         data.sun_axis, data.sun_sharpness, data.sun_amplitude = (
             np.asarray(axis, f), np.asarray(sharpness, f), np.asarray(amplitude, f))
+        data.sun_radius = 0.5 * np.array([light.angle for light in suns], f)
     return data
 
 

@@ -16,7 +16,8 @@ class LightData:
     spot_size (P,) full cone angle (negative: a point light), spot_blend (P,); emitter (P, 3): x 1 for a
     patch of an area light (one-sided, its normal the spot direction: lights.emission_factor), y and z
     the tan of its spread's half angle and the spread's normalization (0: none).
-    sun: axis (S, 3), sharpness (S,), amplitude (S, 3) (precomputed SGs).
+    sun: axis (S, 3), sharpness (S,), amplitude (S, 3) (precomputed SGs), radius (S,) the angular radius
+    (the shadow maps' penumbra).
     """
     point_position: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
     point_radius: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
@@ -28,6 +29,7 @@ class LightData:
     sun_axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
     sun_sharpness: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
     sun_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), FLOAT))
+    sun_radius: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
 
     @property
     def count(self):

@@ -27,14 +27,16 @@ class ObjectInputs:
     light_data: lighting.scene_lighting.LightData; environment: its EnvironmentData; gbuffer: the draw
     writes the G-buffer outputs; per_vertex: per-vertex kind ("ssdf", "transfer") -> vec4 rows a vertex of
     the object's usable precomputation (absent: none), per_vertex_data: kind -> its
-    visibility.per_vertex.PerVertexData (numpy); bounds: (2, 3) local box or None; matrix_world (4, 4).
+    visibility.per_vertex.PerVertexData (numpy); bounds: (2, 3) local box or None; matrix_world (4, 4);
+    shadow_maps: the frame's lights have shadow maps (lighting.shadow_maps, DrawContext.shadow_atlas).
     Derived values a technique computes once per object go in ``memo``.  Everything but matrix_world is the
     frame's or the mesh's: reading matrix_world sets ``matrix_world_read``, and the engine reuses a variant key
     for the other objects drawing the same mesh and material only when it was made without reading it."""
 
     def __init__(self, light_data, environment, gbuffer=False, per_vertex=None, bounds=None, matrix_world=None,
-                 per_vertex_data=None):
+                 per_vertex_data=None, shadow_maps=False):
         self.light_data = light_data
+        self.shadow_maps = bool(shadow_maps)
         self.environment = environment
         self.gbuffer = bool(gbuffer)
         self.per_vertex = dict(per_vertex or {})
@@ -65,6 +67,7 @@ class DrawContext:
     inputs: the object's ObjectInputs (what its variant keys were made from: the lights, the environment);
     per_vertex(kind): the object's engine.per_vertex.PerVertexBuffers of that kind;
     environment_textures(): (prefiltered layers, equirect map) GPU textures of the scene's environment;
+    shadow_atlas(): the depth texture of the lights' shadow maps (inputs.shadow_maps; lighting.shadow_maps);
     table(name, build): a GPU texture of build()'s float32 array ((H, W, 4) or (L, H, W, 4)), made once
       for the renderer and kept on disk (engine/disk_cache): build() must depend on the code alone, and
       name say which table it is; material_table(name, build): the same in memory only, remade when the

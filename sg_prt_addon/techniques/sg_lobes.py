@@ -20,6 +20,7 @@ lobe_visibility, sg_shading) + the per-vertex rows' copy
 """
 from dataclasses import dataclass
 
+from ..lighting import shadow_maps
 from ..reflectance import brdf
 from ..spherical import clamped_cosine_table, warp
 from . import sg_shading, shader_sources, surface_layering
@@ -30,7 +31,7 @@ from .shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
 GLSL_DIR = "sg"
 # Library files in dependency order (shaders/lib), then the technique's own (shaders/techniques/sg)
 LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "lights.glsl",
-                 "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
+                 "shadow_maps.glsl", "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
 # (directory under shaders/techniques, file) in order: lobe_visibility is shared with other techniques
 TECHNIQUE_FILES = (("sg", "anisotropic_lobes.glsl"), ("sg", "ggx_two_lobes.glsl"), ("common", "lobe_visibility.glsl"),
                    ("common", "fitted_texels.glsl"), ("sg", "sg_shading.glsl"))
@@ -58,6 +59,7 @@ class VariantKey:
     # light x slice products take the light's visibility (techniques.sg_shading.shares_light_visibility; with a bake,
     # lights and a specular term)
     shared_light_visibility: bool = False
+    shadow_maps: bool = False       # with lights: the scene's lights have shadow maps (lighting.shadow_maps)
     warp_mode: str = warp.DEFAULT_MODE      # of the view slice (MaterialParams.warp_mode); with a specular term
     layering: tuple = ()            # surface_layering.flags of the material
     biscale_resolution: int = 0     # sg_biscale: the tables' lattice R (0: not bi-scale)
@@ -83,6 +85,8 @@ class VariantKey:
             parts.append(f"per-vertex diffuse visibility ({self.diffuse_visibility_rows} vec4)")
         if self.shared_light_visibility:
             parts.append("light visibility shared by its products")
+        if self.shadow_maps:
+            parts.append("shadow maps")
         if self.has_specular and self.warp_mode != warp.DEFAULT_MODE:
             parts.append(f"warp {self.warp_mode}")
         if self.layering:
@@ -119,8 +123,8 @@ def warp_function(mode):
 
 def scene_fields(inputs, has_diffuse=True, has_specular=True):
     """The VariantKey fields an object's scene decides (base.ObjectInputs): lights, environment, G-buffer,
-    the bake's layers, the per-vertex diffuse pass (with a diffuse term) and shared light visibility
-    (with lights and a specular term).  The per-object values are kept in inputs.memo."""
+    the bake's layers, the per-vertex diffuse pass (with a diffuse term), shared light visibility
+    (with lights and a specular term) and the lights' shadow maps.  The per-object values are kept in inputs.memo."""
     layers = int(inputs.per_vertex.get(VISIBILITY_KIND, 0))
     memo = inputs.memo
     if "diffuse_rows" not in memo:
@@ -134,14 +138,20 @@ def scene_fields(inputs, has_diffuse=True, has_specular=True):
     return dict(has_lights=bool(inputs.has_lights), has_environment=bool(inputs.has_environment),
                 gbuffer=inputs.gbuffer, visibility_layers=layers,
                 diffuse_visibility_rows=int(memo["diffuse_rows"]) if layers and has_diffuse else 0,
-                shared_light_visibility=bool(shared))
+                shared_light_visibility=bool(shared), shadow_maps=bool(inputs.has_lights and inputs.shadow_maps))
 
 
 def _constants_source():
     """Constants taken from the numpy side at assembly time, so GLSL and numpy cannot drift apart."""
     rf0 = brdf.AshikhminShirley.__dataclass_fields__["rf0"].default
-    return (f"const float BRDF_AS_RF0 = {shader_sources.float_literal(rf0)};\n"
-            f"const float VISIBILITY_SKIP_FRACTION = {shader_sources.float_literal(sg_shading.VISIBILITY_SKIP_FRACTION)};\n")
+    literal = shader_sources.float_literal
+    return (f"const float BRDF_AS_RF0 = {literal(rf0)};\n"
+            f"const float VISIBILITY_SKIP_FRACTION = {literal(sg_shading.VISIBILITY_SKIP_FRACTION)};\n"
+            f"const float SHADOW_MARGIN = {literal(shadow_maps.MARGIN)};\n"
+            f"const int SHADOW_SEARCH_TAPS = {shadow_maps.SEARCH_TAPS};\n"
+            f"const int SHADOW_FILTER_TAPS = {shadow_maps.FILTER_TAPS};\n"
+            f"const float SHADOW_DEPTH_BIAS = {literal(shadow_maps.DEPTH_BIAS)};\n"
+            f"const float SHADOW_NORMAL_OFFSET = {literal(shadow_maps.NORMAL_OFFSET)};\n")
 
 
 def uses_clamped_cosine_table(key):
@@ -214,6 +224,8 @@ class SGLobes(Technique):
             out["DIFFUSE_VISIBILITY_ROWS"] = key.diffuse_visibility_rows
         if key.shared_light_visibility:
             out["SHARED_LIGHT_VISIBILITY"] = 1
+        if key.shadow_maps:
+            out["LIGHT_SHADOW_MAPS"] = 1
         out.update(surface_layering.layering_defines(key.layering, surface_layering.textured_roughness(key.model,
                                                                                                 key.textures)))
         out.update(self.model_defines(key))
@@ -227,6 +239,8 @@ class SGLobes(Technique):
             skip |= {"brdf.glsl", "warp.glsl"}
         if not key.has_lights:
             skip.add("lights.glsl")
+        if not key.shadow_maps:
+            skip.add("shadow_maps.glsl")
         if not uses_clamped_cosine_table(key):
             skip.add("clamped_cosine_table.glsl")
         if not (key.has_environment and key.has_specular):
@@ -271,6 +285,8 @@ class SGLobes(Technique):
             samplers.append(("FLOAT_2D_ARRAY", "visibility_basis"))
         if key.diffuse_visibility_rows:
             samplers.append(("FLOAT_2D", "diffuse_visibility"))             # read in the vertex shader
+        if key.shadow_maps:
+            samplers.append(("FLOAT_2D", "shadow_atlas"))
         return samplers
 
     def create_info_calls(self, key):
@@ -306,6 +322,8 @@ class SGLobes(Technique):
             shader.uniform_sampler("texture_" + name, context.image(name))
         if key.layering:
             surface_layering.bind(shader, context)
+        if key.shadow_maps:
+            shader.uniform_sampler("shadow_atlas", context.shadow_atlas())
 
     def prepare_object(self, keys, context):
         """The broad diffuse lobes' visibility at the vertices of an object whose variants read it (a bake

@@ -480,12 +480,19 @@ def _light_sets(position, light_data):
     return light_sets
 
 
-def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, specular):
-    """Lights' diffuse (eq. 42) and specular (eq. 43) terms, added to irradiance and specular in place."""
+def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, specular, shadow=None):
+    """Lights' diffuse (eq. 42) and specular (eq. 43) terms, added to irradiance and specular in place.
+    shadow: (N, P, 2) the lights' shadow-map (visible fraction, softness), NaN without a map, or None."""
     n = px.n
     visibility = px.visibility
     light_cosine = _clamped_cosine_integral(light_axis, light_sharpness, FLOAT(1), n[:, None, :])    # (N, P)
-    light_visible = px.visible(light_axis, light_sharpness)
+    light_visible = np.broadcast_to(px.visible(light_axis, light_sharpness), light_sharpness.shape)
+    mapped = np.zeros(light_sharpness.shape, bool)
+    if shadow is not None:      # a mapped light: its map's, blended to the SSDF's by the softness (the shader's)
+        mapped = ~np.isnan(shadow[..., 0])
+        fraction, softness = np.nan_to_num(shadow[..., 0], nan=1.0), np.nan_to_num(shadow[..., 1], nan=0.0)
+        blended = fraction + (light_visible - fraction) * softness if visibility is not None else fraction
+        light_visible = np.where(mapped, blended, light_visible).astype(FLOAT)
     irradiance += np.sum(light_amplitude * (light_cosine * light_visible * px.diffuse_factor(light_axis))[..., None],
                          axis=1)
     # (N, P, 1) x (N, 1, J): every light against every slice lobe
@@ -495,12 +502,14 @@ def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, sp
     weight = _clamped_cosine_integral(axis_m, sharpness_m, amplitude_m, n[:, None, None, :])
     if visibility is not None and visibility.shared_light:
         weight = weight * light_visible[..., None]
-    elif visibility is not None:    # one decode per NDF lobe, if any of its products is not negligible
-        centre = px.centre
-        above = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
-        decoded = px.per_node(above.reshape(above.shape[:2] + (-1, px.nodes)).any(axis=-1))
-        weight = np.where(decoded, weight * px.per_node(px.visible(axis_m[:, :, centre], sharpness_m[:, :, centre])),
-                          weight)
+    else:
+        if visibility is not None:    # one decode per NDF lobe, if any of its products is not negligible
+            centre = px.centre
+            above = weight > FLOAT(VISIBILITY_SKIP_FRACTION) * light_cosine[..., None]
+            decoded = px.per_node(above.reshape(above.shape[:2] + (-1, px.nodes)).any(axis=-1)) & ~mapped[..., None]
+            weight = np.where(decoded, weight * px.per_node(px.visible(axis_m[:, :, centre],
+                                                                       sharpness_m[:, :, centre])), weight)
+        weight = np.where(mapped[..., None], weight * light_visible[..., None], weight)
     weight = np.sum(weight[..., None] * px.slice_colour[:, None], axis=2)                          # (N, P, 3)
     if px.model != FITTED_MODEL and px.biscale is None:
         tail = light_tail(px.model, px.params, px.view_local, px.frame, light_axis, light_sharpness, light_cosine,
@@ -559,7 +568,8 @@ def _add_environment(px, environment, irradiance, specular):
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
-          light_data, environment, lobe_count=1, visibility=None, warp_mode=None, biscale=None, biscale_mask=None):
+          light_data, environment, lobe_count=1, visibility=None, warp_mode=None, biscale=None, biscale_mask=None,
+          light_shadow=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
     ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
     applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
@@ -569,13 +579,19 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     warp_mode: spherical.warp's mode of the view slice (the material's view warp; None: the default).
     biscale: a bi-scale material's biscale.bvndf.BVNDF or MaskedTiles (model: its small-scale model), or None;
     biscale_mask: (N,) the mask between MaskedTiles' two tiles.
+    light_shadow: (N, lights, 2) the lights' shadow maps at the pixels (lighting.shadow_maps.light_visibility:
+    point lights then suns, NaN without a map), or None (no maps).
     """
     px = _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
                  warp_mode, biscale, biscale_mask)
     irradiance = np.zeros(px.position.shape, FLOAT)
     specular = np.zeros(px.position.shape, FLOAT)
+    first = 0
     for light_axis, light_sharpness, light_amplitude in _light_sets(px.position, light_data):
-        _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, specular)
+        count = light_sharpness.shape[1]
+        shadow = None if light_shadow is None else np.asarray(light_shadow, FLOAT)[:, first:first + count]
+        _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, specular, shadow)
+        first += count
     _add_environment(px, environment, irradiance, specular)
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
     return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * specular).astype(FLOAT)
@@ -653,14 +669,15 @@ BISCALE_MASK = "biscale_mask"      # the texture slot of a bi-scale material's m
 
 
 def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,
-                    is_perspective, light_data, environment, visibility=None):
+                    is_perspective, light_data, environment, visibility=None, light_shadow=None):
     """Mirror of surface.frag.glsl's main(): per-fragment inputs as the G-buffer holds them.
 
     material: an object with export.MaterialParams' fields; textures: slot name -> (H, W, 4)
     float32 image (Blender's row order) for the slots the material uses; normal: interpolated
     world normal (already flipped for back faces); tangent (N, 4): the tangent input (the UV
     map's world tangent and sign, or the object axis in world space); uv (N, 2).
-    visibility: per-fragment Visibility (HAS_VISIBILITY variant) or None.
+    visibility: per-fragment Visibility (HAS_VISIBILITY variant) or None; light_shadow: the lights' shadow maps at
+    the fragments (shade's), or None.
     Returns (diffuse, specular), each (N, 3) float32.
     """
     count = len(position)
@@ -673,7 +690,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
         return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
                      model_params, diffuse_color, np.ones((count, 3), FLOAT), light_data, environment,
                      visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale,
-                     biscale_mask=biscale_mask)
+                     biscale_mask=biscale_mask, light_shadow=light_shadow)
     diffuse_color, specular_color = surface_colours(material, textures, uv, count)
     params = {}
     for name in SCALAR_SLOTS:
@@ -693,6 +710,6 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
                  diffuse_color, specular_color, light_data, environment,
                  lobe_count=material.lobe_count if model in models.ANISOTROPIC else 1,
                  visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale,
-                 biscale_mask=biscale_mask)
+                 biscale_mask=biscale_mask, light_shadow=light_shadow)
 
 

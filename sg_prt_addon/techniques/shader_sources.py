@@ -12,6 +12,8 @@ import os
 import re
 from dataclasses import dataclass
 
+from ..lighting import shadow_maps
+
 
 def _shader_dir():
     """shaders/ inside the package (installed extension) or next to it (the repository)."""
@@ -32,8 +34,10 @@ MAX_POINT_LIGHTS = 128     # an area light is lights.area_grid's patches (16 at 
 MAX_SUNS = 8
 MAX_ENV_LOBES = 16
 MAX_LAYERS = 48
+MAX_SHADOW_MAPS = shadow_maps.MAX_SHADOW_MAPS
 LIMITS = {"SGPRT_MAX_POINT_LIGHTS": MAX_POINT_LIGHTS, "SGPRT_MAX_SUNS": MAX_SUNS,
-          "SGPRT_MAX_ENV_LOBES": MAX_ENV_LOBES, "SGPRT_MAX_LAYERS": MAX_LAYERS}
+          "SGPRT_MAX_ENV_LOBES": MAX_ENV_LOBES, "SGPRT_MAX_LAYERS": MAX_LAYERS,
+          "SGPRT_MAX_SHADOW_MAPS": MAX_SHADOW_MAPS}
 
 GBUFFER_OUTPUTS = ("position", "normal", "tangent", "uv")
 # vec4 varyings a surface shader may use where the driver cannot be asked (max_varyings): llvmpipe gives 128

@@ -36,6 +36,18 @@ struct SceneData {
   /* x: the side, in pixels, of the square each pixel's shading averages its specular over (engine/
    * anti_aliasing.py specular_footprint): 1 one frame, 1/m each of m x m jittered frames, 0 the centre alone */
   vec4 shading_footprint;
+  /* the lights' shadow maps (lighting/shadow_maps.py ShadowPlan): x tile side (texels, 0: none), y tiles a row,
+   * z a face's share of its tile, w lights with a map */
+  vec4 shadow_atlas;
+  /* the light of each shadow slot, four a vec4 (point lights first, then suns from counts.x) */
+  vec4 shadow_slot_light[SGPRT_MAX_SHADOW_MAPS / 4];
+  /* x slot (-1: no map), y first of its six tiles, z near, w far */
+  vec4 point_shadow[SGPRT_MAX_POINT_LIGHTS];
+  /* x slot (-1: no map), y tile, z a texel's world size, w the map's depth range; rows: ndc x, ndc y and
+   * depth01 of (p, 1); x of radius: the tangent of the sun's angular radius */
+  vec4 sun_shadow[SGPRT_MAX_SUNS];
+  vec4 sun_shadow_rows[3 * SGPRT_MAX_SUNS];
+  vec4 sun_shadow_radius[SGPRT_MAX_SUNS];
 };
 
 struct MaterialData {

@@ -36,6 +36,9 @@ def new_scene(name, width=256, height=256):
     scene.render.resolution_percentage = 100
     # the Monte Carlo references shade pixel centres; the tests of the footprint sampling turn it on
     scene.sgprt.specular_anti_aliasing = False
+    # the tests of the SSDF's light shadows (and the mirrors of their variants) keep them; test_shadow_maps.py
+    # and the stress tests turn the shadow maps on
+    scene.sgprt.light_shadows = "SSDF"
     camera = bpy.data.objects.new(name + "_camera", bpy.data.cameras.new(name + "_camera"))
     scene.collection.objects.link(camera)
     camera.location = (0.0, -6.0, 1.0)

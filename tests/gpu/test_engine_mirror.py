@@ -18,7 +18,9 @@ def engine(blender):
 
 
 def _mirror(result, textures_by_material=None, use_visibility=True):
-    """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask."""
+    """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask.  With shadow
+    maps, their lookups (lighting.shadow_maps.light_visibility) read the frame's atlas."""
+    from sg_prt_addon.lighting import shadow_maps
     from sg_prt_addon.techniques import sg_shading
 
     passes, state = result["passes"], result["state"]
@@ -37,12 +39,17 @@ def _mirror(result, textures_by_material=None, use_visibility=True):
             if not mask.any():
                 continue
             view_origin = camera.position if camera.is_perspective else camera.forward
+            light_shadow = None
+            if "shadow_atlas" in passes:
+                light_shadow = shadow_maps.light_visibility(passes["shadow_atlas"], passes["shadow_plan"], light_data,
+                                                            passes["gbuffer_position"][mask][:, :3],
+                                                            passes["gbuffer_normal"][mask][:, :3])
             diffuse, specular = sg_shading.shade_fragments(
                 state.materials[name], (textures_by_material or {}).get(name, {}),
                 passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
                 passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
                 light_data, state.environment,
-                visibility=fx.pixel_visibility(result, mask) if use_visibility else None)
+                visibility=fx.pixel_visibility(result, mask) if use_visibility else None, light_shadow=light_shadow)
             expected["Diffuse"][mask] = diffuse
             expected["Specular"][mask] = specular
     return expected, covered

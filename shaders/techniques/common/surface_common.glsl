@@ -63,6 +63,44 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
     amplitude = scene.sun_amplitude[s].rgb;
   }
 }
+
+#ifdef LIGHT_SHADOW_MAPS
+/* Each mapped light's (visible fraction, softness) at the pixel by shadow slot (shadow_maps_evaluate): the
+ * lookups are made once a pixel, not once for each of shade_footprint's samples.  Needs shadow_maps.glsl and the
+ * `shadow_atlas` sampler; mirrored by lighting.shadow_maps.light_visibility. */
+vec2 light_shadow[SGPRT_MAX_SHADOW_MAPS];
+
+void shadow_maps_evaluate(vec3 position, vec3 normal)
+{
+  for (int s = 0; s < SGPRT_MAX_SHADOW_MAPS; s++) {
+    light_shadow[s] = vec2(1.0, 0.0);
+    if (s >= int(scene.shadow_atlas.w)) {
+      continue;
+    }
+    int l = int(scene.shadow_slot_light[s / 4][s % 4]);
+    if (l < scene.counts.x) {
+      vec4 info = scene.point_shadow[l];
+      light_shadow[s] = shadow_point_visibility(shadow_atlas, scene.shadow_atlas, scene.point_position_radius[l].xyz,
+                                                scene.point_position_radius[l].w, int(info.y), info.zw, position,
+                                                normal);
+    }
+    else {
+      int sun = l - scene.counts.x;
+      vec4 info = scene.sun_shadow[sun];
+      light_shadow[s] = shadow_sun_visibility(shadow_atlas, scene.shadow_atlas, scene.sun_shadow_rows[3 * sun],
+                                              scene.sun_shadow_rows[3 * sun + 1], scene.sun_shadow_rows[3 * sun + 2],
+                                              int(info.y), info.z, info.w, scene.sun_shadow_radius[sun].x, position,
+                                              normal);
+    }
+  }
+}
+
+/* Light l's shadow slot (point lights first, then suns), -1 without a map */
+int light_shadow_slot(int l)
+{
+  return int(l < scene.counts.x ? scene.point_shadow[l].x : scene.sun_shadow[l - scene.counts.x].x);
+}
+#endif
 #endif
 
 #if defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)

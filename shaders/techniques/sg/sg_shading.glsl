@@ -316,7 +316,23 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_cosine = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, light_axis, light_sharpness,
                                                               1.0, n);
 #endif
-#if defined(HAS_DIFFUSE) || defined(SHARED_LIGHT_VISIBILITY) || defined(LIGHT_TAIL)
+#ifdef LIGHT_SHADOW_MAPS
+    /* a light with a shadow map: its visible fraction at the pixel, for its products too (a map is made for
+     * point, spot and sun lights, narrow on the object), blended to the SSDF's as far as its penumbra passed
+     * the map's filter (the softness); the others: the SSDF's */
+    int shadow_slot = light_shadow_slot(l);
+    bool mapped = shadow_slot >= 0;
+    vec2 shadow = mapped ? light_shadow[max(shadow_slot, 0)] : vec2(1.0, 1.0);    /* unmapped: the SSDF's alone */
+#ifdef HAS_VISIBILITY
+    float light_visibility = 1.0;
+    if (shadow.y > 0.0) {
+      light_visibility = LOBE_VISIBILITY(light_axis, light_sharpness);
+    }
+    light_visibility = mix(shadow.x, light_visibility, shadow.y);
+#else
+    float light_visibility = shadow.x;
+#endif
+#elif defined(HAS_DIFFUSE) || defined(SHARED_LIGHT_VISIBILITY) || defined(LIGHT_TAIL)
     float light_visibility = LOBE_VISIBILITY(light_axis, light_sharpness);
 #endif
 #ifdef HAS_DIFFUSE
@@ -351,6 +367,9 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
       }
 #ifdef PRODUCT_VISIBILITY
+#ifdef LIGHT_SHADOW_MAPS
+      decode = decode && !mapped;
+#endif
       if (decode) {               /* eq. 43, one decode an NDF lobe: at its centre node's product */
         lobe_weight *= lobe_visibility(centre_axis, centre_sharpness, n);
       }
@@ -359,6 +378,10 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     }
 #ifdef SHARED_LIGHT_VISIBILITY
     weight *= light_visibility;   /* eq. 43 for a narrow light: its products lie inside it */
+#elif defined(LIGHT_SHADOW_MAPS)
+    if (mapped) {
+      weight *= light_visibility;
+    }
 #endif
 #ifdef LIGHT_TAIL
     /* the model's BRDF minus the slice lobes at the light's centre, times what the light delivers there,

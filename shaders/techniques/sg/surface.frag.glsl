@@ -48,6 +48,9 @@ void main()
 #ifdef LAYERING
   surface_layering(shading_normal, diffuse_color, specular_color);
 #endif
+#ifdef LIGHT_SHADOW_MAPS
+  shadow_maps_evaluate(world_position, normal);
+#endif
   vec3 diffuse, specular;
   shade_footprint(world_position, shading_normal, shading_tangent, p, q, diffuse_color, specular_color,
                   diffuse, specular);
