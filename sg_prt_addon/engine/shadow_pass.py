@@ -111,5 +111,5 @@ class ShadowAtlas:
 
     def read(self):
         """(H, W) float32 window depths, row 0 at the bottom (the tests' mirror reads them)."""
-        width, height = self.texture.width, self.texture.height
-        return np.asarray(self.texture.read(), np.float32).reshape(height, width)
+        # through a list: np.asarray of a multi-dimensional gpu Buffer has the wrong strides (renderer.read)
+        return np.asarray(self.texture.read().to_list(), np.float32).reshape(self.texture.height, self.texture.width)

@@ -17,7 +17,7 @@ def engine(blender):
     return blender
 
 
-def _mirror(result, textures_by_material=None, use_visibility=True):
+def _mirror(result, textures_by_material=None, use_visibility=True, use_shadow_maps=True):
     """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask.  With shadow
     maps, their lookups (lighting.shadow_maps.light_visibility) read the frame's atlas."""
     from sg_prt_addon.lighting import shadow_maps
@@ -40,7 +40,7 @@ def _mirror(result, textures_by_material=None, use_visibility=True):
                 continue
             view_origin = camera.position if camera.is_perspective else camera.forward
             light_shadow = None
-            if "shadow_atlas" in passes:
+            if "shadow_atlas" in passes and use_shadow_maps:
                 light_shadow = shadow_maps.light_visibility(passes["shadow_atlas"], passes["shadow_plan"], light_data,
                                                             passes["gbuffer_position"][mask][:, :3],
                                                             passes["gbuffer_normal"][mask][:, :3])
@@ -244,10 +244,11 @@ def test_view_warps_with_visibility(engine, bakes, view_warp):
     _check(result)
 
 
-def _assert_shadows(result):
-    """The visibility variant really shadows: many pixels lose over 20% of their diffuse light."""
+def _assert_shadows(result, unshadowed_scene=False):
+    """The visibility variant really shadows: many pixels lose over 20% of their diffuse light (against the mirror
+    without visibility, or, unshadowed_scene, without the shadow maps too)."""
     shadowed, covered = _mirror(result)
-    unshadowed, _ = _mirror(result, use_visibility=False)
+    unshadowed, _ = _mirror(result, use_visibility=False, use_shadow_maps=not unshadowed_scene)
     darker = shadowed["Diffuse"][covered].sum(-1) < 0.8 * unshadowed["Diffuse"][covered].sum(-1)
     print("pixels darkened by the shadows", darker.mean())
     assert darker.mean() > 0.05
@@ -333,3 +334,32 @@ def test_node_material_with_tiled_uvs(engine):
     assert uv[covered][:, :2].max() > 2.0 and uv[covered][:, :2].min() < 0.0       # tiled beyond [0, 1]
     _check(result, {material.name: {"diffuse_color": export.slot_pixels(params.textures["diffuse_color"],
                                                                         "diffuse_color")}})
+
+
+@pytest.mark.parametrize("baked", [False, True])
+def test_shadow_maps(engine, bakes, baked):
+    """Light Shadows = Shadow Maps: a point light, a spot and a sun, each with a map (lighting.shadow_maps), and a
+    wide sphere light without one (SSDF, or unshadowed unbaked); the mirror's lookups read the frame's atlas.  With a
+    bake the wide light and the maps' softness blend in the SSDF; without one the maps alone shadow."""
+    scene, sphere, floor = _shadow_scene("mirror_shadow_maps_" + str(baked), 96)
+    scene.sgprt.light_shadows = "SHADOW_MAPS"
+    scene.sgprt.shadow_map_size = 256
+    fx.world_colour(scene, (0.05, 0.06, 0.08))
+    fx.point_light(scene, "maps_point_" + str(baked), (1.5, -1.0, 3.5), 800.0, radius=0.1)
+    spot = fx.point_light(scene, "maps_spot_" + str(baked), (-1.5, -1.5, 3.0), 900.0, radius=0.05, kind="SPOT")
+    spot.rotation_euler = (0.5, -0.4, 0.0)
+    fx.point_light(scene, "maps_wide_" + str(baked), (-2.0, 1.0, 2.0), 300.0, radius=1.0)
+    sun = fx.point_light(scene, "maps_sun_" + str(baked), (0.0, 0.0, 5.0), 2.0, kind="SUN")
+    sun.rotation_euler = (0.4, -0.5, 0.0)
+    sun.data.angle = 0.05
+    if baked:
+        bakes(scene, [sphere, floor], resolution=12)
+    with fx.recorded_variant_keys() as keys:
+        result = fx.render(scene, gbuffer=True)
+    assert all(key.shadow_maps for key in keys)
+    plan = result["passes"]["shadow_plan"]
+    assert sorted(plan.slot_lights) == [0, 1, 3], plan.slot_lights     # the point, the spot and the sun (index 3)
+    assert len(result["state"].visibility) == (2 if baked else 0)
+    _check(result)
+    if not baked:
+        _assert_shadows(result, unshadowed_scene=True)
