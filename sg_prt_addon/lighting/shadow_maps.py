@@ -29,9 +29,14 @@ MAX_TEXELS = 64 * 1024 * 1024   # 256 MB of DEPTH_COMPONENT32F
 DEFAULT_SIZE = 1024
 SEARCH_TAPS = 4                 # blocker search: SEARCH_TAPS^2 nearest texels over the search square
 FILTER_TAPS = 4                 # filter: FILTER_TAPS^2 bilinear comparisons over the filter square
+# the filter's grid turned by atan(1 / FILTER_TAPS): its taps' projections on either axis are FILTER_TAPS^2 evenly
+# spaced values, so an edge along an axis crosses them one at a time (17 levels, not 5: a square grid's columns
+# flip together, measured as 0.25 steps across a penumbra)
+FILTER_TURN = (FILTER_TAPS / math.hypot(FILTER_TAPS, 1.0), 1.0 / math.hypot(FILTER_TAPS, 1.0))
 DEPTH_BIAS = 1.5                # texels of depth subtracted from the receiver's
 NORMAL_OFFSET = 1.0             # texels the receiver moves along its normal before the lookup
-# lights wider than this (radians of angular radius from the casters' centre) keep the SSDF: a sphere light of
+# lights wider than this (radians of angular radius from the casters' centre, or from half their box's diagonal
+# when nearer) keep the SSDF: a sphere light of
 # radius 0.75 at 5 m (the truth suite's diffuse_sphere_light) scored 0.118 against Cycles with a map, 0.102 without:
 # its penumbra outgrows the filter's guard band, and the SSDF's smooth profile suits a wide light
 MAX_LIGHT_ANGLE = 0.1
@@ -140,10 +145,13 @@ def plan(light_data, bounds, size=DEFAULT_SIZE):
     sun_radius = np.asarray(light_data.sun_radius if len(light_data.sun_radius) else np.zeros(suns), np.float64)
     mapped_suns = [s for s in range(suns) if sun_radius[s] <= MAX_LIGHT_ANGLE][:MAX_SHADOW_MAPS]
     centre = 0.5 * (np.asarray(bounds[0], np.float64) + bounds[1])
+    half_diagonal = 0.5 * float(np.linalg.norm(np.asarray(bounds[1], np.float64) - bounds[0]))
     mapped_points = []
     for p in range(points):
         position = np.asarray(light_data.point_position[p], np.float64)
-        distance = float(np.linalg.norm(position - centre)) if np.all(np.isfinite(position)) else 0.0
+        # a light among the casters (a lamp in a room) sees them at about the room's size
+        distance = max(float(np.linalg.norm(position - centre)), half_diagonal) if np.all(np.isfinite(position)) \
+            else 0.0
         narrow = distance > 0 and math.atan2(float(light_data.point_radius[p]), distance) <= MAX_LIGHT_ANGLE
         if narrow and light_data.point_emitter[p][0] < 0.5:        # area light patches keep the SSDF
             mapped_points.append(p)
@@ -240,7 +248,9 @@ def tile_visibility(atlas, shadow_plan, tile, ndc, receiver, texel_world, penumb
     lit = np.zeros_like(receiver)
     for j in range(FILTER_TAPS):
         for i in range(FILTER_TAPS):
-            offset = (np.array([i, j], FLOAT) + 0.5) / FILTER_TAPS * 2.0 - 1.0
+            grid = (np.array([i, j], FLOAT) + 0.5) / FILTER_TAPS * 2.0 - 1.0
+            offset = np.array([FILTER_TURN[0] * grid[0] - FILTER_TURN[1] * grid[1],
+                               FILTER_TURN[1] * grid[0] + FILTER_TURN[0] * grid[1]])
             at = coords + offset * radius[:, None]
             base = np.floor(at)
             fraction = at - base

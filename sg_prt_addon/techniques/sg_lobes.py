@@ -150,6 +150,8 @@ def _constants_source():
             f"const float SHADOW_MARGIN = {literal(shadow_maps.MARGIN)};\n"
             f"const int SHADOW_SEARCH_TAPS = {shadow_maps.SEARCH_TAPS};\n"
             f"const int SHADOW_FILTER_TAPS = {shadow_maps.FILTER_TAPS};\n"
+            f"const vec2 SHADOW_FILTER_TURN = vec2({literal(shadow_maps.FILTER_TURN[0])}, "
+            f"{literal(shadow_maps.FILTER_TURN[1])});\n"
             f"const float SHADOW_DEPTH_BIAS = {literal(shadow_maps.DEPTH_BIAS)};\n"
             f"const float SHADOW_NORMAL_OFFSET = {literal(shadow_maps.NORMAL_OFFSET)};\n")
 

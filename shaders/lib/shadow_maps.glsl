@@ -28,7 +28,7 @@ float shadow_penumbra(vec3 light, float receiver, float blocker)
 
 /* (visible fraction, softness) at tile-space ndc of a receiver at linear depth `receiver`: the blocker search (the
  * centre and a grid over the search square), then SHADOW_FILTER_TAPS^2 bilinear comparisons over the penumbra
- * (PCSS).  softness: 0 while the penumbra fits the filter, rising to 1 as it reaches the guard band's width (the
+ * (PCSS; the grid turned by SHADOW_FILTER_TURN).  softness: 0 while the penumbra fits the filter, rising to 1 as it reaches the guard band's width (the
  * filter is clamped there: a baked object takes its SSDF visibility in that share). */
 vec2 shadow_tile_visibility(sampler2D atlas, vec4 atlas_info, int tile, vec2 ndc, float receiver,
                              float texel_world, vec3 light, vec3 depth_map)
@@ -58,7 +58,9 @@ vec2 shadow_tile_visibility(sampler2D atlas, vec4 atlas_info, int tile, vec2 ndc
   float lit = 0.0;
   for (int j = 0; j < SHADOW_FILTER_TAPS; j++) {
     for (int i = 0; i < SHADOW_FILTER_TAPS; i++) {
-      vec2 offset = (vec2(float(i), float(j)) + 0.5) / float(SHADOW_FILTER_TAPS) * 2.0 - 1.0;
+      vec2 grid = (vec2(float(i), float(j)) + 0.5) / float(SHADOW_FILTER_TAPS) * 2.0 - 1.0;
+      vec2 offset = vec2(SHADOW_FILTER_TURN.x * grid.x - SHADOW_FILTER_TURN.y * grid.y,
+                         SHADOW_FILTER_TURN.y * grid.x + SHADOW_FILTER_TURN.x * grid.y);
       vec2 at = coords + offset * radius;
       vec2 base = floor(at);
       vec2 fraction = at - base;
