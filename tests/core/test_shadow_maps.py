@@ -7,90 +7,26 @@ import numpy as np
 import pytest
 
 from sg_prt_addon.lighting import shadow_maps
-from sg_prt_addon.lighting.scene_lighting import LightData
-
-BLOCKER_HEIGHT = 2.0        # a 2 x 2 square at z = 2 over the floor z = 0
-LIGHT_HEIGHT = 4.0
-BOUNDS = np.array([[-4.0, -4.0, 0.0], [4.0, 4.0, BLOCKER_HEIGHT]])
-
-
-def _lights(radius=0.0, sun_radius=None, spot=None):
-    data = LightData()
-    if sun_radius is None:
-        data.point_position = np.array([[0.0, 0.0, LIGHT_HEIGHT]], np.float32)
-        data.point_radius = np.array([radius], np.float32)
-        data.point_intensity = np.ones((1, 3), np.float32)
-        data.spot_direction = np.array([[0.0, 0.0, -1.0]], np.float32)
-        data.spot_size = np.array([-1.0 if spot is None else spot], np.float32)
-        data.spot_blend = np.zeros(1, np.float32)
-        data.point_emitter = np.zeros((1, 3), np.float32)
-    else:
-        data.sun_axis = np.array([[0.0, 0.0, 1.0]], np.float32)
-        data.sun_sharpness = np.array([1000.0], np.float32)
-        data.sun_amplitude = np.ones((1, 3), np.float32)
-        data.sun_radius = np.array([sun_radius], np.float32)
-    return data
-
-
-def _draw_atlas(shadow_plan):
-    """The atlas the GPU would draw: each tile's texels cast into the scene (the floor and the blocker), the
-    window depth of the nearest hit (1 where none)."""
-    width, height = shadow_plan.atlas_shape
-    atlas = np.ones((height, width), np.float64)
-    size = shadow_plan.size
-    centres = (np.arange(size) + 0.5) / size * 2.0 - 1.0
-    x, y = np.meshgrid(centres, centres)
-    for tile, matrix in shadow_plan.tiles:
-        inverse = np.linalg.inv(matrix)
-
-        def unproject(depth, x=x, y=y, inverse=inverse):
-            clip = np.stack([x, y, np.full_like(x, depth), np.ones_like(x)], -1) @ inverse.T
-            return clip[..., :3] / clip[..., 3:]
-        start, end = unproject(-1.0), unproject(1.0)
-        direction = end - start
-        best = np.full(x.shape, np.inf)
-        for plane_z, half in ((0.0, np.inf), (BLOCKER_HEIGHT, 1.0)):
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = (plane_z - start[..., 2]) / direction[..., 2]
-            hit = start + t[..., None] * direction
-            ok = (t >= 0) & (t <= 1) & (np.abs(hit[..., 0]) <= half) & (np.abs(hit[..., 1]) <= half)
-            best = np.where(ok & (t < best), t, best)
-        point = start + np.where(np.isfinite(best), best, 0.0)[..., None] * direction
-        clip = np.concatenate([point, np.ones(x.shape + (1,))], -1) @ matrix.T
-        window = np.where(np.isfinite(best), 0.5 * clip[..., 2] / clip[..., 3] + 0.5, 1.0)
-        ox, oy = shadow_plan.tile_origin(tile)
-        atlas[oy:oy + size, ox:ox + size] = window
-    return atlas.astype(np.float32)
-
-
-def _receivers(low, high, count=201):
-    xs = np.linspace(low, high, count)
-    return xs, np.stack([xs, np.zeros_like(xs), np.zeros_like(xs)], -1), np.tile([0.0, 0.0, 1.0], (count, 1))
-
-
-def _disc_fraction(c, radius):
-    """Visible fraction of a disc of `radius` beyond the chord at signed distance c from its centre."""
-    c = np.clip(c / radius, -1.0, 1.0)
-    return (np.arccos(c) - c * np.sqrt(1.0 - c * c)) / np.pi
+from validation import shadow_map_scene as scene
 
 
 def test_plan_tiles_and_layout():
     """Six tiles a point light (a spot straight down draws only the faces its cone reaches), one a sun; the atlas
     within the limits; lights wider than MAX_LIGHT_ANGLE and area patches get no map."""
-    point = shadow_maps.plan(_lights(), BOUNDS, 512)
+    point = shadow_maps.plan(scene.lights(), scene.BOUNDS, 512)
     assert point.active and point.slot_lights == [0] and len(point.tiles) == 6
     assert point.atlas_shape == (3 * 512, 2 * 512)
-    spot = shadow_maps.plan(_lights(spot=0.6), BOUNDS, 512)
+    spot = shadow_maps.plan(scene.lights(spot=0.6), scene.BOUNDS, 512)
     assert [tile for tile, _ in spot.tiles] == [5]          # -z alone
-    sun = shadow_maps.plan(_lights(sun_radius=0.01), BOUNDS, 512)
+    sun = shadow_maps.plan(scene.lights(sun_radius=0.01), scene.BOUNDS, 512)
     assert sun.slot_lights == [0 + 0] and len(sun.tiles) == 1 and sun.sun_slot[0] == 0
-    wide = shadow_maps.plan(_lights(radius=1.0), BOUNDS, 512)       # 1 m at 4 m: 0.24 rad
+    wide = shadow_maps.plan(scene.lights(radius=1.0), scene.BOUNDS, 512)       # 1 m at 4 m: 0.24 rad
     assert not wide.active
-    area = _lights()
+    area = scene.lights()
     area.point_emitter[0, 0] = 1.0
-    assert not shadow_maps.plan(area, BOUNDS, 512).active
-    assert not shadow_maps.plan(_lights(), None, 512).active
-    huge = shadow_maps.plan(_lights(), BOUNDS, 100000)
+    assert not shadow_maps.plan(area, scene.BOUNDS, 512).active
+    assert not shadow_maps.plan(scene.lights(), None, 512).active
+    huge = shadow_maps.plan(scene.lights(), scene.BOUNDS, 100000)
     assert max(huge.atlas_shape) <= shadow_maps.MAX_SIDE
     assert huge.atlas_shape[0] * huge.atlas_shape[1] <= shadow_maps.MAX_TEXELS
 
@@ -100,18 +36,18 @@ def test_hard_edge_lies_where_the_blocker_casts_it(kind):
     """A point light (radius 0) or a sun straight above (angle 0): the floor is dark under the blocker's shadow
     and lit beyond it, the edge within two texels of its exact place (x = 2 under the point light at 4 m, x = 1
     under the sun)."""
-    lights = _lights() if kind == "point" else _lights(sun_radius=0.0)
-    shadow_plan = shadow_maps.plan(lights, BOUNDS, 1024)
-    atlas = _draw_atlas(shadow_plan)
+    lights = scene.lights() if kind == "point" else scene.lights(sun_radius=0.0)
+    shadow_plan = shadow_maps.plan(lights, scene.BOUNDS, 1024)
+    atlas = scene.draw_atlas(shadow_plan)
     edge = 2.0 if kind == "point" else 1.0
-    texel = 2.0 * LIGHT_HEIGHT / (shadow_plan.size * shadow_plan.inner) if kind == "point" else \
+    texel = 2.0 * scene.LIGHT_HEIGHT / (shadow_plan.size * shadow_plan.inner) if kind == "point" else \
         float(shadow_plan.sun_texel[0])
-    xs, position, normal = _receivers(edge - 0.5, edge + 0.5)
+    xs, position, normal = scene.receivers(edge - 0.5, edge + 0.5)
     visible = shadow_maps.light_visibility(atlas, shadow_plan, lights, position, normal)[:, 0, 0]
     inside, outside = xs < edge - 2 * texel, xs > edge + 2 * texel
     assert np.all(visible[inside] < 1e-6) and np.all(visible[outside] > 1 - 1e-6)
     # the floor far from the blocker: lit, no self-shadowing (the bias and the normal offset)
-    _, far, far_normal = _receivers(2.6 if kind == "point" else 1.5, 3.5)
+    _, far, far_normal = scene.receivers(2.6 if kind == "point" else 1.5, 3.5)
     assert np.all(shadow_maps.light_visibility(atlas, shadow_plan, lights, far, far_normal)[:, 0, 0] > 1 - 1e-6)
 
 
@@ -122,32 +58,32 @@ def test_penumbra_of_a_sphere_light_against_the_exact_fraction():
     ACCURACY.md, shadow_maps).  A light of radius 0.2 needs 25 texels, past the guard band: the softness is 1
     there, and a baked object takes the SSDF's visibility instead."""
     radius = 0.05
-    lights = _lights(radius=radius)
-    shadow_plan = shadow_maps.plan(lights, BOUNDS, 1024)
-    atlas = _draw_atlas(shadow_plan)
-    xs, position, normal = _receivers(2.0 - 1.5 * radius, 2.0 + 1.5 * radius)
+    lights = scene.lights(radius=radius)
+    shadow_plan = shadow_maps.plan(lights, scene.BOUNDS, 1024)
+    atlas = scene.draw_atlas(shadow_plan)
+    xs, position, normal = scene.receivers(2.0 - 1.5 * radius, 2.0 + 1.5 * radius)
     result = shadow_maps.light_visibility(atlas, shadow_plan, lights, position, normal)[:, 0]
-    exact = _disc_fraction(2.0 - xs, radius)
+    exact = scene.disc_fraction(2.0 - xs, radius)
     error = np.abs(result[:, 0] - exact)
     penumbra = np.abs(xs - 2.0) < radius
     print(f"max error {error.max():.3f}, mean over the penumbra {error[penumbra].mean():.3f}")
     assert error.max() < 0.12
     assert error[penumbra].mean() < 0.06
     assert np.all(result[:, 1] == 0.0)
-    wide = _lights(radius=0.2)
-    wide_plan = shadow_maps.plan(wide, BOUNDS, 1024)
-    xs, position, normal = _receivers(1.95, 2.05, 5)
-    softness = shadow_maps.light_visibility(_draw_atlas(wide_plan), wide_plan, wide, position, normal)[:, 0, 1]
+    wide = scene.lights(radius=0.2)
+    wide_plan = shadow_maps.plan(wide, scene.BOUNDS, 1024)
+    xs, position, normal = scene.receivers(1.95, 2.05, 5)
+    softness = shadow_maps.light_visibility(scene.draw_atlas(wide_plan), wide_plan, wide, position, normal)[:, 0, 1]
     assert np.all(softness[1:-1] == 1.0)
 
 
 def test_degenerate_input_stays_finite():
     """NaN positions or normals, a light inside the bounds, zero normals: finite fractions in [0, 1]."""
-    lights = _lights(radius=0.1)
+    lights = scene.lights(radius=0.1)
     lights.point_position[0] = (0.0, 0.0, 1.0)         # inside the casters' box
-    shadow_plan = shadow_maps.plan(lights, BOUNDS, 256)
+    shadow_plan = shadow_maps.plan(lights, scene.BOUNDS, 256)
     assert shadow_plan.active and shadow_plan.point_near_far[0, 0] > 0
-    atlas = _draw_atlas(shadow_plan)
+    atlas = scene.draw_atlas(shadow_plan)
     position = np.array([[0.5, 0.5, 0.0], [np.nan, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.0]])
     normal = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.0], [np.nan, 0.0, 1.0]])
     with np.errstate(invalid="ignore"):
