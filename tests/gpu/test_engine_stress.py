@@ -18,10 +18,11 @@ PASSES = ("Combined", "Diffuse", "Specular")
 
 
 def _new_scene(name, width, height):
-    """fx.new_scene with the engine's default Specular Anti-Aliasing: the footprint's derivatives meet the
-    degenerate geometry and extreme materials too."""
+    """fx.new_scene with the engine's defaults, Specular Anti-Aliasing and shadow maps: the footprint's derivatives
+    and the maps' lookups meet the degenerate geometry, extreme materials and lights too."""
     scene = fx.new_scene(name, width, height)
     scene.sgprt.specular_anti_aliasing = True
+    scene.sgprt.light_shadows = "SHADOW_MAPS"
     return scene
 
 

@@ -1,0 +1,76 @@
+"""Light Shadows = Shadow Maps (scene.sgprt.light_shadows; lighting/shadow_maps.py, engine/shadow_pass.py): the
+setting and its panel, saved and reopened; the atlas drawn once for frames that change only the view; an object
+without a bake shadowed by the maps.  The lookups against their mirror: test_engine_mirror.test_shadow_maps; the
+image against the Monte Carlo reference: test_shadows_reference.test_point_light_shadow_maps."""
+import os
+
+import engine_fixtures as fx
+import numpy as np
+import pytest
+
+
+@pytest.fixture(scope="module")
+def engine(blender):
+    fx.ensure_registered()
+    return blender
+
+
+def _scene(name, light_shadows="SHADOW_MAPS"):
+    scene = fx.new_scene(name, 48, 48)
+    scene.sgprt.light_shadows = light_shadows
+    scene.camera.location = (0.0, -5.5, 4.0)
+    scene.camera.rotation_euler = (np.radians(52.0), 0.0, 0.0)
+    sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 0.9), radius=0.8, segments=24, rings=12)
+    sphere.data.materials.append(fx.material(name + "_mat", model="GGX", roughness=0.4, diffuse_color=(0.6, 0.5, 0.4),
+                                             specular_color=(0.3, 0.3, 0.3)))
+    floor = fx.grid(scene, name + "_floor", (0.0, 0.0, 0.0), size=6.0, segments=16)
+    floor.data.materials.append(fx.material(name + "_floor_mat", model="GGX", roughness=0.6,
+                                            diffuse_color=(0.7, 0.7, 0.7), specular_color=(0.05, 0.05, 0.05)))
+    fx.world_colour(scene, (0.02, 0.02, 0.02))
+    fx.point_light(scene, name + "_light", (1.2, -0.6, 3.6), 600.0, radius=0.05)
+    return scene
+
+
+def test_setting_panel_and_file(engine, tmp_path):
+    import bpy
+
+    from sg_prt_addon.blender import panels
+    from sg_prt_addon.lighting import shadow_maps
+
+    assert panels.SGPRT_PT_shadows.is_registered and panels.SGPRT_PT_shadows.bl_context == "render"
+    scene = bpy.data.scenes.new("shadow_maps_defaults")
+    assert scene.sgprt.light_shadows == "SHADOW_MAPS" and scene.sgprt.shadow_map_size == shadow_maps.DEFAULT_SIZE
+    scene.sgprt.light_shadows = "SSDF"
+    scene.sgprt.shadow_map_size = 512
+    path = os.path.join(tmp_path, "shadow_settings.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    reopened = bpy.data.scenes["shadow_maps_defaults"]
+    assert reopened.sgprt.light_shadows == "SSDF" and reopened.sgprt.shadow_map_size == 512
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    fx.ensure_registered()
+
+
+def test_unbaked_object_is_shadowed_and_the_atlas_is_drawn_once(engine):
+    """No bake: the maps alone shadow the floor under the sphere (its diffuse there drops below a tenth of the lit
+    floor's); three more frames of the same scene (debug timed_redraws) reuse the atlas."""
+    from sg_prt_addon.engine import render_engine
+
+    counts = []
+    render_engine.debug["timed_redraws"] = 3
+    render_engine.debug["after_frame"] = lambda depsgraph, state, renderer, camera: counts.append(
+        renderer.shadow_atlas.draw_count)
+    try:
+        mapped = fx.render(_scene("maps_unbaked"))
+    finally:
+        render_engine.debug["timed_redraws"] = 0
+        render_engine.debug["after_frame"] = None
+    assert "error" not in mapped, mapped.get("error")
+    assert counts == [1]
+    mapped = mapped["passes"]["Diffuse"]        # (the next render replaces last_render's contents)
+    unshadowed = fx.render(_scene("maps_unbaked_ssdf", light_shadows="SSDF"))["passes"]["Diffuse"]   # no bake
+    ratio = mapped[..., 0] / np.maximum(unshadowed[..., 0], 1e-9)
+    covered = unshadowed[..., 3] > 0.5
+    print("shadowed fraction of the surface", float((ratio[covered] < 0.1).mean()))
+    assert (ratio[covered] < 0.1).mean() > 0.05
+    assert np.all(ratio[covered] <= 1.0 + 1e-4)
