@@ -36,7 +36,7 @@ def new_scene(name, width=256, height=256):
     scene.render.resolution_percentage = 100
     # the Monte Carlo references shade pixel centres; the tests of the footprint sampling turn it on
     scene.sgprt.specular_anti_aliasing = False
-    # the tests of the SSDF's light shadows (and the mirrors of their variants) keep them; test_shadow_maps.py
+    # the tests of the SSDF's light shadows (and the mirrors of their variants) keep them; test_light_shadows.py
     # and the stress tests turn the shadow maps on
     scene.sgprt.light_shadows = "SSDF"
     camera = bpy.data.objects.new(name + "_camera", bpy.data.cameras.new(name + "_camera"))

@@ -1,7 +1,8 @@
 """Light Shadows = Shadow Maps (scene.sgprt.light_shadows; lighting/shadow_maps.py, engine/shadow_pass.py): the
 setting and its panel, saved and reopened; the atlas drawn once for frames that change only the view; an object
 without a bake shadowed by the maps.  The lookups against their mirror: test_engine_mirror.test_shadow_maps; the
-image against the Monte Carlo reference: test_shadows_reference.test_point_light_shadow_maps."""
+image against the Monte Carlo reference: test_shadows_reference.test_point_light_shadow_maps; the lookup without
+a GPU: tests/core/test_shadow_maps.py."""
 import os
 
 import engine_fixtures as fx
