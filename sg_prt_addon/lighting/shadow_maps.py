@@ -51,7 +51,7 @@ class ShadowPlan:
     its six faces' first tile (face f at first + f); point_near_far (P, 2); sun_tile (S,); sun_rows (S, 3, 4):
     ndc x, ndc y and depth01 of a world point p as rows @ (p, 1); sun_texel (S,): a texel's world size; sun_range
     (S,): the world depth of depth01 1.  tiles: [(tile, (4, 4) world -> clip matrix)] to render (faces a spot's cone
-    misses are left out)."""
+    or the casters' box misses are left out: their tiles keep the clear, far)."""
     size: int = 0
     columns: int = 1
     rows: int = 1
@@ -130,6 +130,14 @@ def _faces_of_spot(direction, spot_size):
     return faces
 
 
+def _face_sees(face, corners):
+    """Whether cube face `face`'s frustum (|x|, |y| <= z in its frame) may hold any of the box whose corners,
+    relative to the light, are `corners` (8, 3): False only when one of its planes has every corner outside."""
+    local = corners @ face_frame(face).T            # x, y, -z
+    x, y, depth = local[:, 0], local[:, 1], -local[:, 2]
+    return not any(np.all(outside) for outside in (x > depth, -x > depth, y > depth, -y > depth, depth <= 0))
+
+
 def plan(light_data, bounds, size=DEFAULT_SIZE):
     """The ShadowPlan of lighting.scene_lighting.LightData for casters within world `bounds` ((2, 3) or None: no
     geometry, no maps).  Suns first, then point and spot lights in LightData's order (the brightest first),
@@ -199,7 +207,9 @@ def plan(light_data, bounds, size=DEFAULT_SIZE):
         result.point_near_far[p] = near, far
         translate = np.eye(4)
         translate[:3, 3] = -position
-        for face in _faces_of_spot(light_data.spot_direction[p], float(light_data.spot_size[p])):
+        faces = [face for face in _faces_of_spot(light_data.spot_direction[p], float(light_data.spot_size[p]))
+                 if _face_sees(face, corners - position)]
+        for face in faces:
             view = np.eye(4)
             view[:3, :3] = face_frame(face)
             result.tiles.append((tile + face, perspective_rows(near, far, inner) @ view @ translate))
