@@ -20,7 +20,6 @@ lobe_visibility, sg_shading) + the per-vertex rows' copy
 """
 from dataclasses import dataclass
 
-from ..lighting import shadow_maps
 from ..reflectance import brdf
 from ..spherical import clamped_cosine_table, warp
 from . import sg_shading, shader_sources, surface_layering
@@ -147,13 +146,7 @@ def _constants_source():
     literal = shader_sources.float_literal
     return (f"const float BRDF_AS_RF0 = {literal(rf0)};\n"
             f"const float VISIBILITY_SKIP_FRACTION = {literal(sg_shading.VISIBILITY_SKIP_FRACTION)};\n"
-            f"const float SHADOW_MARGIN = {literal(shadow_maps.MARGIN)};\n"
-            f"const int SHADOW_SEARCH_TAPS = {shadow_maps.SEARCH_TAPS};\n"
-            f"const int SHADOW_FILTER_TAPS = {shadow_maps.FILTER_TAPS};\n"
-            f"const vec2 SHADOW_FILTER_TURN = vec2({literal(shadow_maps.FILTER_TURN[0])}, "
-            f"{literal(shadow_maps.FILTER_TURN[1])});\n"
-            f"const float SHADOW_DEPTH_BIAS = {literal(shadow_maps.DEPTH_BIAS)};\n"
-            f"const float SHADOW_NORMAL_OFFSET = {literal(shadow_maps.NORMAL_OFFSET)};\n")
+            + shader_sources.shadow_map_constants())
 
 
 def uses_clamped_cosine_table(key):

@@ -60,6 +60,17 @@ def max_varyings():
     return _driver_varyings[0]
 
 
+def shadow_map_constants():
+    """The SHADOW_* constants shaders/lib/shadow_maps.glsl reads, from lighting.shadow_maps."""
+    turn = shadow_maps.FILTER_TURN
+    return (f"const float SHADOW_MARGIN = {float_literal(shadow_maps.MARGIN)};\n"
+            f"const int SHADOW_SEARCH_TAPS = {shadow_maps.SEARCH_TAPS};\n"
+            f"const int SHADOW_FILTER_TAPS = {shadow_maps.FILTER_TAPS};\n"
+            f"const vec2 SHADOW_FILTER_TURN = vec2({float_literal(turn[0])}, {float_literal(turn[1])});\n"
+            f"const float SHADOW_DEPTH_BIAS = {float_literal(shadow_maps.DEPTH_BIAS)};\n"
+            f"const float SHADOW_NORMAL_OFFSET = {float_literal(shadow_maps.NORMAL_OFFSET)};\n")
+
+
 def output_names(gbuffer):
     """Colour attachments in slot order.  Framebuffers take at most 6, so the G-buffer variant
     leaves Combined out (the caller adds Diffuse + Specular, the same float32 sum)."""

@@ -6,6 +6,7 @@ import re
 
 import pytest
 
+from sg_prt_addon.techniques import shader_sources
 from sg_prt_addon.visibility.per_vertex import MAX_ROWS
 from validation import glsl_harness
 
@@ -22,9 +23,10 @@ DEPENDENCIES = {
     "env_prefilter.glsl": ["sg.glsl"],
     "hemisphere_map.glsl": ["sg.glsl"],
     "ssdf.glsl": ["sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n"],
+    "shadow_maps.glsl": [shader_sources.shadow_map_constants()],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
-         "lights.glsl", "env_prefilter.glsl", "hemisphere_map.glsl", "ssdf.glsl"]
+         "lights.glsl", "env_prefilter.glsl", "hemisphere_map.glsl", "ssdf.glsl", "shadow_maps.glsl"]
 
 
 def test_every_file_is_listed():
@@ -44,7 +46,8 @@ def test_file_compiles_with_its_dependencies(glsl, file_name):
 def test_all_files_together(glsl):
     call = ("vec4(sg_sphere_integral(a.x, 1.0), fh(0.0, a.x), clamped_cosine_from_cosine(1.0, a.x),"
             " ggx_ndf_lobe(0.5).x)")
-    out = glsl(ORDER[:-1] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", ORDER[-1]], call, {"a": [0.0, 1.0]}, 4)
+    out = glsl(ORDER[:-2] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", "ssdf.glsl", shader_sources.shadow_map_constants(),
+                             "shadow_maps.glsl"], call, {"a": [0.0, 1.0]}, 4)
     assert out.shape == (2, 4)
     # lambda = 0: 4 pi, half of it, pi
     assert abs(out[0, 0] - 4 * 3.14159265) < 1e-5 and abs(out[0, 1] - 2 * 3.14159265) < 1e-5

@@ -954,6 +954,60 @@ def test_fitted_pieces_stress(glsl, fuzz):
     assert out[:, :3].min() >= 0
 
 
+def _shadow_atlas(light_data):
+    """(plan, depths, RGBA atlas with the depth in r) of validation.shadow_map_scene's blocker for `light_data`."""
+    from sg_prt_addon.lighting import shadow_maps
+    from validation import shadow_map_scene
+
+    shadow_plan = shadow_maps.plan(light_data, shadow_map_scene.BOUNDS, 256)
+    depth = shadow_map_scene.draw_atlas(shadow_plan)
+    return shadow_plan, depth, np.repeat(depth[..., None], 4, axis=-1)
+
+
+def test_shadow_maps_stress(glsl, fuzz):
+    """shadow_maps.glsl on a ray-cast atlas (validation/shadow_map_scene.py), a point light of radius 0.1 and a sun
+    of 0.02 rad: on the floor and blocker around the shadow, GLSL against the numpy mirror
+    (lighting.shadow_maps.light_visibility), (fraction, softness) within 1e-4 but where float32 and float64 could
+    round a depth comparison or a texel apart (allowed on 1% of the points, measured none of 131072); with hostile
+    positions and
+    normals (zero, huge, NaN-free extremes) finite and in [0, 1].  The two entry points run the rest:
+    shadow_tile_visibility(), shadow_fetch() and shadow_penumbra()."""
+    from sg_prt_addon.lighting import shadow_maps
+    from sg_prt_addon.techniques import shader_sources
+    from validation import shadow_map_scene
+
+    rng = fuzz.rng
+    count = SMALL_ROWS
+    position = _f32(np.c_[rng.uniform(-3.0, 3.0, (count, 2)), rng.choice([0.0, 2.0, 1.0], count)])
+    normal = _f32(np.tile([0.0, 0.0, 1.0], (count, 1)))
+    hostile = fuzz.stress_vectors(count)
+    library = [shader_sources.shadow_map_constants(), "shadow_maps.glsl"]
+    for light_data, call in ((shadow_map_scene.lights(radius=0.1),
+                          "vec4(shadow_point_visibility(shadow_atlas, a, l.xyz, l.w, int(t.x), t.yz, p.xyz, n.xyz), "
+                          "0.0, 0.0)"),
+                         (shadow_map_scene.lights(sun_radius=0.02),
+                          "vec4(shadow_sun_visibility(shadow_atlas, a, rx, ry, rz, int(t.x), t.y, t.z, t.w, p.xyz, "
+                          "n.xyz), 0.0, 0.0)")):
+        shadow_plan, depth, atlas = _shadow_atlas(light_data)
+        constant = {"a": [shadow_plan.size, shadow_plan.columns, shadow_plan.inner, len(shadow_plan.slot_lights)]}
+        if len(light_data.point_radius):
+            constant["l"] = list(light_data.point_position[0]) + [float(light_data.point_radius[0])]
+            constant["t"] = [shadow_plan.point_first_tile[0], *shadow_plan.point_near_far[0], 0.0]
+        else:
+            constant["rx"], constant["ry"], constant["rz"] = (list(row) for row in shadow_plan.sun_rows[0])
+            constant["t"] = [shadow_plan.sun_tile[0], shadow_plan.sun_texel[0], shadow_plan.sun_range[0],
+                             np.tan(float(light_data.sun_radius[0]))]
+        rows = {name: _f32(np.tile(np.asarray(value, np.float64), (count, 1))) for name, value in constant.items()}
+        out = glsl(library, call, dict(rows, p=position, n=normal), 2, {"shadow_atlas": atlas})
+        expected = shadow_maps.light_visibility(depth, shadow_plan, light_data, position, normal)[:, 0]
+        differs = np.any(np.abs(out - expected) > 1e-4, axis=1)
+        print(f"{call[:30]}: shadowed {float((expected[:, 0] < 0.5).mean()):.3f}, differing {differs.mean():.4%}")
+        assert (expected[:, 0] < 0.5).mean() > 0.05 and differs.mean() < 0.01
+        hostile_out = glsl(library, call, dict(rows, p=hostile * 3.0, n=hostile[::-1]), 2, {"shadow_atlas": atlas})
+        _assert_finite(hostile_out, "shadow_maps.glsl")
+        assert hostile_out.min() >= 0.0 and hostile_out.max() <= 1.0
+
+
 # ---- coverage: every function of shaders/lib is fuzzed
 
 COVERED = {
@@ -972,6 +1026,8 @@ COVERED = {
                        "ggx_anisotropic_m_factor"],
     test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "spot_light_sg", "directional_light_sg"],
     test_light_emission_stress: ["light_emission_factor"],
+    test_shadow_maps_stress: ["shadow_point_visibility", "shadow_sun_visibility", "shadow_tile_visibility",
+                              "shadow_fetch", "shadow_penumbra"],
     test_clamped_cosine_stress: ["sg_clamped_cosine_integral", "sg_clamped_cosine_integral_paper",
                                  "clamped_cosine_from_cosine", "clamped_cosine_lobe_evaluate"],
     test_clamped_cosine_table_stress: ["sg_clamped_cosine_integral_tabulated", "clamped_cosine_tabulated"],
