@@ -403,19 +403,23 @@ class Renderer:
                                                                                    state.world.equirect)
             self.environment_source = state.environment
         light_data = state.light_data()
-        self.shadow_plan = self._plan_shadows(state, light_data)
+        self.shadow_plan = self._plan_shadows(state, light_data, camera)
         block = scene_block(camera, light_data, state.environment, self.shadow_plan)
         if self.scene_buffer is None:
             self.scene_buffer = _uniform_buffer(block)
         else:
             self.scene_buffer.update(gpu_buffer(block))
 
-    def _plan_shadows(self, state, light_data):
-        """The frame's lighting.shadow_maps.ShadowPlan over the uploaded objects, or None (no maps)."""
+    def _plan_shadows(self, state, light_data, camera):
+        """The frame's lighting.shadow_maps.ShadowPlan over the uploaded objects (a sun's tile over what the camera
+        sees of them), or None (no maps)."""
         if not state.shadow_map_size or not light_data.count:
             return None
-        shadow_plan = shadow_maps.plan(light_data, shadow_pass.world_bounds(state.objects.values(), self.mesh_buffers),
-                                       state.shadow_map_size)
+        bounds = shadow_pass.world_bounds(state.objects.values(), self.mesh_buffers)
+        view = None
+        if bounds is not None and len(light_data.sun_sharpness):
+            view = shadow_maps.view_corners(camera.projection @ camera.view, bounds)
+        shadow_plan = shadow_maps.plan(light_data, bounds, state.shadow_map_size, view)
         return shadow_plan if shadow_plan.active else None
 
     # ----------------------------------------------------------------- targets

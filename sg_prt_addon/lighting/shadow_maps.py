@@ -138,9 +138,43 @@ def _face_sees(face, corners):
     return not any(np.all(outside) for outside in (x > depth, -x > depth, y > depth, -y > depth, depth <= 0))
 
 
-def plan(light_data, bounds, size=DEFAULT_SIZE):
+def view_corners(view_projection, bounds):
+    """(8, 3) world corners of the camera's frustum (world -> clip `view_projection`) from its near plane to the
+    farthest corner of `bounds` in front of it, or None (the box is behind the camera, or a matrix is singular):
+    what the camera can see of the box lies inside them."""
+    view_projection = np.asarray(view_projection, np.float64)
+    clip = np.c_[_corners(bounds), np.ones(8)] @ view_projection.T
+    front = clip[:, 3] > 1e-12
+    if not front.any():
+        return None
+    far = float(np.clip((clip[front, 2] / clip[front, 3]).max(), -1.0, 1.0))
+    try:
+        inverse = np.linalg.inv(view_projection)
+    except np.linalg.LinAlgError:
+        return None
+    ndc = np.array([[x, y, z, 1.0] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, far)])
+    world = ndc @ inverse.T
+    if np.any(np.abs(world[:, 3]) < 1e-30):
+        return None
+    corners = world[:, :3] / world[:, 3:]
+    return corners if np.all(np.isfinite(corners)) else None
+
+
+def _sun_extent(coordinate_of_bounds, coordinate_of_view):
+    """(low, high) of a sun tile's axis: the casters' range, narrowed to the camera's view where it overlaps."""
+    low, high = float(coordinate_of_bounds.min()), float(coordinate_of_bounds.max())
+    if coordinate_of_view is not None:
+        narrowed = max(low, float(coordinate_of_view.min())), min(high, float(coordinate_of_view.max()))
+        if narrowed[0] < narrowed[1]:
+            return narrowed
+    return low, high
+
+
+def plan(light_data, bounds, size=DEFAULT_SIZE, view=None):
     """The ShadowPlan of lighting.scene_lighting.LightData for casters within world `bounds` ((2, 3) or None: no
-    geometry, no maps).  Suns first, then point and spot lights in LightData's order (the brightest first),
+    geometry, no maps); view: view_corners' frustum or None: a sun's tile covers only what of the box it may show
+    (its casters are those above, within the box's depth).  Suns first, then point and spot lights in LightData's
+    order (the brightest first),
     MAX_SHADOW_MAPS in all; area light patches and lights wider than MAX_LIGHT_ANGLE get none.  The tile side is `size` unless the atlas would pass
     MAX_SIDE or MAX_TEXELS."""
     points, suns = len(light_data.point_radius), len(light_data.sun_sharpness)
@@ -181,9 +215,11 @@ def plan(light_data, bounds, size=DEFAULT_SIZE):
         forward = -np.asarray(light_data.sun_axis[s], np.float64)
         forward /= max(np.linalg.norm(forward), 1e-30)
         right, up = _orthonormal_basis(forward)
-        u, v, z = corners @ right, corners @ up, corners @ forward
-        half = max(0.5 * max(u.max() - u.min(), v.max() - v.min()), 1e-6) * 1.01
-        centre_u, centre_v = 0.5 * (u.max() + u.min()), 0.5 * (v.max() + v.min())
+        z = corners @ forward
+        u_range = _sun_extent(corners @ right, None if view is None else view @ right)
+        v_range = _sun_extent(corners @ up, None if view is None else view @ up)
+        half = max(0.5 * max(u_range[1] - u_range[0], v_range[1] - v_range[0]), 1e-6) * 1.01
+        centre_u, centre_v = 0.5 * (u_range[0] + u_range[1]), 0.5 * (v_range[0] + v_range[1])
         pad = 0.01 * max(z.max() - z.min(), half) + 1e-6
         z0, z1 = z.min() - pad, z.max() + pad
         result.sun_rows[s] = [np.append(right * inner / half, -centre_u * inner / half),

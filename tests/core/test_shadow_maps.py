@@ -91,3 +91,26 @@ def test_degenerate_input_stays_finite():
         result = shadow_maps.light_visibility(atlas, shadow_plan, lights, position, normal)
     assert np.all(np.isfinite(result[:, 0, 0])) and np.all((result >= 0) & (result <= 1))
     assert math.isfinite(float(shadow_plan.point_near_far[0, 1]))
+
+
+def test_sun_tile_narrowed_to_the_view():
+    """A camera 10 m over the floor at x = 2 looking down with a 20-degree field sees x in [0.24, 3.76] of the 8 m
+    box: the sun's tile covers that (a texel 2.3x finer), and the shadow's edge at x = 1 stays in place."""
+    fov = np.radians(20.0)
+    f, near, far = 1.0 / np.tan(fov / 2), 0.1, 100.0
+    projection = np.array([[f, 0, 0, 0], [0, f, 0, 0], [0, 0, -(far + near) / (far - near), -2 * far * near /
+                                                          (far - near)], [0, 0, -1, 0]])
+    view = np.eye(4)
+    view[:3, 3] = (-2.0, 0.0, -10.0)
+    corners = shadow_maps.view_corners(projection @ view, scene.BOUNDS)
+    lights = scene.lights(sun_radius=0.0)
+    whole = shadow_maps.plan(lights, scene.BOUNDS, 1024)
+    narrowed = shadow_maps.plan(lights, scene.BOUNDS, 1024, corners)
+    assert whole.sun_texel[0] / narrowed.sun_texel[0] > 2.0
+    atlas = scene.draw_atlas(narrowed)
+    texel = float(narrowed.sun_texel[0])
+    xs, position, normal = scene.receivers(0.5, 1.5)
+    visible = shadow_maps.light_visibility(atlas, narrowed, lights, position, normal)[:, 0, 0]
+    assert np.all(visible[xs < 1.0 - 2 * texel] < 1e-6) and np.all(visible[xs > 1.0 + 2 * texel] > 1 - 1e-6)
+    looking_up = np.diag([1.0, -1.0, -1.0, 1.0]) @ view         # the box behind the camera: no narrowing
+    assert shadow_maps.view_corners(projection @ looking_up, scene.BOUNDS) is None
