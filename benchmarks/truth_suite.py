@@ -318,8 +318,9 @@ def markdown_section(data, before=None):
         "perfect image would score; errors are raw, not corrected for it. Scores over the surface pixels "
         "(camera rays that hit a mesh) eroded by one pixel: relative RMSE, bias (mean image - mean truth) / "
         "mean truth, mean HDR-FLIP (flip_evaluator; the test image over the truth's background). SG-PRT: "
-        "visibility baked by the operator at its defaults, `render()` wall time after a warm-up render; "
-        "unshadowed: no bake. EEVEE at " + eevee + " samples (direct light as far as its settings go). "
+        "visibility baked by the operator at its defaults, Light Shadows at their default (shadow maps for the "
+        "point, spot and sun lights), `render()` wall time after a warm-up render; unshadowed: no bake and no "
+        "shadow maps. EEVEE at " + eevee + " samples (direct light as far as its settings go). "
         "Cycles equal time: as many samples as fit in SG-PRT's render() time (spp in brackets). "
         "Cycles s: one seed's render at the truth's samples. SG-PRT 2x2: the same bake rendered at twice the "
         "size and box-filtered down: SG-PRT shades each pixel's centre, Cycles (and the truth) average over the "
@@ -820,9 +821,14 @@ class SceneRun:
         from sg_prt_addon.blender import visibility_bake
 
         self.engine_seconds = None
-        if "SG-PRT unshadowed" in self.methods:
-            seconds, image, warm = self.engine_render()
-            self.add("SG-PRT unshadowed", "no bake", seconds, image, warm_up_seconds=warm)
+        if "SG-PRT unshadowed" in self.methods:      # no bake, and no shadow maps (they shadow unbaked objects)
+            scene = bpy.context.scene
+            light_shadows, scene.sgprt.light_shadows = scene.sgprt.light_shadows, "SSDF"
+            try:
+                seconds, image, warm = self.engine_render()
+            finally:
+                scene.sgprt.light_shadows = light_shadows
+            self.add("SG-PRT unshadowed", "no bake, no shadow maps", seconds, image, warm_up_seconds=warm)
         if not self.methods & {"SG-PRT", "SG-PRT 2x2", "Cycles equal time"}:
             return
         start = time.perf_counter()

@@ -28,11 +28,7 @@ MAX_SIDE = 16384                # GPUTexture side limit (llvmpipe's)
 MAX_TEXELS = 64 * 1024 * 1024   # 256 MB of DEPTH_COMPONENT32F
 DEFAULT_SIZE = 1024
 SEARCH_TAPS = 4                 # blocker search: SEARCH_TAPS^2 nearest texels over the search square
-FILTER_TAPS = 4                 # filter: FILTER_TAPS^2 bilinear comparisons over the filter square
-# the filter's grid turned by atan(1 / FILTER_TAPS): its taps' projections on either axis are FILTER_TAPS^2 evenly
-# spaced values, so an edge along an axis crosses them one at a time (17 levels, not 5: a square grid's columns
-# flip together, measured as 0.25 steps across a penumbra)
-FILTER_TURN = (FILTER_TAPS / math.hypot(FILTER_TAPS, 1.0), 1.0 / math.hypot(FILTER_TAPS, 1.0))
+FILTER_TAPS = 4                 # filter: at most FILTER_TAPS^2 bilinear comparisons over the filter square
 DEPTH_BIAS = 1.5                # texels of depth subtracted from the receiver's
 NORMAL_OFFSET = 1.0             # texels the receiver moves along its normal before the lookup
 # lights wider than this (radians of angular radius from the casters' centre, or from half their box's diagonal
@@ -261,53 +257,77 @@ def _linear_depth(window, near, far):
     return 2.0 * far * near / np.maximum((far + near) - ndc * (far - near), 1e-30)
 
 
-def _fetch(atlas, shadow_plan, tile, texel, linearize):
-    """Linear depth of texel (N, 2) (integer, clamped to the tile) of tiles (N,)."""
+def _window_depth(linear, near, far):
+    """The window depth a cube face stores at linear depth `linear` (_linear_depth's inverse, increasing)."""
+    return 0.5 * ((far + near) / (far - near) - 2.0 * far * near / ((far - near) * np.maximum(linear, 1e-30))) + 0.5
+
+
+def _fetch(atlas, shadow_plan, tile, texel):
+    """Window depth of texel (N, 2) (integer, clamped to the tile) of tiles (N,)."""
     origin = np.stack([tile % shadow_plan.columns, tile // shadow_plan.columns], -1) * shadow_plan.size
     texel = np.clip(texel, 0, shadow_plan.size - 1) + origin
-    return linearize(atlas[texel[:, 1], texel[:, 0]])
+    return atlas[texel[:, 1], texel[:, 0]].astype(np.float64)
 
 
-def tile_visibility(atlas, shadow_plan, tile, ndc, receiver, texel_world, penumbra, linearize):
+def filter_turn(taps):
+    """(cos, sin) of atan(1 / taps): a taps x taps grid turned so, its taps' projections on either axis are taps^2
+    evenly spaced values, and an edge along an axis crosses them one at a time (a square grid's columns flip
+    together: measured as 0.25 steps across a penumbra with 4 x 4)."""
+    return taps / math.hypot(taps, 1.0), 1.0 / math.hypot(taps, 1.0)
+
+
+def tile_visibility(atlas, shadow_plan, tile, ndc, receiver, texel_world, penumbra, linearize, window_of):
     """(visible fraction, softness), (N,) each, at tile-space ndc (N, 2) of receivers at linear depth `receiver`
     (N,): the blocker search, then the filter sized by penumbra(receiver, blocker) (world radius) over
-    texel_world (N,).  softness: 0 while the penumbra fits the filter, 1 once it reaches the guard band (the
-    filter is clamped there; the surface shaders blend a baked object's SSDF visibility in by it)."""
+    texel_world (N,); the tile stores window depths (linearize: to linear, window_of: back).  The comparisons are
+    made on window depths (the test depth converted once), the blockers' mean on linear ones.  The search reads the
+    centre, and a SEARCH_TAPS^2 grid where it spans a texel or more; every tap of that grid blocked: the umbra (0).  The filter
+    takes a n x n grid of bilinear comparisons, n = ceil(radius) up to FILTER_TAPS (taps at most 2 texels apart).
+    softness: 0 while the penumbra fits the filter, 1 once it reaches the guard band (the filter is clamped there;
+    the surface shaders blend a baked object's SSDF visibility in by it)."""
     size = shadow_plan.size
     coords = (0.5 + 0.5 * ndc) * size - 0.5               # continuous texel of the texel centres
     test = receiver - DEPTH_BIAS * texel_world
+    test_window = window_of(test)
     search = np.clip(penumbra(receiver, np.zeros_like(receiver)) / texel_world, 0.0, MARGIN - 1.0)
+    wide = search >= 1.0
     total = np.zeros_like(receiver)
     count = np.zeros_like(receiver)
     # the centre, then a grid over the search square (a thin blocker at the centre is never missed)
     offsets = [np.zeros(2)] + [(np.array([i, j], FLOAT) + 0.5) / SEARCH_TAPS * 2.0 - 1.0
                                for j in range(SEARCH_TAPS) for i in range(SEARCH_TAPS)]
-    for offset in offsets:
-        depth = _fetch(atlas, shadow_plan, tile, np.floor(coords + 0.5 + offset * search[:, None]).astype(int),
-                       linearize)
-        blocked = depth < test
-        total += np.where(blocked, depth, 0.0)
+    for index, offset in enumerate(offsets):
+        window = _fetch(atlas, shadow_plan, tile, np.floor(coords + 0.5 + offset * search[:, None]).astype(int))
+        blocked = (window < test_window) & (wide if index else True)
+        total += np.where(blocked, linearize(window), 0.0)
         count += blocked
+    taps = np.where(wide, len(offsets), 1)
     blocker = total / np.maximum(count, 1.0)
     needed = penumbra(receiver, blocker) / texel_world
     radius = np.clip(needed, 0.5, MARGIN - 1.0)
+    grid_side = np.clip(np.ceil(radius), 1, FILTER_TAPS).astype(int)
     lit = np.zeros_like(receiver)
-    for j in range(FILTER_TAPS):
-        for i in range(FILTER_TAPS):
-            grid = (np.array([i, j], FLOAT) + 0.5) / FILTER_TAPS * 2.0 - 1.0
-            offset = np.array([FILTER_TURN[0] * grid[0] - FILTER_TURN[1] * grid[1],
-                               FILTER_TURN[1] * grid[0] + FILTER_TURN[0] * grid[1]])
-            at = coords + offset * radius[:, None]
-            base = np.floor(at)
-            fraction = at - base
-            base = base.astype(int)
-            corners = [_fetch(atlas, shadow_plan, tile, base + np.array(d), linearize) >= test
-                       for d in ((0, 0), (1, 0), (0, 1), (1, 1))]
-            bottom = corners[0] + (corners[1].astype(FLOAT) - corners[0]) * fraction[:, 0]
-            top = corners[2] + (corners[3].astype(FLOAT) - corners[2]) * fraction[:, 0]
-            lit += bottom + (top - bottom) * fraction[:, 1]
+    for side in range(1, FILTER_TAPS + 1):
+        rows = np.nonzero(grid_side == side)[0]
+        if not len(rows):
+            continue
+        turn = filter_turn(side)
+        for j in range(side):
+            for i in range(side):
+                grid = (np.array([i, j], FLOAT) + 0.5) / side * 2.0 - 1.0
+                offset = np.array([turn[0] * grid[0] - turn[1] * grid[1], turn[1] * grid[0] + turn[0] * grid[1]])
+                at = coords[rows] + offset * radius[rows, None]
+                base = np.floor(at)
+                fraction = at - base
+                base = base.astype(int)
+                corners = [_fetch(atlas, shadow_plan, tile[rows], base + np.array(d)) >= test_window[rows]
+                           for d in ((0, 0), (1, 0), (0, 1), (1, 1))]
+                bottom = corners[0] + (corners[1].astype(FLOAT) - corners[0]) * fraction[:, 0]
+                top = corners[2] + (corners[3].astype(FLOAT) - corners[2]) * fraction[:, 0]
+                lit[rows] += (bottom + (top - bottom) * fraction[:, 1]) / side ** 2
+    lit = np.where(wide & (count >= taps), 0.0, lit)          # every tap of a wide search blocked: the umbra
     softness = np.clip(2.0 * needed / (MARGIN - 1.0) - 1.0, 0.0, 1.0)
-    return np.where(count > 0, lit / FILTER_TAPS ** 2, 1.0), np.where(count > 0, softness, 0.0)
+    return np.where(count > 0, lit, 1.0), np.where(count > 0, softness, 0.0)
 
 
 def point_visibility(atlas, shadow_plan, light_data, p, position, normal):
@@ -331,7 +351,7 @@ def point_visibility(atlas, shadow_plan, light_data, p, position, normal):
     tile = shadow_plan.point_first_tile[p] + face
     return tile_visibility(atlas, shadow_plan, tile, ndc, z, texel_world,
                            lambda receiver, blocker: radius * (receiver - blocker) / np.maximum(blocker, near),
-                           lambda window: _linear_depth(window, near, far))
+                           lambda window: _linear_depth(window, near, far), lambda linear: _window_depth(linear, near, far))
 
 
 def sun_visibility(atlas, shadow_plan, s, tan_radius, position, normal):
@@ -351,7 +371,7 @@ def sun_visibility(atlas, shadow_plan, s, tan_radius, position, normal):
     inside = np.all(np.abs(ndc) <= 1.0, axis=1)
     visible, softness = tile_visibility(atlas, shadow_plan, np.full(len(position), shadow_plan.sun_tile[s]), ndc,
                                         receiver, np.full(len(position), texel), lambda r, b: tan_radius * (r - b),
-                                        lambda window: window * depth_range)
+                                        lambda window: window * depth_range, lambda linear: linear / depth_range)
     return np.where(inside, visible, 1.0), np.where(inside, softness, 0.0)
 
 

@@ -62,11 +62,9 @@ def max_varyings():
 
 def shadow_map_constants():
     """The SHADOW_* constants shaders/lib/shadow_maps.glsl reads, from lighting.shadow_maps."""
-    turn = shadow_maps.FILTER_TURN
     return (f"const float SHADOW_MARGIN = {float_literal(shadow_maps.MARGIN)};\n"
             f"const int SHADOW_SEARCH_TAPS = {shadow_maps.SEARCH_TAPS};\n"
             f"const int SHADOW_FILTER_TAPS = {shadow_maps.FILTER_TAPS};\n"
-            f"const vec2 SHADOW_FILTER_TURN = vec2({float_literal(turn[0])}, {float_literal(turn[1])});\n"
             f"const float SHADOW_DEPTH_BIAS = {float_literal(shadow_maps.DEPTH_BIAS)};\n"
             f"const float SHADOW_NORMAL_OFFSET = {float_literal(shadow_maps.NORMAL_OFFSET)};\n")
 

@@ -3,17 +3,32 @@
  * module (techniques/sg_lobes.py _constants_source).  atlas_info: x tile side (texels), y tiles a row, z the
  * face's share of its tile (inner), w mapped lights. */
 
-/* Linear depth of a texel: depth_map x near, y far (a cube face's perspective window depth), or z > 0 the
- * world depth of window depth 1 (a sun's linear map). */
-float shadow_fetch(sampler2D atlas, ivec2 origin, int size, ivec2 texel, vec3 depth_map)
+/* Window depth of a texel (clamped to its tile). */
+float shadow_fetch(sampler2D atlas, ivec2 origin, int size, ivec2 texel)
 {
-  float window = texelFetch(atlas, origin + clamp(texel, ivec2(0), ivec2(size - 1)), 0).r;
+  return texelFetch(atlas, origin + clamp(texel, ivec2(0), ivec2(size - 1)), 0).r;
+}
+
+/* Linear depth of a window depth: depth_map x near, y far (a cube face's perspective), or z > 0 the world depth
+ * of window depth 1 (a sun's linear map); shadow_window is its inverse. */
+float shadow_linear(float window, vec3 depth_map)
+{
   if (depth_map.z > 0.0) {
     return window * depth_map.z;
   }
   float ndc = 2.0 * window - 1.0;
   return 2.0 * depth_map.y * depth_map.x / max((depth_map.y + depth_map.x) - ndc * (depth_map.y - depth_map.x),
                                                1.0e-30);
+}
+
+float shadow_window(float linear, vec3 depth_map)
+{
+  if (depth_map.z > 0.0) {
+    return linear / depth_map.z;
+  }
+  float n = depth_map.x;
+  float f = depth_map.y;
+  return 0.5 * ((f + n) / (f - n) - 2.0 * f * n / ((f - n) * max(linear, 1.0e-30))) + 0.5;
 }
 
 /* World radius of the penumbra at the receiver behind a blocker: light x its radius, y 1 a sphere (z its map's
@@ -27,26 +42,31 @@ float shadow_penumbra(vec3 light, float receiver, float blocker)
 }
 
 /* (visible fraction, softness) at tile-space ndc of a receiver at linear depth `receiver`: the blocker search (the
- * centre and a grid over the search square), then SHADOW_FILTER_TAPS^2 bilinear comparisons over the penumbra
- * (PCSS; the grid turned by SHADOW_FILTER_TURN).  softness: 0 while the penumbra fits the filter, rising to 1 as it reaches the guard band's width (the
- * filter is clamped there: a baked object takes its SSDF visibility in that share). */
+ * centre, and a grid over the search square where it spans a texel or more; every tap of that grid blocked: the
+ * umbra), then an n x n grid of bilinear comparisons (n = ceil(radius) up to SHADOW_FILTER_TAPS, turned by
+ * atan(1/n)) over the penumbra (PCSS).  Comparisons on window depths, the blockers' mean on linear ones.
+ * softness: 0 while the penumbra fits the filter, rising to 1 as it reaches the guard band's width (the filter is
+ * clamped there: a baked object takes its SSDF visibility in that share). */
 vec2 shadow_tile_visibility(sampler2D atlas, vec4 atlas_info, int tile, vec2 ndc, float receiver,
-                             float texel_world, vec3 light, vec3 depth_map)
+                            float texel_world, vec3 light, vec3 depth_map)
 {
   int size = int(atlas_info.x);
   int columns = max(int(atlas_info.y), 1);
   ivec2 origin = ivec2(tile % columns, tile / columns) * size;
   vec2 coords = (0.5 + 0.5 * ndc) * float(size) - 0.5;
-  float test = receiver - SHADOW_DEPTH_BIAS * texel_world;
+  float test = shadow_window(receiver - SHADOW_DEPTH_BIAS * texel_world, depth_map);
   float search = clamp(shadow_penumbra(light, receiver, 0.0) / texel_world, 0.0, SHADOW_MARGIN - 1.0);
+  bool wide = search >= 1.0;
+  int taps = wide ? SHADOW_SEARCH_TAPS * SHADOW_SEARCH_TAPS + 1 : 1;
   float total = 0.0;
   float count = 0.0;
-  for (int t = -1; t < SHADOW_SEARCH_TAPS * SHADOW_SEARCH_TAPS; t++) {
-    vec2 offset = t < 0 ? vec2(0.0) : (vec2(float(t % SHADOW_SEARCH_TAPS), float(t / SHADOW_SEARCH_TAPS)) + 0.5) /
-                                      float(SHADOW_SEARCH_TAPS) * 2.0 - 1.0;
-    float depth = shadow_fetch(atlas, origin, size, ivec2(floor(coords + 0.5 + offset * search)), depth_map);
-    if (depth < test) {
-      total += depth;
+  for (int t = 0; t < taps; t++) {
+    int g = t - 1;
+    vec2 offset = t == 0 ? vec2(0.0) : (vec2(float(g % SHADOW_SEARCH_TAPS), float(g / SHADOW_SEARCH_TAPS)) + 0.5) /
+                                       float(SHADOW_SEARCH_TAPS) * 2.0 - 1.0;
+    float window = shadow_fetch(atlas, origin, size, ivec2(floor(coords + 0.5 + offset * search)));
+    if (window < test) {
+      total += shadow_linear(window, depth_map);
       count += 1.0;
     }
   }
@@ -54,28 +74,32 @@ vec2 shadow_tile_visibility(sampler2D atlas, vec4 atlas_info, int tile, vec2 ndc
     return vec2(1.0, 0.0);
   }
   float needed = shadow_penumbra(light, receiver, total / count) / texel_world;
+  float softness = clamp(2.0 * needed / (SHADOW_MARGIN - 1.0) - 1.0, 0.0, 1.0);
+  if (wide && count >= float(taps)) {
+    return vec2(0.0, softness);
+  }
   float radius = clamp(needed, 0.5, SHADOW_MARGIN - 1.0);
+  int side = clamp(int(ceil(radius)), 1, SHADOW_FILTER_TAPS);
+  vec2 turn = vec2(float(side), 1.0) * inversesqrt(float(side * side + 1));
   float lit = 0.0;
-  for (int j = 0; j < SHADOW_FILTER_TAPS; j++) {
-    for (int i = 0; i < SHADOW_FILTER_TAPS; i++) {
-      vec2 grid = (vec2(float(i), float(j)) + 0.5) / float(SHADOW_FILTER_TAPS) * 2.0 - 1.0;
-      vec2 offset = vec2(SHADOW_FILTER_TURN.x * grid.x - SHADOW_FILTER_TURN.y * grid.y,
-                         SHADOW_FILTER_TURN.y * grid.x + SHADOW_FILTER_TURN.x * grid.y);
+  for (int j = 0; j < side; j++) {
+    for (int i = 0; i < side; i++) {
+      vec2 grid = (vec2(float(i), float(j)) + 0.5) / float(side) * 2.0 - 1.0;
+      vec2 offset = vec2(turn.x * grid.x - turn.y * grid.y, turn.y * grid.x + turn.x * grid.y);
       vec2 at = coords + offset * radius;
       vec2 base = floor(at);
       vec2 fraction = at - base;
       ivec2 texel = ivec2(base);
-      float c00 = shadow_fetch(atlas, origin, size, texel, depth_map) >= test ? 1.0 : 0.0;
-      float c10 = shadow_fetch(atlas, origin, size, texel + ivec2(1, 0), depth_map) >= test ? 1.0 : 0.0;
-      float c01 = shadow_fetch(atlas, origin, size, texel + ivec2(0, 1), depth_map) >= test ? 1.0 : 0.0;
-      float c11 = shadow_fetch(atlas, origin, size, texel + ivec2(1, 1), depth_map) >= test ? 1.0 : 0.0;
+      float c00 = shadow_fetch(atlas, origin, size, texel) >= test ? 1.0 : 0.0;
+      float c10 = shadow_fetch(atlas, origin, size, texel + ivec2(1, 0)) >= test ? 1.0 : 0.0;
+      float c01 = shadow_fetch(atlas, origin, size, texel + ivec2(0, 1)) >= test ? 1.0 : 0.0;
+      float c11 = shadow_fetch(atlas, origin, size, texel + ivec2(1, 1)) >= test ? 1.0 : 0.0;
       float bottom = c00 + (c10 - c00) * fraction.x;
       float top = c01 + (c11 - c01) * fraction.x;
       lit += bottom + (top - bottom) * fraction.y;
     }
   }
-  return vec2(lit / float(SHADOW_FILTER_TAPS * SHADOW_FILTER_TAPS),
-              clamp(2.0 * needed / (SHADOW_MARGIN - 1.0) - 1.0, 0.0, 1.0));
+  return vec2(lit / float(side * side), softness);
 }
 
 /* A point or spot light (radius light_radius) of six faces from first_tile, near_far its maps' planes. */
@@ -90,9 +114,13 @@ vec2 shadow_point_visibility(sampler2D atlas, vec4 atlas_info, vec3 light_positi
   d += towards * (SHADOW_NORMAL_OFFSET * 2.0 * z / inner_texels);
   a = abs(d);
   int k = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
-  z = max(a[k], 1.0e-30);
-  int face = 2 * k + (d[k] < 0.0 ? 1 : 0);
-  vec2 ndc = vec2(d[(k + 1) % 3], d[(k + 2) % 3]) / z * atlas_info.z;
+  /* axis k and the two after it as one-hot vectors: a vector's component at a computed index is kept in memory
+   * by llvmpipe */
+  vec3 axis = k == 0 ? vec3(1.0, 0.0, 0.0) : (k == 1 ? vec3(0.0, 1.0, 0.0) : vec3(0.0, 0.0, 1.0));
+  float dk = dot(d, axis);
+  z = max(abs(dk), 1.0e-30);
+  int face = 2 * k + (dk < 0.0 ? 1 : 0);
+  vec2 ndc = vec2(dot(d, axis.zxy), dot(d, axis.yzx)) / z * atlas_info.z;
   return shadow_tile_visibility(atlas, atlas_info, first_tile + face, ndc, z, 2.0 * z / inner_texels,
                                 vec3(light_radius, 1.0, near_far.x), vec3(near_far, 0.0));
 }

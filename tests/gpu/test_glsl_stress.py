@@ -971,7 +971,7 @@ def test_shadow_maps_stress(glsl, fuzz):
     round a depth comparison or a texel apart (allowed on 1% of the points, measured none of 131072); with hostile
     positions and
     normals (zero, huge, NaN-free extremes) finite and in [0, 1].  The two entry points run the rest:
-    shadow_tile_visibility(), shadow_fetch() and shadow_penumbra()."""
+    shadow_tile_visibility(), shadow_fetch(), shadow_linear(), shadow_window() and shadow_penumbra()."""
     from sg_prt_addon.lighting import shadow_maps
     from sg_prt_addon.techniques import shader_sources
     from validation import shadow_map_scene
@@ -1027,7 +1027,7 @@ COVERED = {
     test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "spot_light_sg", "directional_light_sg"],
     test_light_emission_stress: ["light_emission_factor"],
     test_shadow_maps_stress: ["shadow_point_visibility", "shadow_sun_visibility", "shadow_tile_visibility",
-                              "shadow_fetch", "shadow_penumbra"],
+                              "shadow_fetch", "shadow_linear", "shadow_window", "shadow_penumbra"],
     test_clamped_cosine_stress: ["sg_clamped_cosine_integral", "sg_clamped_cosine_integral_paper",
                                  "clamped_cosine_from_cosine", "clamped_cosine_lobe_evaluate"],
     test_clamped_cosine_table_stress: ["sg_clamped_cosine_integral_tabulated", "clamped_cosine_tabulated"],

@@ -322,7 +322,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
      * the map's filter (the softness); the others: the SSDF's */
     int shadow_slot = light_shadow_slot(l);
     bool mapped = shadow_slot >= 0;
-    vec2 shadow = mapped ? light_shadow[max(shadow_slot, 0)] : vec2(1.0, 1.0);    /* unmapped: the SSDF's alone */
+    vec2 shadow = mapped ? light_shadow_of(shadow_slot) : vec2(1.0, 1.0);    /* unmapped: the SSDF's alone */
 #ifdef HAS_VISIBILITY
     float light_visibility = 1.0;
     if (shadow.y > 0.0) {
