@@ -31,7 +31,8 @@ MODES = ("SSDF", "SHADOW_MAPS")
 
 
 def timed_render(scene, mode, redraws):
-    """(render() seconds, median steady frame seconds) with Light Shadows `mode`."""
+    """(render() seconds, median steady frame seconds) with Light Shadows `mode`: the render's own seconds are
+    bpy.ops.render.render's less the steady frames it was asked to time after it."""
     import bpy
 
     from sg_prt_addon.engine import render_engine
@@ -46,7 +47,8 @@ def timed_render(scene, mode, redraws):
         render_engine.debug["timed_redraws"] = 0
     if "error" in render_engine.last_render:
         raise RuntimeError(render_engine.last_render["error"])
-    return seconds, statistics.median(render_engine.last_render["timings"]["frames"])
+    frames = render_engine.last_render["timings"]["frames"]
+    return seconds - sum(frames), statistics.median(frames)
 
 
 def measure_scene(name, builder, size, redraws, rounds):
@@ -77,7 +79,8 @@ def section(results, command, rounds):
     intro = (f"`{command}` (Blender {bpy.app.version_string}, {os.cpu_count()} cores, Mesa llvmpipe; "
              f"{time.strftime('%Y-%m-%d')}; benchmarks/shadow_maps_speed.py says how): Light Shadows on Baked "
              f"Visibility (the SSDF) and on Shadow Maps (tile side 1024), alternated in one process, medians of "
-             f"{rounds} rounds.  render() draws the atlas (six 1024 x 1024 faces a point or spot light, one tile a "
+             f"{rounds} rounds.  render(): bpy.ops.render.render's own seconds (the steady frames it timed after it "
+             "taken off), which draws the atlas (up to six 1024 x 1024 faces a point or spot light, one tile a "
              "sun); the steady frame reuses it, as a viewport redraw that only moves the view does, so it is the "
              "per-pixel lookups' cost.")
     lines = [TITLE, "", textwrap.fill(intro, 110), "",
