@@ -10,6 +10,15 @@ from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SHADOW_MAPS, MAX_S
 from . import shader_cache
 
 
+def world_corners(matrices, boxes):
+    """(N, 8, 3) world corners of local boxes (N, 2, 3) under matrices (N, 4, 4)."""
+    boxes = np.asarray(boxes, np.float64).reshape(-1, 2, 3)
+    corners = np.stack([np.stack([boxes[:, x, 0], boxes[:, y, 1], boxes[:, z, 2]], -1)
+                        for x in (0, 1) for y in (0, 1) for z in (0, 1)], 1)
+    matrices = np.asarray(matrices, np.float64).reshape(-1, 4, 4)
+    return np.einsum("nij,nkj->nki", matrices[:, :3, :3], corners) + matrices[:, None, :3, 3]
+
+
 def world_bounds(entries, mesh_buffers):
     """(2, 3) box of every object's mesh (ObjectEntry, MeshBuffers by mesh key) in the world, or None."""
     matrices, boxes = [], []
@@ -20,11 +29,7 @@ def world_bounds(entries, mesh_buffers):
             boxes.append(buffers.bounds)
     if not boxes:
         return None
-    boxes = np.asarray(boxes, np.float64)                           # (N, 2, 3)
-    corners = np.stack([np.stack([boxes[:, x, 0], boxes[:, y, 1], boxes[:, z, 2]], -1)
-                        for x in (0, 1) for y in (0, 1) for z in (0, 1)], 1)        # (N, 8, 3)
-    matrices = np.asarray(matrices, np.float64)
-    world = np.einsum("nij,nkj->nki", matrices[:, :3, :3], corners) + matrices[:, None, :3, 3]
+    world = world_corners(matrices, boxes)
     world = world[np.all(np.isfinite(world), axis=(1, 2))]
     if not len(world):
         return None
@@ -63,6 +68,28 @@ def shadow_calls():
             ("fragment_source", ("void main()\n{\n  out_unused = vec4(0.0);\n}\n",))]
 
 
+def _object_corners(objects):
+    """(N, 8, 3) world box corners of draw()'s objects; an object without bounds gets NaN (always drawn)."""
+    corners = np.full((len(objects), 8, 3), np.nan)
+    known = [index for index, item in enumerate(objects) if item[3] is not None]
+    if known:
+        corners[known] = world_corners([objects[i][2] for i in known], [objects[i][3] for i in known])
+    return corners
+
+
+def in_tile(tile_matrix, corners):
+    """(N,) whether each box of corners (N, 8, 3) may reach the tile of world -> clip `tile_matrix`: False only
+    when one clip plane has all 8 corners outside (a box with a non-finite corner: True)."""
+    clip = np.concatenate([corners, np.ones(corners.shape[:2] + (1,))], -1) @ np.asarray(tile_matrix, np.float64).T
+    x, y, z, w = clip[..., 0], clip[..., 1], clip[..., 2], clip[..., 3]
+    with np.errstate(invalid="ignore"):
+        outside = [x > w, x < -w, y > w, y < -w, z > w, z < -w]
+        culled = np.zeros(len(corners), bool)
+        for plane in outside:
+            culled |= np.all(plane, axis=1)
+    return ~culled | ~np.all(np.isfinite(corners), axis=(1, 2))
+
+
 class ShadowAtlas:
     """The depth texture of a frame's shadow maps, drawn by draw()."""
 
@@ -73,13 +100,14 @@ class ShadowAtlas:
         self.draw_count = 0         # atlases drawn (tests: a view change alone draws none)
 
     def draw(self, shadow_plan, objects):
-        """Draw every tile of shadow_plan with `objects`, [(model matrix (16 floats, column-major), [GPUBatch])],
-        unless the plan and the objects are those of the last atlas."""
+        """Draw every tile of shadow_plan with `objects`, [(model matrix (16 floats, column-major), [GPUBatch],
+        (4, 4) matrix_world, (2, 3) local bounds or None)], each in the tiles its box may reach, unless the plan and
+        the objects are those of the last atlas."""
         import gpu
 
         signature = (shadow_plan.size, shadow_plan.columns, shadow_plan.rows,
                      tuple((tile, matrix.tobytes()) for tile, matrix in shadow_plan.tiles),
-                     tuple((tuple(matrix), tuple(id(batch) for batch in batches)) for matrix, batches in objects))
+                     tuple((tuple(matrix), tuple(id(batch) for batch in batches)) for matrix, batches, *_ in objects))
         if signature == self.signature:
             return
         self.signature = None
@@ -95,11 +123,13 @@ class ShadowAtlas:
             gpu.state.face_culling_set("NONE")
             gpu.state.color_mask_set(False, False, False, False)
             shader.bind()
+            corners = _object_corners(objects)
             for tile, matrix in shadow_plan.tiles:
                 x, y = shadow_plan.tile_origin(tile)
                 gpu.state.viewport_set(x, y, shadow_plan.size, shadow_plan.size)
                 shader.uniform_float("tile_matrix", np.asarray(matrix, np.float32).T.ravel().tolist())
-                for model_matrix, batches in objects:
+                for index in np.nonzero(in_tile(matrix, corners))[0]:
+                    model_matrix, batches = objects[index][:2]
                     shader.uniform_float("model_matrix", model_matrix)
                     for batch in batches:
                         batch.draw(shader)

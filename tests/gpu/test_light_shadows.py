@@ -75,3 +75,21 @@ def test_unbaked_object_is_shadowed_and_the_atlas_is_drawn_once(engine):
     print("shadowed fraction of the surface", float((ratio[covered] < 0.1).mean()))
     assert (ratio[covered] < 0.1).mean() > 0.05
     assert np.all(ratio[covered] <= 1.0 + 1e-4)
+
+
+def test_objects_are_drawn_into_the_tiles_they_reach(engine):
+    """engine/shadow_pass.in_tile: a box below a light is in its -z face's tile and not in its +z face's; a box with
+    a non-finite corner is always drawn (never culled wrongly)."""
+    from sg_prt_addon.engine import shadow_pass
+    from sg_prt_addon.lighting import shadow_maps
+    from validation import shadow_map_scene
+
+    shadow_plan = shadow_maps.plan(shadow_map_scene.lights(), shadow_map_scene.BOUNDS, 256)
+    tiles = dict(shadow_plan.tiles)
+    below = shadow_pass.world_corners([np.eye(4)], [[[-0.5, -0.5, 0.0], [0.5, 0.5, 1.0]]])
+    unknown = np.full((1, 8, 3), np.nan)
+    assert shadow_pass.in_tile(tiles[5], below)[0]                       # -z: looking down
+    assert 4 not in tiles                                                # +z sees nothing of the box: not drawn
+    above = shadow_pass.world_corners([np.eye(4)], [[[-0.5, -0.5, 5.0], [0.5, 0.5, 6.0]]])
+    assert not shadow_pass.in_tile(tiles[5], above)[0]
+    assert shadow_pass.in_tile(tiles[5], unknown)[0]
