@@ -4,8 +4,8 @@ lookup the surface shaders make (shaders/lib/shadow_maps.glsl), mirrored here in
 Why: the SSDF visibility of wang2009 widens a small light's shadow edge 1.5-1.8x (docs/ACCURACY.md, "Shadow edge"):
 fh's smooth profile stands for the light's disc.  A depth map from the light resolves the edge at its texel
 size, and a percentage-closer filter sized by the blocker's distance (PCSS) gives a sphere light's or the sun's
-penumbra.  Point and spot lights take six cube faces (a spot only the faces its cone reaches), a sun one
-orthographic tile over the casters' bounds.  Area lights' patches keep the SSDF (a map each would be 16 lights),
+penumbra.  Point and spot lights take six cube faces (drawn where the spot's cone and the casters' box reach), a
+sun one orthographic tile over what the camera sees of the casters' box.  Area lights' patches keep the SSDF (a map each would be 16 lights),
 and so do lights wider than MAX_LIGHT_ANGLE; where a map's penumbra outgrows its filter, a baked object blends in
 the SSDF's visibility (the lookup's softness).
 
@@ -14,7 +14,8 @@ face (the projection maps the face to the inner size - 2 MARGIN texels), so the 
 edge read the scene beyond it, not the neighbouring tile.
 
 Depths: a cube face stores the window depth of a perspective projection (near, far) along its axis; a sun's tile
-the depth along the light's direction, linear over the casters' range.  The lookup compares linear depths.
+the depth along the light's direction, linear over the casters' range.  The lookup compares window depths and
+averages the blockers' linear ones.
 """
 import math
 from dataclasses import dataclass, field
@@ -23,7 +24,7 @@ import numpy as np
 
 FLOAT = np.float32
 MARGIN = 16                     # texels of guard band around each face
-MAX_SHADOW_MAPS = 8             # lights with a map: the shader's light_shadow slots
+MAX_SHADOW_MAPS = 8             # lights with a map: the shader's shadow slots (common/surface_common.glsl)
 MAX_SIDE = 16384                # GPUTexture side limit (llvmpipe's)
 MAX_TEXELS = 64 * 1024 * 1024   # 256 MB of DEPTH_COMPONENT32F
 DEFAULT_SIZE = 1024
@@ -32,9 +33,9 @@ FILTER_TAPS = 4                 # filter: at most FILTER_TAPS^2 bilinear compari
 DEPTH_BIAS = 1.5                # texels of depth subtracted from the receiver's
 NORMAL_OFFSET = 1.0             # texels the receiver moves along its normal before the lookup
 # lights wider than this (radians of angular radius from the casters' centre, or from half their box's diagonal
-# when nearer) keep the SSDF: a sphere light of
-# radius 0.75 at 5 m (the truth suite's diffuse_sphere_light) scored 0.118 against Cycles with a map, 0.102 without:
-# its penumbra outgrows the filter's guard band, and the SSDF's smooth profile suits a wide light
+# when nearer) keep the SSDF: a sphere light of radius 0.75 at 3.2 m (the truth suite's diffuse_sphere_light) scored
+# 0.118 against Cycles with a map, 0.102 without: its penumbra outgrows the filter's guard band, and the SSDF's
+# smooth profile suits a wide light
 MAX_LIGHT_ANGLE = 0.1
 FACE_COS_LIMIT = math.cos(math.atan(math.sqrt(2.0)))   # a cube face's corner from its axis (54.7 degrees)
 
