@@ -614,6 +614,8 @@ class Renderer:
         self.material_tables.clear()
         self.object_targets.clear()
         self.object_tables.clear()
+        self.shadow_plan = None
+        self.shadow_atlas = shadow_pass.ShadowAtlas()
         self.targets = []
         self.framebuffer = None
         self.size = None
