@@ -488,11 +488,12 @@ class Renderer:
 
         draws = self.object_draws(state)
         self._prepare_objects(draws)
-        if self.shadow_plan is not None:        # every object casts, holdouts too (as in Cycles)
+        if self.shadow_plan is not None:        # holdouts cast too, as in Cycles; objects whose Shadow is off do not
             self.shadow_atlas.draw(self.shadow_plan, [(context.model_matrix,
                                                        [batch for *_, batch in context.buffers.batches],
                                                        entry.matrix_world, context.buffers.bounds)
-                                                      for _index, _key, entry, context, _slots in draws])
+                                                      for _index, _key, entry, context, _slots in draws
+                                                      if entry.casts_shadow])
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")

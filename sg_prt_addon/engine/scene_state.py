@@ -103,6 +103,7 @@ class ObjectEntry:
     matrix_world: np.ndarray
     material_names: list            # material name (or "") per slot
     holdout: bool = False           # a holdout: occludes, shades nothing, alpha 0 (export.render_roles)
+    casts_shadow: bool = True       # Object > Visibility > Ray Visibility > Shadow: drawn into the shadow maps
 
 
 @dataclass
@@ -183,7 +184,8 @@ class SceneState:
                 self._export_mesh(obj, mesh_key)
                 seen_meshes.add(mesh_key)
             self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(instance.matrix_world),
-                                             self._read_materials(obj), obj.original.name in roles.holdout)
+                                             self._read_materials(obj), obj.original.name in roles.holdout,
+                                             _casts_shadow(obj))
         self.world = export.export_world(depsgraph.scene.world)
         self.environment = environment_data(self.world, self.environment_layer_size)
         self._warn_outdated_bakes(depsgraph)
@@ -390,7 +392,8 @@ class SceneState:
                     self._exported_in_update.add(mesh_key)
                     dirty.meshes.add(mesh_key)
                 self.objects[name] = ObjectEntry(name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
-                                                 self._read_materials(obj), obj.original.name in roles.holdout)
+                                                 self._read_materials(obj), obj.original.name in roles.holdout,
+                                                 _casts_shadow(obj))
                 dirty.objects = True
         if len([obj for obj in present.values() if obj.type == "LIGHT"]) != len(self.lights):
             dirty.lights = True
@@ -414,7 +417,8 @@ class SceneState:
             self._exported_in_update.add(mesh_key)
             dirty.meshes.add(mesh_key)
         self.objects[obj.name] = ObjectEntry(obj.name, mesh_key, export.matrix_to_numpy(obj.matrix_world),
-                                             self._read_materials(obj), obj.original.name in self._roles.holdout)
+                                             self._read_materials(obj), obj.original.name in self._roles.holdout,
+                                             _casts_shadow(obj))
         dirty.objects = True
 
     def mark_all_dirty(self):
@@ -444,6 +448,11 @@ def _visible(obj):
         return original.visible_get()
     except RuntimeError:
         return True
+
+
+def _casts_shadow(obj):
+    """Whether an object casts shadows (its Shadow ray visibility, as Cycles and EEVEE read it)."""
+    return bool(getattr(obj, "visible_shadow", True))
 
 
 def _area_patches(scene):

@@ -93,3 +93,19 @@ def test_objects_are_drawn_into_the_tiles_they_reach(engine):
     above = shadow_pass.world_corners([np.eye(4)], [[[-0.5, -0.5, 5.0], [0.5, 0.5, 6.0]]])
     assert not shadow_pass.in_tile(tiles[5], above)[0]
     assert shadow_pass.in_tile(tiles[5], unknown)[0]
+
+
+def test_object_without_shadow_visibility_casts_none(engine):
+    """Object > Visibility > Ray Visibility > Shadow off: the sphere is left out of the maps, so the floor under it
+    is lit as without shadows (as Cycles and EEVEE read the setting; with it on, the same scene's floor is shadowed:
+    test_unbaked_object_is_shadowed_and_the_atlas_is_drawn_once)."""
+    import bpy
+
+    scene = _scene("maps_no_cast")
+    bpy.data.objects["maps_no_cast_sphere"].visible_shadow = False
+    mapped = fx.render(scene)["passes"]["Diffuse"]
+    unshadowed = fx.render(_scene("maps_no_cast_ssdf", light_shadows="SSDF"))["passes"]["Diffuse"]
+    covered = unshadowed[..., 3] > 0.5
+    ratio = mapped[..., 0] / np.maximum(unshadowed[..., 0], 1e-9)
+    print("pixels darker than half", float((ratio[covered] < 0.5).mean()))
+    assert (ratio[covered] < 0.5).mean() < 0.002
