@@ -1,10 +1,9 @@
 """The lights' shadow maps on the GPU: the plan of a frame (lighting.shadow_maps) from the drawn objects' bounds,
 its rows of the scene block, and the depth atlas drawn from the lights (drawn again only when the plan or what
 is drawn changed: a viewport redraw that moves the view alone reuses it)."""
-import math
-
 import numpy as np
 
+from ..lighting import shadow_maps
 from ..techniques import shader_sources
 from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SHADOW_MAPS, MAX_SUNS
 from . import shader_cache
@@ -12,9 +11,7 @@ from . import shader_cache
 
 def world_corners(matrices, boxes):
     """(N, 8, 3) world corners of local boxes (N, 2, 3) under matrices (N, 4, 4)."""
-    boxes = np.asarray(boxes, np.float64).reshape(-1, 2, 3)
-    corners = np.stack([np.stack([boxes[:, x, 0], boxes[:, y, 1], boxes[:, z, 2]], -1)
-                        for x in (0, 1) for y in (0, 1) for z in (0, 1)], 1)
+    corners = shadow_maps.box_corners(boxes)
     matrices = np.asarray(matrices, np.float64).reshape(-1, 4, 4)
     return np.einsum("nij,nkj->nki", matrices[:, :3, :3], corners) + matrices[:, None, :3, 3]
 
@@ -55,8 +52,7 @@ def scene_rows(shadow_plan, light_data):
         sun_rows[:suns] = np.stack([shadow_plan.sun_slot, shadow_plan.sun_tile, shadow_plan.sun_texel,
                                     shadow_plan.sun_range], 1)
         sun_frames[:3 * suns] = shadow_plan.sun_rows.reshape(-1, 4)
-        if len(light_data.sun_radius):
-            sun_radius[:suns, 0] = [math.tan(min(float(r), 1.5)) for r in light_data.sun_radius]
+        sun_radius[:suns, 0] = shadow_plan.sun_tan_radius
     return np.concatenate([atlas, slots, point_rows, sun_rows, sun_frames, sun_radius])
 
 

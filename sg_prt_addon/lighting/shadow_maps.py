@@ -37,7 +37,7 @@ NORMAL_OFFSET = 1.0             # texels the receiver moves along its normal bef
 # 0.118 against Cycles with a map, 0.102 without: its penumbra outgrows the filter's guard band, and the SSDF's
 # smooth profile suits a wide light
 MAX_LIGHT_ANGLE = 0.1
-FACE_COS_LIMIT = math.cos(math.atan(math.sqrt(2.0)))   # a cube face's corner from its axis (54.7 degrees)
+FACE_CORNER_ANGLE = math.atan(math.sqrt(2.0))   # a cube face's corner from its axis (54.7 degrees)
 
 
 @dataclass
@@ -47,7 +47,8 @@ class ShadowPlan:
     point_slot (P,) / sun_slot (S,): the light's slot in light_shadow, -1 without a map; point_first_tile (P,):
     its six faces' first tile (face f at first + f); point_near_far (P, 2); sun_tile (S,); sun_rows (S, 3, 4):
     ndc x, ndc y and depth01 of a world point p as rows @ (p, 1); sun_texel (S,): a texel's world size; sun_range
-    (S,): the world depth of depth01 1.  tiles: [(tile, (4, 4) world -> clip matrix)] to render (faces a spot's cone
+    (S,): the world depth of depth01 1; sun_tan_radius (S,): the tangent of each sun's angular radius (its
+    penumbra's slope).  tiles: [(tile, (4, 4) world -> clip matrix)] to render (faces a spot's cone
     or the casters' box misses are left out: their tiles keep the clear, far)."""
     size: int = 0
     columns: int = 1
@@ -60,6 +61,7 @@ class ShadowPlan:
     sun_rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 4), FLOAT))
     sun_texel: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
     sun_range: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
+    sun_tan_radius: np.ndarray = field(default_factory=lambda: np.zeros(0, FLOAT))
     slot_lights: list = field(default_factory=list)      # light index per slot (points, then suns after P)
     tiles: list = field(default_factory=list)
 
@@ -107,9 +109,11 @@ def _orthonormal_basis(axis):
     return right, np.cross(axis, right)
 
 
-def _corners(bounds):
-    low, high = np.asarray(bounds, np.float64)
-    return np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
+def box_corners(boxes):
+    """(N, 8, 3) corners of boxes (N, 2, 3) (low, high)."""
+    boxes = np.asarray(boxes, np.float64).reshape(-1, 2, 3)
+    return np.stack([np.stack([boxes[:, x, 0], boxes[:, y, 1], boxes[:, z, 2]], -1)
+                     for x in (0, 1) for y in (0, 1) for z in (0, 1)], 1)
 
 
 def _faces_of_spot(direction, spot_size):
@@ -122,7 +126,7 @@ def _faces_of_spot(direction, spot_size):
     for face in range(6):
         axis = -face_frame(face)[2]
         angle = math.acos(float(np.clip(axis @ direction, -1.0, 1.0)))
-        if angle <= half + math.acos(FACE_COS_LIMIT) + 1e-3:
+        if angle <= half + FACE_CORNER_ANGLE + 1e-3:
             faces.append(face)
     return faces
 
@@ -140,7 +144,7 @@ def view_corners(view_projection, bounds):
     farthest corner of `bounds` in front of it, or None (the box is behind the camera, or a matrix is singular):
     what the camera can see of the box lies inside them."""
     view_projection = np.asarray(view_projection, np.float64)
-    clip = np.c_[_corners(bounds), np.ones(8)] @ view_projection.T
+    clip = np.c_[box_corners(bounds)[0], np.ones(8)] @ view_projection.T
     front = clip[:, 3] > 1e-12
     if not front.any():
         return None
@@ -171,17 +175,17 @@ def plan(light_data, bounds, size=DEFAULT_SIZE, view=None):
     """The ShadowPlan of lighting.scene_lighting.LightData for casters within world `bounds` ((2, 3) or None: no
     geometry, no maps); view: view_corners' frustum or None: a sun's tile covers only what of the box it may show
     (its casters are those above, within the box's depth).  Suns first, then point and spot lights in LightData's
-    order (the brightest first),
-    MAX_SHADOW_MAPS in all; area light patches and lights wider than MAX_LIGHT_ANGLE get none.  The tile side is `size` unless the atlas would pass
-    MAX_SIDE or MAX_TEXELS."""
+    order (the brightest first), MAX_SHADOW_MAPS in all; area light patches and lights wider than MAX_LIGHT_ANGLE
+    get none.  The tile side is `size` unless the atlas would pass MAX_SIDE or MAX_TEXELS."""
     points, suns = len(light_data.point_radius), len(light_data.sun_sharpness)
     result = ShadowPlan(point_slot=np.full(points, -1, np.int32), point_first_tile=np.zeros(points, np.int32),
                         point_near_far=np.zeros((points, 2), FLOAT), sun_slot=np.full(suns, -1, np.int32),
                         sun_tile=np.zeros(suns, np.int32), sun_rows=np.zeros((suns, 3, 4), FLOAT),
                         sun_texel=np.zeros(suns, FLOAT), sun_range=np.zeros(suns, FLOAT))
+    sun_radius = np.asarray(light_data.sun_radius if len(light_data.sun_radius) else np.zeros(suns), np.float64)
+    result.sun_tan_radius = np.tan(np.minimum(sun_radius, 1.5)).astype(FLOAT)
     if bounds is None or size <= 2 * MARGIN or not np.all(np.isfinite(bounds)):
         return result
-    sun_radius = np.asarray(light_data.sun_radius if len(light_data.sun_radius) else np.zeros(suns), np.float64)
     mapped_suns = [s for s in range(suns) if sun_radius[s] <= MAX_LIGHT_ANGLE][:MAX_SHADOW_MAPS]
     centre = 0.5 * (np.asarray(bounds[0], np.float64) + bounds[1])
     half_diagonal = 0.5 * float(np.linalg.norm(np.asarray(bounds[1], np.float64) - bounds[0]))
@@ -206,7 +210,7 @@ def plan(light_data, bounds, size=DEFAULT_SIZE, view=None):
         return result
     result.size, result.columns, result.rows = side, columns, rows
     inner = result.inner
-    corners = _corners(bounds)
+    corners = box_corners(bounds)[0]
     tile = 0
     for slot, s in enumerate(mapped_suns):
         forward = -np.asarray(light_data.sun_axis[s], np.float64)
@@ -243,9 +247,9 @@ def plan(light_data, bounds, size=DEFAULT_SIZE, view=None):
         faces = [face for face in _faces_of_spot(light_data.spot_direction[p], float(light_data.spot_size[p]))
                  if _face_sees(face, corners - position)]
         for face in faces:
-            view = np.eye(4)
-            view[:3, :3] = face_frame(face)
-            result.tiles.append((tile + face, perspective_rows(near, far, inner) @ view @ translate))
+            face_view = np.eye(4)
+            face_view[:3, :3] = face_frame(face)
+            result.tiles.append((tile + face, perspective_rows(near, far, inner) @ face_view @ translate))
         tile += 6
     result.slot_lights = [int(s) + points for s in mapped_suns] + mapped_points
     return result
@@ -282,8 +286,9 @@ def tile_visibility(atlas, shadow_plan, tile, ndc, receiver, texel_world, penumb
     (N,): the blocker search, then the filter sized by penumbra(receiver, blocker) (world radius) over
     texel_world (N,); the tile stores window depths (linearize: to linear, window_of: back).  The comparisons are
     made on window depths (the test depth converted once), the blockers' mean on linear ones.  The search reads the
-    centre, and a SEARCH_TAPS^2 grid where it spans a texel or more; every tap of that grid blocked: the umbra (0).  The filter
-    takes a n x n grid of bilinear comparisons, n = ceil(radius) up to FILTER_TAPS (taps at most 2 texels apart).
+    centre, and a SEARCH_TAPS^2 grid where it spans a texel or more; every tap of that grid blocked: the umbra (0).
+    The filter takes a n x n grid of bilinear comparisons, n = ceil(radius) up to FILTER_TAPS (taps at most 2
+    texels apart).
     softness: 0 while the penumbra fits the filter, 1 once it reaches the guard band (the filter is clamped there;
     the surface shaders blend a baked object's SSDF visibility in by it)."""
     size = shadow_plan.size
@@ -352,12 +357,13 @@ def point_visibility(atlas, shadow_plan, light_data, p, position, normal):
     tile = shadow_plan.point_first_tile[p] + face
     return tile_visibility(atlas, shadow_plan, tile, ndc, z, texel_world,
                            lambda receiver, blocker: radius * (receiver - blocker) / np.maximum(blocker, near),
-                           lambda window: _linear_depth(window, near, far), lambda linear: _window_depth(linear, near, far))
+                           lambda window: _linear_depth(window, near, far),
+                           lambda linear: _window_depth(linear, near, far))
 
 
-def sun_visibility(atlas, shadow_plan, s, tan_radius, position, normal):
-    """(visible fraction, softness) (N,) of sun s (its angular radius's tangent) at world positions (N, 3) with
-    normals (N, 3)."""
+def sun_visibility(atlas, shadow_plan, s, position, normal):
+    """(visible fraction, softness) (N,) of sun s at world positions (N, 3) with normals (N, 3)."""
+    tan_radius = float(shadow_plan.sun_tan_radius[s])
     rows = np.asarray(shadow_plan.sun_rows[s], np.float64)
     texel = float(shadow_plan.sun_texel[s])
     depth_range = float(shadow_plan.sun_range[s])
@@ -387,6 +393,5 @@ def light_visibility(atlas, shadow_plan, light_data, position, normal):
             out[:, p] = np.stack(point_visibility(atlas, shadow_plan, light_data, p, position, normal), -1)
     for s in range(suns):
         if shadow_plan.sun_slot[s] >= 0:
-            tan_radius = math.tan(min(float(light_data.sun_radius[s]), 1.5)) if len(light_data.sun_radius) else 0.0
-            out[:, points + s] = np.stack(sun_visibility(atlas, shadow_plan, s, tan_radius, position, normal), -1)
+            out[:, points + s] = np.stack(sun_visibility(atlas, shadow_plan, s, position, normal), -1)
     return out
