@@ -1,7 +1,8 @@
 """What the lights' shadow maps cost (scene.sgprt.light_shadows): the truth suite's scenes with lights at its size
 and the brushed-metal example at 512, visibility baked by the operator at its defaults, in one process:
 
-- render(): bpy.ops.render.render's wall time, which draws the atlas (a final render makes a new renderer);
+- render(): bpy.ops.render.render's own seconds (the steady frames it timed taken off), which draws the atlas (a
+  final render makes a new renderer);
 - the steady frame (draw + read back, render_engine.debug["timed_redraws"], median), which reuses the atlas as a
   viewport redraw that moves only the view does: the per-pixel lookups' cost alone;
 
@@ -12,7 +13,6 @@ medians of the rounds, and the ratios maps / SSDF.
 
 --update-doc writes the "Light shadows: shadow maps" section of docs/PERFORMANCE.md.
 """
-import argparse
 import os
 import statistics
 import sys
@@ -22,6 +22,8 @@ import time
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if REPO_ROOT not in sys.path:
     sys.path.insert(0, REPO_ROOT)
+
+from benchmarks import scene_benchmark  # noqa: E402 (after the path)
 
 TITLE = "## Light shadows: shadow maps"
 SCENES = (("ggx030_point", "truth_suite", 128), ("diffuse_point", "truth_suite", 128),
@@ -53,9 +55,8 @@ def timed_render(scene, mode, redraws):
 
 def measure_scene(name, builder, size, redraws, rounds):
     from benchmarks.engine_vs_eevee import bake_all
-    from benchmarks.specular_aa import build
 
-    scene = build(name, builder, size)
+    scene = scene_benchmark.build(name, builder, size)
     bake_all(name)
     for mode in MODES:            # compile both variants before timing
         timed_render(scene, mode, 1)
@@ -94,22 +95,9 @@ def section(results, command, rounds):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--scenes", nargs="*", default=[name for name, _, _ in SCENES])
-    parser.add_argument("--redraws", type=int, default=5)
-    parser.add_argument("--rounds", type=int, default=5)
-    parser.add_argument("--update-doc", action="store_true")
-    args = parser.parse_args(argv)
-
-    from sg_prt_addon import render as addon
-
-    addon.ensure_registered()
-    results = []
-    for name, builder, size in SCENES:
-        if name in args.scenes:
-            results.append(measure_scene(name, builder, size, args.redraws, args.rounds))
-            print(results[-1], flush=True)
-    command = ".venv/bin/python -m benchmarks.shadow_maps_speed" + (" --update-doc" if args.update_doc else "")
+    args = scene_benchmark.parse(argv, __doc__.split("\n")[0], SCENES, rounds=5)
+    results = scene_benchmark.measure(SCENES, args, measure_scene)
+    command = scene_benchmark.command("shadow_maps_speed", args)
     text = section(results, command, args.rounds)
     print(text)
     if args.update_doc:

@@ -14,7 +14,6 @@ Per scene (visibility baked by the operator at its defaults), in one process:
 
 --update-doc writes the "Specular anti-aliasing" sections of docs/ACCURACY.md and docs/PERFORMANCE.md.
 """
-import argparse
 import os
 import statistics
 import sys
@@ -25,6 +24,8 @@ REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if REPO_ROOT not in sys.path:
     sys.path.insert(0, REPO_ROOT)
 
+from benchmarks import scene_benchmark  # noqa: E402 (after the path)
+
 ACCURACY_TITLE = "## Specular anti-aliasing"
 PERFORMANCE_TITLE = "## Specular anti-aliasing"
 REFERENCE_SAMPLES = 64          # an 8 x 8 grid of jittered frames
@@ -34,21 +35,6 @@ SCENES = (("suzanne_courtyard", "examples", 512), ("brushed_metal", "examples", 
           ("ggx030_point", "truth_suite", 128), ("ggx010_hdri", "truth_suite", 128),
           ("ggx005_torus_hdri", "truth_suite", 128), ("ggx035_metal_hdri", "truth_suite", 128),
           ("aniso_torus_hdri", "truth_suite", 128))
-
-
-def build(name, builder, size):
-    import bpy
-
-    if builder == "examples":
-        from examples import build_scenes
-        scene = build_scenes.SCENES[name](size)
-    else:
-        from benchmarks import truth_suite
-        truth_suite.SCENES[name].build(size)
-        scene = bpy.context.scene
-    scene.render.resolution_x = scene.render.resolution_y = size
-    scene.render.resolution_percentage = 100
-    return scene
 
 
 def render(scene, anti_aliasing, samples=1, redraws=0):
@@ -79,7 +65,7 @@ def measure_scene(name, builder, size, redraws, rounds):
     from benchmarks.engine_vs_eevee import bake_all
     from validation import image_error
 
-    scene = build(name, builder, size)
+    scene = scene_benchmark.build(name, builder, size)
     bake_all(name)
     reference, mask, _ = render(scene, False, REFERENCE_SAMPLES)
     figures = {"scene": name, "size": size}
@@ -132,22 +118,9 @@ def performance_section(results, command):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--scenes", nargs="*", default=[name for name, _, _ in SCENES])
-    parser.add_argument("--redraws", type=int, default=5)
-    parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--update-doc", action="store_true")
-    args = parser.parse_args(argv)
-
-    from sg_prt_addon import render as addon
-
-    addon.ensure_registered()
-    results = []
-    for name, builder, size in SCENES:
-        if name in args.scenes:
-            results.append(measure_scene(name, builder, size, args.redraws, args.rounds))
-            print(results[-1], flush=True)
-    command = ".venv/bin/python -m benchmarks.specular_aa" + (" --update-doc" if args.update_doc else "")
+    args = scene_benchmark.parse(argv, __doc__.split("\n")[0], SCENES, rounds=3)
+    results = scene_benchmark.measure(SCENES, args, measure_scene)
+    command = scene_benchmark.command("specular_aa", args)
     accuracy, performance = accuracy_section(results, command), performance_section(results, command)
     print(accuracy)
     print(performance)
