@@ -73,19 +73,6 @@ def _object_corners(objects):
     return corners
 
 
-def in_tile(tile_matrix, corners):
-    """(N,) whether each box of corners (N, 8, 3) may reach the tile of world -> clip `tile_matrix`: False only
-    when one clip plane has all 8 corners outside (a box with a non-finite corner: True)."""
-    clip = np.concatenate([corners, np.ones(corners.shape[:2] + (1,))], -1) @ np.asarray(tile_matrix, np.float64).T
-    x, y, z, w = clip[..., 0], clip[..., 1], clip[..., 2], clip[..., 3]
-    with np.errstate(invalid="ignore"):
-        outside = [x > w, x < -w, y > w, y < -w, z > w, z < -w]
-        culled = np.zeros(len(corners), bool)
-        for plane in outside:
-            culled |= np.all(plane, axis=1)
-    return ~culled | ~np.all(np.isfinite(corners), axis=(1, 2))
-
-
 class ShadowAtlas:
     """The depth texture of a frame's shadow maps, drawn by draw()."""
 
@@ -124,7 +111,7 @@ class ShadowAtlas:
                 x, y = shadow_plan.tile_origin(tile)
                 gpu.state.viewport_set(x, y, shadow_plan.size, shadow_plan.size)
                 shader.uniform_float("tile_matrix", np.asarray(matrix, np.float32).T.ravel().tolist())
-                for index in np.nonzero(in_tile(matrix, corners))[0]:
+                for index in np.nonzero(shadow_maps.in_tile(matrix, corners))[0]:
                     model_matrix, batches = objects[index][:2]
                     shader.uniform_float("model_matrix", model_matrix)
                     for batch in batches:

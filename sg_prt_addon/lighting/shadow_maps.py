@@ -131,12 +131,17 @@ def _faces_of_spot(direction, spot_size):
     return faces
 
 
-def _face_sees(face, corners):
-    """Whether cube face `face`'s frustum (|x|, |y| <= z in its frame) may hold any of the box whose corners,
-    relative to the light, are `corners` (8, 3): False only when one of its planes has every corner outside."""
-    local = corners @ face_frame(face).T            # x, y, -z
-    x, y, depth = local[:, 0], local[:, 1], -local[:, 2]
-    return not any(np.all(outside) for outside in (x > depth, -x > depth, y > depth, -y > depth, depth <= 0))
+def in_tile(tile_matrix, corners):
+    """(N,) whether each box of corners (N, 8, 3) may reach the tile of world -> clip `tile_matrix`: False only
+    when one clip plane has all 8 corners outside (a box with a non-finite corner: True)."""
+    clip = np.concatenate([corners, np.ones(corners.shape[:2] + (1,))], -1) @ np.asarray(tile_matrix, np.float64).T
+    x, y, z, w = clip[..., 0], clip[..., 1], clip[..., 2], clip[..., 3]
+    with np.errstate(invalid="ignore"):
+        outside = [x > w, x < -w, y > w, y < -w, z > w, z < -w]
+        culled = np.zeros(len(corners), bool)
+        for plane in outside:
+            culled |= np.all(plane, axis=1)
+    return ~culled | ~np.all(np.isfinite(corners), axis=(1, 2))
 
 
 def view_corners(view_projection, bounds):
@@ -244,12 +249,12 @@ def plan(light_data, bounds, size=DEFAULT_SIZE, view=None):
         result.point_near_far[p] = near, far
         translate = np.eye(4)
         translate[:3, 3] = -position
-        faces = [face for face in _faces_of_spot(light_data.spot_direction[p], float(light_data.spot_size[p]))
-                 if _face_sees(face, corners - position)]
-        for face in faces:
+        for face in _faces_of_spot(light_data.spot_direction[p], float(light_data.spot_size[p])):
             face_view = np.eye(4)
             face_view[:3, :3] = face_frame(face)
-            result.tiles.append((tile + face, perspective_rows(near, far, inner) @ face_view @ translate))
+            matrix = perspective_rows(near, far, inner) @ face_view @ translate
+            if in_tile(matrix, corners[None])[0]:       # a face that sees none of the casters' box is not drawn
+                result.tiles.append((tile + face, matrix))
         tile += 6
     result.slot_lights = [int(s) + points for s in mapped_suns] + mapped_points
     return result

@@ -78,7 +78,8 @@ def test_unbaked_object_is_shadowed_and_the_atlas_is_drawn_once(engine):
 
 
 def test_objects_are_drawn_into_the_tiles_they_reach(engine):
-    """engine/shadow_pass.in_tile: a box below a light is in its -z face's tile and not in its +z face's; a box with
+    """lighting/shadow_maps.in_tile (by which the plan leaves out faces and engine/shadow_pass draws each object):
+    a box below a light is in its -z face's tile and not in its +z face's; a box with
     a non-finite corner is always drawn (never culled wrongly)."""
     from sg_prt_addon.engine import shadow_pass
     from sg_prt_addon.lighting import shadow_maps
@@ -88,11 +89,11 @@ def test_objects_are_drawn_into_the_tiles_they_reach(engine):
     tiles = dict(shadow_plan.tiles)
     below = shadow_pass.world_corners([np.eye(4)], [[[-0.5, -0.5, 0.0], [0.5, 0.5, 1.0]]])
     unknown = np.full((1, 8, 3), np.nan)
-    assert shadow_pass.in_tile(tiles[5], below)[0]                       # -z: looking down
+    assert shadow_maps.in_tile(tiles[5], below)[0]                       # -z: looking down
     assert 4 not in tiles                                                # +z sees nothing of the box: not drawn
     above = shadow_pass.world_corners([np.eye(4)], [[[-0.5, -0.5, 5.0], [0.5, 0.5, 6.0]]])
-    assert not shadow_pass.in_tile(tiles[5], above)[0]
-    assert shadow_pass.in_tile(tiles[5], unknown)[0]
+    assert not shadow_maps.in_tile(tiles[5], above)[0]
+    assert shadow_maps.in_tile(tiles[5], unknown)[0]
 
 
 def test_object_without_shadow_visibility_casts_none(engine):
