@@ -130,9 +130,16 @@ class SGPRT_PT_sampling(RenderPanel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         layout.use_property_split = True
-        layout.prop(context.scene.sgprt, "render_samples")
-        layout.prop(context.scene.sgprt, "specular_anti_aliasing")
-        layout.prop(context.scene.sgprt, "area_light_patches")
+        settings = context.scene.sgprt
+        layout.prop(settings, "render_samples")
+        column = layout.column()
+        column.active = settings.render_samples > 1
+        column.prop(settings, "sample_edges_only")
+        row = column.row()
+        row.active = settings.sample_edges_only
+        row.prop(settings, "edge_threshold")
+        layout.prop(settings, "specular_anti_aliasing")
+        layout.prop(settings, "area_light_patches")
 
 
 class SGPRT_PT_shadows(RenderPanel, bpy.types.Panel):

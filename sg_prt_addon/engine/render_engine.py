@@ -6,9 +6,9 @@ import traceback
 import bpy
 import numpy as np
 
-from ..blender import export
+from ..blender import export, properties
 from ..techniques.shader_sources import GBUFFER_OUTPUTS, MAX_POINT_LIGHTS, MAX_SUNS
-from . import anti_aliasing, scene_state
+from . import anti_aliasing, multi_sample, scene_state
 from . import renderer as renderer_module
 from .shader_cache import ShaderCompileError
 
@@ -60,7 +60,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             return
         self.update_stats("", "SG-PRT: exporting the scene, drawing")
         try:
-            samples = 1 if debug["capture_gbuffer"] else getattr(getattr(scene, "sgprt", None), "render_samples", 1)
+            samples = 1 if debug["capture_gbuffer"] else getattr(getattr(scene, "sgprt", None), "render_samples",
+                                                                  properties.DEFAULT_RENDER_SAMPLES)
             passes, state, timings = render_frame(depsgraph, width, height, gbuffer=debug["capture_gbuffer"],
                                                   samples=samples)
         except ShaderCompileError as error:
@@ -267,9 +268,65 @@ def specular_anti_aliasing(scene):
     return bool(getattr(getattr(scene, "sgprt", None), "specular_anti_aliasing", True))
 
 
+def edge_sampling(scene):
+    """(Edges Only, its threshold, the difference floor) of the scene's Render Samples: the floor, in the
+    scene's linear units, is EDGE_FLOOR of the display's white, which the view's exposure moves."""
+    settings = getattr(scene, "sgprt", None)
+    exposure = float(getattr(getattr(scene, "view_settings", None), "exposure", 0.0))
+    return (bool(getattr(settings, "sample_edges_only", True)),
+            float(getattr(settings, "edge_threshold", properties.DEFAULT_EDGE_THRESHOLD)),
+            anti_aliasing.EDGE_FLOOR * 2.0 ** -exposure)
+
+
+def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, timings):
+    """The passes of Render Samples > 1, summed on the GPU (engine/multi_sample.py).  Every pixel: the mean of
+    `samples` frames, each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset.  Edges
+    Only: a frame at the pixels' centres (its specular over the whole pixel); where it shows an edge
+    (passes["edge_pixels"]; timings["edge_pixels"]: their fraction), the mean of a grid_side x grid_side grid of
+    samples, drawn tile by tile (timings["edge_tiles"])."""
+    width, height = renderer.size
+    sums = renderer.frame_sums
+    edges_only, threshold, floor = edge_sampling(scene)
+    if not edges_only:
+        sums.start(width, height)
+        offsets = anti_aliasing.pixel_jitter(samples)
+        for offset in offsets:
+            # the view-projection is in the scene block: upload it moved (the shadow maps keep the centred plan)
+            frame_camera = dataclasses.replace(
+                camera, projection=anti_aliasing.jittered_projection(camera.projection, offset, width, height))
+            renderer.upload(state, state.consume_dirty(), frame_camera, shadow_camera=camera)
+            renderer.draw(state, frame_camera, background_alpha=background_alpha)
+            sums.add(renderer, 1.0 / len(offsets))
+        summed = sums.read()
+        return {name: summed[name.lower()] for name in renderer_module.PASS_NAMES}
+    # a sample's specular footprint: the whole pixel at the centre, a grid cell (one pixel of a tile) in the grid
+    whole_pixel = anti_aliasing.specular_footprint(1, camera.shading_footprint > 0.0)
+    centred = dataclasses.replace(camera, shading_footprint=whole_pixel)
+    renderer.upload(state, state.consume_dirty(), centred)
+    renderer.draw(state, centred, background_alpha=background_alpha)
+    sums.start_at_edges(renderer, threshold, floor)
+    edges = sums.read_mask()
+    side = anti_aliasing.grid_side(samples)
+    tile = multi_sample.tile_side(side, width, height)
+    tiles = anti_aliasing.edge_tiles(edges, tile)
+    for origin in tiles:
+        tile_camera = dataclasses.replace(
+            camera, projection=anti_aliasing.tile_projection(camera.projection, origin, tile, width, height),
+            shading_footprint=whole_pixel, footprint_grid_limit=anti_aliasing.footprint_grid_limit(side))
+        renderer.upload(state, state.consume_dirty(), tile_camera, shadow_camera=camera)
+        sums.draw_edge_tile(renderer, state, tile_camera, origin, tile, side, background_alpha)
+    timings["edge_pixels"] = float(edges.mean())
+    timings["edge_tiles"] = len(tiles)
+    summed = sums.read()
+    passes = {name: summed[name.lower()] for name in renderer_module.PASS_NAMES}
+    passes["edge_pixels"] = edges        # (H, W) bool, row 0 at the bottom: for tests and benchmarks
+    return passes
+
+
 def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1):
     """Export, upload, draw and read back one frame; with ``samples`` > 1 the average of that many draws,
-    each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset (anti-aliasing).
+    each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset (anti-aliasing), at the
+    edges alone with Edges Only (_sampled_passes).
 
     Returns (passes: name -> (H, W, 4) float32 with row 0 at the bottom, the SceneState, timings).
     """
@@ -292,22 +349,12 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     timings["upload"] = time.perf_counter() - start
     start = time.perf_counter()
     background_alpha = 0.0 if scene.render.film_transparent else 1.0
-    offsets = anti_aliasing.pixel_jitter(samples) if samples > 1 else np.zeros((1, 2))
-    passes = {}
-    for offset in offsets:
-        if samples > 1:        # the view-projection is in the scene block: upload it moved (nothing else is dirty)
-            frame_camera = dataclasses.replace(
-                camera, projection=anti_aliasing.jittered_projection(camera.projection, offset, width, height))
-            renderer.upload(state, state.consume_dirty(), frame_camera)
-        else:
-            frame_camera = camera
-        renderer.draw(state, frame_camera, background_alpha=background_alpha)
-        for name in renderer_module.PASS_NAMES:
-            image = renderer.read_output(name.lower())
-            passes[name] = image if name not in passes else passes[name] + image
     if samples > 1:
-        passes = {name: image / np.float32(len(offsets)) for name, image in passes.items()}
-    timings["samples"] = len(offsets)
+        passes = _sampled_passes(scene, state, renderer, camera, samples, background_alpha, timings)
+    else:
+        renderer.draw(state, camera, background_alpha=background_alpha)
+        passes = {name: renderer.read_output(name.lower()) for name in renderer_module.PASS_NAMES}
+    timings["samples"] = samples
     if gbuffer:
         for name in GBUFFER_OUTPUTS:
             passes["gbuffer_" + name] = renderer.read_output(name)

@@ -18,7 +18,7 @@ from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility.per_vertex import texture_of as per_vertex_texture  # the layout of every per-vertex texture
 from ..visibility.per_vertex import vertices_per_row
-from . import disk_cache, shader_cache, shadow_pass
+from . import disk_cache, multi_sample, shader_cache, shadow_pass
 
 PASS_NAMES = ("Combined", "Diffuse", "Specular")
 
@@ -110,7 +110,7 @@ def scene_block(camera, light_data, environment, shadow_plan=None):
         vec4_array(2 * MAX_ENV_LOBES, clamped_cosine.sharpness_terms(environment.lobe_sharpness[:env_lobes], np.float32)
                    if env_lobes else []),
         np.asarray(_column_major(camera.projection @ camera.view), np.float32).reshape(4, 4),   # mat4 columns
-        np.array([[camera.shading_footprint, 0.0, 0.0, 0.0]], np.float32),
+        np.array([[camera.shading_footprint, camera.footprint_grid_limit, 0.0, 0.0]], np.float32),
         shadow_pass.scene_rows(shadow_plan, light_data),
     ]
     return np.concatenate(parts, axis=0)
@@ -366,11 +366,14 @@ class Renderer:
         self.uploads = {"meshes": 0, "materials": 0}
         self.shadow_plan = None         # lighting.shadow_maps.ShadowPlan of the frame (None: no maps)
         self.shadow_atlas = shadow_pass.ShadowAtlas()
+        self.frame_sums = multi_sample.FrameSums()     # Render Samples' sums, Edges Only's mask and tile
         self._full_screen_batches = {}  # pass name -> GPUBatch of a full-screen triangle
 
     # ----------------------------------------------------------------- uploads
 
-    def upload(self, state, dirty, camera):
+    def upload(self, state, dirty, camera, shadow_camera=None):
+        """Upload what `dirty` names of `state`, and the scene block of `camera`; the shadow maps planned for
+        shadow_camera's view when given (a jittered frame keeps its centred frame's plan, and so the atlas)."""
         import bpy
 
         for key in dirty.meshes:
@@ -403,7 +406,7 @@ class Renderer:
                                                                                    state.world.equirect)
             self.environment_source = state.environment
         light_data = state.light_data()
-        self.shadow_plan = self._plan_shadows(state, light_data, camera)
+        self.shadow_plan = self._plan_shadows(state, light_data, shadow_camera or camera)
         block = scene_block(camera, light_data, state.environment, self.shadow_plan)
         if self.scene_buffer is None:
             self.scene_buffer = _uniform_buffer(block)
@@ -481,9 +484,11 @@ class Renderer:
                           slots))
         return draws
 
-    def draw(self, state, camera, background_alpha=1.0):
+    def draw(self, state, camera, background_alpha=1.0, framebuffer=None, before_shading=None):
         """Draw every object, then the world behind them, into our framebuffer (call ensure_targets
-        first).  background_alpha: alpha of the world pixels (0 for a transparent film)."""
+        first) or `framebuffer` (its colour slots as ours).  background_alpha: alpha of the world pixels (0
+        for a transparent film); before_shading(): run with the framebuffer bound after the depth of the
+        surfaces is in (multi_sample's pixel mask)."""
         import gpu
 
         draws = self.object_draws(state)
@@ -494,17 +499,21 @@ class Renderer:
                                                        entry.matrix_world, context.buffers.bounds)
                                                       for _index, _key, entry, context, _slots in draws
                                                       if entry.casts_shadow])
-        with self.framebuffer.bind():
-            self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+        framebuffer = framebuffer or self.framebuffer
+        with framebuffer.bind():
+            framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(True)
             gpu.state.face_culling_set("NONE")
             gpu.state.blend_set("NONE")
             if self.depth_prepass:
                 self._draw_depth(draws)
-                gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
             else:       # holdouts shade nothing but occlude: their depth alone, first
                 self._draw_depth(draws, holdouts_only=True)
+            if before_shading is not None:
+                before_shading()
+            if self.depth_prepass:
+                gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
             self._draw_surfaces(draws)
             if not self.gbuffer:
                 self._draw_background(camera, state.environment.prefiltered is not None, background_alpha)
@@ -617,6 +626,7 @@ class Renderer:
         self.object_tables.clear()
         self.shadow_plan = None
         self.shadow_atlas = shadow_pass.ShadowAtlas()
+        self.frame_sums = multi_sample.FrameSums()
         self.targets = []
         self.framebuffer = None
         self.size = None

@@ -183,8 +183,10 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
 
 def full_screen_calls(interface_name, defines):
     """Create-info calls of a full-screen triangle (engine/background.vert.glsl, `ndc` out) with the scene
-    block's typedefs, the limits and `defines`: the caller adds the rest."""
-    calls = [("define", (name, str(value))) for name, value in {**LIMITS, **defines}.items()]
+    block's typedefs, the limits and `defines` (FULL_SCREEN_DEPTH: NDC z, the far plane unless given): the
+    caller adds the rest."""
+    calls = [("define", (name, str(value))) for name, value in {**LIMITS, "FULL_SCREEN_DEPTH": "1.0",
+                                                                **defines}.items()]
     calls += [("typedef_source", (typedef_source(),)), ("vertex_in", (0, "VEC2", "position")),
               ("vertex_out", (interface_name, (("smooth", ("VEC2", "ndc")),))),
               ("vertex_source", (engine_source("background.vert.glsl"),))]

@@ -34,7 +34,8 @@ struct SceneData {
   /* world -> clip of the surface draws (push constants stay within 128 bytes: model matrix + G-buffer ids) */
   mat4 view_projection;
   /* x: the side, in pixels, of the square each pixel's shading averages its specular over (engine/
-   * anti_aliasing.py specular_footprint): 1 one frame, 1/m each of m x m jittered frames, 0 the centre alone */
+   * anti_aliasing.py specular_footprint): 1 one frame, 1/m each of m x m jittered frames, 0 the centre alone;
+   * y: the most samples a side of that square (anti_aliasing.footprint_grid_limit) */
   vec4 shading_footprint;
   /* the lights' shadow maps (lighting/shadow_maps.py ShadowPlan): x tile side (texels, 0: none), y tiles a row,
    * z a face's share of its tile, w lights with a map */

@@ -34,8 +34,10 @@ def new_scene(name, width=256, height=256):
     scene.render.resolution_x = width
     scene.render.resolution_y = height
     scene.render.resolution_percentage = 100
-    # the Monte Carlo references shade pixel centres; the tests of the footprint sampling turn it on
+    # the Monte Carlo references shade pixel centres; the tests of the footprint sampling and of Render Samples
+    # turn them on
     scene.sgprt.specular_anti_aliasing = False
+    scene.sgprt.render_samples = 1
     # the tests of the SSDF's light shadows (and the mirrors of their variants) keep them; test_light_shadows.py
     # and the stress tests turn the shadow maps on
     scene.sgprt.light_shadows = "SSDF"

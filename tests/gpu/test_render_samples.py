@@ -29,9 +29,10 @@ def test_pixel_jitter_patterns():
     assert anti_aliasing.specular_footprint(16, enabled=False) == 0.0
 
 
-def _scene(name, size, samples, specular_anti_aliasing=False, roughness=0.25):
+def _scene(name, size, samples, specular_anti_aliasing=False, roughness=0.25, edges_only=False):
     scene = fx.new_scene(name, size, size)
     scene.sgprt.render_samples = samples
+    scene.sgprt.sample_edges_only = edges_only
     scene.sgprt.specular_anti_aliasing = specular_anti_aliasing
     fx.world_colour(scene, (0.05, 0.05, 0.05))
     sphere = fx.uv_sphere(scene, name + "_sphere", (0.0, 0.0, 1.0), radius=1.0)
@@ -59,12 +60,14 @@ def test_four_samples_equal_a_box_filtered_double_size_render(engine):
 def test_render_panel_shows_the_setting(engine):
     import bpy
 
-    from sg_prt_addon.blender import panels
+    from sg_prt_addon.blender import panels, properties
 
     assert bpy.types.Scene.bl_rna.properties.get("sgprt") is not None
     assert panels.SGPRT_PT_sampling.is_registered and panels.SGPRT_PT_sampling.bl_context == "render"
     scene = bpy.data.scenes.new("specular_aa_default")
     assert scene.sgprt.specular_anti_aliasing          # on unless turned off
+    assert scene.sgprt.render_samples == 16 and scene.sgprt.sample_edges_only
+    assert scene.sgprt.edge_threshold == pytest.approx(properties.DEFAULT_EDGE_THRESHOLD)
 
 
 def _surface_rmse(image, reference, mask):
@@ -99,3 +102,110 @@ def test_specular_anti_aliasing_comes_close_to_the_box_filter(engine):
         scene.objects[f"specular_aa_diffuse_{footprint}_sphere"].data.materials[0].sgprt.specular_color = (0, 0, 0)
         diffuse[footprint] = fx.render(scene)["passes"]["Combined"].copy()
     np.testing.assert_allclose(diffuse[True], diffuse[False], rtol=1e-5, atol=1e-6)     # measured: 2.2e-7
+
+
+# ----------------------------------------------------------------- Edges Only
+
+def _passes(scene):
+    result = fx.render(scene)
+    assert "error" not in result, result.get("error")
+    return {name: np.array(image) for name, image in result["passes"].items() if isinstance(image, np.ndarray)}, \
+        dict(result["timings"])
+
+
+def test_edges_only_samples_the_edges_and_keeps_the_centred_frame_elsewhere(engine):
+    """Edges Only: where the frame at the pixels' centres shows an edge (the GLSL edge pass, as its mirror
+    anti_aliasing.edge_pixels finds them), the 4 x 4 grid of a supersampled tile gives what 16 jittered frames
+    of every pixel give there; every other pixel is the one-sample render's (to float32 rounding: the sums
+    blend)."""
+    from sg_prt_addon.blender import properties
+
+    one, _ = _passes(_scene("edges_one", 48, 1))
+    every, _ = _passes(_scene("edges_every", 48, 16))
+    edged, timings = _passes(_scene("edges_only", 48, 16, edges_only=True))
+    edges = edged["edge_pixels"]
+    mirror = anti_aliasing.edge_pixels(one["Combined"], properties.DEFAULT_EDGE_THRESHOLD)
+    print(f"edge pixels {edges.mean():.1%} in {timings['edge_tiles']} tile(s); the mirror disagrees on "
+          f"{np.mean(mirror != edges):.2%}")
+    assert 0.02 < edges.mean() < 0.5 and timings["edge_tiles"] == 1 and timings["edge_pixels"] == edges.mean()
+    assert np.mean(mirror != edges) < 1e-3                  # measured: 0
+    for name in ("Combined", "Diffuse", "Specular"):
+        np.testing.assert_allclose(edged[name][~edges], one[name][~edges], rtol=1e-6, atol=1e-7)  # measured: 6e-8
+        difference = edged[name][edges] - every[name][edges]
+        rms = float(np.sqrt(np.mean(difference ** 2)) / np.mean(np.abs(every[name][edges])))
+        print(f"{name}: relative RMS of Edges Only - every pixel over the edges {rms:.2e}")
+        # the same samples, drawn through a cropped projection rather than a jittered one: the rasterizer snaps
+        # vertices to 1/256 of a pixel of each, so a sample that close to a triangle's edge may fall on its other
+        # side (1/16 of the pixel; measured: 0.001 Combined, 0.015 Diffuse, whose alpha is the coverage)
+        assert rms < 0.05
+    changed = np.abs(edged["Combined"] - one["Combined"]).max(axis=-1) > 1e-3
+    # the samples did change the edges (measured: half of them; both sides of an edge are marked, and a pixel the
+    # surface covers whole may change little)
+    assert changed[edges].mean() > 0.25
+
+
+def test_edges_only_tiles_join_and_a_high_threshold_samples_nothing(engine, monkeypatch):
+    from sg_prt_addon.engine import multi_sample
+
+    whole, timings = _passes(_scene("edges_whole", 48, 16, edges_only=True))
+    assert timings["edge_tiles"] == 1
+    monkeypatch.setattr(multi_sample, "MAX_TILE_PIXELS", 64)        # tiles of 16 pixels: 9 over the image
+    tiled, timings = _passes(_scene("edges_tiled", 48, 16, edges_only=True))
+    assert 1 < timings["edge_tiles"] <= 9
+    for name in ("Combined", "Diffuse", "Specular"):
+        # the tiles' projections put a sample within the rasterizer's 1/256 pixel of a triangle's edge on one
+        # side or the other (measured: under 0.1% of the values moved, by one sample's share); nothing else moves
+        moved = np.abs(tiled[name] - whole[name]) > 1e-5 * (1.0 + np.abs(whole[name]))
+        print(f"{name}: tiled - whole, {moved.mean():.2%} of the values moved, by at most "
+              f"{np.abs(tiled[name] - whole[name]).max():.4f}")
+        assert moved.mean() < 0.005 and np.abs(tiled[name] - whole[name]).max() < 0.1 * np.abs(whole[name]).max()
+    monkeypatch.undo()
+    scene = _scene("edges_none", 48, 16, edges_only=True)
+    scene.sgprt.edge_threshold = 1.0                # no difference passes it: the centred frame alone
+    nothing, timings = _passes(scene)
+    one, _ = _passes(_scene("edges_none_one", 48, 1))
+    assert timings["edge_tiles"] == 0 and not nothing["edge_pixels"].any()
+    np.testing.assert_allclose(nothing["Combined"], one["Combined"], rtol=1e-5, atol=1e-6)   # measured: 3.6e-6
+
+
+def test_edge_pass_matches_its_mirror_on_hostile_frames(engine):
+    """engine/edge_pixels.frag.glsl against anti_aliasing.edge_pixels on frames of random, huge, negative,
+    NaN and infinite values; the sums' first values: 0 at the edges, the frame elsewhere."""
+    from types import SimpleNamespace
+
+    from sg_prt_addon.engine import multi_sample, render_engine
+    from sg_prt_addon.engine import renderer as renderer_module
+
+    rng = np.random.default_rng(7)
+    height, width = 64, 96
+    frames = []
+    for _ in range(3):
+        # flat 8 x 8 blocks (edges at their borders only), some of them noise, some of them nearly equal
+        blocks = rng.uniform(0.0, 1.0, (height // 8, width // 8, 4)).astype(np.float32)
+        blocks[rng.random(blocks.shape[:2]) < 0.3] = blocks[0, 0] * np.float32(1.1)
+        frame = np.repeat(np.repeat(blocks, 8, axis=0), 8, axis=1)
+        noisy = np.repeat(np.repeat(rng.random(blocks.shape[:2]) < 0.2, 8, axis=0), 8, axis=1)
+        frame[noisy] *= rng.uniform(0.7, 1.3, (int(noisy.sum()), 4)).astype(np.float32)
+        spots = rng.random((height, width)) < 0.005
+        frame[spots, 0] = rng.choice(np.array([np.nan, np.inf, -np.inf, 1e30, -5.0], np.float32), spots.sum())
+        frames.append(frame)
+
+    def edge_pass(depsgraph, state, renderer, camera):
+        textures = [renderer_module._texture_2d(frame) for frame in frames]
+        sums = multi_sample.FrameSums()
+        sums.start_at_edges(SimpleNamespace(size=(width, height), targets=textures,
+                                            full_screen_batch=renderer.full_screen_batch), 0.2, 0.03)
+        return sums.read_mask(), sums.read()
+
+    render_engine.debug["after_frame"] = edge_pass
+    try:
+        result = fx.render(_scene("edge_pass_mirror", 8, 1))
+    finally:
+        render_engine.debug["after_frame"] = None
+    mask, starts = result["after_frame"]
+    mirror = anti_aliasing.edge_pixels(frames[0], 0.2, 0.03)
+    print(f"edges {mask.mean():.1%}; GLSL and mirror disagree on {np.mean(mask != mirror):.3%}")
+    assert 0.2 < mask.mean() < 0.95 and np.mean(mask != mirror) < 1e-3          # measured: 0
+    for name, frame in zip(multi_sample.PASSES, frames):
+        assert not starts[name][mask].any()
+        np.testing.assert_array_equal(starts[name][~mask], frame[~mask])

@@ -473,7 +473,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef HAS_SPECULAR
 /* shade_footprint's grid: a sample a side for each 4/3 of an NDF width the normal turns across the footprint, at
  * most 4 (benchmarks/specular_aa.py, relative RMSE against the box filter on ggx030_point: 0.29 at this rate,
- * 0.46 at a sample for two widths, for 3.4x and 2.3x the frame) */
+ * 0.46 at a sample for two widths, for 3.4x and 2.3x the frame), and at most scene.shading_footprint.y */
 #define SPECULAR_AA_RATE 0.75
 #define SPECULAR_AA_MAX_SIDE 4
 #endif
@@ -501,7 +501,8 @@ void shade_footprint(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q, v
     vec2 turn_x = vec2(dot(dndx, t), dot(dndx, b)) / widths;
     vec2 turn_y = vec2(dot(dndy, t), dot(dndy, b)) / widths;
     float turn = sqrt(dot(turn_x, turn_x) + dot(turn_y, turn_y));
-    side = clamp(int(ceil(SPECULAR_AA_RATE * turn)), 1, SPECULAR_AA_MAX_SIDE);
+    side = clamp(int(ceil(SPECULAR_AA_RATE * turn)), 1,
+                 clamp(int(scene.shading_footprint.y), 1, SPECULAR_AA_MAX_SIDE));
   }
 #endif
   shade_surface(position, normal, tangent, p, q, diffuse_color, specular_color, true, diffuse, specular);

@@ -1,0 +1,195 @@
+"""Render Samples on the GPU: the frames' passes summed in float targets and read back once.
+
+Every pixel sampled: jittered frames (anti_aliasing.pixel_jitter), each added whole.  Edges Only: a frame
+shaded at the pixels' centres, the mask of its edges (engine/edge_pixels.frag.glsl; mirror
+anti_aliasing.edge_pixels), and each tile of the image that holds an edge drawn grid_side times larger with only
+the edge pixels shaded (the others fail a near-plane depth) and box-filtered into the sums: one pass of the
+objects' vertices a tile instead of one a sample.  Runs where the `gpu` module works.
+"""
+import numpy as np
+
+from ..techniques import shader_sources
+from . import shader_cache
+
+PASSES = shader_sources.output_names(False)     # ("combined", "diffuse", "specular"): the final render's targets
+MAX_TILE_PIXELS = 2048      # side of a supersampled tile's targets (3 RGBA32F + depth: 208 MB at 2048)
+
+
+def tile_side(grid_side, width, height):
+    """Image pixels a side of Edges Only's tiles: their supersampled targets at most MAX_TILE_PIXELS a side, and
+    no larger than the image needs."""
+    return max(1, min(MAX_TILE_PIXELS // grid_side, max(width, height)))
+
+
+def _frame_samplers():
+    return [("sampler", (index, "FLOAT_2D", "frame_" + name)) for index, name in enumerate(PASSES)]
+
+
+def _pass_outputs():
+    return [("fragment_out", (index, "VEC4", "out_" + name)) for index, name in enumerate(PASSES)]
+
+
+def edge_pixels_calls():
+    """The edges of the centred frame and the sums' first values (engine/edge_pixels.frag.glsl)."""
+    calls = shader_sources.full_screen_calls("sgprt_edge_pixels_interface", {})
+    calls += [("push_constant", ("FLOAT", "edge_threshold")), ("push_constant", ("FLOAT", "edge_floor"))]
+    calls += _frame_samplers() + _pass_outputs()
+    calls += [("fragment_out", (len(PASSES), "VEC4", "out_mask")),
+              ("fragment_source", (shader_sources.engine_source("edge_pixels.frag.glsl"),))]
+    return calls
+
+
+def pixel_mask_calls():
+    """Near-plane depth over a supersampled tile's pixels that the mask leaves out (engine/pixel_mask.frag.glsl)."""
+    calls = shader_sources.full_screen_calls("sgprt_pixel_mask_interface", {"FULL_SCREEN_DEPTH": "-1.0"})
+    calls += [("push_constant", ("IVEC2", "mask_origin")), ("push_constant", ("INT", "mask_scale")),
+              ("sampler", (0, "FLOAT_2D", "pixel_mask")), ("fragment_out", (0, "VEC4", "out_unused")),
+              ("fragment_source", (shader_sources.engine_source("pixel_mask.frag.glsl"),))]
+    return calls
+
+
+def add_frame_calls():
+    """A frame's passes, box-filtered and weighted, into the sums (engine/add_frame.frag.glsl)."""
+    calls = shader_sources.full_screen_calls("sgprt_add_frame_interface", {})
+    calls += [("push_constant", ("IVEC2", "tile_origin")), ("push_constant", ("INT", "grid_side")),
+              ("push_constant", ("FLOAT", "frame_weight"))]
+    calls += _frame_samplers() + _pass_outputs()
+    calls.append(("fragment_source", (shader_sources.engine_source("add_frame.frag.glsl"),)))
+    return calls
+
+
+class FrameSums:
+    """The sums of a final render's frames (one RGBA32F target a pass), the mask of Edges Only's pixels and
+    its supersampled tile.  start() then add() after each jittered frame; or start_at_edges() then
+    draw_edge_tile() for each tile of anti_aliasing.edge_tiles; then read()."""
+
+    def __init__(self):
+        self.size = None
+        self.sums = []                  # GPUTexture a pass, in PASSES' order
+        self.mask = None                # GPUTexture R32F: 1 at the pixels Edges Only samples
+        self.sums_framebuffer = None
+        self.edges_framebuffer = None   # the sums and the mask: written by the edge pass
+        self.masked = False             # whether the sums since start are those of start_at_edges
+        self.tile_size = None
+        self.tile_targets = []          # the supersampled tile's GPUTextures, in PASSES' order
+        self.tile_depth = None
+        self.tile_framebuffer = None
+
+    def _ensure(self, width, height):
+        import gpu
+
+        if self.size == (width, height):
+            return
+        self.sums = [gpu.types.GPUTexture((width, height), format="RGBA32F") for _ in PASSES]
+        self.mask = gpu.types.GPUTexture((width, height), format="R32F")
+        self.sums_framebuffer = gpu.types.GPUFrameBuffer(color_slots=self.sums)
+        self.edges_framebuffer = gpu.types.GPUFrameBuffer(color_slots=self.sums + [self.mask])
+        self.size = (width, height)
+
+    def _ensure_tile(self, side):
+        import gpu
+
+        if self.tile_size == side:
+            return
+        self.tile_targets = [gpu.types.GPUTexture((side, side), format="RGBA32F") for _ in PASSES]
+        # kept here: a framebuffer does not keep its attachments alive
+        self.tile_depth = gpu.types.GPUTexture((side, side), format="DEPTH_COMPONENT32F")
+        self.tile_framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.tile_depth, color_slots=self.tile_targets)
+        self.tile_size = side
+
+    def start(self, width, height):
+        """Sums of 0 over every pixel: each jittered frame shades the whole image."""
+        self._ensure(width, height)
+        with self.sums_framebuffer.bind():
+            self.sums_framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0))
+        self.masked = False
+
+    def start_at_edges(self, renderer, threshold, floor):
+        """After renderer drew the frame shaded at the pixels' centres: the mask of its edges
+        (anti_aliasing.edge_pixels(frame, threshold, floor)), and the sums 0 there and that frame elsewhere."""
+        import gpu
+
+        width, height = renderer.size
+        self._ensure(width, height)
+        shader = shader_cache.get_fixed_shader(("edge_pixels",), edge_pixels_calls, "edge pixels")
+        with self.edges_framebuffer.bind():
+            gpu.state.depth_test_set("NONE")
+            gpu.state.blend_set("NONE")
+            shader.bind()
+            shader.uniform_float("edge_threshold", float(threshold))
+            shader.uniform_float("edge_floor", float(floor))
+            for name, texture in zip(PASSES, renderer.targets):
+                shader.uniform_sampler("frame_" + name, texture)
+            renderer.full_screen_batch(shader, "edge_pixels").draw(shader)
+        self.masked = True
+
+    def add(self, renderer, weight):
+        """Add the renderer's whole frame, times weight, into the sums."""
+        self._add(renderer, renderer.targets, (0, 0), 1, weight, None)
+
+    def draw_edge_tile(self, renderer, state, tile_camera, origin, tile, grid_side, background_alpha):
+        """The tile x tile image pixels from `origin` (x right, y up) drawn grid_side times larger by
+        tile_camera (anti_aliasing.tile_projection), shading only the pixels of the edge mask, each image pixel's
+        grid_side x grid_side samples then averaged into the sums (which hold 0 there: start_at_edges)."""
+        import gpu
+
+        self._ensure_tile(tile * grid_side)
+        shader = shader_cache.get_fixed_shader(("pixel_mask",), pixel_mask_calls, "pixel mask")
+
+        def mask_pixels():
+            # after the depth of the surfaces: the near plane over the pixels left out
+            gpu.state.depth_test_set("ALWAYS")
+            gpu.state.depth_mask_set(True)
+            gpu.state.color_mask_set(False, False, False, False)
+            shader.bind()
+            shader.uniform_int("mask_origin", tuple(int(v) for v in origin))
+            shader.uniform_int("mask_scale", int(grid_side))
+            shader.uniform_sampler("pixel_mask", self.mask)
+            renderer.full_screen_batch(shader, "pixel_mask").draw(shader)
+            gpu.state.color_mask_set(True, True, True, True)
+            gpu.state.depth_test_set("LESS_EQUAL")
+
+        renderer.draw(state, tile_camera, background_alpha=background_alpha, framebuffer=self.tile_framebuffer,
+                      before_shading=mask_pixels)
+        self._add(renderer, self.tile_targets, origin, grid_side, 1.0 / grid_side ** 2, tile)
+
+    def _add(self, renderer, targets, origin, grid_side, weight, tile):
+        import gpu
+
+        shader = shader_cache.get_fixed_shader(("add_frame",), add_frame_calls, "add frame")
+        with self.sums_framebuffer.bind():
+            if tile is not None:
+                gpu.state.viewport_set(int(origin[0]), int(origin[1]), int(tile), int(tile))
+            gpu.state.depth_test_set("NONE")
+            gpu.state.blend_set("ADDITIVE_PREMULT")
+            shader.bind()
+            shader.uniform_int("tile_origin", tuple(int(v) for v in origin))
+            shader.uniform_int("grid_side", int(grid_side))
+            shader.uniform_float("frame_weight", float(weight))
+            for name, texture in zip(PASSES, targets):
+                shader.uniform_sampler("frame_" + name, texture)
+            renderer.full_screen_batch(shader, "add_frame").draw(shader)
+            gpu.state.blend_set("NONE")
+            if tile is not None:
+                gpu.state.viewport_set(0, 0, *self.size)
+
+    def read(self):
+        """name -> (H, W, 4) float32 of each pass's sum, row 0 at the bottom."""
+        return {name: self._read(self.sums_framebuffer, slot, 4) for slot, name in enumerate(PASSES)}
+
+    def read_mask(self):
+        """(H, W) bool of the pixels sampled (every pixel, unless started at edges), row 0 at the bottom."""
+        if not self.masked:
+            return np.ones(self.size[::-1], bool)
+        return self._read(self.edges_framebuffer, len(PASSES), 1)[..., 0] > 0.5
+
+    def _read(self, framebuffer, slot, channels):
+        import gpu
+
+        width, height = self.size
+        out = np.empty((height, width, channels), np.float32)
+        with framebuffer.bind():
+            # our own array: np.asarray of read_color's multi-dimensional Buffer has wrong strides
+            framebuffer.read_color(0, 0, width, height, channels, slot, "FLOAT",
+                                   data=gpu.types.Buffer("FLOAT", (height, width, channels), out))
+        return out
