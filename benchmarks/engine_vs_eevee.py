@@ -98,6 +98,7 @@ def measure_scene(name, size, renders, redraws, eevee_samples):
     from sg_prt_addon.engine import render_engine
 
     scene = build_scenes.SCENES[name](size)
+    scene.sgprt.render_samples = 1      # the frame, one sample (as EEVEE's); Render Samples: edge_samples.py
     depsgraph = bpy.context.evaluated_depsgraph_get()
     triangles = sum(len(obj.evaluated_get(depsgraph).data.loop_triangles)
                     for obj in scene.objects if obj.type == "MESH")

@@ -103,7 +103,8 @@ def measure_scene(name, size, rounds):
     from benchmarks.engine_vs_eevee import bake_all
     from examples import build_scenes
 
-    build_scenes.SCENES[name](size)
+    scene = build_scenes.SCENES[name](size)
+    scene.sgprt.render_samples = 1      # the frame, one sample (as EEVEE's); Render Samples: edge_samples.py
     bake_all(name)
     render_seconds(True)                       # compiles, prefilters
     rows = {}

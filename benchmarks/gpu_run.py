@@ -65,6 +65,7 @@ def example_scene(name, image_size, scenes_dir, bake_resolution, renders, redraw
     from examples import build_scenes
 
     scene = build_scenes.SCENES[name]()
+    scene.sgprt.render_samples = 1      # the frame, one sample (as EEVEE's); Render Samples: edge_samples.py
     scene.render.resolution_x, scene.render.resolution_y = image_size
     options = {"resolution": bake_resolution} if bake_resolution else {}
     start = time.perf_counter()

@@ -107,6 +107,7 @@ def build_scene(spec):
 
     scene = build_scenes._empty_file()
     scene.render.engine = build_scenes.ENGINE_ID
+    scene.sgprt.render_samples = 1      # the frame, one sample (as EEVEE's); Render Samples: edge_samples.py
     scene.render.resolution_x, scene.render.resolution_y = spec.width, spec.height
     scene.render.resolution_percentage = 100
     build_scenes._world_with_colour(scene, (0.05, 0.06, 0.08))

@@ -57,6 +57,7 @@ def measure_scene(name, builder, size, redraws, rounds):
     from benchmarks.engine_vs_eevee import bake_all
 
     scene = scene_benchmark.build(name, builder, size)
+    scene.sgprt.render_samples = 1      # the frame, one sample (as EEVEE's); Render Samples: edge_samples.py
     bake_all(name)
     for mode in MODES:            # compile both variants before timing
         timed_render(scene, mode, 1)

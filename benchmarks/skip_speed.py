@@ -52,6 +52,7 @@ def build_scene(size):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "SG_PRT"
+    scene.sgprt.render_samples = 1      # the frame, one sample (as EEVEE's); Render Samples: edge_samples.py
     scene.render.resolution_x = scene.render.resolution_y = size
     scene.render.resolution_percentage = 100
     bpy.ops.mesh.primitive_monkey_add(size=2.0, location=(0.0, 0.0, 1.0))

@@ -46,6 +46,7 @@ def render(scene, anti_aliasing, samples=1, redraws=0):
 
     scene.sgprt.specular_anti_aliasing = anti_aliasing
     scene.sgprt.render_samples = samples
+    scene.sgprt.sample_edges_only = False       # the reference: every pixel's jittered frames
     render_engine.debug["timed_redraws"] = redraws
     render_engine.last_render.clear()
     try:

@@ -39,6 +39,7 @@ def measure_scene(name, size, renders, redraws, runs=RUNS):
     from examples import build_scenes
 
     scene = build_scenes.SCENES[name](size)
+    scene.sgprt.render_samples = 1      # the frame, one sample (as EEVEE's); Render Samples: edge_samples.py
     figures = {}
     operators = {"visibility": bpy.ops.sgprt.bake_visibility, "transfer": bpy.ops.sgprt.bake_transfer}
     clears = {"visibility": bpy.ops.sgprt.clear_visibility, "transfer": bpy.ops.sgprt.clear_transfer}

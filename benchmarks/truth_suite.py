@@ -17,11 +17,11 @@ process, by:
 
 1. SG-PRT unshadowed (no bake), then with visibility baked for every mesh by the Bake Visibility
    operator at its defaults (``bpy.ops.render.render`` wall time after a warm-up render; the bake
-   time is reported apart: a precomputation); and "SG-PRT 2x2", the same bake rendered at twice the
-   size and box-filtered down to the truth's pixels: SG-PRT shades one point per pixel (its centre)
-   while Cycles averages over the pixel's area (the 1-pixel box filter), and on sub-pixel highlights
-   and silhouettes that alone makes most of SG-PRT's RMSE (ggx030_point at 128 px: 1.46 at the
-   pixel centres, 0.36 box-filtered from 2x), a diagnostic row, not the engine's output.  SG-PRT
+   time is reported apart: a precomputation), its render settings at their defaults; "SG-PRT 1
+   sample", the same with Render Samples 1: one point a pixel (its centre) where Cycles averages
+   over the pixel's area (the 1-pixel box filter), which on sub-pixel highlights and silhouettes
+   alone makes most of the error; "SG-PRT 2x2", one sample at twice the size, box-filtered down;
+   "SG-PRT 16 samples", Render Samples 16 of every pixel (Edges Only off).  SG-PRT
    reads only ``material.sgprt``; it renders before the node trees are rewritten for Cycles and
    EEVEE (step 2), in every scene; then the same bake rendered by each of the engine's other
    techniques (TECHNIQUE_METHODS: every material switched to it, then back; the SH technique after a
@@ -63,6 +63,7 @@ its rows (for a gpu-tier test).  The pure parts (rows, noise floor, equal-time s
 tables, tone mapping) need no bpy and are tested in tests/core/test_truth_suite.py.
 """
 import argparse
+import contextlib
 import datetime
 import json
 import math
@@ -96,12 +97,12 @@ GLOSSY_MIN_ROUGHNESS = 0.1
 FULL = dict(size=256, cycles_samples=512, eevee_samples=(1, 16, 64))
 QUICK = dict(size=64, cycles_samples=32, eevee_samples=(1, 16))
 
-METHODS = ("SG-PRT", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Factored BRDF",
+METHODS = ("SG-PRT", "SG-PRT 1 sample", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Factored BRDF",
            "Spherical harmonics", "Cycles", "Cycles 1 sample", "Cycles equal time", "EEVEE")
 # the engine's other techniques: method -> (the technique every material is switched to, the bake it reads
 # besides the visibility bake: None, or "transfer" (the transfer bake at the operator's defaults))
 TECHNIQUE_METHODS = {"Factored BRDF": ("FACTORED", None), "Spherical harmonics": ("SH", "transfer")}
-ANTI_ALIASING_SAMPLES = 16  # "SG-PRT 16 samples": the engine's Render Samples (scene.sgprt.render_samples), 4 x 4
+ANTI_ALIASING_SAMPLES = 16  # "SG-PRT 16 samples": Render Samples (scene.sgprt.render_samples) of every pixel, 4 x 4
 SUPERSAMPLING = 2          # "SG-PRT 2x2": the engine at twice the size, box-filtered down (Cycles' pixel filter)
 
 
@@ -208,14 +209,16 @@ def markdown_table(rows, scenes):
     """One line per scene (``scenes``: ordered names) of the figures the summary shows."""
     lines = ["| scene | kind | SG-PRT rel. RMSE | SG-PRT bias | SG-PRT HDR-FLIP | SG-PRT unshadowed RMSE "
              "| EEVEE 16 HDR-FLIP | EEVEE 16 RMSE | Cycles equal-time HDR-FLIP (spp) | noise floor "
-             "| SG-PRT s | Cycles s | SG-PRT 2x2 RMSE / HDR-FLIP | SG-PRT 16 samples RMSE / HDR-FLIP / s |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| SG-PRT s | Cycles s | SG-PRT 1 sample RMSE / HDR-FLIP / s | SG-PRT 2x2 RMSE / HDR-FLIP "
+             "| SG-PRT 16 samples RMSE / HDR-FLIP / s |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, info in scenes.items():
         engine = find_row(rows, name, "SG-PRT") or {}
         unshadowed = find_row(rows, name, "SG-PRT unshadowed") or {}
         eevee16 = eevee_row(rows, name, 16) or {}
         equal = find_row(rows, name, "Cycles equal time") or {}
         truth = find_row(rows, name, "Cycles") or {}
+        one_sample = find_row(rows, name, "SG-PRT 1 sample") or {}
         supersampled = find_row(rows, name, "SG-PRT 2x2") or {}
         sampled = find_row(rows, name, "SG-PRT 16 samples") or {}
         kind = info.get("kind", "-")
@@ -229,7 +232,9 @@ def markdown_table(rows, scenes):
             f"{_number(engine.get('hdr_flip'))} | {_number(unshadowed.get('relative_rmse'))} | "
             f"{_number(eevee16.get('hdr_flip'))} | {_number(eevee16.get('relative_rmse'))} | {equal_cell} | "
             f"{_number(truth.get('noise_floor', engine.get('noise_floor')))} | {_number(engine.get('seconds'))} | "
-            f"{_number(truth.get('seconds'))} | {_number(supersampled.get('relative_rmse'))} / "
+            f"{_number(truth.get('seconds'))} | {_number(one_sample.get('relative_rmse'))} / "
+            f"{_number(one_sample.get('hdr_flip'))} / {_number(one_sample.get('seconds'))} | "
+            f"{_number(supersampled.get('relative_rmse'))} / "
             f"{_number(supersampled.get('hdr_flip'))} | {_number(sampled.get('relative_rmse'))} / "
             f"{_number(sampled.get('hdr_flip'))} / {_number(sampled.get('seconds'))} |")
     return "\n".join(lines)
@@ -319,14 +324,14 @@ def markdown_section(data, before=None):
         "(camera rays that hit a mesh) eroded by one pixel: relative RMSE, bias (mean image - mean truth) / "
         "mean truth, mean HDR-FLIP (flip_evaluator; the test image over the truth's background). SG-PRT: "
         "visibility baked by the operator at its defaults, Light Shadows at their default (shadow maps for the "
-        "point, spot and sun lights), `render()` wall time after a warm-up render; unshadowed: no bake and no "
+        "point, spot and sun lights), Render Samples at theirs (16 at the edges, Edges Only), `render()` wall "
+        "time after a warm-up render; 1 sample: Render Samples 1 (no anti-aliasing); unshadowed: no bake and no "
         "shadow maps. EEVEE at " + eevee + " samples (direct light as far as its settings go). "
         "Cycles equal time: as many samples as fit in SG-PRT's render() time (spp in brackets). "
-        "Cycles s: one seed's render at the truth's samples. SG-PRT 2x2: the same bake rendered at twice the "
-        "size and box-filtered down: SG-PRT shades each pixel's centre, Cycles (and the truth) average over the "
-        "pixel, which on sub-pixel highlights and edges is most of SG-PRT's RMSE; this column shows how much "
-        "(it equals Render Samples 4). SG-PRT 16 samples: the engine's own anti-aliasing, Render Samples 16 (a "
-        "4 x 4 grid per pixel, the same box filter as the truth's), render() seconds beside.",
+        "Cycles s: one seed's render at the truth's samples. SG-PRT 2x2: the same bake, one sample, rendered at "
+        "twice the size and box-filtered down (it equals Render Samples 4 of every pixel). SG-PRT 16 samples: "
+        "Render Samples 16 of every pixel (a 4 x 4 grid, the same box filter as the truth's), render() seconds "
+        "beside.",
         "",
         markdown_table(data["rows"], data["scenes"]), "",
         "The engine's techniques on the same scenes, each with the same bake (SG lobes: wang2009, the SG-PRT "
@@ -425,6 +430,19 @@ class Scene:
     @property
     def description(self):
         return " ".join((self.build.__doc__ or "").split())
+
+
+@contextlib.contextmanager
+def _engine_settings(settings, **values):
+    """scene.sgprt's `values` set for the block, then put back."""
+    saved = {name: getattr(settings, name) for name in values}
+    try:
+        for name, value in values.items():
+            setattr(settings, name, value)
+        yield
+    finally:
+        for name, value in saved.items():
+            setattr(settings, name, value)
 
 
 def _start(size):
@@ -847,29 +865,33 @@ class SceneRun:
         resolution = self.scene.sgprt_bake.resolution
         self.info.update(bake_seconds=bake_seconds, bake_resolution=resolution, bake_terms=terms)
         self.log(f"  bake: {bake_seconds:.1f} s at resolution {resolution}, terms {terms}")
+        settings = self.scene.sgprt
         seconds, image, warm = self.engine_render()
         self.engine_seconds = seconds
-        self.add("SG-PRT", f"bake R={resolution}", seconds, image, bake_seconds=bake_seconds,
+        sampling = f"Render Samples {settings.render_samples}" + (", Edges Only" if settings.sample_edges_only else "")
+        self.add("SG-PRT", f"bake R={resolution}, {sampling}", seconds, image, bake_seconds=bake_seconds,
                  warm_up_seconds=warm, bake_terms=terms)
+        if "SG-PRT 1 sample" in self.methods:      # no anti-aliasing: what the samples buy
+            with _engine_settings(settings, render_samples=1):
+                seconds, image, warm = self.engine_render()
+            self.add("SG-PRT 1 sample", f"bake R={resolution}, Render Samples 1", seconds, image,
+                     warm_up_seconds=warm)
         if "SG-PRT 2x2" in self.methods:       # the same bake; what the pixel-centre sampling costs
             size = self.config["size"]
             render = self.scene.render
             render.resolution_x = render.resolution_y = SUPERSAMPLING * size
             try:
-                seconds, image, warm = self.engine_render()
+                with _engine_settings(settings, render_samples=1):
+                    seconds, image, warm = self.engine_render()
             finally:
                 render.resolution_x = render.resolution_y = size
             self.add("SG-PRT 2x2", f"bake R={resolution}, {SUPERSAMPLING}x size, box-filtered down", seconds,
                      box_downsample(image, SUPERSAMPLING), warm_up_seconds=warm)
-        settings = getattr(self.scene, "sgprt", None)
-        if "SG-PRT 16 samples" in self.methods and hasattr(settings, "render_samples"):    # the engine's own AA
-            settings.render_samples = ANTI_ALIASING_SAMPLES
-            try:
+        if "SG-PRT 16 samples" in self.methods:      # the engine's anti-aliasing at every pixel
+            with _engine_settings(settings, render_samples=ANTI_ALIASING_SAMPLES, sample_edges_only=False):
                 seconds, image, warm = self.engine_render()
-            finally:
-                settings.render_samples = 1
-            self.add("SG-PRT 16 samples", f"bake R={resolution}, Render Samples {ANTI_ALIASING_SAMPLES}", seconds,
-                     image, warm_up_seconds=warm)
+            self.add("SG-PRT 16 samples", f"bake R={resolution}, Render Samples {ANTI_ALIASING_SAMPLES} of every "
+                     "pixel", seconds, image, warm_up_seconds=warm)
         for method, (technique, extra_bake) in TECHNIQUE_METHODS.items():
             if method in self.methods:
                 setting, extra = f"bake R={resolution}, technique {technique}", {}

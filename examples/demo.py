@@ -71,6 +71,7 @@ def main(argv=None):
     # The first render pays for prefiltering the environment; the second is the frame time.
     clock.run("engine render (first, prefilters)", render.render_to_file, scene, output / "demo.exr")
     exr = clock.run("engine render", render.render_to_file, scene, output / "demo.exr")
+    sampling = engine_sampling(scene)
     engine_image = render.read_float_image(exr)
     save_display_png(engine_image, output / "demo.png", scene)
 
@@ -91,17 +92,29 @@ def main(argv=None):
         "reference mean relative noise": mean_relative_error(reference, error),
     }
     write_report(output / "report.md", arguments.size, len(reference_scene.triangles), samples, clock.durations,
-                 figures)
+                 figures, sampling)
     print(f"[sg-prt] wrote {output / 'demo.png'}, {output / 'reference.png'}, {output / 'report.md'}", flush=True)
     return figures
 
 
-def write_report(path, size, triangles, samples, durations, figures):
+def engine_sampling(scene):
+    """How the last render sampled its pixels, in words (scene.sgprt's Render Samples)."""
+    from sg_prt_addon.engine import render_engine
+
+    settings = scene.sgprt
+    timings = render_engine.last_render.get("timings", {})
+    words = f"Render Samples {settings.render_samples}"
+    if "edge_pixels" in timings:
+        words += f", Edges Only ({timings['edge_pixels']:.1%} of the pixels sampled, the rest one sample)"
+    return words
+
+
+def write_report(path, size, triangles, samples, durations, figures, sampling):
     lines = [f"# SG-PRT demo: {SCENE}", "",
              f"{size}x{size} pixels, {triangles} triangles, bpy {bpy.app.version_string}, "
              f"{platform.machine()}, Python {platform.python_version()}, {time.strftime('%Y-%m-%d %H:%M')}.", "",
-             "Images: demo.png (SG-PRT), reference.png (Monte Carlo, exact direct light, "
-             f"{samples} samples per pixel).", "", "## Timings", "", "| stage | seconds |", "|---|---|"]
+             f"Images: demo.png (SG-PRT, {sampling}), reference.png (Monte Carlo, exact direct light, "
+             f"{samples} samples per pixel over each pixel's area).", "", "## Timings", "", "| stage | seconds |", "|---|---|"]
     lines += [f"| {name} | {seconds:.2f} |" for name, seconds in durations.items()]
     lines += ["", "## Error", "", "| figure | value |", "|---|---|"]
     lines += [f"| {name} | {value:.4f} |" for name, value in figures.items()]
