@@ -1,6 +1,11 @@
 """Sub-pixel offsets of the frames a final render averages (Render Samples), and the projection moved by
 one: anti-aliasing with a 1-pixel box filter; and the footprint each frame's shading averages its
-specular over (Specular Anti-Aliasing).  Pixels: x to the right, y DOWN, as validation/camera.py."""
+specular over (Specular Anti-Aliasing).  Pixels: x to the right, y DOWN, as validation/camera.py.
+
+Edges Only (engine/multi_sample.py draws it): which pixels of a frame shaded at the pixels' centres are
+edges (edge_pixels, the mirror of engine/edge_pixels.frag.glsl), the grid of samples an edge pixel takes,
+the tiles holding edges and the projection that draws a tile larger (there pixels count x right, y UP, as
+the read-back mask's rows)."""
 import numpy as np
 
 
@@ -38,7 +43,6 @@ def specular_footprint(samples, enabled=True):
     of the 1 / sqrt(samples) grid for each of ``samples`` jittered frames, 0 (the centre alone) when
     Specular Anti-Aliasing is off."""
     return 1.0 / float(np.sqrt(max(int(samples), 1))) if enabled else 0.0
-
 
 
 # Render Samples' Edges Only: a pixel pair differs when a channel differs by more than the threshold times the
