@@ -39,20 +39,15 @@ SETTINGS = (("one", 1, True), ("edges", SAMPLES, True), ("every", SAMPLES, False
 
 
 def render(scene, samples, edges_only):
-    """(Combined RGB, surface mask, seconds, timings) of one final render."""
-    import bpy
+    """(Combined RGB, surface mask, seconds, timings) of one final render of `scene`, the context's."""
     import numpy as np
 
+    from benchmarks.engine_vs_eevee import render_seconds
     from sg_prt_addon.engine import render_engine
 
     scene.sgprt.render_samples = samples
     scene.sgprt.sample_edges_only = edges_only
-    render_engine.last_render.clear()
-    start = time.perf_counter()
-    bpy.ops.render.render()
-    seconds = time.perf_counter() - start
-    if "error" in render_engine.last_render:
-        raise RuntimeError(render_engine.last_render["error"])
+    seconds = render_seconds()
     passes = render_engine.last_render["passes"]
     return (passes["Combined"][..., :3].astype(np.float64), passes["Diffuse"][..., 3] > 0.5, seconds,
             dict(render_engine.last_render["timings"]))
@@ -122,18 +117,15 @@ def performance_section(results, command):
     return "\n".join(lines) + "\n"
 
 
+def sections(results, command, _args):
+    from benchmarks import markdown_sections
+
+    return [(markdown_sections.ACCURACY_DOC, TITLE, accuracy_section(results, command)),
+            (markdown_sections.PERFORMANCE_DOC, TITLE, performance_section(results, command))]
+
+
 def main(argv=None):
-    args = scene_benchmark.parse(argv, __doc__.split("\n")[0], SCENES, rounds=5)
-    results = scene_benchmark.measure(SCENES, args, measure_scene)
-    command = scene_benchmark.command("edge_samples", args)
-    accuracy, performance = accuracy_section(results, command), performance_section(results, command)
-    print(accuracy)
-    print(performance)
-    if args.update_doc:
-        from benchmarks import markdown_sections
-        markdown_sections.update_file(markdown_sections.ACCURACY_DOC, TITLE, accuracy)
-        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, TITLE, performance)
-    return results
+    return scene_benchmark.main("edge_samples", __doc__.split("\n")[0], SCENES, 5, measure_scene, sections, argv)
 
 
 if __name__ == "__main__":

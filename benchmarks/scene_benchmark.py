@@ -1,6 +1,6 @@
-"""What the scene-by-scene setting benchmarks share (benchmarks/specular_aa.py, benchmarks/shadow_maps_speed.py):
-building a scene of the examples or of the truth suite at a size, their command line, and measuring the scenes
-asked for."""
+"""What the scene-by-scene setting benchmarks share (benchmarks/specular_aa.py, shadow_maps_speed.py,
+edge_samples.py): building a scene of the examples or of the truth suite at a size, their command line,
+measuring the scenes asked for, and printing and writing their sections of docs/."""
 import argparse
 
 
@@ -47,3 +47,19 @@ def measure(scenes, args, measure_scene):
 def command(module, args):
     """The command line that reproduces a run of benchmarks.<module>."""
     return f".venv/bin/python -m benchmarks.{module}" + (" --update-doc" if args.update_doc else "")
+
+
+def main(module, description, scenes, rounds, measure_scene, sections, argv=None):
+    """A scene benchmark's command line: measure the scenes asked for, print the sections that
+    sections(results, command, args) gives ([(markdown_sections doc path, title, text)]), and write them with
+    --update-doc; returns the results."""
+    args = parse(argv, description, scenes, rounds)
+    results = measure(scenes, args, measure_scene)
+    written = sections(results, command(module, args), args)
+    for _doc, _title, text in written:
+        print(text)
+    if args.update_doc:
+        from benchmarks import markdown_sections
+        for doc, title, text in written:
+            markdown_sections.update_file(doc, title, text)
+    return results

@@ -95,15 +95,14 @@ def section(results, command, rounds):
     return "\n".join(lines) + "\n"
 
 
+def sections(results, command, args):
+    from benchmarks import markdown_sections
+
+    return [(markdown_sections.PERFORMANCE_DOC, TITLE, section(results, command, args.rounds))]
+
+
 def main(argv=None):
-    args = scene_benchmark.parse(argv, __doc__.split("\n")[0], SCENES, rounds=5)
-    results = scene_benchmark.measure(SCENES, args, measure_scene)
-    command = scene_benchmark.command("shadow_maps_speed", args)
-    text = section(results, command, args.rounds)
-    print(text)
-    if args.update_doc:
-        from benchmarks import markdown_sections
-        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, TITLE, text)
+    scene_benchmark.main("shadow_maps_speed", __doc__.split("\n")[0], SCENES, 5, measure_scene, sections, argv)
     return 0
 
 

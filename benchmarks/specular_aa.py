@@ -118,18 +118,15 @@ def performance_section(results, command):
     return "\n".join(lines) + "\n"
 
 
+def sections(results, command, _args):
+    from benchmarks import markdown_sections
+
+    return [(markdown_sections.ACCURACY_DOC, ACCURACY_TITLE, accuracy_section(results, command)),
+            (markdown_sections.PERFORMANCE_DOC, PERFORMANCE_TITLE, performance_section(results, command))]
+
+
 def main(argv=None):
-    args = scene_benchmark.parse(argv, __doc__.split("\n")[0], SCENES, rounds=3)
-    results = scene_benchmark.measure(SCENES, args, measure_scene)
-    command = scene_benchmark.command("specular_aa", args)
-    accuracy, performance = accuracy_section(results, command), performance_section(results, command)
-    print(accuracy)
-    print(performance)
-    if args.update_doc:
-        from benchmarks import markdown_sections
-        markdown_sections.update_file(markdown_sections.ACCURACY_DOC, ACCURACY_TITLE, accuracy)
-        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, PERFORMANCE_TITLE, performance)
-    return results
+    return scene_benchmark.main("specular_aa", __doc__.split("\n")[0], SCENES, 3, measure_scene, sections, argv)
 
 
 if __name__ == "__main__":
