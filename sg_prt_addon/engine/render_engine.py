@@ -16,8 +16,10 @@ from .shader_cache import ShaderCompileError
 # final render also writes the shading inputs; every final render leaves its float
 # passes, the G-buffer and the SceneState in `last_render`.
 # `after_frame(depsgraph, state, renderer, camera)` runs inside the render's GPU context after the
-# frame (its result: last_render["after_frame"]), e.g. to time the viewport's redraws or re-uploads.
-debug = {"capture_gbuffer": False, "environment_layer_size": None, "timed_redraws": 0, "after_frame": None}
+# frame (its result: last_render["after_frame"]), e.g. to time the viewport's redraws or re-uploads;
+# `test_break()`, when set, stands in for the RenderEngine's (Esc), which Python cannot override.
+debug = {"capture_gbuffer": False, "environment_layer_size": None, "timed_redraws": 0, "after_frame": None,
+         "test_break": None}
 last_render = {}
 
 
@@ -63,7 +65,9 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             samples = 1 if debug["capture_gbuffer"] else getattr(getattr(scene, "sgprt", None), "render_samples",
                                                                   properties.DEFAULT_RENDER_SAMPLES)
             passes, state, timings = render_frame(depsgraph, width, height, gbuffer=debug["capture_gbuffer"],
-                                                  samples=samples)
+                                                  samples=samples,
+                                                  cancelled=debug["test_break"] or self.test_break,
+                                                  progress=self.update_progress)
         except ShaderCompileError as error:
             print(error)
             # the UI gets the variant and the first located error; the console has every line quoted
@@ -78,6 +82,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             last_render.clear()
             last_render["error"] = traceback.format_exc()
             return
+        if timings.get("cancelled"):
+            self.report({"WARNING"}, "SG-PRT: render cancelled; the image holds the samples taken until then")
         for warning in dict.fromkeys(state.warnings + state.unshadowed_warnings()):
             self.report({"WARNING"}, f"SG-PRT: {warning}")
         dropped = state.dropped_lights(MAX_POINT_LIGHTS, MAX_SUNS)
@@ -278,25 +284,33 @@ def edge_sampling(scene):
             anti_aliasing.EDGE_FLOOR * 2.0 ** -exposure)
 
 
-def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, timings):
+def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, timings, cancelled, progress):
     """The passes of Render Samples > 1, summed on the GPU (engine/multi_sample.py).  Every pixel: the mean of
     `samples` frames, each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset.  Edges
     Only: a frame at the pixels' centres (its specular over the whole pixel); where it shows an edge
     (passes["edge_pixels"]; timings["edge_pixels"]: their fraction), the mean of a grid_side x grid_side grid of
-    samples, drawn tile by tile (timings["edge_tiles"])."""
+    samples, drawn tile by tile (timings["edge_tiles"]).  cancelled() is asked between frames or tiles: when it
+    says so (Esc), the mean of the frames so far, or the tiles not drawn keep the centred frame
+    (timings["cancelled"]); progress(fraction) is told after each."""
     width, height = renderer.size
     sums = renderer.frame_sums
     edges_only, threshold, floor = edge_sampling(scene)
     if not edges_only:
         sums.start(width, height)
         offsets = anti_aliasing.pixel_jitter(samples)
-        for offset in offsets:
+        for done, offset in enumerate(offsets):
+            if done and cancelled():
+                timings["cancelled"] = True
+                summed = sums.read()
+                return {name: summed[name.lower()] * np.float32(len(offsets) / done)
+                        for name in renderer_module.PASS_NAMES}
             # the view-projection is in the scene block: upload it moved (the shadow maps keep the centred plan)
             frame_camera = dataclasses.replace(
                 camera, projection=anti_aliasing.jittered_projection(camera.projection, offset, width, height))
             renderer.upload(state, state.consume_dirty(), frame_camera, shadow_camera=camera)
             renderer.draw(state, frame_camera, background_alpha=background_alpha)
             sums.add(renderer, 1.0 / len(offsets))
+            progress((done + 1) / len(offsets))
         summed = sums.read()
         return {name: summed[name.lower()] for name in renderer_module.PASS_NAMES}
     # a sample's specular footprint: the whole pixel at the centre, a grid cell (one pixel of a tile) in the grid
@@ -309,21 +323,35 @@ def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, t
     side = anti_aliasing.grid_side(samples)
     tile = multi_sample.tile_side(side, width, height)
     tiles = anti_aliasing.edge_tiles(edges, tile)
+    drawn = 0
     for origin in tiles:
+        if cancelled():
+            timings["cancelled"] = True
+            break
         tile_camera = dataclasses.replace(
             camera, projection=anti_aliasing.tile_projection(camera.projection, origin, tile, width, height),
             shading_footprint=whole_pixel, footprint_grid_limit=anti_aliasing.footprint_grid_limit(side))
         renderer.upload(state, state.consume_dirty(), tile_camera, shadow_camera=camera)
         sums.draw_edge_tile(renderer, state, tile_camera, origin, tile, side, background_alpha)
+        drawn += 1
+        progress(drawn / len(tiles))
     timings["edge_pixels"] = float(edges.mean())
-    timings["edge_tiles"] = len(tiles)
+    timings["edge_tiles"] = drawn
     summed = sums.read()
     passes = {name: summed[name.lower()] for name in renderer_module.PASS_NAMES}
+    if drawn < len(tiles):      # cancelled: the tiles not drawn keep the centred frame (the renderer's targets)
+        undrawn = np.zeros_like(edges)
+        for x0, y0 in tiles[drawn:]:
+            undrawn[y0:y0 + tile, x0:x0 + tile] = True
+        undrawn &= edges
+        for name in renderer_module.PASS_NAMES:
+            passes[name][undrawn] = renderer.read_output(name.lower())[undrawn]
     passes["edge_pixels"] = edges        # (H, W) bool, row 0 at the bottom: for tests and benchmarks
     return passes
 
 
-def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1):
+def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=None, samples=1,
+                 cancelled=lambda: False, progress=lambda fraction: None):
     """Export, upload, draw and read back one frame; with ``samples`` > 1 the average of that many draws,
     each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset (anti-aliasing), at the
     edges alone with Edges Only (_sampled_passes).
@@ -350,7 +378,8 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     start = time.perf_counter()
     background_alpha = 0.0 if scene.render.film_transparent else 1.0
     if samples > 1:
-        passes = _sampled_passes(scene, state, renderer, camera, samples, background_alpha, timings)
+        passes = _sampled_passes(scene, state, renderer, camera, samples, background_alpha, timings, cancelled,
+                                 progress)
     else:
         renderer.draw(state, camera, background_alpha=background_alpha)
         passes = {name: renderer.read_output(name.lower()) for name in renderer_module.PASS_NAMES}

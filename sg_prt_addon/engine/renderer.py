@@ -485,8 +485,9 @@ class Renderer:
         return draws
 
     def draw(self, state, camera, background_alpha=1.0, framebuffer=None, before_shading=None):
-        """Draw every object, then the world behind them, into our framebuffer (call ensure_targets
-        first) or `framebuffer` (its colour slots as ours).  background_alpha: alpha of the world pixels (0
+        """Draw every object the view may see (all of them cast into the shadow maps), then the world behind
+        them, into our framebuffer (call ensure_targets first) or `framebuffer` (its colour slots as ours).
+        background_alpha: alpha of the world pixels (0
         for a transparent film); before_shading(): run with the framebuffer bound after the depth of the
         surfaces is in (multi_sample's pixel mask)."""
         import gpu
@@ -499,6 +500,7 @@ class Renderer:
                                                        entry.matrix_world, context.buffers.bounds)
                                                       for _index, _key, entry, context, _slots in draws
                                                       if entry.casts_shadow])
+        draws = in_view(draws, camera.projection @ camera.view)     # an edge tile sees a part of the view
         framebuffer = framebuffer or self.framebuffer
         with framebuffer.bind():
             framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
@@ -630,6 +632,18 @@ class Renderer:
         self.targets = []
         self.framebuffer = None
         self.size = None
+
+
+def in_view(draws, view_projection):
+    """Renderer.object_draws' `draws` whose world box may reach the view of world -> clip `view_projection`
+    (shadow_maps.in_tile's test); an object without bounds is kept."""
+    known = [index for index, draw in enumerate(draws) if draw[3].buffers.bounds is not None]
+    keep = np.ones(len(draws), bool)
+    if known:
+        corners = shadow_pass.world_corners([draws[i][2].matrix_world for i in known],
+                                            [draws[i][3].buffers.bounds for i in known])
+        keep[known] = shadow_maps.in_tile(view_projection, corners)
+    return [draw for draw, kept in zip(draws, keep) if kept]
 
 
 def gpu_buffer(block):

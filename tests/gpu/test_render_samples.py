@@ -215,3 +215,57 @@ def test_edge_pass_matches_its_mirror_on_hostile_frames(engine):
     for name, frame in zip(multi_sample.PASSES, frames):
         assert not starts[name][mask].any()
         np.testing.assert_array_equal(starts[name][~mask], frame[~mask])
+
+
+def test_objects_outside_the_view_are_not_drawn(engine):
+    """renderer.in_view keeps the draws whose world box may reach the view (an edge tile sees a part of it), and
+    those it cannot tell: no bounds, or a non-finite transform."""
+    from types import SimpleNamespace
+
+    from sg_prt_addon.engine import renderer as renderer_module
+
+    def draw(name, location, bounds=((-0.5, -0.5, -0.5), (0.5, 0.5, 0.5))):
+        matrix = np.eye(4)
+        matrix[:3, 3] = location
+        return (0, name, SimpleNamespace(matrix_world=matrix), SimpleNamespace(
+            buffers=SimpleNamespace(bounds=None if bounds is None else np.array(bounds))), [])
+
+    draws = [draw("inside", (0.0, 0.0, 0.0)), draw("beyond x", (5.0, 0.0, 0.0)), draw("straddles", (1.2, 0.0, 0.0)),
+             draw("behind", (0.0, 0.0, -3.0)), draw("no bounds", (9.0, 9.0, 9.0), bounds=None),
+             draw("not finite", (np.nan, 0.0, 0.0))]
+    kept = [name for _index, name, *_ in renderer_module.in_view(draws, np.eye(4))]    # clip = world: [-1, 1]^3
+    assert kept == ["inside", "straddles", "no bounds", "not finite"]
+    assert renderer_module.in_view([], np.eye(4)) == []
+
+
+def test_esc_keeps_the_samples_taken(engine, monkeypatch):
+    """Esc between an Edges Only tile and the next: the tiles drawn keep their samples, the others the centred
+    frame; between jittered frames of every pixel: the mean of those drawn.  The render reports it."""
+    from sg_prt_addon.engine import multi_sample, render_engine
+
+    monkeypatch.setattr(multi_sample, "MAX_TILE_PIXELS", 64)        # tiles of 16 pixels
+    finished, timings = _passes(_scene("esc_finished", 48, 16, edges_only=True))
+    centred, _ = _passes(_scene("esc_centred", 48, 1))
+    assert timings["edge_tiles"] > 3
+    asked = []
+
+    def test_break():
+        asked.append(True)
+        return len(asked) > 2                   # Esc after two tiles (or frames)
+
+    monkeypatch.setitem(render_engine.debug, "test_break", test_break)
+    result = fx.render(_scene("esc_edges", 48, 16, edges_only=True))
+    assert "error" not in result and result["timings"]["cancelled"] and result["timings"]["edge_tiles"] == 2
+    image, edges = result["passes"]["Combined"], result["passes"]["edge_pixels"]
+    kept = np.isclose(image, finished["Combined"], rtol=1e-4, atol=1e-5).all(axis=-1)
+    fell_back = np.isclose(image, centred["Combined"], rtol=1e-4, atol=1e-5).all(axis=-1)
+    print(f"edge pixels sampled before Esc {np.mean(kept[edges] & ~fell_back[edges]):.0%}, left at the centred "
+          f"frame {np.mean(fell_back[edges] & ~kept[edges]):.0%}")
+    assert (kept | fell_back).mean() > 0.999
+    assert (edges & kept & ~fell_back).any() and (edges & fell_back & ~kept).any()
+
+    asked.clear()
+    result = fx.render(_scene("esc_every", 48, 16))
+    assert result["timings"]["cancelled"] and "error" not in result
+    image = result["passes"]["Combined"]
+    assert np.isfinite(image).all() and abs(float(image[..., 3].mean()) - 1.0) < 1e-5   # the mean of 2 frames
