@@ -292,7 +292,7 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
 
 
 # Render Samples' defaults, from the truth suite's scenes and the example scenes (docs/ACCURACY.md and
-# PERFORMANCE.md "Edges Only"): 16 samples at the edges leave 1-13% of one sample's error against 16 samples of
+# PERFORMANCE.md "Edges Only"): 16 samples at the edges leave 0.3-13% of one sample's error against 16 samples of
 # every pixel, a threshold of 0.2 sampling 3-24% of the pixels, for 1.7-3.7x a one-sample render
 DEFAULT_RENDER_SAMPLES = 16
 DEFAULT_EDGE_THRESHOLD = 0.2
