@@ -106,10 +106,14 @@ ROWS = (("SG-PRT cold render, empty disk cache (prefilter, fits, tables, compile
 def section(results, size, repeats, command):
     import bpy
 
+    from sg_prt_addon.blender import properties
+
     intro = (f"`{command}` ({size}x{size}, Blender {bpy.app.version_string}, {os.cpu_count()} cores, Mesa "
              f"llvmpipe; {time.strftime('%Y-%m-%d')}). Written by the benchmark (`--update-doc`). Every figure is "
              f"the median of {repeats} new processes, each rendering twice (the first render is the cold one); "
-             "ratios are to EEVEE's warm 1-sample render in the same run.  Scenes baked (operator defaults).")
+             "ratios are to EEVEE's warm 1-sample render in the same run.  Scenes baked (operator defaults), "
+             f"SG-PRT at its default render settings (Render Samples {properties.DEFAULT_RENDER_SAMPLES}, Edges "
+             "Only: what a job renders).")
     lines = [SECTION_TITLE, "", textwrap.fill(intro, 110), ""]
     lines += ["| what | " + " | ".join(f"{r['scene']} s | ratio" for r in results) + " |",
               "|---|" + "---|---|" * len(results)]
