@@ -130,7 +130,8 @@ def test_edges_only_samples_the_edges_and_keeps_the_centred_frame_elsewhere(engi
     assert 0.02 < edges.mean() < 0.5 and timings["edge_tiles"] == 1 and timings["edge_pixels"] == edges.mean()
     assert np.mean(mirror != edges) < 1e-3                  # measured: 0
     for name in ("Combined", "Diffuse", "Specular"):
-        np.testing.assert_allclose(edged[name][~edges], one[name][~edges], rtol=1e-6, atol=1e-7)  # measured: 6e-8
+        # measured: 6e-8; two renders of equal scenes differ by up to 1.3e-5 at a highlight's pixel (bpy 5.3)
+        np.testing.assert_allclose(edged[name][~edges], one[name][~edges], rtol=1e-4, atol=1e-6)
         difference = edged[name][edges] - every[name][edges]
         rms = float(np.sqrt(np.mean(difference ** 2)) / np.mean(np.abs(every[name][edges])))
         print(f"{name}: relative RMS of Edges Only - every pixel over the edges {rms:.2e}")
@@ -171,7 +172,7 @@ def test_edges_only_tiles_join_and_a_high_threshold_samples_nothing(engine, monk
     nothing, timings = _passes(scene)
     one, _ = _passes(_scene("edges_none_one", 48, 1))
     assert timings["edge_tiles"] == 0 and not nothing["edge_pixels"].any()
-    np.testing.assert_allclose(nothing["Combined"], one["Combined"], rtol=1e-5, atol=1e-6)   # measured: 3.6e-6
+    np.testing.assert_allclose(nothing["Combined"], one["Combined"], rtol=1e-4, atol=1e-6)   # measured: 1.3e-5
 
 
 def test_edge_pass_matches_its_mirror_on_hostile_frames(engine):
@@ -269,3 +270,23 @@ def test_esc_keeps_the_samples_taken(engine, monkeypatch):
     assert result["timings"]["cancelled"] and "error" not in result
     image = result["passes"]["Combined"]
     assert np.isfinite(image).all() and abs(float(image[..., 3].mean()) - 1.0) < 1e-5   # the mean of 2 frames
+
+
+def test_edges_only_on_a_transparent_film(engine):
+    """A transparent film: the silhouette is an edge of alpha alone (the world is (0, 0, 0, 0)), and Edges Only
+    averages its coverage as every pixel's samples do."""
+    images = {}
+    for key, samples, edges_only in (("one", 1, False), ("every", 16, False), ("edges", 16, True)):
+        scene = _scene(f"film_{key}", 48, samples, edges_only=edges_only)
+        scene.render.film_transparent = True
+        images[key], _ = _passes(scene)
+    edges = images["edges"]["edge_pixels"]
+    alpha = {key: passes["Combined"][..., 3] for key, passes in images.items()}
+    partial = (alpha["every"] > 0.01) & (alpha["every"] < 0.99)         # the silhouette's pixels
+    print(f"silhouette pixels {partial.sum()}, of them marked {edges[partial].mean():.0%}; edge alpha "
+          f"|Edges Only - every pixel| max {np.abs(alpha['edges'] - alpha['every'])[edges].max():.4f}")
+    assert partial.sum() > 20 and edges[partial].all()
+    assert set(np.unique(alpha["one"])) <= {0.0, 1.0}                    # one sample: covered or not
+    # the same coverage, but for samples the rasterizer's 1/256-pixel snap puts on the other side of an edge
+    assert np.abs(alpha["edges"] - alpha["every"])[edges].max() <= 2.0 / 16 + 1e-6
+    np.testing.assert_allclose(alpha["edges"][~edges], alpha["one"][~edges], atol=1e-6)
