@@ -2,7 +2,9 @@
 (engine.anti_aliasing.pixel_jitter).  Four samples sample the same points as a render twice as large, so their
 average must equal that render box-filtered down (Cycles' 1-pixel box filter); the render panel shows it.
 Specular Anti-Aliasing (scene.sgprt.specular_anti_aliasing, sg_shading.glsl shade_footprint): one frame
-shading each pixel over its footprint comes close to the box-filtered frames the jitter averages."""
+shading each pixel over its footprint comes close to the box-filtered frames the jitter averages.  Edges Only
+(scene.sgprt.sample_edges_only, engine/multi_sample.py): the samples at the edges of a frame shaded at the
+pixels' centres, drawn tile by tile, equal every pixel's samples there and leave the rest as that frame."""
 import engine_fixtures as fx
 import numpy as np
 import pytest
