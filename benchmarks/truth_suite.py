@@ -9,9 +9,9 @@
 ``python -m benchmarks.accuracy`` rewrites docs/ACCURACY.md from its own topics only and drops this
 section: run ``--update-doc`` again after it.)
 
-Thirteen scenes (SCENES below: Suzanne subdivided twice on a floor, a UV sphere over a floor, a
+Fourteen scenes (SCENES below: Suzanne subdivided twice on a floor, a UV sphere over a floor, a
 torus over a floor; Lambert, GGX from roughness 0.05 to 0.6, anisotropic Ashikhmin-Shirley; lit by
-courtyard.exr / sunset.exr, a small point light, a sun, a large sphere light, a spot light), each
+courtyard.exr / sunset.exr, a uniform sky (a constant world, Blender's default kind), a small point light, a sun, a large sphere light, a spot light), each
 built from Blender's primitives in a fresh empty file and rendered, one after another in one
 process, by:
 
@@ -541,6 +541,11 @@ def _black_world(scene):
     return build_scenes._world_with_colour(scene, (0.0, 0.0, 0.0))
 
 
+def _white_world(scene):
+    from examples import build_scenes
+    return build_scenes._world_with_colour(scene, (1.0, 1.0, 1.0))
+
+
 def _light(scene, kind, location, energy, radius=0.0, target=(0.0, 0.0, 0.8)):
     """A light aimed at ``target``.  Point and spot lights turn Blender's soft falloff off: with it a
     sphere light is not a uniform sphere closer than a few radii, and SG-PRT (lighting.lights) models the
@@ -580,6 +585,11 @@ def _point_lit(scene):
 def build_diffuse_hdri(size=256):
     """Suzanne (Lambert kd 0.7) on a Lambert floor under courtyard.exr."""
     return _suzanne_on_floor(size, lambda: _lambert("Suzanne", 0.7), _hdri)
+
+
+def build_diffuse_sky(size=256):
+    """Suzanne (Lambert kd 0.7) on the floor under a uniform white sky (a constant world colour)."""
+    return _suzanne_on_floor(size, lambda: _lambert("Suzanne", 0.7), _white_world)
 
 
 def build_ggx035_metal_hdri(size=256):
@@ -686,6 +696,7 @@ def _ashikhmin_shirley_roughness(exponent):
 
 SCENES = {
     "diffuse_hdri": Scene(build_diffuse_hdri, "diffuse"),
+    "diffuse_sky": Scene(build_diffuse_sky, "diffuse"),
     "ggx035_metal_hdri": Scene(build_ggx035_metal_hdri, "glossy", 0.35),
     "ggx010_hdri": Scene(build_ggx010_hdri, "glossy", 0.10),
     "ggx030_point": Scene(build_ggx030_point, "glossy", 0.30),

@@ -3,7 +3,7 @@ import numpy as np
 
 from benchmarks.bake_speed import sphere_over_floor
 from sg_prt_addon.spherical import hemisphere, sg
-from sg_prt_addon.visibility import BakeOptions, binary_visibility, decode, hemisphere_map, pca, ssdf
+from sg_prt_addon.visibility import BakeOptions, binary_visibility, broad_lobes, decode, hemisphere_map, pca, ssdf
 from sg_prt_addon.visibility.pipeline import bake_ssdf
 from sg_prt_addon.visibility.raytrace import RayTracer
 
@@ -48,6 +48,43 @@ def _plane_bake(tilt_degrees, resolution, refinement=5):
     tracer.close()
     frame = hemisphere_map.local_frame(np.array([[0.0, 0.0, 1.0]]))[0]
     return values.astype(np.float64).reshape(resolution, resolution), m, frame
+
+
+def _broad_lobe_rows(model, samples, normals, dense, fine_local, rng):
+    """The visible fraction of lobes G(i; axis, lambda) max(0, n.i) at baked vertices against dense rays:
+    the quadrature of visibility.broad_lobes, eq. 30's reading at the axis (techniques.sg_shading.
+    lobe_visibility), and the blend the per-vertex pass of the diffuse lobes uses."""
+    from sg_prt_addon.techniques import sg_shading
+
+    resolution = 32
+    coefficients = pca.project(model, samples)
+    basis, mean = model.basis.reshape(-1, resolution, resolution), model.mean.reshape(resolution, resolution)
+    vertices = sg_shading.Visibility(rows=decode.pack_coefficients(coefficients), normal=normals.astype(np.float32),
+                                     basis_texture=decode.pack_basis_texture(mean, basis))
+    axes = rng.normal(size=(len(samples), 16, 3))
+    axes[..., 2] = np.abs(axes[..., 2]) + 0.1
+    axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+    world_axes = np.einsum("nex,nxw->new", axes, hemisphere_map.local_frame(normals))
+    coverage = sg_shading.vertex_coverage(vertices)
+    lit = dense.reshape(len(samples), -1)
+    rows = []
+    for sharpness in (0.0, 2.0, 5.0, 10.0, 20.0, 40.0):
+        lobe = np.exp(sharpness * (np.einsum("nex,px->nep", axes, fine_local) - 1.0)) * fine_local[:, 2]
+        exact = np.einsum("nep,np->ne", lobe, lit) / lobe.sum(-1)
+        lam = np.full(axes.shape[:2], sharpness)
+        quadrature = broad_lobes.quadrature_visible_fraction(coverage, axes, lam)
+        eq30 = sg_shading.lobe_visibility(world_axes.astype(np.float32), lam.astype(np.float32),
+                                          normals.astype(np.float32), vertices)
+        weight = broad_lobes.quadrature_weight(sharpness)
+        shipped = weight * quadrature + (1 - weight) * eq30
+        note = (f"eq. 30 at the axis: max {np.abs(eq30 - exact).max():.3g}, mean {np.abs(eq30 - exact).mean():.3g}, "
+                f"bias {np.mean(eq30 - exact):+.3f}; the quadrature alone: max {np.abs(quadrature - exact).max():.3g}, "
+                f"mean {np.abs(quadrature - exact).mean():.3g}; quadrature weight {weight:g}")
+        rows.append(_row(f"broad lobe visible fraction, lambda {sharpness:g} ({broad_lobes.QUADRATURE_POINTS}-point "
+                         "quadrature handing over to eq. 30)", np.abs(shipped - exact),
+                         "dense 160^2 ray-traced visibility", "abs error of the visible fraction",
+                         note=f"{len(samples)} vertices of sphere over floor, 16 lobe axes each; " + note))
+    return rows
 
 
 def measure():
@@ -128,6 +165,7 @@ def measure():
             rows.append(_row(f"bake end to end: mu fh(V_d(p)), lambda {sharpness:g}, PCA {truncated.terms} terms",
                              np.concatenate(errors), "SG over dense 160^2 ray-traced visibility",
                              "abs error / fh(pi/2)", note=f"{len(pick)} vertices of sphere over floor, 32 lobe axes each"))
+    rows += _broad_lobe_rows(model, samples[pick], normals[pick], dense, fine_local, np.random.default_rng(1))
     data = samples.astype(np.float64)
     for terms in (8, 16, 32, 48):
         truncated = pca.PcaModel(model.mean, model.basis[:terms], model.eigenvalues, model.rms_error_by_terms,

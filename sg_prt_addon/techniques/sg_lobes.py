@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 from ..reflectance import brdf
 from ..spherical import clamped_cosine_table, warp
+from ..visibility import broad_lobes
 from . import sg_shading, shader_sources, surface_layering
 from .base import Technique
 from .fitted_texels import FITTED_MODEL
@@ -36,6 +37,8 @@ TECHNIQUE_FILES = (("sg", "anisotropic_lobes.glsl"), ("sg", "ggx_two_lobes.glsl"
                    ("common", "fitted_texels.glsl"), ("sg", "sg_shading.glsl"))
 # The per-vertex precomputation this technique reads (visibility.per_vertex kinds)
 VISIBILITY_KIND = "ssdf"
+# texels a vertex of the SSDF's coverage at the quadrature points (vertex_coverage.frag.glsl), four points each
+COVERAGE_TEXELS = broad_lobes.QUADRATURE_POINTS // 4
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
                  "alpha_x", "alpha_y", "nu", "nv", "normal_map")
 
@@ -322,44 +325,86 @@ class SGLobes(Technique):
 
     def prepare_object(self, keys, context):
         """The broad diffuse lobes' visibility at the vertices of an object whose variants read it (a bake
-        and a diffuse term; vertex_visibility.frag.glsl): one texel a vertex and vec4, in the coefficient
-        texture's rows."""
+        and a diffuse term): the SSDF's coverage at the quadrature points (vertex_coverage.frag.glsl), then
+        each lobe's visible fraction (vertex_visibility.frag.glsl), in the coefficient texture's rows."""
         rows = max((key.diffuse_visibility_rows for key in keys), default=0)
         if not rows:
             return
         key = next(key for key in keys if key.diffuse_visibility_rows)
         buffers = context.per_vertex(VISIBILITY_KIND)
+        import gpu  # the gpu module exists only in Blender's GPU context
+
+        coverage, coverage_framebuffer = context.object_target(
+            "quadrature_coverage", (buffers.vertices_per_row * COVERAGE_TEXELS, buffers.rows_texture.height))
+        shader = context.fixed_shader(("vertex_coverage", key.visibility_layers),
+                                      lambda: vertex_coverage_calls(key.visibility_layers))
+        with coverage_framebuffer.bind():
+            gpu.state.depth_test_set("NONE")
+            gpu.state.blend_set("NONE")
+            shader.bind()
+            shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
+            shader.uniform_sampler("visibility_basis", buffers.basis_texture)
+            context.full_screen_batch(shader, "vertex_coverage").draw(shader)
+
         texture, framebuffer = context.object_target(
             "diffuse_visibility", (buffers.vertices_per_row * rows, buffers.rows_texture.height))
         shader = context.fixed_shader(("vertex_visibility", key.visibility_layers, rows, key.has_environment),
                                       lambda: vertex_visibility_calls(key.visibility_layers, rows,
                                                                       key.has_environment))
-        import gpu  # the gpu module exists only in Blender's GPU context
-
         with framebuffer.bind():
             gpu.state.depth_test_set("NONE")
             gpu.state.blend_set("NONE")
             shader.bind()
-            shader.uniform_float("model_matrix", context.model_matrix)
-            shader.uniform_block("scene", context.scene_buffer)
-            shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
-            shader.uniform_sampler("vertex_normals", buffers.normal_texture)
-            shader.uniform_sampler("visibility_basis", buffers.basis_texture)
+            shader.uniform_sampler("vertex_coverage", coverage)
+            if key.has_environment:      # the constant world's cosine lobe needs neither (the SSDF's normal)
+                shader.uniform_float("model_matrix", context.model_matrix)
+                shader.uniform_block("scene", context.scene_buffer)
+                shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
+                shader.uniform_sampler("vertex_normals", buffers.normal_texture)
+                shader.uniform_sampler("visibility_basis", buffers.basis_texture)
             context.full_screen_batch(shader, "vertex_visibility").draw(shader)
+
+
+def quadrature_defines():
+    """The quadrature's constants (visibility.broad_lobes) for lib/ssdf_quadrature.glsl."""
+    return {"SSDF_QUADRATURE_POINTS": broad_lobes.QUADRATURE_POINTS,
+            "SSDF_QUADRATURE_SHARPNESS_START": repr(float(broad_lobes.QUADRATURE_SHARPNESS_START)),
+            "SSDF_QUADRATURE_SHARPNESS_END": repr(float(broad_lobes.QUADRATURE_SHARPNESS_END))}
+
+
+def vertex_coverage_calls(visibility_layers):
+    """Create-info calls of the pass of the SSDF's quadrature points at the vertices
+    (vertex_coverage.frag.glsl): a full-screen triangle over its target, COVERAGE_TEXELS texels a vertex."""
+    defines = {"HAS_VISIBILITY": 1, "SSDF_MAX_LAYERS": visibility_layers, "COVERAGE_TEXELS": COVERAGE_TEXELS,
+               **quadrature_defines()}
+    calls = shader_sources.full_screen_calls("sgprt_vertex_coverage_interface", defines)
+    calls += [("sampler", (0, "FLOAT_2D", "visibility_coefficients")),
+              ("sampler", (1, "FLOAT_2D_ARRAY", "visibility_basis")), ("fragment_out", (0, "VEC4", "out_coverage"))]
+    sources = [shader_sources.library_source(name)
+               for name in ("sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", "ssdf.glsl", "ssdf_quadrature.glsl")]
+    sources += ["vec4 visibility_rows[SSDF_MAX_LAYERS];",
+                shader_sources.technique_source(GLSL_DIR, "vertex_coverage.frag.glsl")]
+    calls.append(("fragment_source", ("\n".join(sources),)))
+    return calls
 
 
 def vertex_visibility_calls(visibility_layers, rows, has_environment):
     """Create-info calls of the per-vertex pass of the broad diffuse lobes (vertex_visibility.frag.glsl),
     drawn as one full-screen triangle over its target (one texel a vertex and vec4)."""
-    defines = {"HAS_VISIBILITY": 1, "SSDF_MAX_LAYERS": visibility_layers, "DIFFUSE_VISIBILITY_ROWS": rows}
+    defines = {"HAS_VISIBILITY": 1, "SSDF_MAX_LAYERS": visibility_layers, "DIFFUSE_VISIBILITY_ROWS": rows,
+               **quadrature_defines()}
     if has_environment:
         defines["HAS_ENVIRONMENT"] = 1
     calls = shader_sources.full_screen_calls("sgprt_vertex_visibility_interface", defines)
-    calls += [("push_constant", ("MAT4", "model_matrix")), ("uniform_buf", (0, "SceneData", "scene")),
+    if has_environment:
+        calls.append(("push_constant", ("MAT4", "model_matrix")))
+    calls += [("uniform_buf", (0, "SceneData", "scene")),
               ("sampler", (0, "FLOAT_2D", "visibility_coefficients")), ("sampler", (1, "FLOAT_2D", "vertex_normals")),
-              ("sampler", (2, "FLOAT_2D_ARRAY", "visibility_basis")), ("fragment_out", (0, "VEC4", "out_fractions"))]
+              ("sampler", (2, "FLOAT_2D_ARRAY", "visibility_basis")), ("sampler", (3, "FLOAT_2D", "vertex_coverage")),
+              ("fragment_out", (0, "VEC4", "out_fractions"))]
     sources = [shader_sources.library_source(name)
-               for name in ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "hemisphere_map.glsl", "ssdf.glsl")]
+               for name in ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "hemisphere_map.glsl", "ssdf.glsl",
+                            "ssdf_quadrature.glsl")]
     sources += [shader_sources.technique_source("common", "lobe_visibility.glsl"),
                 shader_sources.technique_source(GLSL_DIR, "vertex_visibility.frag.glsl")]
     calls.append(("fragment_source", ("\n".join(sources),)))

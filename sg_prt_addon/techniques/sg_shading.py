@@ -131,19 +131,38 @@ def lobe_visibility(axis, sharpness, n, visibility):
     return np.clip(visible / np.maximum(unshadowed, FLOAT(1e-30)), 0, 1).astype(FLOAT)
 
 
+def vertex_coverage(vertices):
+    """The SSDF's coverage (V, P) at the quadrature points of visibility.broad_lobes at mesh vertices
+    (shaders/techniques/sg/vertex_coverage.frag.glsl); vertices: a Visibility of their coefficient rows."""
+    from ..visibility import broad_lobes
+
+    rows = np.asarray(vertices.rows, FLOAT)
+    points = np.broadcast_to(broad_lobes.quadrature_points().astype(FLOAT), (len(rows), broad_lobes.QUADRATURE_POINTS, 3))
+    theta = ssdf_decode_packed(rows, vertices.basis_texture, points)
+    return broad_lobes.cell_coverage(theta, broad_lobes.cell_radius()).astype(FLOAT)
+
+
 def vertex_diffuse_visibility(environment, vertices):
     """Visible fractions (V, E) of the broad diffuse lobes at mesh vertices (shaders/techniques/sg/
     vertex_visibility.frag.glsl): the environment's SG mixture, or the constant world's cosine lobe
-    (E = 1).  vertices: a Visibility of the vertices (their coefficient rows and world SSDF normals),
-    whose normal also stands in for the shading normal in the product with the cosine lobe."""
+    (E = 1), by the quadrature of visibility.broad_lobes over the SSDF's coverage, handing over to eq. 30's
+    reading (lobe_visibility) for the sharper lobes.  vertices: a Visibility of the vertices (their
+    coefficient rows and world SSDF normals), whose normal also stands in for the shading normal."""
+    from ..visibility import broad_lobes, hemisphere_map
+
+    coverage = vertex_coverage(vertices)
+    if not environment.has_texture:           # the cosine lobe about the SSDF's normal
+        return broad_lobes.quadrature_visible_fraction(
+            coverage, np.array([[[0.0, 0.0, 1.0]]]), np.zeros((1, 1))).astype(FLOAT)
     n = sg.normalize(np.asarray(vertices.normal, FLOAT))
-    if environment.has_texture:
-        count = len(environment.lobe_sharpness)
-        axis = np.broadcast_to(np.asarray(environment.lobe_axis, FLOAT)[None], (len(n), count, 3))
-        sharpness = np.broadcast_to(np.asarray(environment.lobe_sharpness, FLOAT)[None], (len(n), count))
-    else:
-        axis, sharpness = n[:, None, :], np.zeros((len(n), 1), FLOAT)
-    return lobe_visibility(axis, sharpness, n, vertices)
+    count = len(environment.lobe_sharpness)
+    axis = np.broadcast_to(np.asarray(environment.lobe_axis, FLOAT)[None], (len(n), count, 3))
+    sharpness = np.broadcast_to(np.asarray(environment.lobe_sharpness, FLOAT)[None], (len(n), count))
+    frame = hemisphere_map.local_frame(np.asarray(vertices.normal, np.float64))
+    local = np.einsum("nij,nkj->nki", frame, axis.astype(np.float64))
+    weight = broad_lobes.quadrature_weight(sharpness)
+    quadrature = broad_lobes.quadrature_visible_fraction(coverage, local, sharpness)
+    return (weight * quadrature + (1.0 - weight) * lobe_visibility(axis, sharpness, n, vertices)).astype(FLOAT)
 
 
 def visible_part_offset(visible):

@@ -6,10 +6,11 @@ import re
 
 import pytest
 
-from sg_prt_addon.techniques import shader_sources
+from sg_prt_addon.techniques import sg_lobes, shader_sources
 from sg_prt_addon.visibility.per_vertex import MAX_ROWS
 from validation import glsl_harness
 
+QUADRATURE_DEFINES = "".join(f"#define {name} {value}\n" for name, value in sg_lobes.quadrature_defines().items())
 LIB_DIR = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", "lib")
 # file -> the files it needs before it (README.md's table)
 DEPENDENCIES = {
@@ -23,10 +24,12 @@ DEPENDENCIES = {
     "env_prefilter.glsl": ["sg.glsl"],
     "hemisphere_map.glsl": ["sg.glsl"],
     "ssdf.glsl": ["sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n"],
+    "ssdf_quadrature.glsl": ["sg.glsl", QUADRATURE_DEFINES],
     "shadow_maps.glsl": [shader_sources.shadow_map_constants()],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
-         "lights.glsl", "env_prefilter.glsl", "hemisphere_map.glsl", "ssdf.glsl", "shadow_maps.glsl"]
+         "lights.glsl", "env_prefilter.glsl", "hemisphere_map.glsl", "ssdf.glsl", "ssdf_quadrature.glsl",
+         "shadow_maps.glsl"]
 
 
 def test_every_file_is_listed():
@@ -46,8 +49,9 @@ def test_file_compiles_with_its_dependencies(glsl, file_name):
 def test_all_files_together(glsl):
     call = ("vec4(sg_sphere_integral(a.x, 1.0), fh(0.0, a.x), clamped_cosine_from_cosine(1.0, a.x),"
             " ggx_ndf_lobe(0.5).x)")
-    out = glsl(ORDER[:-2] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", "ssdf.glsl", shader_sources.shadow_map_constants(),
-                             "shadow_maps.glsl"], call, {"a": [0.0, 1.0]}, 4)
+    out = glsl(ORDER[:-3] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", "ssdf.glsl", QUADRATURE_DEFINES,
+                             "ssdf_quadrature.glsl", shader_sources.shadow_map_constants(), "shadow_maps.glsl"],
+               call, {"a": [0.0, 1.0]}, 4)
     assert out.shape == (2, 4)
     # lambda = 0: 4 pi, half of it, pi
     assert abs(out[0, 0] - 4 * 3.14159265) < 1e-5 and abs(out[0, 1] - 2 * 3.14159265) < 1e-5

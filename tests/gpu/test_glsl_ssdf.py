@@ -83,3 +83,31 @@ def test_decode_degenerate_directions_are_finite(glsl, fuzz):
     assert np.all(np.isfinite(out))
     expected = decode.decode(coefficients, basis, mean, d)
     assert np.abs(out - expected).max() < 1e-3 * (1 + np.abs(coefficients).sum(axis=1) * 3).max()
+
+
+def _quadrature_library():
+    from sg_prt_addon.techniques import sg_lobes
+
+    defines = "".join(f"#define {name} {value}\n" for name, value in sg_lobes.quadrature_defines().items())
+    return ["sg.glsl", defines, "ssdf_quadrature.glsl"]
+
+
+def test_quadrature_points_coverage_and_weight(glsl, fuzz, record_error):
+    """lib/ssdf_quadrature.glsl against visibility.broad_lobes, with the constants the engine defines."""
+    from sg_prt_addon.visibility import broad_lobes
+
+    library = _quadrature_library()
+    index = np.arange(broad_lobes.QUADRATURE_POINTS, dtype=np.float32)
+    out = glsl(library, "vec4(ssdf_quadrature_point(int(a.x)), 0)", {"a": np.stack([index] * 4, 1)}, 3)
+    # float32 cos / sin of up to 31 golden angles (74 rad): measured 2.3e-6
+    assert record_error("ssdf quadrature points, absolute",
+                        np.abs(out - broad_lobes.quadrature_points()).max()) <= 1e-5
+    distance = fuzz.f32(np.concatenate([fuzz.rng.uniform(-0.5, 0.5, N - 4), [-1.0, 1.0, 0.0, 0.25]]))
+    sharpness = fuzz.f32(fuzz.rng.uniform(0.0, 40.0, N))
+    inputs = {"a": np.stack([distance, sharpness, distance, sharpness], 1)}
+    out = glsl(library, "vec4(ssdf_cell_coverage(a.x, 0.25), ssdf_quadrature_weight(a.y), 0, 0)", inputs, 2)
+    # llvmpipe's float32 asin (a polynomial): measured 1.2e-4
+    assert record_error("ssdf cell coverage, absolute",
+                        np.abs(out[:, 0] - broad_lobes.cell_coverage(distance, 0.25)).max()) <= 5e-4
+    assert record_error("ssdf quadrature weight, absolute",
+                        np.abs(out[:, 1] - broad_lobes.quadrature_weight(sharpness)).max()) <= 1e-6

@@ -518,6 +518,30 @@ def test_ssdf_stress(glsl, fuzz):
     assert out[:, 2:].min() >= 0
 
 
+def test_ssdf_quadrature_stress(glsl, fuzz):
+    """ssdf_quadrature.glsl: every point index, signed distances of any size (theta_d's hostile set, the
+    infinities), radii from tiny to wide, any sharpness."""
+    from sg_prt_addon.techniques import sg_lobes
+
+    x = _sg_inputs()
+    count = len(x["sharpness"])
+    distance = np.array(x["theta_d"], np.float64)
+    distance[::13] = np.inf
+    distance[1::13] = -np.inf
+    distance[2::13] = 3e38
+    radius = fuzz.stress_sharpness(count) + 1e-30
+    index = np.arange(count) % 64
+    inputs = {"a": np.c_[distance, radius, x["sharpness"], index]}
+    defines = "".join(f"#define {name} {value}\n" for name, value in sg_lobes.quadrature_defines().items())
+    body = """
+    vec3 point = ssdf_quadrature_point(int(a.w) % SSDF_QUADRATURE_POINTS);
+    result = vec4(dot(point, vec3(1.0)), ssdf_cell_coverage(a.x, a.y), ssdf_quadrature_weight(a.z), 0.0);
+    """
+    out = glsl(["sg.glsl", defines, "ssdf_quadrature.glsl"], body, inputs, 3)
+    _assert_finite(out, "ssdf_quadrature.glsl")
+    assert out[:, 1:].min() >= 0 and out[:, 1:].max() <= 1
+
+
 def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
     """The kernels the shaders call per pixel (fuzzed above with this file's generators) over the
     numpy suite's own hostile sets too: SG algebra, fh, clamped cosine, the split warp, M_o."""
@@ -1048,6 +1072,7 @@ COVERED = {
     test_env_prefilter_helpers_stress: ["env_sign_not_zero", "oct_encode", "env_prefilter_blend_parameter"],
     test_ssdf_stress: ["hemisphere_map_disc_to_square", "hemisphere_map_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",
                        "ssdf_to_local", "ssdf_decode", "ssdf_visibility_amplitude", "ssdf_shadowed_integral"],
+    test_ssdf_quadrature_stress: ["ssdf_quadrature_point", "ssdf_cell_coverage", "ssdf_quadrature_weight"],
     test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility"],
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
     test_factored_brdf_stress: ["parabolic_uv", "factored_brdf"],
