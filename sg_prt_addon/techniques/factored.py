@@ -20,7 +20,7 @@ import numpy as np
 from ..measured import homomorphic
 from ..reflectance import brdf, models
 from ..spherical import lattice
-from . import factored_shading, shader_sources, surface_layering
+from . import factored_shading, sg_lobes, shader_sources, surface_layering
 from .base import Technique
 
 NAME = "FACTORED"
@@ -45,6 +45,7 @@ class FactoredKey:
     gbuffer: bool = False
     visibility_layers: int = 0      # vec4 of SSDF coefficients per vertex (0: no visibility bake)
     layering: tuple = ()            # surface_layering.flags of the material
+    diffuse_visibility_rows: int = 0    # vec4 a vertex of the diffuse lobes' visibility (sg_lobes' per-vertex pass)
 
     def describe(self):
         parts = [homomorphic.FORM_LABELS[self.form], "lights" if self.has_lights else "no lights",
@@ -55,6 +56,8 @@ class FactoredKey:
             parts.append("G-buffer")
         if self.visibility_layers:
             parts.append(f"visibility ({self.visibility_layers} coefficient vec4)")
+        if self.diffuse_visibility_rows:
+            parts.append(f"per-vertex diffuse visibility ({self.diffuse_visibility_rows} vec4)")
         if self.layering:
             parts.append("layering: " + ", ".join(self.layering))
         return ", ".join(parts)
@@ -156,9 +159,10 @@ class Factored(Technique):
 
     def variant_key(self, params, inputs):
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS))
+        layers = int(inputs.per_vertex.get(VISIBILITY_KIND, 0))
         return FactoredKey(textures=textures, has_lights=inputs.has_lights, has_environment=inputs.has_environment,
-                           gbuffer=inputs.gbuffer, visibility_layers=int(inputs.per_vertex.get(VISIBILITY_KIND, 0)),
-                           layering=surface_layering.flags(params))
+                           gbuffer=inputs.gbuffer, visibility_layers=layers, layering=surface_layering.flags(params),
+                           diffuse_visibility_rows=sg_lobes.diffuse_visibility_rows(inputs.environment) if layers else 0)
 
     def defines(self, key):
         out = {"FACTOR_P_LIGHT": 1} if homomorphic.FORMS[key.form][2] == "p" else {}
@@ -174,6 +178,8 @@ class Factored(Technique):
             out["GBUFFER"] = 1
         if key.visibility_layers:
             out.update(HAS_VISIBILITY=1, SSDF_MAX_LAYERS=key.visibility_layers)
+        if key.diffuse_visibility_rows:
+            out["DIFFUSE_VISIBILITY_ROWS"] = key.diffuse_visibility_rows
         out.update(surface_layering.layering_defines(key.layering, False))     # its parameters are uniform
         return out
 
@@ -189,13 +195,12 @@ class Factored(Technique):
             samplers.append(surface_layering.SAMPLER)
         if key.visibility_layers:
             samplers += [("FLOAT_2D", "visibility_coefficients"), ("FLOAT_2D_ARRAY", "visibility_basis")]
+        if key.diffuse_visibility_rows:
+            samplers.append(("FLOAT_2D", "diffuse_visibility"))             # read in the vertex shader
         return samplers
 
     def per_vertex_inputs(self, key):
-        if not key.visibility_layers:
-            return ()
-        return (shader_sources.PerVertexInput("visibility_coefficients", key.visibility_layers, "ssdf_coefficients",
-                                              "visibility_rows"),)
+        return sg_lobes.per_vertex_inputs(key)
 
     def create_info_calls(self, key):
         files = [name for name in LIBRARY_FILES if (name != "lights.glsl" or key.has_lights)
@@ -208,10 +213,11 @@ class Factored(Technique):
             sources.append(surface_layering.source())
         per_vertex = self.per_vertex_inputs(key)
         if per_vertex:
-            sources += [shader_sources.technique_source("common", "lobe_visibility.glsl"),
-                        shader_sources.per_vertex_copy_source(per_vertex)]
-        sources += [shader_sources.technique_source(GLSL_DIR, name)
-                    for name in ("factored_shading.glsl", "surface.frag.glsl")]
+            sources.append(shader_sources.technique_source("common", "lobe_visibility.glsl"))
+        sources.append(shader_sources.technique_source(GLSL_DIR, "factored_shading.glsl"))
+        if per_vertex:      # after the arrays it fills (diffuse_fractions: factored_shading.glsl)
+            sources.append(shader_sources.per_vertex_copy_source(per_vertex))
+        sources.append(shader_sources.technique_source(GLSL_DIR, "surface.frag.glsl"))
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
                                             per_vertex, push_constants=(("VEC4", "factor_scale"),))
 
@@ -240,6 +246,11 @@ class Factored(Technique):
             buffers = context.per_vertex(VISIBILITY_KIND)
             shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
             shader.uniform_sampler("visibility_basis", buffers.basis_texture)
+        if key.diffuse_visibility_rows:
+            shader.uniform_sampler("diffuse_visibility", context.object_texture("diffuse_visibility"))
+
+    def prepare_object(self, keys, context):
+        sg_lobes.draw_diffuse_visibility(keys, context)      # the diffuse lobes' visibility, as the SG techniques'
 
 
 TECHNIQUE = Factored()

@@ -40,6 +40,8 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
         flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
         return sg_shading.lobe_visibility(flat_axis, flat_sharpness, n, visibility).reshape(shape)
 
+    # the broad diffuse lobes' fractions from the vertices (the GPU's per-vertex pass), when given
+    diffuse_visible = None if visibility is None or visibility.diffuse is None else np.asarray(visibility.diffuse, FLOAT)
     irradiance = np.zeros(position.shape, FLOAT)
     radiance = np.zeros(position.shape, FLOAT)
     for axis, sharpness, amplitude in sg_shading._light_sets(position, light_data):
@@ -57,13 +59,15 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
         count = len(environment.lobe_sharpness)
         env_axis = np.broadcast_to(environment.lobe_axis[None], (len(n), count, 3))
         env_sharpness = np.broadcast_to(environment.lobe_sharpness[None], (len(n), count))
+        env_visible = visible(env_axis, env_sharpness) if diffuse_visible is None else diffuse_visible[:, :count]
         irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
-            env_axis, env_sharpness, FLOAT(1), n[:, None]) * visible(env_axis, env_sharpness))[..., None], axis=1)
+            env_axis, env_sharpness, FLOAT(1), n[:, None]) * env_visible)[..., None], axis=1)
         radiance += albedo * sg_shading.environment_radiance(environment, mirror, lobe[:, 0]) * mirror_visible
     else:
         colour = np.asarray(environment.colour, FLOAT)
-        irradiance += np.pi * colour * np.asarray(visible(n[:, None], np.zeros((len(n), 1), FLOAT)),
-                                                  FLOAT).reshape(-1, 1)
+        world_visible = visible(n[:, None], np.zeros((len(n), 1), FLOAT)) if diffuse_visible is None \
+            else diffuse_visible[:, :1]
+        irradiance += np.pi * colour * np.asarray(world_visible, FLOAT).reshape(-1, 1)
         radiance += albedo * colour * mirror_visible
     diffuse = np.asarray(diffuse_color, FLOAT) * FLOAT(1 / np.pi) * irradiance
     return diffuse.astype(FLOAT), (np.asarray(specular_color, FLOAT) * radiance).astype(FLOAT)

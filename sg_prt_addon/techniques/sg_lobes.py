@@ -324,45 +324,49 @@ class SGLobes(Technique):
             shader.uniform_sampler("shadow_atlas", context.shadow_atlas())
 
     def prepare_object(self, keys, context):
-        """The broad diffuse lobes' visibility at the vertices of an object whose variants read it (a bake
-        and a diffuse term): the SSDF's coverage at the quadrature points (vertex_coverage.frag.glsl), then
-        each lobe's visible fraction (vertex_visibility.frag.glsl), in the coefficient texture's rows."""
-        rows = max((key.diffuse_visibility_rows for key in keys), default=0)
-        if not rows:
-            return
-        key = next(key for key in keys if key.diffuse_visibility_rows)
-        buffers = context.per_vertex(VISIBILITY_KIND)
-        import gpu  # the gpu module exists only in Blender's GPU context
+        draw_diffuse_visibility(keys, context)
 
-        coverage, coverage_framebuffer = context.object_target(
-            "quadrature_coverage", (buffers.vertices_per_row * COVERAGE_TEXELS, buffers.rows_texture.height))
-        shader = context.fixed_shader(("vertex_coverage", key.visibility_layers),
-                                      lambda: vertex_coverage_calls(key.visibility_layers))
-        with coverage_framebuffer.bind():
-            gpu.state.depth_test_set("NONE")
-            gpu.state.blend_set("NONE")
-            shader.bind()
+
+def draw_diffuse_visibility(keys, context):
+    """The broad diffuse lobes' visibility at the vertices of an object whose variants read it (keys with
+    diffuse_visibility_rows: a bake and a diffuse term; the SG techniques' and the factored one's): the SSDF's
+    coverage at the quadrature points (vertex_coverage.frag.glsl), then each lobe's visible fraction
+    (vertex_visibility.frag.glsl), in the coefficient texture's rows."""
+    rows = max((getattr(key, "diffuse_visibility_rows", 0) for key in keys), default=0)
+    if not rows:
+        return
+    key = next(key for key in keys if getattr(key, "diffuse_visibility_rows", 0))
+    buffers = context.per_vertex(VISIBILITY_KIND)
+    import gpu  # the gpu module exists only in Blender's GPU context
+
+    coverage, coverage_framebuffer = context.object_target(
+        "quadrature_coverage", (buffers.vertices_per_row * COVERAGE_TEXELS, buffers.rows_texture.height))
+    shader = context.fixed_shader(("vertex_coverage", key.visibility_layers),
+                                  lambda: vertex_coverage_calls(key.visibility_layers))
+    with coverage_framebuffer.bind():
+        gpu.state.depth_test_set("NONE")
+        gpu.state.blend_set("NONE")
+        shader.bind()
+        shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
+        shader.uniform_sampler("visibility_basis", buffers.basis_texture)
+        context.full_screen_batch(shader, "vertex_coverage").draw(shader)
+
+    texture, framebuffer = context.object_target(
+        "diffuse_visibility", (buffers.vertices_per_row * rows, buffers.rows_texture.height))
+    shader = context.fixed_shader(("vertex_visibility", key.visibility_layers, rows, key.has_environment),
+                                  lambda: vertex_visibility_calls(key.visibility_layers, rows, key.has_environment))
+    with framebuffer.bind():
+        gpu.state.depth_test_set("NONE")
+        gpu.state.blend_set("NONE")
+        shader.bind()
+        shader.uniform_sampler("vertex_coverage", coverage)
+        if key.has_environment:      # the constant world's cosine lobe needs neither (the SSDF's normal)
+            shader.uniform_float("model_matrix", context.model_matrix)
+            shader.uniform_block("scene", context.scene_buffer)
             shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
+            shader.uniform_sampler("vertex_normals", buffers.normal_texture)
             shader.uniform_sampler("visibility_basis", buffers.basis_texture)
-            context.full_screen_batch(shader, "vertex_coverage").draw(shader)
-
-        texture, framebuffer = context.object_target(
-            "diffuse_visibility", (buffers.vertices_per_row * rows, buffers.rows_texture.height))
-        shader = context.fixed_shader(("vertex_visibility", key.visibility_layers, rows, key.has_environment),
-                                      lambda: vertex_visibility_calls(key.visibility_layers, rows,
-                                                                      key.has_environment))
-        with framebuffer.bind():
-            gpu.state.depth_test_set("NONE")
-            gpu.state.blend_set("NONE")
-            shader.bind()
-            shader.uniform_sampler("vertex_coverage", coverage)
-            if key.has_environment:      # the constant world's cosine lobe needs neither (the SSDF's normal)
-                shader.uniform_float("model_matrix", context.model_matrix)
-                shader.uniform_block("scene", context.scene_buffer)
-                shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
-                shader.uniform_sampler("vertex_normals", buffers.normal_texture)
-                shader.uniform_sampler("visibility_basis", buffers.basis_texture)
-            context.full_screen_batch(shader, "vertex_visibility").draw(shader)
+        context.full_screen_batch(shader, "vertex_visibility").draw(shader)
 
 
 def quadrature_defines():

@@ -35,6 +35,14 @@ vec3 factored_brdf(vec3 o, vec3 i)
 #else
 #define FACTORED_VISIBILITY(axis, sharpness) 1.0
 #endif
+#ifdef DIFFUSE_VISIBILITY_ROWS
+/* the broad diffuse lobes' visible fractions from the vertices (the SG techniques' per-vertex pass:
+ * environment lobe e, the constant world's 0), 4 a row */
+vec4 diffuse_fractions[DIFFUSE_VISIBILITY_ROWS];
+#define FACTORED_DIFFUSE_VISIBILITY(e, axis, sharpness) diffuse_fractions[(e) / 4][(e) % 4]
+#else
+#define FACTORED_DIFFUSE_VISIBILITY(e, axis, sharpness) FACTORED_VISIBILITY(axis, sharpness)
+#endif
 
 void shade_factored(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3 specular_color,
                     out vec3 diffuse, out vec3 specular)
@@ -65,11 +73,11 @@ void shade_factored(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color
     vec3 env_axis = scene.env_axis_sharpness[e].xyz;
     float env_sharpness = scene.env_axis_sharpness[e].w;
     irradiance += scene.env_amplitude[e].rgb * (sg_clamped_cosine_integral(env_axis, env_sharpness, 1.0, n) *
-                                                FACTORED_VISIBILITY(env_axis, env_sharpness));
+                                                FACTORED_DIFFUSE_VISIBILITY(e, env_axis, env_sharpness));
   }
   radiance += albedo * environment_radiance(mirror, factor_scale.w) * FACTORED_VISIBILITY(mirror, factor_scale.w);
 #else
-  irradiance += SG_PI * scene.world_colour.rgb * FACTORED_VISIBILITY(n, 0.0);
+  irradiance += SG_PI * scene.world_colour.rgb * FACTORED_DIFFUSE_VISIBILITY(0, n, 0.0);
   radiance += albedo * scene.world_colour.rgb * FACTORED_VISIBILITY(mirror, factor_scale.w);
 #endif
   diffuse = diffuse_color * (1.0 / SG_PI) * irradiance;
