@@ -32,7 +32,10 @@ process, by:
    two.  Its noise floor is the relative RMSE between the two seed images divided by 2: the
    difference of two independent images carries sqrt(2) x one image's noise and their mean
    1/sqrt(2) of it, so rmse(seed1 - seed2) / 2 is the RMSE a perfect image would score against the
-   truth (the truth's own noise, in the same relative units);
+   truth (the truth's own noise, in the same relative units).  "Cycles unshadowed": the same with every
+   mesh seen by camera rays alone (CAST_NOTHING: no shadows, no reflections of one another), the truth
+   without visibility; "SG-PRT unshadowed" is also scored against it (shading_relative_rmse: the shading's
+   own error, error_budget_table);
 3. Cycles at 1 sample per pixel and at "equal time": as many samples as fit in SG-PRT's render()
    time (at least 1; Cycles' fixed cost per render and its cost per sample are measured from the
    1-sample and the truth renders of the same scene), an independent seed (3 and 4);
@@ -98,7 +101,9 @@ FULL = dict(size=256, cycles_samples=512, eevee_samples=(1, 16, 64))
 QUICK = dict(size=64, cycles_samples=32, eevee_samples=(1, 16))
 
 METHODS = ("SG-PRT", "SG-PRT 1 sample", "SG-PRT unshadowed", "SG-PRT 2x2", "SG-PRT 16 samples", "Factored BRDF",
-           "Spherical harmonics", "Cycles", "Cycles 1 sample", "Cycles equal time", "EEVEE")
+           "Spherical harmonics", "Cycles", "Cycles unshadowed", "Cycles 1 sample", "Cycles equal time", "EEVEE")
+# Cycles' ray visibility a mesh loses for "Cycles unshadowed" (the truth without visibility): camera rays alone
+CAST_NOTHING = ("visible_shadow", "visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter")
 # the engine's other techniques: method -> (the technique every material is switched to, the bake it reads
 # besides the visibility bake: None, or "transfer" (the transfer bake at the operator's defaults))
 TECHNIQUE_METHODS = {"Factored BRDF": ("FACTORED", None), "Spherical harmonics": ("SH", "transfer")}
@@ -261,6 +266,27 @@ def techniques_table(rows, scenes):
     return "\n".join(lines)
 
 
+def error_budget_table(rows, scenes):
+    """One line per scene of what SG-PRT's error is made of: the shading alone (the unshadowed engine against
+    Cycles without visibility) and the rest, visibility's share in quadrature (the two are far from
+    independent, so it is a guide, not a split)."""
+    lines = ["| scene | kind | SG-PRT RMSE | shading alone: RMSE / bias | visibility's share | "
+             "unshadowed truth's noise floor |", "|---|---|---|---|---|---|"]
+    for name, info in scenes.items():
+        engine = find_row(rows, name, "SG-PRT") or {}
+        unshadowed = find_row(rows, name, "SG-PRT unshadowed") or {}
+        truth = find_row(rows, name, "Cycles unshadowed") or {}
+        total, shading = engine.get("relative_rmse"), unshadowed.get("shading_relative_rmse")
+        share = None if total is None or shading is None else math.sqrt(max(total * total - shading * shading, 0.0))
+        kind = info.get("kind", "-")
+        if kind == "glossy" and info.get("roughness") is not None:
+            kind = f"glossy {info['roughness']:g}"
+        lines.append(f"| {name} | {kind} | {_number(total)} | {_number(shading)} / "
+                     f"{_signed(unshadowed.get('shading_relative_bias'))} | {_number(share)} | "
+                     f"{_number(truth.get('unshadowed_noise_floor'))} |")
+    return "\n".join(lines)
+
+
 def goal_lines(checks):
     """One line per scene: the two goals, met or not."""
     lines = []
@@ -339,6 +365,11 @@ def markdown_section(data, before=None):
         "parabolic maps, its environment term as techniques/factored.py says; Spherical harmonics: kautz2002 "
         "at order 5 with a transfer bake of order 5 at the operator's defaults):", "",
         techniques_table(data["rows"], data["scenes"]), "",
+        "What SG-PRT's error is made of: the shading alone is the unshadowed engine (no bake, no shadow maps) "
+        "against Cycles with every mesh seen by camera rays alone (no shadow, diffuse, glossy, transmission or "
+        "volume rays: the truth without visibility, the same samples and seeds); visibility's share is "
+        "sqrt(RMSE^2 - shading^2), the rest:", "",
+        error_budget_table(data["rows"], data["scenes"]), "",
         f"Goals (relative RMSE < {GLOSSY_RMSE_GOAL:.2f} glossy of roughness >= {GLOSSY_MIN_ROUGHNESS:g}, "
         f"< {DIFFUSE_RMSE_GOAL:.2f} diffuse): {goal_summary(checks)}.", ""]
     lines += [f"- {line}" for line in goal_lines(checks)]
@@ -430,6 +461,22 @@ class Scene:
     @property
     def description(self):
         return " ".join((self.build.__doc__ or "").split())
+
+
+@contextlib.contextmanager
+def _meshes_cast_nothing(scene):
+    """Every mesh of the scene seen by camera rays alone for the block (no shadow, no reflection of one
+    another): Cycles' truth without visibility, which the unshadowed engine is scored against."""
+    saved = [(obj, [getattr(obj, name) for name in CAST_NOTHING]) for obj in scene.objects if obj.type == "MESH"]
+    try:
+        for obj, _ in saved:
+            for name in CAST_NOTHING:
+                setattr(obj, name, False)
+        yield
+    finally:
+        for obj, values in saved:
+            for name, value in zip(CAST_NOTHING, values):
+                setattr(obj, name, value)
 
 
 @contextlib.contextmanager
@@ -725,6 +772,7 @@ class SceneRun:
         self.spec = SCENES[name]
         self.methods = set(methods) | {"Cycles"}
         self.images = {}          # (method, setting) -> image
+        self.unshadowed_truth = None      # Cycles without visibility ("Cycles unshadowed")
         self.pending = []         # rows waiting for the truth: (row, image)
         self.info = {"kind": self.spec.kind, "roughness": self.spec.roughness, "description": self.spec.description,
                      "notes": list(self.spec.notes)}
@@ -806,6 +854,11 @@ class SceneRun:
                 row["relative_bias"] = image_error.relative_mean_bias(image, self.truth, self.mask)
                 flip = hdr_flip(self.truth, image, self.mask, background_mask=~self.surface)
                 row["hdr_flip"] = None if flip is None else float(flip)
+                if row["method"] == "SG-PRT unshadowed" and self.unshadowed_truth is not None:
+                    # the shading alone: against the truth without visibility
+                    row["shading_relative_rmse"] = image_error.relative_rmse(image, self.unshadowed_truth, self.mask)
+                    row["shading_relative_bias"] = image_error.relative_mean_bias(image, self.unshadowed_truth,
+                                                                                  self.mask)
                 self.log(f"  {row['method']:18s} {row['setting']:30s} rmse {_number(row['relative_rmse'])}  "
                          f"bias {_signed(row['relative_bias'])}  HDR-FLIP {_number(row['hdr_flip'])}")
             rows.append(row)
@@ -967,6 +1020,12 @@ class SceneRun:
                                                                                            self.mask),
                      seed_hdr_flip=seed_flip)
             self.images[("Cycles", "truth")] = self.truth
+            if "Cycles unshadowed" in self.methods:
+                with _meshes_cast_nothing(self.scene):
+                    seeds = [self._cycles(samples, seed, folder) for seed in TRUTH_SEEDS]
+                self.unshadowed_truth, noise = truth_and_noise_floor(seeds[0][1], seeds[1][1], self.mask)
+                self.add("Cycles unshadowed", f"{samples} spp x 2 seeds, meshes seen by camera rays alone",
+                         seeds[0][0], samples=samples, seeds=list(TRUTH_SEEDS), unshadowed_noise_floor=noise)
             if "Cycles 1 sample" in self.methods:
                 self.add("Cycles 1 sample", "1 spp", one_seconds, one_image, samples=1, seed=CYCLES_ONE_SAMPLE_SEED)
             if "Cycles equal time" in self.methods and self.engine_seconds is not None:
@@ -1031,6 +1090,8 @@ def print_summary(data):
     print(markdown_table(data["rows"], data["scenes"]))
     print()
     print(techniques_table(data["rows"], data["scenes"]))
+    print()
+    print(error_budget_table(data["rows"], data["scenes"]))
     print()
     checks = [goal_check(data["rows"], name, info.get("kind"), info.get("roughness"))
               for name, info in data["scenes"].items()]

@@ -209,3 +209,15 @@ def test_before_after_table_lists_both_versions():
              truth_suite.make_row("s", "SG-PRT 2x2", "2x", 0.4, relative_rmse=0.1)]
     table = truth_suite.before_after_table(before, after, ["s"]).splitlines()
     assert table[2] == "| s | 0.500 | 0.250 | -0.080 | +0.010 | 0.200 | 0.100 | - | 0.100 |"
+
+
+def test_error_budget_splits_the_shading_from_the_rest():
+    rows = [ts.make_row("s", "SG-PRT", "bake", 0.1, relative_rmse=0.5),
+            ts.make_row("s", "SG-PRT unshadowed", "no bake", 0.1, relative_rmse=0.9, shading_relative_rmse=0.3,
+                        shading_relative_bias=-0.02),
+            ts.make_row("s", "Cycles unshadowed", "truth", 1.0, unshadowed_noise_floor=0.01),
+            ts.make_row("t", "SG-PRT", "bake", 0.1, relative_rmse=0.1)]          # no unshadowed truth
+    table = ts.error_budget_table(rows, {"s": {"kind": "glossy", "roughness": 0.3}, "t": {"kind": "diffuse"}})
+    lines = table.splitlines()
+    assert lines[2] == "| s | glossy 0.3 | 0.500 | 0.300 / -0.020 | 0.400 | 0.010 |"      # sqrt(0.5^2 - 0.3^2)
+    assert lines[3] == "| t | diffuse | 0.100 | - / - | - | - |"
