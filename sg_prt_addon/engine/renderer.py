@@ -307,15 +307,19 @@ class _DrawContext(techniques.DrawContext):
     def image(self, slot):
         return self.renderer.textures[_texture_key(self.params.textures[slot], slot, self.params)]
 
-    def object_target(self, name, size):
+    def object_target(self, name, size, sources=()):
         import gpu
 
         targets = self.renderer.object_targets.setdefault(self.object_key, {})
         target = targets.get(name)
         if target is None or (target[0].width, target[0].height) != tuple(size):
             texture = gpu.types.GPUTexture(tuple(size), format="RGBA32F")
-            target = targets[name] = (texture, gpu.types.GPUFrameBuffer(color_slots=texture))
-        return target
+            target = (texture, gpu.types.GPUFrameBuffer(color_slots=texture), None)
+        drawn_from = target[2]
+        current = bool(sources) and drawn_from is not None and len(drawn_from) == len(sources) and all(
+            a is b for a, b in zip(drawn_from, sources))
+        targets[name] = (target[0], target[1], tuple(sources))
+        return target[0], target[1], current
 
     def object_table(self, name, sources, build):
         tables = self.renderer.object_tables.setdefault(self.object_key, {})
@@ -354,7 +358,7 @@ class Renderer:
         self.tables = {}                # a technique's tables (DrawContext.table): name -> GPUTexture
         self.environment_tables = {}    # name -> (EnvironmentData, GPUTexture) (DrawContext.environment_table)
         self.material_tables = {}       # material name -> {name: GPUTexture} (DrawContext.material_table)
-        self.object_targets = {}        # object key -> {name: (GPUTexture, GPUFrameBuffer)} of techniques' passes
+        self.object_targets = {}        # object key -> {name: (GPUTexture, GPUFrameBuffer, sources)} of techniques' passes
         self.object_tables = {}         # object key -> {name: (sources, GPUTexture)} (DrawContext.object_table)
         self.scene_buffer = None
         self.environment_texture = None

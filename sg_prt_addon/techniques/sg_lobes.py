@@ -339,19 +339,21 @@ def draw_diffuse_visibility(keys, context):
     buffers = context.per_vertex(VISIBILITY_KIND)
     import gpu  # the gpu module exists only in Blender's GPU context
 
-    coverage, coverage_framebuffer = context.object_target(
-        "quadrature_coverage", (buffers.vertices_per_row * COVERAGE_TEXELS, buffers.rows_texture.height))
-    shader = context.fixed_shader(("vertex_coverage", key.visibility_layers),
-                                  lambda: vertex_coverage_calls(key.visibility_layers))
-    with coverage_framebuffer.bind():
-        gpu.state.depth_test_set("NONE")
-        gpu.state.blend_set("NONE")
-        shader.bind()
-        shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
-        shader.uniform_sampler("visibility_basis", buffers.basis_texture)
-        context.full_screen_batch(shader, "vertex_coverage").draw(shader)
+    # the coverage depends on the bake alone: drawn again only for new buffers (a new bake or mesh)
+    coverage, coverage_framebuffer, current = context.object_target(
+        "quadrature_coverage", (buffers.vertices_per_row * COVERAGE_TEXELS, buffers.rows_texture.height), (buffers,))
+    if not current:
+        shader = context.fixed_shader(("vertex_coverage", key.visibility_layers),
+                                      lambda: vertex_coverage_calls(key.visibility_layers))
+        with coverage_framebuffer.bind():
+            gpu.state.depth_test_set("NONE")
+            gpu.state.blend_set("NONE")
+            shader.bind()
+            shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
+            shader.uniform_sampler("visibility_basis", buffers.basis_texture)
+            context.full_screen_batch(shader, "vertex_coverage").draw(shader)
 
-    texture, framebuffer = context.object_target(
+    _, framebuffer, _ = context.object_target(
         "diffuse_visibility", (buffers.vertices_per_row * rows, buffers.rows_texture.height))
     shader = context.fixed_shader(("vertex_visibility", key.visibility_layers, rows, key.has_environment),
                                   lambda: vertex_visibility_calls(key.visibility_layers, rows, key.has_environment))
