@@ -384,7 +384,9 @@ def vertex_coverage_calls(visibility_layers):
     defines = {"HAS_VISIBILITY": 1, "SSDF_MAX_LAYERS": visibility_layers, "COVERAGE_TEXELS": COVERAGE_TEXELS,
                **quadrature_defines()}
     calls = shader_sources.full_screen_calls("sgprt_vertex_coverage_interface", defines)
-    calls += [("sampler", (0, "FLOAT_2D", "visibility_coefficients")),
+    # the scene block, unused and unbound: without a uniform block Blender 5.3's OpenGL backend drew nothing
+    # from this pass once it sampled its textures (the coverage came out zero; 5.0 drew it either way)
+    calls += [("uniform_buf", (0, "SceneData", "scene")), ("sampler", (0, "FLOAT_2D", "visibility_coefficients")),
               ("sampler", (1, "FLOAT_2D_ARRAY", "visibility_basis")), ("fragment_out", (0, "VEC4", "out_coverage"))]
     sources = [shader_sources.library_source(name)
                for name in ("sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", "ssdf.glsl", "ssdf_quadrature.glsl")]
