@@ -318,8 +318,14 @@ class _DrawContext(techniques.DrawContext):
         drawn_from = target[2]
         current = bool(sources) and drawn_from is not None and len(drawn_from) == len(sources) and all(
             a is b for a, b in zip(drawn_from, sources))
-        targets[name] = (target[0], target[1], tuple(sources))
+        # not current: forgotten until object_target_drawn, so a pass that fails is drawn again next time
+        targets[name] = target if current else (target[0], target[1], None)
         return target[0], target[1], current
+
+    def object_target_drawn(self, name, sources):
+        target = self.renderer.object_targets.get(self.object_key, {}).get(name)
+        if target is not None:
+            self.renderer.object_targets[self.object_key][name] = (target[0], target[1], tuple(sources))
 
     def object_table(self, name, sources, build):
         tables = self.renderer.object_tables.setdefault(self.object_key, {})

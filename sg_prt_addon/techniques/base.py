@@ -79,8 +79,9 @@ class DrawContext:
     object_table(name, sources, build): a GPU texture of build()'s array for the object, remade when any of
       the objects in the tuple `sources` is not the one it was made from, dropped with the object;
     object_target(name, size, sources=()): a float RGBA (texture, framebuffer, current) of the object, kept while
-      it lives; current: the target was kept and was last asked for with the same `sources` (by identity; never
-      with none), so a pass drawn from them alone need not be drawn again;
+      it lives; current: the target was kept and object_target_drawn(name, sources) said it was drawn from the
+      same `sources` (by identity; never with none), so a pass drawn from them alone need not be drawn again;
+    object_target_drawn(name, sources): after a pass drew the target from `sources`;
     object_texture(name): the texture of object_target(name, ...), or None;
     fixed_shader(cache_key, create_info_calls): a compiled shader of a pass of the technique's own;
     full_screen_batch(shader, name): a triangle covering the target for the pass `name`, position in NDC.

@@ -352,6 +352,7 @@ def draw_diffuse_visibility(keys, context):
             shader.uniform_sampler("visibility_coefficients", buffers.rows_texture)
             shader.uniform_sampler("visibility_basis", buffers.basis_texture)
             context.full_screen_batch(shader, "vertex_coverage").draw(shader)
+        context.object_target_drawn("quadrature_coverage", (buffers,))
 
     _, framebuffer, _ = context.object_target(
         "diffuse_visibility", (buffers.vertices_per_row * rows, buffers.rows_texture.height))

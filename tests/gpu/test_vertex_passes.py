@@ -70,3 +70,44 @@ def test_coverage_is_drawn_once_a_bake(engine, bakes, pass_counts):
     result = fx.render(scene)
     assert "error" not in result, result.get("error")
     assert pass_counts == {"vertex_coverage": 2, "vertex_visibility": 2}, pass_counts
+
+
+def test_a_failed_coverage_pass_is_drawn_again(engine, bakes, monkeypatch):
+    """A viewport whose coverage pass failed (an error injected into its draw) draws it again at its next
+    redraw, and then shows what the final render shows: a failed pass is not taken for a current one."""
+    from sg_prt_addon.engine import render_engine, renderer
+
+    scene, sphere, floor = _scene("vertex_passes_failed")
+    bakes(scene, [sphere, floor], resolution=8)
+    original = renderer._DrawContext.full_screen_batch
+    drawn, failures = [], []
+
+    def failing_once(self, shader, name):
+        if name == "vertex_coverage":
+            if not failures:
+                failures.append(name)
+                raise RuntimeError("injected")
+            drawn.append(name)
+        return original(self, shader, name)
+
+    def viewport(depsgraph, state, renderer_, camera):
+        width, height = renderer_.size
+        state.mark_all_dirty()                           # a new viewport uploads everything
+        frame = render_engine.ViewportFrame()
+        monkeypatch.setattr(renderer._DrawContext, "full_screen_batch", failing_once)
+        try:
+            with pytest.raises(RuntimeError, match="injected"):
+                frame.update(state, camera, width, height)
+            assert frame.update(state, camera, width, height)      # a failed draw is tried again
+        finally:
+            monkeypatch.setattr(renderer._DrawContext, "full_screen_batch", original)
+        return frame.renderer.read_output("combined")
+
+    render_engine.debug["after_frame"] = viewport
+    try:
+        result = fx.render(scene)
+    finally:
+        render_engine.debug["after_frame"] = None
+    assert "error" not in result, result.get("error")
+    assert failures == ["vertex_coverage"] and drawn == ["vertex_coverage", "vertex_coverage"]   # both objects
+    np.testing.assert_allclose(result["after_frame"], result["passes"]["Combined"], rtol=1e-5, atol=1e-6)
