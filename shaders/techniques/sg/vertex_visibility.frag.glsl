@@ -10,18 +10,19 @@
  * vertices than the pixels it covers.  The vertex normal stands in for the shading normal (the cosine
  * integral itself stays per pixel). */
 
+/* The vertex's coverage at each point, and the points and their open coverage (set once a texel, not a lobe) */
 float quadrature_coverage[SSDF_QUADRATURE_POINTS];
+vec3 quadrature_points[SSDF_QUADRATURE_POINTS];
+float quadrature_open[SSDF_QUADRATURE_POINTS];
 
 /* The quadrature's visible fraction of G(i; local_axis, sharpness) i.z (broad_lobes.quadrature_visible_fraction). */
 float quadrature_fraction(vec3 local_axis, float sharpness)
 {
-  float radius = sqrt(2.0 / float(SSDF_QUADRATURE_POINTS));
   float visible = 0.0, open = 0.0;
   for (int j = 0; j < SSDF_QUADRATURE_POINTS; j++) {
-    vec3 point = ssdf_quadrature_point(j);
-    float lobe = exp(sharpness * (dot(point, local_axis) - 1.0)) * point.z;
+    float lobe = exp(sharpness * (dot(quadrature_points[j], local_axis) - 1.0)) * quadrature_points[j].z;
     visible += lobe * quadrature_coverage[j];
-    open += lobe * ssdf_cell_coverage(asin(point.z), radius);
+    open += lobe * quadrature_open[j];
   }
   return clamp(visible / max(open, 1.0e-30), 0.0, 1.0);
 }
@@ -52,6 +53,11 @@ void main()
     for (int j = 0; j < 4; j++) {
       quadrature_coverage[4 * t + j] = shares[j];
     }
+  }
+  float radius = sqrt(2.0 / float(SSDF_QUADRATURE_POINTS));
+  for (int j = 0; j < SSDF_QUADRATURE_POINTS; j++) {
+    quadrature_points[j] = ssdf_quadrature_point(j);
+    quadrature_open[j] = ssdf_cell_coverage(asin(quadrature_points[j].z), radius);
   }
   vec4 fractions = vec4(1.0);
 #ifdef HAS_ENVIRONMENT
