@@ -100,9 +100,9 @@ def test_environment_shadows_under_courtyard(engine, bakes):
     fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
     scores, noise = _scores(scene, sphere, floor, bakes, 0.025)
     assert noise < 0.04
-    # measured (64 x 64, bake R = 16): shadowed 0.062 (bias -0.001), unshadowed 0.194 (bias +0.096),
-    # reference noise floor 0.028
-    assert scores["shadowed"][0] < 0.09
+    # measured (64 x 64, bake R = 16): shadowed 0.056 (bias +0.001; 0.062 with eq. 30's reading of the diffuse
+    # lobes), unshadowed 0.194 (bias +0.101), reference noise floor 0.028
+    assert scores["shadowed"][0] < 0.08
     assert abs(scores["shadowed"][1]) < 0.03
     assert scores["shadowed"][0] < 0.5 * scores["unshadowed"][0]
 
