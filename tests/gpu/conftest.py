@@ -103,6 +103,15 @@ class Fuzz:
 
 
 @pytest.fixture
+def bakes():
+    """engine_fixtures.bake_objects for a test, every bake cleared after it."""
+    import engine_fixtures as fx
+
+    yield fx.bake_objects
+    fx.clear_bakes()
+
+
+@pytest.fixture
 def fuzz(request):
     """A Fuzz seeded from the test's name: reproducible, different per test."""
     return Fuzz(zlib.crc32(request.node.name.encode()))

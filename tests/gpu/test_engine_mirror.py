@@ -185,12 +185,6 @@ def test_orthographic_camera(engine):
     _check(result)
 
 
-@pytest.fixture
-def bakes():
-    yield fx.bake_objects
-    fx.clear_bakes()
-
-
 def _shadow_scene(name, size):
     """A sphere over a 24 x 24 floor, both baked (the sphere shadows the floor and itself)."""
     scene = fx.new_scene(name, size, size)

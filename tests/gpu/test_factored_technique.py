@@ -68,12 +68,6 @@ def test_shader_matches_mirror(engine, world):
     assert max(errors.values()) <= TOLERANCE
 
 
-@pytest.fixture
-def bakes():
-    yield fx.bake_objects
-    fx.clear_bakes()
-
-
 @pytest.mark.parametrize("world", ["colour", "environment"])
 def test_shadowed_shader_matches_mirror(engine, bakes, world):
     """A sphere over a floor, both baked: every light, environment lobe and the glossy lookup shadowed by its

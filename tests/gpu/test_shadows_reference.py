@@ -27,12 +27,6 @@ def engine(blender):
     return blender
 
 
-@pytest.fixture
-def bakes():
-    yield fx.bake_objects
-    fx.clear_bakes()
-
-
 def _scene(name):
     scene = fx.new_scene(name, SIZE, SIZE)
     scene.camera.location = (0.0, -5.5, 4.0)

@@ -14,12 +14,6 @@ def engine(blender):
 
 
 @pytest.fixture
-def bakes():
-    yield fx.bake_objects
-    fx.clear_bakes()
-
-
-@pytest.fixture
 def pass_counts(monkeypatch):
     """Full-screen passes drawn by the techniques, by name."""
     from sg_prt_addon.engine import renderer
