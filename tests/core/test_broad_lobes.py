@@ -11,14 +11,6 @@ from sg_prt_addon.visibility import broad_lobes
 DENSE = 400_000
 
 
-def _fibonacci_hemisphere(count):
-    k = np.arange(count) + 0.5
-    z = k / count
-    phi = np.pi * (3.0 - np.sqrt(5.0)) * np.arange(count)
-    r = np.sqrt(1.0 - z * z)
-    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
-
-
 def _cap_ssdf(direction, centre, radius):
     """Signed angle (+ visible) to the occluded set: below the horizon, or within `radius` of `centre` (a
     cap wholly above the horizon)."""
@@ -28,7 +20,7 @@ def _cap_ssdf(direction, centre, radius):
 
 
 def _exact(axes, sharpness, centre, radius):
-    points = _fibonacci_hemisphere(DENSE)
+    points = broad_lobes.quadrature_points(DENSE)       # equal-area cells, dense
     visible = np.arccos(np.clip(points @ centre, -1, 1)) >= radius
     lobe = np.exp(sharpness * (axes @ points.T - 1.0)) * points[:, 2]
     return (lobe * visible).sum(-1) / lobe.sum(-1)
