@@ -332,10 +332,10 @@ def draw_diffuse_visibility(keys, context):
     diffuse_visibility_rows: a bake and a diffuse term; the SG techniques' and the factored one's): the SSDF's
     coverage at the quadrature points (vertex_coverage.frag.glsl), then each lobe's visible fraction
     (vertex_visibility.frag.glsl), in the coefficient texture's rows."""
-    rows = max((getattr(key, "diffuse_visibility_rows", 0) for key in keys), default=0)
+    rows = max((key.diffuse_visibility_rows for key in keys), default=0)
     if not rows:
         return
-    key = next(key for key in keys if getattr(key, "diffuse_visibility_rows", 0))
+    key = next(key for key in keys if key.diffuse_visibility_rows)
     buffers = context.per_vertex(VISIBILITY_KIND)
     import gpu  # the gpu module exists only in Blender's GPU context
 

@@ -2,11 +2,12 @@
  * sg_prt_addon/visibility/broad_lobes.py.  Depends on sg.glsl.
  *
  *   ssdf_quadrature_point        <- broad_lobes.quadrature_points (one row)
+ *   ssdf_cell_radius             <- broad_lobes.cell_radius
  *   ssdf_cell_coverage           <- broad_lobes.cell_coverage
  *   ssdf_quadrature_weight       <- broad_lobes.quadrature_weight
  *
  * The points (SSDF_QUADRATURE_POINTS, equal-area cells of the local upper hemisphere) and the hand-over to
- * eq. 30 come from the module (techniques/shader_sources.py LIMITS); the sums are written where the
+ * eq. 30 come from the module (techniques/sg_lobes.py quadrature_defines); the sums are written where the
  * decoded coverages are read (techniques/sg/vertex_visibility.frag.glsl). */
 
 const float SSDF_GOLDEN_ANGLE = 2.399963229728653;
@@ -18,6 +19,12 @@ vec3 ssdf_quadrature_point(int j)
   float phi = float(j) * SSDF_GOLDEN_ANGLE;
   float r = sqrt(max(1.0 - z * z, 0.0));
   return vec3(r * cos(phi), r * sin(phi), z);
+}
+
+/* Angular radius of a disc of one cell's solid angle, 2 pi / SSDF_QUADRATURE_POINTS. */
+float ssdf_cell_radius()
+{
+  return sqrt(2.0 / float(SSDF_QUADRATURE_POINTS));
 }
 
 /* Visible share of a disc of `radius` whose centre lies `signed_distance` (+ visible) from a straight

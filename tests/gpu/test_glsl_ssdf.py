@@ -105,7 +105,10 @@ def test_quadrature_points_coverage_and_weight(glsl, fuzz, record_error):
     distance = fuzz.f32(np.concatenate([fuzz.rng.uniform(-0.5, 0.5, N - 4), [-1.0, 1.0, 0.0, 0.25]]))
     sharpness = fuzz.f32(fuzz.rng.uniform(0.0, 40.0, N))
     inputs = {"a": np.stack([distance, sharpness, distance, sharpness], 1)}
-    out = glsl(library, "vec4(ssdf_cell_coverage(a.x, 0.25), ssdf_quadrature_weight(a.y), 0, 0)", inputs, 2)
+    out = glsl(library, "vec4(ssdf_cell_coverage(a.x, 0.25), ssdf_quadrature_weight(a.y), ssdf_cell_radius(), 0)",
+               inputs, 3)
+    assert record_error("ssdf cell radius, relative",
+                        np.abs(out[:, 2] / broad_lobes.cell_radius() - 1).max()) <= 1e-6
     # llvmpipe's float32 asin (a polynomial): measured 1.2e-4
     assert record_error("ssdf cell coverage, absolute",
                         np.abs(out[:, 0] - broad_lobes.cell_coverage(distance, 0.25)).max()) <= 5e-4

@@ -535,11 +535,12 @@ def test_ssdf_quadrature_stress(glsl, fuzz):
     defines = "".join(f"#define {name} {value}\n" for name, value in sg_lobes.quadrature_defines().items())
     body = """
     vec3 point = ssdf_quadrature_point(int(a.w) % SSDF_QUADRATURE_POINTS);
-    result = vec4(dot(point, vec3(1.0)), ssdf_cell_coverage(a.x, a.y), ssdf_quadrature_weight(a.z), 0.0);
+    result = vec4(dot(point, vec3(1.0)), ssdf_cell_coverage(a.x, a.y), ssdf_quadrature_weight(a.z),
+                  ssdf_cell_radius());
     """
-    out = glsl(["sg.glsl", defines, "ssdf_quadrature.glsl"], body, inputs, 3)
+    out = glsl(["sg.glsl", defines, "ssdf_quadrature.glsl"], body, inputs, 4)
     _assert_finite(out, "ssdf_quadrature.glsl")
-    assert out[:, 1:].min() >= 0 and out[:, 1:].max() <= 1
+    assert out[:, 1:3].min() >= 0 and out[:, 1:3].max() <= 1
 
 
 def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
@@ -1072,7 +1073,8 @@ COVERED = {
     test_env_prefilter_helpers_stress: ["env_sign_not_zero", "oct_encode", "env_prefilter_blend_parameter"],
     test_ssdf_stress: ["hemisphere_map_disc_to_square", "hemisphere_map_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",
                        "ssdf_to_local", "ssdf_decode", "ssdf_visibility_amplitude", "ssdf_shadowed_integral"],
-    test_ssdf_quadrature_stress: ["ssdf_quadrature_point", "ssdf_cell_coverage", "ssdf_quadrature_weight"],
+    test_ssdf_quadrature_stress: ["ssdf_quadrature_point", "ssdf_cell_radius", "ssdf_cell_coverage",
+                                  "ssdf_quadrature_weight"],
     test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility"],
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
     test_factored_brdf_stress: ["parabolic_uv", "factored_brdf"],

@@ -12,7 +12,7 @@ void main()
   for (int layer = 0; layer < SSDF_MAX_LAYERS; layer++) {
     visibility_rows[layer] = texelFetch(visibility_coefficients, ivec2(slot * SSDF_MAX_LAYERS + layer, texel.y), 0);
   }
-  float radius = sqrt(2.0 / float(SSDF_QUADRATURE_POINTS));
+  float radius = ssdf_cell_radius();
   vec4 coverage;
   for (int j = 0; j < 4; j++) {
     float theta = ssdf_decode(visibility_basis, visibility_rows, SSDF_MAX_LAYERS, ssdf_quadrature_point(first_point + j));

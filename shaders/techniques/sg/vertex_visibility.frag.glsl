@@ -54,7 +54,7 @@ void main()
       quadrature_coverage[4 * t + j] = shares[j];
     }
   }
-  float radius = sqrt(2.0 / float(SSDF_QUADRATURE_POINTS));
+  float radius = ssdf_cell_radius();
   for (int j = 0; j < SSDF_QUADRATURE_POINTS; j++) {
     quadrature_points[j] = ssdf_quadrature_point(j);
     quadrature_open[j] = ssdf_cell_coverage(asin(quadrature_points[j].z), radius);
