@@ -210,6 +210,14 @@ def _met(value):
     return "n/a" if value is None else ("met" if value else "NOT met")
 
 
+def kind_label(info):
+    """A scene's kind for the tables: diffuse, or glossy with its roughness."""
+    kind = info.get("kind", "-")
+    if kind == "glossy" and info.get("roughness") is not None:
+        kind = f"glossy {info['roughness']:g}"
+    return kind
+
+
 def markdown_table(rows, scenes):
     """One line per scene (``scenes``: ordered names) of the figures the summary shows."""
     lines = ["| scene | kind | SG-PRT rel. RMSE | SG-PRT bias | SG-PRT HDR-FLIP | SG-PRT unshadowed RMSE "
@@ -226,9 +234,7 @@ def markdown_table(rows, scenes):
         one_sample = find_row(rows, name, "SG-PRT 1 sample") or {}
         supersampled = find_row(rows, name, "SG-PRT 2x2") or {}
         sampled = find_row(rows, name, "SG-PRT 16 samples") or {}
-        kind = info.get("kind", "-")
-        if kind == "glossy" and info.get("roughness") is not None:
-            kind = f"glossy {info['roughness']:g}"
+        kind = kind_label(info)
         equal_cell = _number(equal.get("hdr_flip"))
         if equal.get("samples") is not None:
             equal_cell += f" ({equal['samples']})"
@@ -253,9 +259,7 @@ def techniques_table(rows, scenes):
                                            for m in methods) + " | noise floor |",
              "|---|---|" + "---|" * len(methods) + "---|"]
     for name, info in scenes.items():
-        kind = info.get("kind", "-")
-        if kind == "glossy" and info.get("roughness") is not None:
-            kind = f"glossy {info['roughness']:g}"
+        kind = kind_label(info)
         cells = []
         for method in methods:
             row = find_row(rows, name, method) or {}
@@ -278,9 +282,7 @@ def error_budget_table(rows, scenes):
         truth = find_row(rows, name, "Cycles unshadowed") or {}
         total, shading = engine.get("relative_rmse"), unshadowed.get("shading_relative_rmse")
         share = None if total is None or shading is None else math.sqrt(max(total * total - shading * shading, 0.0))
-        kind = info.get("kind", "-")
-        if kind == "glossy" and info.get("roughness") is not None:
-            kind = f"glossy {info['roughness']:g}"
+        kind = kind_label(info)
         lines.append(f"| {name} | {kind} | {_number(total)} | {_number(shading)} / "
                      f"{_signed(unshadowed.get('shading_relative_bias'))} | {_number(share)} | "
                      f"{_number(truth.get('unshadowed_noise_floor'))} |")
