@@ -16,41 +16,41 @@ point lights as SGs) takes them unchanged:
              where h.wo is larger, i.e. towards the normal).  The paper's
              single lobe has the geometric-mean sharpness lambda / (4 c): too
              narrow in the plane, so at grazing views it sits at the horizon
-             and loses most of its cosine-weighted energy.  split2 first
-             splits the NDF lobe into two half-amplitude lobes offset by
-             +-delta along the plane of incidence, delta = sqrt((1 - c) /
-             lambda) (the two-point Gauss-Hermite rule, shrunk so that the
-             in-plane variance of the pair after warping, 4c/lambda +
-             4 delta^2, equals the true 4/lambda), then warps each with the
-             paper's rule at its own centre, so each half gets its own
-             Jacobian: the fan shape and the energy near the horizon come
-             back.  At normal incidence delta = 0 and split2 equals 'paper'.
-             Sub-lobes whose centre is not a valid half vector (h.wo <= 0) get
-             zero amplitude: no wi reflects wo about them.  delta is capped at
-             MAX_SPLIT_OFFSET, and the cap fades to 0 below lambda =
-             FULL_SPLIT_SHARPNESS: for broad lobes the split overshoots the
-             planar model it comes from, so they stay (nearly) 'paper'.
+             and loses most of its cosine-weighted energy, and too wide
+             across it.  split2 splits the NDF lobe into two half-amplitude
+             lobes offset by +-delta along the plane of incidence (the
+             two-point Gauss-Hermite rule) and warps each with the paper's
+             rule at its own centre, so each half gets its own Jacobian: the
+             fan shape and the energy near the horizon come back.  delta =
+             sqrt((1 - c m) / lambda) (m = 1 here) makes the in-plane variance
+             of the pair after warping, 4 c m / lambda + 4 delta^2, the true
+             4 / lambda.  At normal incidence delta = 0 and split2 equals
+             'paper'.  Sub-lobes whose centre is not a valid half vector
+             (h.wo <= 0) get zero amplitude: no wi reflects wo about them.
+             delta is capped at MAX_SPLIT_OFFSET, and the cap fades to 0 below
+             lambda = FULL_SPLIT_SHARPNESS: for broad lobes the split
+             overshoots the planar model it comes from, so they stay (nearly)
+             'paper'.
 
-``'split3'`` (default) the same with the three-point rule (nodes 0,
-             +-sqrt(3) delta, weights 2/3, 1/6, 1/6), three lobes.
+``'split3'`` (default) the three-point rule (nodes 0, +-sqrt(3) delta,
+             weights 2/3, 1/6, 1/6), three lobes, each of the true ACROSS-plane
+             sharpness lambda / (4 c_i m), m = c, with its amplitude over m so
+             that the parts keep the warped lobe's integral (the centre node
+             fills the middle, so the narrower parts still make one streak).
+             Below c = 1/2, m = 1 - c: back to the paper's width at grazing
+             views, where parts of the true width across would draw apart
+             into separate spots (``split_across``).  Where the offset cap
+             bites, m grows back towards 1 to hold the in-plane variance the
+             offsets no longer give.  (With m = 1, the paper's width, the
+             environment's specular at views of 45-70 degrees read a lobe
+             1 / sqrt(c) too wide across the plane.)
 
-Measured (benchmarks/accuracy/warp.py, quadrature of D(h(wi)), lambda =
-2/alpha^2): cosine-weighted energy ratio at 85 deg for alpha 0.05 / 0.1 /
-0.3 / 0.5: paper 0.75 / 0.46 / 0.15 / 0.11, split2 0.98 / 1.03 / 1.05 / 0.56,
-split3 0.99 / 0.95 / 0.86 / 0.45.  Relative L2 over lambda 1..1e4 (mean) at
-60 / 75 / 85 deg: paper 0.34 / 0.61 / 0.94, split2 0.31 / 0.54 / 0.74,
-split3 0.28 / 0.49 / 0.77.  On the grid lambda 0.3..1e4 x views 0..85 deg
-split2 is never worse than 'paper' by more than 0.05 in energy or 0.01 in L2.
-
-End to end, eq. 22 with GGX's own SG lobe and Mo (roughness 0.2-0.9), mean
-|energy ratio - 1| at 60 / 75 / 85 / 89 deg: paper 0.031 / 0.080 / 0.198 /
-0.638, split2 0.021 / 0.152 / 0.130 / 0.336, split3 0.021 / 0.090 / 0.122 /
-0.315.  split2 loses at 75 deg because a sub-lobe whose centre falls below
-the horizon gets Mo = 0 while part of it is above (split3 gives that node
-only 1/6 of the weight).  Evaluating Mo at a lifted centre (the lobe's mean
-upper-hemisphere cosine) was measured and is worse.  So split3 is the
-default: as good as 'paper' up to 75 deg (mean within 0.01), better beyond,
-for 3x the lobes; split2 is the cheaper middle ground.
+Measured (benchmarks/accuracy/warp.py, quadrature of D(h(wi)), lambda = 2 / alpha^2 for alpha 0.05-0.5
+and 1..1e4; docs/ACCURACY.md "warp"): the lobes' response to SG lights (what the prefiltered environment,
+sphere lights and the visibility products read) and their energy are what the split keeps right; their
+pointwise shape at grazing views is not (separate parts where the true lobe is one streak).  The figures
+are in ACCURACY.md's warp table and in tests/core/test_warp.py.  split3 is the default: three lobes a NDF
+lobe for a lower error than split2 at 60-85 degrees; split2 is the cheaper middle ground.
 
 Not a mode: an anisotropic SG (Xu et al. 2013) with the exact Jacobian at the
 centre has a much lower L2 for sharp lobes (mean 0.17 at 60 deg against
@@ -96,17 +96,28 @@ def _dot(a, b):
     return np.sum(a * b, axis=-1)
 
 
-def _warp_at(half, sharpness, wo, signed_cos):
+def _warp_at(half, sharpness, wo, signed_cos, across=1.0):
     """Paper's per-lobe warp (eq. 18-21) of lobes centred at ``half``.
 
     Returns the reflected axis psi(half) = 2 (wo.h) h - wo (unit for unit h and
     wo: |psi|^2 = 4 c^2 - 4 c^2 + 1, so no normalize) and the sharpness
-    lambda / tau with tau = 4 |half.wo| clamped below by 4 COS_FLOOR.
+    lambda / tau with tau = 4 |half.wo| clamped below by 4 COS_FLOOR, times
+    ``across`` (the split modes' m, 1 for the paper's warp).
     """
     axis = 2 * signed_cos[..., None] * half - wo
-    tau = 4 * np.maximum(np.abs(signed_cos), COS_FLOOR)
+    tau = 4 * np.maximum(np.abs(signed_cos), COS_FLOOR) * across
     warped_sharpness = np.minimum(sharpness / tau, MAX_WARPED_SHARPNESS)
     return axis, warped_sharpness
+
+
+def split_across(cosine, mode):
+    """m of a split mode at c = |p.wo|: its parts are lambda / (4 c_i m) sharp (module doc).  split3: m = c
+    (the true width across the plane) down to c = 1/2, then back towards the paper's m = 1 as c -> 0;
+    split2: m = 1 (its two parts, narrowed, would draw apart into two spots: relative L2 at 60 degrees 0.42
+    against the paper's 0.34)."""
+    if mode == "split2":
+        return np.ones_like(cosine)
+    return np.maximum(cosine, 1 - cosine)
 
 
 def warp_lobes(axis, sharpness, amplitude, wo, mode=DEFAULT_MODE):
@@ -142,17 +153,25 @@ def warp_lobes(axis, sharpness, amplitude, wo, mode=DEFAULT_MODE):
     # wo near -axis: wo - c axis cancels, so restore orthogonality (the error left is second order)
     in_plane = in_plane - _dot(in_plane, axis)[..., None] * axis
     safe_sharpness = np.where(sharpness > 0, sharpness, 1)
-    offset_squared = np.where(sharpness > 0, (1 - signed_cos) / safe_sharpness, np.inf)
+    cosine = np.maximum(np.abs(signed_cos), COS_FLOOR)
+    across = split_across(cosine, mode)
+    offset_squared = np.where(sharpness > 0, (1 - signed_cos * across) / safe_sharpness, np.inf)
     # broad lobes: the split overshoots the planar model it is derived from, fade back to 'paper'
     offset_cap = MAX_SPLIT_OFFSET * np.minimum(sharpness * (1 / FULL_SPLIT_SHARPNESS), 1)
-    offset = np.minimum(np.sqrt(offset_squared), offset_cap)
+    uncapped = np.sqrt(offset_squared)
+    offset = np.minimum(uncapped, offset_cap)
+    # where the cap bites, wider parts hold the in-plane variance the offsets no longer give (m -> 1: 'paper')
+    across = np.where(offset_cap < uncapped, np.clip((1 - safe_sharpness * offset * offset) / cosine, across, 1),
+                      across)
     nodes, weights = (np.array(r, dtype) for r in SPLIT_RULES[mode])   # node > 0: towards wo
     node_offset = offset[..., None] * nodes                               # (..., K, n)
     half = (np.cos(node_offset)[..., None] * axis[..., None, :]
             + np.sin(node_offset)[..., None] * in_plane[..., None, :])    # (..., K, n, 3)
     half_cos = _dot(half, wo[..., None, :])
-    warped_axis, warped_sharpness = _warp_at(half, sharpness[..., None], wo[..., None, :], half_cos)
-    warped_amplitude = np.where(half_cos > 0, weights * amplitude[..., None], 0).astype(dtype)
+    warped_axis, warped_sharpness = _warp_at(half, sharpness[..., None], wo[..., None, :], half_cos,
+                                             across[..., None])
+    # amplitude over m: the narrower parts keep the warped lobe's integral
+    warped_amplitude = np.where(half_cos > 0, weights * (amplitude / across)[..., None], 0).astype(dtype)
     shape = warped_sharpness.shape[:-2] + (len(nodes) * warped_sharpness.shape[-2],)
     return (warped_axis.reshape(shape + (3,)), warped_sharpness.reshape(shape),
             warped_amplitude.reshape(shape))
@@ -229,13 +248,19 @@ def slice_errors(wo, ndf_axis, ndf_sharpness, mode, azimuths=1024, panels=30, no
     Returns dict: energy_sphere (integral ratio approx / true over the
     sphere), energy_cosine (same, weighted by max(0, wi.z)), l2 (relative L2
     error over the sphere), l2_cosine (relative L2 error weighted by the
-    clamped cosine).
+    clamped cosine), lit (the relative RMS error of what the slice reflects of
+    SG lights as narrow as the true lobe is across (sharpness lambda / (4 c^2)),
+    on a 5 x 5 grid of axes one width apart in and across the plane of
+    incidence around the true centre, cosine-weighted: what a consumer that
+    integrates the slice against light -- the prefiltered environment, sphere
+    lights -- sees of its shape).
     """
     wo = np.asarray(wo, float) / np.linalg.norm(wo)
     ndf_axis = np.asarray(ndf_axis, float) / np.linalg.norm(ndf_axis)
-    centre = 2 * (wo @ ndf_axis) * ndf_axis - wo
+    cosine_view = wo @ ndf_axis
+    centre = 2 * cosine_view * ndf_axis - wo
     # finest feature: the across-plane width of the true lobe, 2 c / sqrt(lambda)
-    finest = 2 * max(abs(wo @ ndf_axis), 0.02) / np.sqrt(max(ndf_sharpness, 1.0))
+    finest = 2 * max(abs(cosine_view), 0.02) / np.sqrt(max(ndf_sharpness, 1.0))
     directions, weights = lighting_quadrature(centre, finest, azimuths, panels, nodes)
     exact = true_slice(directions, wo, ndf_axis[None], np.array([ndf_sharpness]))
     lobes = warp_lobes(ndf_axis[None], np.array([ndf_sharpness]), np.array([1.0]), wo, mode)
@@ -246,4 +271,22 @@ def slice_errors(wo, ndf_axis, ndf_sharpness, mode, azimuths=1024, panels=30, no
         out["energy_" + name] = float(np.sum(approx * w) / np.sum(exact * w))
         l2 = np.sqrt(np.sum((approx - exact) ** 2 * w) / np.sum(exact ** 2 * w))
         out["l2" if name == "sphere" else "l2_cosine"] = float(l2)
+    out["lit"] = _lit_error(centre, wo, finest, exact, approx, directions, weights * cosine)
     return out
+
+
+def _lit_error(centre, wo, finest, exact, approx, directions, weights):
+    """slice_errors' ``lit``: relative RMS over a 5 x 5 grid of SG lights of width ``finest`` (see there)."""
+    in_plane = wo - (wo @ centre) * centre
+    in_plane = in_plane / np.linalg.norm(in_plane) if np.linalg.norm(in_plane) > 1e-9 else _frame(centre)[0]
+    across = np.cross(centre, in_plane)
+    light_sharpness = 1.0 / finest ** 2
+    steps = np.arange(-2, 3) * finest
+    responses = []
+    for u in steps:
+        for v in steps:
+            axis = sg.normalize(centre + np.tan(u) * in_plane + np.tan(v) * across)
+            light = np.exp(light_sharpness * (directions @ axis - 1)) * weights
+            responses.append((np.sum(light * approx), np.sum(light * exact)))
+    approx_response, exact_response = np.array(responses).T
+    return float(np.sqrt(np.sum((approx_response - exact_response) ** 2) / np.sum(exact_response ** 2)))

@@ -420,19 +420,20 @@ def test_warp_helpers_stress(glsl):
     inputs = {"p": np.c_[x["axis1"], x["sharpness"]], "wo": np.c_[wo, x["amplitude1"]]}
     body = """
     vec3 unit_axis, unit_wo, in_plane;
-    float offset;
-    warp_split_frame(p.xyz, p.w, wo.xyz, unit_axis, unit_wo, in_plane, offset);
+    float offset, across;
+    warp_split_frame(p.xyz, p.w, wo.xyz, true, unit_axis, unit_wo, in_plane, offset, across);
     vec3 node_axis; float node_sharpness, node_amplitude;
-    warp_split_node(unit_axis, in_plane, unit_wo, offset, 1.7320508075688772, 1.0 / 6.0, p.w, wo.w,
+    warp_split_node(unit_axis, in_plane, unit_wo, offset, across, 1.7320508075688772, 1.0 / 6.0, p.w, wo.w,
                     node_axis, node_sharpness, node_amplitude);
     vec3 at_axis; float at_sharpness;
-    warp_at(unit_axis, p.w, unit_wo, clamp(dot(unit_axis, unit_wo), -1.0, 1.0), at_axis, at_sharpness);
+    warp_at(unit_axis, p.w, unit_wo, clamp(dot(unit_axis, unit_wo), -1.0, 1.0), across, at_axis, at_sharpness);
     result = vec4(dot(in_plane + node_axis + at_axis, vec3(1.0)) + offset, node_sharpness + at_sharpness,
-                  node_amplitude, offset);
+                  node_amplitude, across);
     """
     out = glsl(["sg.glsl", "brdf.glsl", "warp.glsl"], body, inputs, 4)
     _assert_finite(out, "warp_split_frame / warp_split_node / warp_at")
-    assert out[:, 1:].min() >= 0 and out[:, 1].max() <= 2e6 * (1 + 1e-6)
+    assert out[:, 1:3].min() >= 0 and out[:, 1].max() <= 2e6 * (1 + 1e-6)
+    assert out[:, 3].min() >= 0.5 and out[:, 3].max() <= 1.0       # m = max(c, 1 - c), widened to 1 at most
 
 
 def test_lights_helpers_stress(glsl):
