@@ -149,6 +149,8 @@ def _constants_source():
     literal = shader_sources.float_literal
     return (f"const float BRDF_AS_RF0 = {literal(rf0)};\n"
             f"const float VISIBILITY_SKIP_FRACTION = {literal(sg_shading.VISIBILITY_SKIP_FRACTION)};\n"
+            f"const float COSINE_LOOKUP_FULL = {literal(sg_shading.COSINE_LOOKUP_SHARPNESS[0])};\n"
+            f"const float COSINE_LOOKUP_NONE = {literal(sg_shading.COSINE_LOOKUP_SHARPNESS[1])};\n"
             + shader_sources.shadow_map_constants())
 
 

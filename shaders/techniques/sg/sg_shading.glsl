@@ -191,6 +191,22 @@ float visible_part_offset(float v)
   return exp(-0.5 * z * z) * 0.3989422804014327 / v;
 }
 #endif
+#if defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
+/* Where and how sharp to read the environment for a lobe: its product with the clamped cosine's SG for lobes
+ * broader than COSINE_LOOKUP_FULL (or always), handing over to the lobe itself at COSINE_LOOKUP_NONE
+ * (techniques.sg_shading.cosine_weighted_lookup): a broad lobe crosses the cosine from its peak to the horizon. */
+void cosine_weighted_lookup(inout vec3 axis, inout float sharpness, vec3 n, bool always)
+{
+  vec3 product = sharpness * axis + CLAMPED_COSINE_SHARPNESS * n;
+  float product_sharpness = length(product);
+  vec3 product_axis = product / max(product_sharpness, 1.0e-30);
+  float weight = always ? 1.0 : clamp((COSINE_LOOKUP_NONE - sharpness) / (COSINE_LOOKUP_NONE - COSINE_LOOKUP_FULL),
+                                      0.0, 1.0);
+  axis = safe_normalize(axis + (product_axis - axis) * weight);
+  sharpness += (product_sharpness - sharpness) * weight;
+}
+#endif
+
 /* The warped lobes of one NDF lobe lie close together: they share the visibility of the centre one
  * (techniques.sg_shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3; split2 has
  * no centre node and takes node 0, the one towards the viewer (a valid half vector whenever the lobe's
@@ -431,7 +447,9 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
         tail_axis = lookup_axis;
       }
 #ifdef HAS_ENVIRONMENT
-      radiance += slice_cosine * slice_colour[j] * environment_radiance(lookup_axis, slice_sharpness[j]);
+      float lookup_sharpness = slice_sharpness[j];
+      cosine_weighted_lookup(lookup_axis, lookup_sharpness, n, false);
+      radiance += slice_cosine * slice_colour[j] * environment_radiance(lookup_axis, lookup_sharpness);
 #else
       radiance += slice_cosine * slice_colour[j] * scene.world_colour.rgb;
 #endif
@@ -442,7 +460,9 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
    * lobe's centre node (techniques.sg_shading.environment_tail) */
   float tail_albedo = max(model_albedo - slice_albedo, 0.0) * tail_visibility;
 #ifdef HAS_ENVIRONMENT
-  radiance += tail_albedo * environment_radiance(tail_axis, slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO);
+  float tail_sharpness = slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO;
+  cosine_weighted_lookup(tail_axis, tail_sharpness, n, true);
+  radiance += tail_albedo * environment_radiance(tail_axis, tail_sharpness);
 #else
   radiance += tail_albedo * scene.world_colour.rgb;
 #endif
