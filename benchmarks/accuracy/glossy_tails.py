@@ -9,6 +9,7 @@ import numpy as np
 
 from benchmarks.accuracy.lighting import load_world
 from sg_prt_addon.lighting import env_prefilter
+from sg_prt_addon.lighting.scene_lighting import EnvironmentData
 from sg_prt_addon.reflectance import brdf, ggx_albedo
 from sg_prt_addon.spherical import sg
 from sg_prt_addon.techniques import sg_shading
@@ -107,7 +108,7 @@ def _sharp_lookup_rows():
         exact = env_prefilter.brute_force_convolution(image, axis, sharpness)
         scale = np.maximum(np.abs(exact).max(axis=1), 1e-3 * float(image.mean()))
         top = env_prefilter.lookup(prefiltered, axis.astype(np.float32), sharpness.astype(np.float32))
-        blended = sg_shading.environment_radiance(sg_shading.EnvironmentData(prefiltered=prefiltered, radiance=image),
+        blended = sg_shading.environment_radiance(EnvironmentData(prefiltered=prefiltered, radiance=image),
                                                axis.astype(np.float32), sharpness.astype(np.float32))
         for label, value in (("top layer alone", top), ("blended towards the map", blended)):
             error = np.abs(value - exact).max(axis=1) / scale

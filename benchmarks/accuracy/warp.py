@@ -6,15 +6,17 @@ the exact slice D(h(wi)), h = normalize(wo + wi), of one SG NDF lobe around
 the normal.  Sharpness set: GGX-like alpha 0.05, 0.1, 0.3, 0.5 as lambda =
 2 / alpha^2, and lambda = 1, 10, 100, 1e3, 1e4.  End to end: the SG
 technique's environment specular on a sphere under courtyard.exr against the
-sum over the map's texels (validation/environment_specular.py), with split3's
-parts as narrow across as the true lobe (warp.split_across) and, measured in
-the same run, at the paper's width (m = 1).
+sum over the map's texels (validation/environment_specular.py), as shipped
+and, measured in the same run, with split3's parts at the paper's width
+across the plane (m = 1, not warp.split_across), with every lobe read at its
+own axis (not sg_shading.cosine_weighted_lookup), and with neither.
 """
 import importlib.util
 
 import numpy as np
 
 from sg_prt_addon.spherical import sg, warp
+from sg_prt_addon.techniques import sg_shading
 
 VIEW_ANGLES = (0, 30, 60, 75, 85)
 ALPHAS = (0.05, 0.1, 0.3, 0.5)
@@ -121,7 +123,8 @@ def measure():
 
 def _environment_rows(roughnesses=(0.35, 0.6)):
     """The SG technique's environment specular against the exact sum over courtyard.exr, by view band; the
-    note gives the same with split3's parts at the paper's width across the plane (m = 1)."""
+    note gives the same with split3's parts at the paper's width across the plane (m = 1), with every lobe
+    read at its own axis (sg_shading.cosine_weighted_lookup left out), and with neither."""
     from benchmarks.accuracy.lighting import load_world
     from validation import environment_specular as es
 
@@ -134,17 +137,24 @@ def _environment_rows(roughnesses=(0.35, 0.6)):
         reference = es.exact_specular(small, normals, forward, roughness)
         ours = es.band_errors(es.engine_specular(environment, normals, forward, roughness), reference, normals,
                               forward)
-        narrow = warp.split_across
+        narrow, weighted = warp.split_across, sg_shading.cosine_weighted_lookup
         warp.split_across = lambda cosine, mode: np.ones_like(cosine)
         try:
             paper_width = es.band_errors(es.engine_specular(environment, normals, forward, roughness), reference,
                                          normals, forward)
-        finally:
+            sg_shading.cosine_weighted_lookup = lambda axis, sharpness, n, always=False: (axis, sharpness)
+            neither = es.band_errors(es.engine_specular(environment, normals, forward, roughness), reference,
+                                     normals, forward)
             warp.split_across = narrow
-        for (low, high), error, before in zip(es.VIEW_BANDS, ours, paper_width):
+            own_axes = es.band_errors(es.engine_specular(environment, normals, forward, roughness), reference,
+                                      normals, forward)
+        finally:
+            warp.split_across, sg_shading.cosine_weighted_lookup = narrow, weighted
+        for (low, high), error, *others in zip(es.VIEW_BANDS, ours, paper_width, own_axes, neither):
             rows.append({"name": f"environment specular, GGX {roughness}, views {low}-{high} deg",
                          "reference": "sum over courtyard.exr's texels (256 x 512) of L rho max(0, n.i)",
                          "metric": "relative RMSE over a sphere's pixels in the band", "max_error": error,
                          "mean_error": error,
-                         "note": f"split3's parts at the paper's width across (m = 1): {before:.3g}"})
+                         "note": ("split3's parts at the paper's width across (m = 1): {:.3g}; every lobe read at "
+                                  "its own axis (no cosine_weighted_lookup): {:.3g}; neither: {:.3g}").format(*others)})
     return rows
