@@ -109,7 +109,7 @@ def _sharp_lookup_rows():
         scale = np.maximum(np.abs(exact).max(axis=1), 1e-3 * float(image.mean()))
         top = env_prefilter.lookup(prefiltered, axis.astype(np.float32), sharpness.astype(np.float32))
         blended = sg_shading.environment_radiance(EnvironmentData(prefiltered=prefiltered, radiance=image),
-                                               axis.astype(np.float32), sharpness.astype(np.float32))
+                                                  axis.astype(np.float32), sharpness.astype(np.float32))
         for label, value in (("top layer alone", top), ("blended towards the map", blended)):
             error = np.abs(value - exact).max(axis=1) / scale
             rows.append(dict(name=f"environment lookup, lambda {low:.0f}-{high:.0f}: {label}",
