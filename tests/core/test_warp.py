@@ -95,9 +95,9 @@ def test_split3_lowers_shape_error_further():
 
 def test_split3_takes_the_true_width_across():
     """split3's parts are as narrow across the plane of incidence as the true lobe (warp.split_across), which
-    lights that narrow see (slice_errors' lit).  lambda 800, lit error at 30 / 45 / 60 / 75 / 85 deg: 0.001 / 0.008 / 0.084 /
-    0.21 / 0.35 (with the paper's width across, m = 1: 0.029 / 0.072 / 0.147 / 0.251 / 0.32); relative L2 at
-    30 / 45 deg 0.003 / 0.038 (0.061 / 0.143)."""
+    lights that narrow see (slice_errors' lit).  lambda 800, lit error at 30 / 45 / 60 / 75 / 85 deg: 0.001 /
+    0.008 / 0.084 / 0.21 / 0.35 (with the paper's width across, m = 1: 0.029 / 0.072 / 0.147 / 0.251 / 0.32);
+    relative L2 at 30 / 45 deg 0.003 / 0.038 (0.061 / 0.143)."""
     for theta, lit_bound, l2_bound in ((30, 0.005, 0.01), (45, 0.015, 0.05), (60, 0.1, 0.27), (75, 0.23, 0.49),
                                        (85, 0.37, 0.83)):
         e = errors(theta, 800.0, "split3")
