@@ -238,10 +238,8 @@ def cosine_weighted_lookup(axis, sharpness, n, always=False):
     axis = np.asarray(axis, FLOAT)
     sharpness = np.asarray(sharpness, FLOAT)
     cosine_sharpness, _ = clamped_cosine.clamped_cosine_lobe()
-    product = sharpness[..., None] * axis + FLOAT(cosine_sharpness) * np.broadcast_to(np.asarray(n, FLOAT),
-                                                                                       axis.shape)
-    product_sharpness = np.linalg.norm(product, axis=-1)
-    product_axis = product / np.maximum(product_sharpness, FLOAT(1e-30))[..., None]
+    product_axis, product_sharpness, _ = sg.product(axis, sharpness, FLOAT(1), np.asarray(n, FLOAT),
+                                                    FLOAT(cosine_sharpness), FLOAT(1))
     full, none = COSINE_LOOKUP_SHARPNESS
     weight = FLOAT(1) if always else np.clip((FLOAT(none) - sharpness) / FLOAT(none - full), 0, 1)
     lookup_axis = sg.normalize(axis + (product_axis - axis) * np.asarray(weight, FLOAT)[..., None])

@@ -197,9 +197,10 @@ float visible_part_offset(float v)
  * (techniques.sg_shading.cosine_weighted_lookup): a broad lobe crosses the cosine from its peak to the horizon. */
 void cosine_weighted_lookup(inout vec3 axis, inout float sharpness, vec3 n, bool always)
 {
-  vec3 product = sharpness * axis + CLAMPED_COSINE_SHARPNESS * n;
-  float product_sharpness = length(product);
-  vec3 product_axis = product / max(product_sharpness, 1.0e-30);
+  vec3 product_axis;
+  float product_sharpness, product_amplitude;
+  sg_product(axis, sharpness, 1.0, n, CLAMPED_COSINE_SHARPNESS, 1.0, product_axis, product_sharpness,
+             product_amplitude);
   float weight = always ? 1.0 : clamp((COSINE_LOOKUP_NONE - sharpness) / (COSINE_LOOKUP_NONE - COSINE_LOOKUP_FULL),
                                       0.0, 1.0);
   axis = safe_normalize(axis + (product_axis - axis) * weight);
