@@ -62,6 +62,13 @@ def mesh_triangles(mesh):
     return flat.reshape(-1, 3)
 
 
+def mesh_triangle_corners(mesh):
+    """(T, 3) int64 corner (loop) indices of the loop triangles of a bpy Mesh (after mesh_triangles)."""
+    flat = np.empty(len(mesh.loop_triangles) * 3, np.int64)
+    mesh.loop_triangles.foreach_get("loops", flat)
+    return flat.reshape(-1, 3)
+
+
 def mesh_topology_hash(mesh):
     """``visibility.pipeline.topology_hash`` of a bpy Mesh: its vertex count and loop triangles' vertices."""
     return topology_hash(len(mesh.vertices), mesh_triangles(mesh))

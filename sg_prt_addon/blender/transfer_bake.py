@@ -170,13 +170,14 @@ class TransferJob(BackgroundJob):
         results = {}
         count = len(self.receivers)
         try:
-            for index, (key, label, vertices, normals, triangles, _) in enumerate(self.receivers):
-                def progress(fraction, message, index=index, label=label):
+            for index, receiver in enumerate(self.receivers):
+                def progress(fraction, message, index=index, label=receiver.label):
                     overall = (index + min(max(fraction, 0.0), 1.0)) / count
                     return self.record_progress(overall, f"{label}: {message}", always_print=fraction >= 1.0)
 
-                results[key] = transfer.bake_transfer(vertices, triangles, normals, self.occluder_vertices,
-                                                      self.occluder_triangles, self.options, progress)
+                results[receiver.key] = transfer.bake_transfer(
+                    receiver.points, receiver.triangles, receiver.normals, self.occluder_vertices,
+                    self.occluder_triangles, self.options, progress, point_triangles=receiver.point_triangles)
                 if self.cancelling:
                     raise BakeCancelled("cancelled after a receiver finished")
         except BakeCancelled:
@@ -258,8 +259,9 @@ class SGPRT_OT_bake_transfer(SceneJobOperator, bpy.types.Operator):
     def _finish(self, context, job):
         def store(mesh, result, corner_point, evaluation):
             store_transfer_bake(mesh, result, job.options, self._occluders, corner_point, evaluation)
+            buried = f", {result.buried_points} buried points from their neighbours" if result.buried_points else ""
             return (f"order {result.order}, {result.terms} terms, error {result.relative_error:.3f}, "
-                    f"{result.seconds:.1f} s")
+                    f"{result.seconds:.1f} s{buried}")
 
         return store_results(self, job, self._targets, KIND, store, "transfer bake",
                              "SG-PRT baked the transfer of")

@@ -72,7 +72,7 @@ bake leaves the previous bakes untouched.  The bake thread never touches bpy.
 """
 import datetime
 from dataclasses import dataclass
-from typing import Optional
+from typing import NamedTuple, Optional
 
 import bpy
 import numpy as np
@@ -85,7 +85,7 @@ from . import export, modifier_stack, occluders, per_vertex_store
 from .background_job import BackgroundJob, SceneJobOperator
 from .occluders import occluder_arrays
 from .panels import RenderPanel
-from .per_vertex_store import mesh_face_hash, mesh_topology_hash, mesh_triangles
+from .per_vertex_store import mesh_face_hash, mesh_topology_hash, mesh_triangle_corners, mesh_triangles
 
 FORMAT_VERSION = 1
 KIND = "ssdf"           # the bake's per-vertex kind (visibility.per_vertex; stored by per_vertex_store)
@@ -139,11 +139,11 @@ def _evaluated_mesh(obj, depsgraph):
 
 
 def receiver_arrays(obj, depsgraph):
-    """World-space (points, normals, triangles, corner_point) where a mesh object is baked, from its evaluated
-    geometry: its vertices (corner_point None) where every corner has its vertex's normal, else one point a
-    vertex and normal (visibility.per_vertex.split_points: flat faces and sharp edges get their faces'
-    hemispheres) and the point each corner reads; ValueError with a message for the user when it cannot be
-    baked."""
+    """World-space (points, normals, triangles, corner_point, point_triangles) where a mesh object is baked, from
+    its evaluated geometry: its vertices (corner_point None) where every corner has its vertex's normal, else one
+    point a vertex and normal (visibility.per_vertex.split_points: flat faces and sharp edges get their faces'
+    hemispheres) and the point each corner reads; triangles over the mesh's vertices (hashed) and over the
+    points (which points neighbour which); ValueError with a message for the user when it cannot be baked."""
     mesh = _evaluated_mesh(obj, depsgraph)
     matrix = _matrix(obj.evaluated_get(depsgraph).matrix_world)
     vertices = _vertex_array(mesh, "co")
@@ -152,14 +152,30 @@ def receiver_arrays(obj, depsgraph):
     mesh.loops.foreach_get("vertex_index", corner_vertex)
     corner_normals = export.mesh_corner_normals(mesh, corner_vertex, obj.name)
     # the render asks the same question of the exported mesh (scene_state): a bake per vertex must not look stale
+    triangles = mesh_triangles(mesh)
     if not per_vertex.has_split_normals(corner_normals, normals, corner_vertex):
         corner_point = None                  # one normal a vertex: rows per vertex, as smooth meshes always had
+        point_triangles = triangles
     else:
         corner_point, point_vertex, normals = per_vertex.split_points(corner_vertex, corner_normals)
         vertices = per_vertex.inset_points(vertices[point_vertex], corner_point, _corner_face_centres(mesh))
+        point_triangles = corner_point[mesh_triangle_corners(mesh)]
     normals = normals @ np.linalg.inv(matrix[:3, :3])   # inverse transpose
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
-    return _to_world(vertices, matrix), normals, mesh_triangles(mesh), corner_point
+    return _to_world(vertices, matrix), normals, triangles, corner_point, point_triangles
+
+
+class Receiver(NamedTuple):
+    """One mesh a per-vertex bake writes to (bake_inputs), world space (receiver_arrays)."""
+    key: str                        # the BakeTarget's key
+    label: str                      # the object's name, for progress and messages
+    points: np.ndarray              # (P, 3) where the rows are baked
+    normals: np.ndarray             # (P, 3)
+    triangles: np.ndarray           # (T, 3) over the mesh's vertices (the topology hash)
+    corner_point: Optional[np.ndarray]      # (C,) the point each corner reads; None: the points are the vertices
+    point_triangles: Optional[np.ndarray] = None    # (T, 3) over the points: neighbours (visibility.buried)
+
+
 
 
 @dataclass
@@ -392,7 +408,7 @@ def unusable_bakes(scene, depsgraph):
 class BakeJob(BackgroundJob):
     """Bakes receivers one after another; run() synchronously or start() a thread.  Never touches bpy.
 
-    receivers: [(key, label, points, normals, triangles, corner_point)] (receiver_arrays), world space.
+    receivers: [Receiver] (bake_inputs), world space.
     results: {key: BakeResult} (a row a point)
     once every receiver finished; cancelled / error otherwise (results then empty).
     """
@@ -419,10 +435,11 @@ class BakeJob(BackgroundJob):
     def run(self):
         results = {}
         try:
-            for index, (key, label, vertices, normals, triangles, _) in enumerate(self.receivers):
-                results[key] = bake_visibility(vertices, triangles, normals, self.occluder_vertices,
-                                               self.occluder_triangles, self.options,
-                                               progress=self._progress_for(index, label))
+            for index, receiver in enumerate(self.receivers):
+                results[receiver.key] = bake_visibility(
+                    receiver.points, receiver.triangles, receiver.normals, self.occluder_vertices,
+                    self.occluder_triangles, self.options, progress=self._progress_for(index, receiver.label),
+                    point_triangles=receiver.point_triangles)
                 if self.cancelling:
                     raise BakeCancelled("cancelled after a receiver finished")
         except BakeCancelled:
@@ -489,7 +506,7 @@ def mesh_objects(context, target):
 
 
 def bake_inputs(operator, context, objects, what):
-    """(receivers [(target key, object name, points, normals, triangles, corner_point)] (receiver_arrays),
+    """(receivers [Receiver] (receiver_arrays),
     occluder vertices, occluder triangles, {target key: BakeTarget}, the occluders' fingerprints
     (occluders.fingerprints, stored with the bake)) of the objects a per-vertex bake writes to, world space, as
     a final render evaluates the scene (modifier_stack.as_rendered); None after the operator reported why not.
@@ -511,12 +528,12 @@ def bake_inputs(operator, context, objects, what):
                     operator.report({"WARNING"}, f"'{obj.name}' shares its mesh with an object baked already; "
                                                  f"the {what} is stored once per mesh")
                     continue
-                vertices, normals, triangles, corner_point = receiver_arrays(obj, depsgraph)
+                arrays = receiver_arrays(obj, depsgraph)
             except ValueError as error:
                 operator.report({"WARNING"}, f"SG-PRT {what} skips {error}")
                 continue
             targets[target.key] = target
-            receivers.append((target.key, obj.name, vertices, normals, triangles, corner_point))
+            receivers.append(Receiver(target.key, obj.name, *arrays))
         if not receivers:
             operator.report({"ERROR"}, f"SG-PRT {what}: none of the objects can be baked (see the warnings)")
             return None
@@ -542,7 +559,7 @@ def store_results(operator, job, targets, kind, store, what, done):
         if problem is not None:
             operator.report({"WARNING"}, f"'{target.object_name}' {problem} during the {what}: not stored")
             continue
-        corner_point = next(receiver[5] for receiver in job.receivers if receiver[0] == key)
+        corner_point = next(receiver.corner_point for receiver in job.receivers if receiver.key == key)
         summary = target.write(kind, lambda mesh, evaluation: store(mesh, result, corner_point, evaluation))
         written.append(f"{target.object_name} ({summary})")
     if not written:
@@ -584,7 +601,8 @@ class SGPRT_OT_bake_visibility(SceneJobOperator, bpy.types.Operator):
     def _finish(self, context, job):
         def store(mesh, result, corner_point, evaluation):
             store_visibility_bake(mesh, result, job.options, self._occluders, corner_point, evaluation)
-            return f"{result.terms} terms, {np.degrees(result.rms_error):.2f} deg, {result.seconds:.1f} s"
+            buried = f", {result.buried_points} buried points from their neighbours" if result.buried_points else ""
+            return f"{result.terms} terms, {np.degrees(result.rms_error):.2f} deg, {result.seconds:.1f} s{buried}"
 
         outcome = store_results(self, job, self._targets, KIND, store, "bake", "SG-PRT baked")
         if not job.cancelled and job.error is None:

@@ -12,7 +12,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from . import binary_visibility, hemisphere_map, pca, ssdf
+from . import binary_visibility, buried, hemisphere_map, pca, ssdf
 from .per_vertex import MAX_TERMS
 from .raytrace import RayTracer
 
@@ -48,6 +48,7 @@ class BakeResult:
     topology_hash: str              # of the baked mesh (vertex count + triangles): detects stale bakes
     frame_reference_axis: np.ndarray = field(default_factory=lambda: hemisphere_map.FRAME_REFERENCE_AXIS.copy())
     rays_traced: int = 0
+    buried_points: int = 0          # points inside other geometry whose rows came from their neighbours (buried)
     seconds_tracing: float = 0.0    # inside Embree's queries, summed over threads (the rest is SSDF, PCA, numpy)
     seconds: float = 0.0
 
@@ -107,15 +108,18 @@ def bake_ssdf(vertices, normals, tracer, options, progress=None, tangents=None):
 def bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_triangles,
                     options: Optional[BakeOptions] = None,
                     progress: Optional[Callable[[float, str], Optional[bool]]] = None,
-                    tangents=None) -> BakeResult:
+                    tangents=None, point_triangles=None) -> BakeResult:
     """Bake PCA-compressed SSDF visibility at every vertex of a mesh.
 
     vertices (V, 3), normals (V, 3) (per vertex, world space); triangles (T, 3)
     of the baked mesh (only hashed); occluder_vertices / occluder_triangles: all
     scene triangles that cast shadows, the baked mesh included.  tangents:
     optional (V, 3) x axes of the local frames (default ``hemisphere_map.local_frame``:
-    the shader must build the same frame).  progress(fraction, message) is called
-    after each batch of vertices; returning True raises BakeCancelled.
+    the shader must build the same frame).  point_triangles: optional (T, 3) triangles over the baked
+    points (the mesh's triangles where the points are its vertices): with them, points buried inside
+    other geometry take their rows from their neighbours (``visibility.buried``).
+    progress(fraction, message) is called after each batch of vertices; returning True raises
+    BakeCancelled.
     """
     options = options or BakeOptions()
     if options.refinement % 2 != 1 or options.resolution < 2:
@@ -131,6 +135,8 @@ def bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_tr
                        relative_offset=options.relative_offset)
     try:
         samples = bake_ssdf(vertices, normals, tracer, options, progress, tangents)
+        buried_points = 0 if point_triangles is None else buried.fill_buried_points(
+            samples, tracer, vertices, normals, point_triangles, options.threads)
         rays, seconds_tracing = tracer.rays_traced, tracer.seconds_tracing
     finally:
         tracer.close()
@@ -144,8 +150,8 @@ def bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_tr
         mean=model.mean.reshape(resolution, resolution).astype(np.float32),
         resolution=resolution, terms=model.terms, rms_error=model.rms_error,
         rms_error_by_terms=model.rms_error_by_terms, vertex_count=len(vertices),
-        topology_hash=topology_hash(len(vertices), triangles), rays_traced=rays, seconds_tracing=seconds_tracing,
-        seconds=time.perf_counter() - started)
+        topology_hash=topology_hash(len(vertices), triangles), rays_traced=rays, buried_points=buried_points,
+        seconds_tracing=seconds_tracing, seconds=time.perf_counter() - started)
     if progress is not None:
         progress(1.0, "done")  # finished: a late cancel request no longer discards the result
     return result

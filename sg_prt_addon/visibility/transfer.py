@@ -24,7 +24,7 @@ import numpy as np
 
 from ..harmonics import basis, projection, rotation
 from ..spherical import lattice
-from . import decode, hemisphere_map, pca
+from . import buried, decode, hemisphere_map, pca
 from .per_vertex import MAX_TERMS
 from .pipeline import BakeCancelled, topology_hash
 from .raytrace import RayTracer
@@ -56,6 +56,7 @@ class TransferResult:
     rays_traced: int
     seconds: float
     relative_error_by_terms: np.ndarray = None
+    buried_points: int = 0          # points inside other geometry whose vectors came from their neighbours
 
 
 def vector_size(order):
@@ -140,9 +141,10 @@ def transfer_vectors(vertices, normals, tracer, order, directions, progress=None
 
 
 def bake_transfer(vertices, triangles, normals, occluder_vertices, occluder_triangles, options=None,
-                  progress=None):
+                  progress=None, point_triangles=None):
     """Bake and compress the transfer of one mesh's vertices (world space; occluders: every scene triangle
-    that casts shadows, the mesh included).  progress(fraction, message) -> True cancels (BakeCancelled)."""
+    that casts shadows, the mesh included).  progress(fraction, message) -> True cancels (BakeCancelled).
+    point_triangles: as pipeline.bake_visibility's (buried points take their neighbours' vectors)."""
     options = options or TransferOptions()
     if not 2 <= options.order <= MAX_ORDER:
         raise ValueError(f"transfer order {options.order}: 2 to {MAX_ORDER}")
@@ -155,6 +157,8 @@ def bake_transfer(vertices, triangles, normals, occluder_vertices, occluder_tria
         def scaled(fraction, message):
             return progress is not None and progress(0.9 * fraction, message)
         samples = transfer_vectors(vertices, normals, tracer, options.order, options.directions, scaled)
+        buried_points = 0 if point_triangles is None else buried.fill_buried_points(
+            samples, tracer, vertices, normals, point_triangles, options.threads)
         rays = tracer.rays_traced
     finally:
         tracer.close()
@@ -164,7 +168,7 @@ def bake_transfer(vertices, triangles, normals, occluder_vertices, occluder_tria
     result = TransferResult(options.order, pca.project(model, samples), model.mean.astype(np.float32),
                             model.basis.astype(np.float32), model.terms, float(errors[model.terms]),
                             len(vertices), topology_hash(len(vertices), triangles), rays,
-                            time.perf_counter() - started, errors)
+                            time.perf_counter() - started, errors, buried_points)
     if progress is not None:
         progress(1.0, "done")
     return result

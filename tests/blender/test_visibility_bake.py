@@ -60,6 +60,12 @@ def test_operator_bakes_floor_and_suzanne_and_stores_attributes(scene, capfd, tm
     assert bpy.ops.sgprt.bake_visibility(target="ALL") == {"FINISHED"}
     printed = capfd.readouterr().out
     assert "[sg-prt] bake" in printed and "100%" in printed
+    # Suzanne's eyes sink into her head: those points take their rows from their neighbours (visibility.buried),
+    # split per corner as her flat faces are
+    report = next(line for line in printed.splitlines() if "SG-PRT baked" in line)
+    suzanne_report = report[report.index("Suzanne"):]
+    assert "buried points from their neighbours" in suzanne_report, report
+    assert int(suzanne_report.split(" buried points")[0].rsplit(" ", 1)[1]) >= 20, report
 
     # the flat floor has one normal a vertex: rows per vertex; flat-shaded Suzanne's corners differ: per corner
     for obj, domain, rows in ((floor, "POINT", len(floor.data.vertices)), (suzanne, "CORNER", len(suzanne.data.loops))):
@@ -110,7 +116,7 @@ def test_operator_bakes_floor_and_suzanne_and_stores_attributes(scene, capfd, tm
 def test_store_is_bit_exact_against_the_bake_result(scene, tmp_path):
     _, floor, suzanne = scene
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    vertices, normals, triangles, corner_point = vb.receiver_arrays(suzanne, depsgraph)
+    vertices, normals, triangles, corner_point, _ = vb.receiver_arrays(suzanne, depsgraph)
     assert corner_point is not None and len(corner_point) == len(suzanne.data.loops)       # flat-shaded
     occluder_vertices, occluder_triangles = vb.occluder_arrays(depsgraph)
     assert len(occluder_triangles) == len(floor.data.loop_triangles) + len(suzanne.data.loop_triangles)
@@ -193,18 +199,17 @@ def test_cancelled_rebake_keeps_the_previous_bake(scene, tmp_path):
 def test_threaded_job_cancels_and_writes_nothing(scene):
     _, floor, suzanne = scene
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    vertices, normals, triangles, corner_point = vb.receiver_arrays(floor, depsgraph)
-    assert corner_point is None                         # a flat grid: one normal a vertex
-    job = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles, None)], *vb.occluder_arrays(depsgraph),
-                     BakeOptions(resolution=8, refinement=1, terms=2), hook=lambda f, m: f > 0.0)
+    receiver = vb.Receiver("Floor", "Floor", *vb.receiver_arrays(floor, depsgraph))
+    assert receiver.corner_point is None                # a flat grid: one normal a vertex
+    job = vb.BakeJob([receiver], *vb.occluder_arrays(depsgraph), BakeOptions(resolution=8, refinement=1, terms=2),
+                     hook=lambda f, m: f > 0.0)
     job.start()
     job.join(30)
     assert not job.running and job.cancelled and job.results == {} and job.error is None
-    done = vb.BakeJob([("Floor", "Floor", vertices, normals, triangles, None)], *vb.occluder_arrays(depsgraph),
-                      BakeOptions(resolution=8, refinement=1, terms=2))
+    done = vb.BakeJob([receiver], *vb.occluder_arrays(depsgraph), BakeOptions(resolution=8, refinement=1, terms=2))
     done.start()
     done.join(30)
-    assert not done.cancelled and done.results["Floor"].coefficients.shape == (len(vertices), 2)
+    assert not done.cancelled and done.results["Floor"].coefficients.shape == (len(receiver.points), 2)
     assert done.fraction == 1.0
 
 
