@@ -57,6 +57,12 @@ def blender_sun_radiance(strength, angle):
     return np.asarray(strength) / (np.pi * np.maximum(sin_half * sin_half, 1e-300))
 
 
+def cap_radius(sharpness):
+    """Half-angle of the cap a light's SG of this sharpness stands for (the inverse of ln(10) / sin^2)."""
+    ratio = _LN10 / np.maximum(np.asarray(sharpness, np.float64), 1e-30)
+    return np.arcsin(np.sqrt(np.clip(ratio, 0.0, 1.0)))
+
+
 def _cap_sharpness_and_integral(sin2, energy_scale, model, paper_amplitude):
     """Shared by sphere and directional lights: sin2 = sin^2 theta of the cap (0 = a point)."""
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -253,6 +253,13 @@ def visibility_product_integral_preserving(axis, sharpness, amplitude, theta_d):
 
 
 
+def disc_coverage(signed_distance, radius):
+    """Visible share of a disc of angular ``radius`` whose centre lies ``signed_distance`` (+ visible) from a
+    straight boundary: the disc's area beyond a chord (a small disc's, as on a plane)."""
+    x = np.clip(np.asarray(signed_distance, np.float64) / np.maximum(radius, 1e-30), -1.0, 1.0)
+    return np.clip(0.5 + (np.arcsin(x) + x * np.sqrt(1.0 - x * x)) / np.pi, 0.0, 1.0)
+
+
 def derive_fast_constants(n_sharpness=43, seed_constants=None):
     """Re-derive ERF_APPROX_A and the FH_K2_* constants with scipy (about 10 s); returns a dict
     with the constants and the max abs error of fh_hat on the fitting grid.

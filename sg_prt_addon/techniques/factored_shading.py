@@ -45,8 +45,9 @@ def shade(position, normal, tangent, view_origin, is_perspective, diffuse_color,
     irradiance = np.zeros(position.shape, FLOAT)
     radiance = np.zeros(position.shape, FLOAT)
     for axis, sharpness, amplitude in sg_shading._light_sets(position, light_data):
+        light_visible = 1 if visibility is None else sg_shading.light_cap_visibility(axis, sharpness, visibility)
         energy = amplitude * (clamped_cosine.sg_clamped_cosine_integral(axis, sharpness, FLOAT(1), n[:, None])
-                              * visible(axis, sharpness))[..., None]
+                              * light_visible)[..., None]
         irradiance += np.sum(energy, axis=1)
         local = np.einsum("nji,nlj->nli", frame, axis)
         f = scale * factored_brdf(maps, form, np.broadcast_to(o[:, None], local.shape), local)[..., :3]

@@ -136,6 +136,21 @@ def lobe_visibility(axis, sharpness, n, visibility):
     return np.clip(visible / np.maximum(unshadowed, FLOAT(1e-30)), 0, 1).astype(FLOAT)
 
 
+def light_cap_visibility(axis, sharpness, visibility):
+    """Visible fraction (N, K) of lights' caps: axis (N, K, 3), sharpness (N, K) of their SGs, whose caps are
+    lights.cap_radius wide (lobe_visibility.glsl's light_cap_visibility with sg_shading.glsl's light_cap_radius)."""
+    from ..spherical import hemisphere
+    from ..visibility import hemisphere_map
+
+    frame = hemisphere_map.local_frame(np.asarray(visibility.normal, np.float64))      # (N, 3, 3)
+    local = np.einsum("nij,nkj->nki", frame, np.asarray(axis, np.float64))
+    theta_d = ssdf_decode_packed(visibility.rows, visibility.basis_texture, local)
+    radius = lights.cap_radius(sharpness)
+    theta_h = np.arcsin(np.clip(sg.normalize(local.astype(FLOAT))[..., 2], -1, 1))
+    unshadowed = hemisphere.disc_coverage(theta_h, radius)
+    return np.clip(hemisphere.disc_coverage(theta_d, radius) / np.maximum(unshadowed, 1e-30), 0, 1).astype(FLOAT)
+
+
 def vertex_coverage(vertices):
     """The SSDF's coverage (V, P) at the quadrature points of visibility.broad_lobes at mesh vertices
     (shaders/techniques/sg/vertex_coverage.frag.glsl); vertices: a Visibility of their coefficient rows."""
@@ -463,6 +478,12 @@ class _Pixels:
         flat_sharpness = np.broadcast_to(np.asarray(sharpness, FLOAT), shape).reshape(shape[0], -1)
         return lobe_visibility(flat_axis, flat_sharpness, self.n, self.visibility).reshape(shape)
 
+    def light_visible(self, axis, sharpness):
+        """Lights' visible fractions (N, P) (LIGHT_VISIBILITY), 1 without visibility."""
+        if self.visibility is None:
+            return FLOAT(1)
+        return light_cap_visibility(axis, sharpness, self.visibility)
+
     @property
     def nodes(self):
         return warp.nodes_per_lobe(self.warp_mode)
@@ -528,7 +549,7 @@ def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, sp
     n = px.n
     visibility = px.visibility
     light_cosine = _clamped_cosine_integral(light_axis, light_sharpness, FLOAT(1), n[:, None, :])    # (N, P)
-    light_visible = np.broadcast_to(px.visible(light_axis, light_sharpness), light_sharpness.shape)
+    light_visible = np.broadcast_to(px.light_visible(light_axis, light_sharpness), light_sharpness.shape)
     mapped = np.zeros(light_sharpness.shape, bool)
     if shadow is not None:      # a mapped light: its map's, blended to the SSDF's by the softness (the shader's)
         mapped = ~np.isnan(shadow[..., 0])

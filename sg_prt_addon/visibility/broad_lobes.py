@@ -18,6 +18,8 @@ Mirrored by shaders/lib/ssdf_quadrature.glsl; the per-vertex pass of the broad d
 """
 import numpy as np
 
+from ..spherical import hemisphere
+
 QUADRATURE_POINTS = 32
 GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
 # Lobe sharpness (of the lobe before its product with the cosine) from which the quadrature hands over to
@@ -43,10 +45,9 @@ def cell_radius(count=QUADRATURE_POINTS):
 
 
 def cell_coverage(signed_distance, radius):
-    """Visible share of a disc of ``radius`` whose centre lies ``signed_distance`` (+ visible) from a
-    straight boundary: the disc's area beyond a chord."""
-    x = np.clip(np.asarray(signed_distance, np.float64) / radius, -1.0, 1.0)
-    return np.clip(0.5 + (np.arcsin(x) + x * np.sqrt(1.0 - x * x)) / np.pi, 0.0, 1.0)
+    """Visible share of a cell (a disc of ``radius``) whose centre lies ``signed_distance`` (+ visible) from a
+    straight boundary."""
+    return hemisphere.disc_coverage(signed_distance, radius)
 
 
 def open_coverage(count=QUADRATURE_POINTS):

@@ -11,6 +11,7 @@
  *                                    axis and sharpness pass through unchanged)
  *   visibility_product_integral_preserving_amplitude
  *                                 <- hemisphere.visibility_product_integral_preserving (amplitude)
+ *   disc_coverage                 <- hemisphere.disc_coverage
  *
  * fh_hat = e^-lambda + (1 - e^-lambda) (1 + g) / 2,
  * g = erf(k x (1 - (1 - x^2)/9)) / erf(k), x = sin(theta_d) = p.m.
@@ -88,4 +89,22 @@ float visibility_product_amplitude(float sharpness, float amplitude, float theta
 float visibility_product_integral_preserving_amplitude(float sharpness, float amplitude, float theta_d)
 {
   return amplitude * fh_normalized(theta_d, sharpness) / (1.0 + exp(-max(sharpness, 0.0)));
+}
+
+/* Visible share of a disc of angular `radius` whose centre lies `signed_distance` (+ visible) from a
+ * straight boundary: its area beyond a chord.  Written as the smaller segment's share, (t - sin t) / 2 pi for
+ * the chord's angle t, with a series for thin segments: the direct form's asin(x) + x sqrt(1 - x^2) cancels
+ * near the edge (|x| -> 1), where a shadow's penumbra starts, and llvmpipe's asin is good to 4e-4 only. */
+float disc_coverage(float signed_distance, float radius)
+{
+  float x = clamp(signed_distance / max(radius, 1.0e-30), -1.0, 1.0);
+  float a = abs(x);
+  /* acos(a), from the side where its argument keeps its precision in float32 */
+  float half_chord = a < 0.7 ? 0.5 * SG_PI - precise_asin(a) : precise_asin(sqrt(max((1.0 - a) * (1.0 + a), 0.0)));
+  float t = 2.0 * half_chord;
+  float t2 = t * t;
+  float segment = t < 0.5 ? t * t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0)))
+                          : t - sin(t);
+  segment = clamp(segment / (2.0 * SG_PI), 0.0, 0.5);
+  return x >= 0.0 ? 1.0 - segment : segment;
 }

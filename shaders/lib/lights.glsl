@@ -8,6 +8,7 @@
  *   spot_light_sg                 <- lights.spot_light_sg (energy model)
  *   directional_light_sg          <- lights.directional_light_sg(model="energy")
  *   light_emission_factor         <- lights.emission_factor (spots' cones, area lights' patches)
+ *   light_cap_radius              <- lights.cap_radius
  *
  * Lobes come back in out parameters (axis, sharpness, amplitude); intensity
  * and irradiance are scalars: for a colour pass 1 and multiply.  lights.py
@@ -31,6 +32,12 @@ void light_cap_energy_lobe(float sin2, float energy, out float sharpness, out fl
 {
   sharpness = sin2 > 0.0 ? min(LIGHT_LN10 / sin2, LIGHT_MAX_SHARPNESS) : LIGHT_MAX_SHARPNESS;
   amplitude = min(energy / sg_sphere_integral(sharpness, 1.0), LIGHT_MAX_AMPLITUDE);
+}
+
+/* Half-angle of the cap a light's SG stands for (the inverse of light_cap_energy_lobe's sharpness). */
+float light_cap_radius(float sharpness)
+{
+  return precise_asin(sqrt(clamp(LIGHT_LN10 / max(sharpness, 1.0e-30), 0.0, 1.0)));
 }
 
 /* Geometry shared by both sphere-light models: returns sin^2 of the cap and

@@ -1,5 +1,5 @@
 /* The visible fraction of a broad lobe by a quadrature of the SSDF over the hemisphere: GLSL mirror of
- * sg_prt_addon/visibility/broad_lobes.py.  Depends on sg.glsl.
+ * sg_prt_addon/visibility/broad_lobes.py.  Depends on sg.glsl and hemisphere.glsl.
  *
  *   ssdf_quadrature_point        <- broad_lobes.quadrature_points (one row)
  *   ssdf_cell_radius             <- broad_lobes.cell_radius
@@ -27,13 +27,11 @@ float ssdf_cell_radius()
   return sqrt(2.0 / float(SSDF_QUADRATURE_POINTS));
 }
 
-/* Visible share of a disc of `radius` whose centre lies `signed_distance` (+ visible) from a straight
- * boundary. */
+/* Visible share of a quadrature cell (a disc of `radius`) whose centre lies `signed_distance` (+ visible)
+ * from a straight boundary. */
 float ssdf_cell_coverage(float signed_distance, float radius)
 {
-  float x = clamp(signed_distance / radius, -1.0, 1.0);
-  /* clamped: the GPU's asin(-1) may fall short of -pi/2 */
-  return clamp(0.5 + (asin(x) + x * sqrt(max(1.0 - x * x, 0.0))) / SG_PI, 0.0, 1.0);
+  return disc_coverage(signed_distance, radius);
 }
 
 /* Weight of the quadrature against eq. 30's reading of a lobe of this sharpness. */

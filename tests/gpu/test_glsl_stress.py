@@ -53,6 +53,15 @@ def test_sg_stress(glsl, fuzz):
     out = glsl(["sg.glsl"], others, inputs, 4)
     _assert_finite(out, "sg_evaluate / integrals")
     assert out.min() >= 0
+    # precise_asin: any argument (clamped to [-1, 1]); near 0 relative precision where GLSL's asin has 1e-4
+    x = _f32(np.concatenate([[0.0, 1e-30, -1e-8, 0.2499, 0.25, 1.0, -1.0, 3e38, -3e38],
+                             np.sign(fuzz.rng.normal(size=ROWS)) * 10.0 ** fuzz.uniform(-8.0, 0.3, ROWS)]))
+    out = glsl(["sg.glsl"], "vec4(precise_asin(a.x), 0.0, 0.0, 0.0)", {"a": x[:, None]}, 1)
+    _assert_finite(out, "precise_asin")
+    exact = np.arcsin(np.clip(x.astype(np.float64), -1, 1))
+    small = np.abs(x) < 0.25
+    assert np.abs(out[small] / np.where(exact[small] == 0, 1, exact[small]) - 1)[exact[small] != 0].max() <= 1e-6
+    assert np.abs(out - exact).max() <= 2e-5       # llvmpipe's atan: 3e-6 (its asin: 4e-4)
 
 
 def test_safe_normalize_stress(glsl, fuzz):
@@ -361,11 +370,12 @@ def test_sg_helpers_stress(glsl):
 def test_hemisphere_helpers_stress(glsl):
     x = _sg_inputs()
     inputs = {"t": np.c_[x["theta_d"], x["sharpness"], x["theta_d"] * x["sharpness"]]}
-    out = glsl(["sg.glsl", "hemisphere.glsl"], "vec4(erf_approx(t.z), fh_k(t.y), fh_normalized(t.x, t.y), 0.0)",
-               inputs, 3)
-    _assert_finite(out, "erf_approx / fh_k / fh_normalized")
+    out = glsl(["sg.glsl", "hemisphere.glsl"], "vec4(erf_approx(t.z), fh_k(t.y), fh_normalized(t.x, t.y), "
+               "disc_coverage(t.x, t.z))", inputs, 4)      # radius: any sign and size, zero included
+    _assert_finite(out, "erf_approx / fh_k / fh_normalized / disc_coverage")
     assert np.abs(out[:, 0]).max() <= 1 and out[:, 1].min() > 0.59
     assert out[:, 2].min() >= 0 and out[:, 2].max() <= 1
+    assert out[:, 3].min() >= 0 and out[:, 3].max() <= 1
 
 
 def test_clamped_cosine_helpers_stress(glsl):
@@ -448,11 +458,12 @@ def test_lights_helpers_stress(glsl):
     vec3 axis; float sharpness, amplitude;
     point_light_sg(x.xyz, l.xyz, i.x, l.w, axis, sharpness, amplitude);
     result = vec4(cap + effective2 + dot(cap_axis + axis, vec3(1.0)), cap_sharpness + sharpness,
-                  cap_amplitude + amplitude, 0.0);
+                  cap_amplitude + amplitude, light_cap_radius(sharpness) + light_cap_radius(x.w));
     """
-    out = glsl(["sg.glsl", "lights.glsl"], body, inputs, 3)
-    _assert_finite(out, "sphere_light_cap / light_cap_energy_lobe / point_light_sg")
+    out = glsl(["sg.glsl", "lights.glsl"], body, inputs, 4)
+    _assert_finite(out, "sphere_light_cap / light_cap_energy_lobe / point_light_sg / light_cap_radius")
     assert out[:, 1].min() > 0 and out[:, 2].min() >= 0
+    assert out[:, 3].min() >= 0 and out[:, 3].max() <= np.pi + 1e-5       # two half-angles of at most pi / 2
 
 
 def test_env_prefilter_helpers_stress(glsl, fuzz):
@@ -539,7 +550,7 @@ def test_ssdf_quadrature_stress(glsl, fuzz):
     result = vec4(dot(point, vec3(1.0)), ssdf_cell_coverage(a.x, a.y), ssdf_quadrature_weight(a.z),
                   ssdf_cell_radius());
     """
-    out = glsl(["sg.glsl", defines, "ssdf_quadrature.glsl"], body, inputs, 4)
+    out = glsl(["sg.glsl", "hemisphere.glsl", defines, "ssdf_quadrature.glsl"], body, inputs, 4)
     _assert_finite(out, "ssdf_quadrature.glsl")
     assert out[:, 1:3].min() >= 0 and out[:, 1:3].max() <= 1
 
@@ -588,7 +599,7 @@ def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
 # ---- shaders/techniques/sg: the per-pixel pieces that can be called alone
 
 RESOURCE_KERNELS = {
-    "../common/lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility"],
+    "../common/lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility", "light_cap_visibility"],
     "sg_shading.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_m_factor"],
     "../common/fitted_texels.glsl": ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
                                      "fitted_shadowing_at", "fitted_shadowing_of"],
@@ -604,8 +615,9 @@ LIBRARY_ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "brdf.glsl
 
 
 def test_lobe_visibility_stress(glsl, fuzz):
-    """lobe_visibility.glsl's lobe_visibility after set_visibility_frame: any lobe, any
-    normal and SSDF normal (zero, tiny, huge, opposite), random bake rows: a fraction in [0, 1]."""
+    """lobe_visibility.glsl's lobe_visibility and light_cap_visibility after set_visibility_frame: any lobe or
+    cap (radius zero to past pi), any normal and SSDF normal (zero, tiny, huge, opposite), random bake rows: a
+    fraction in [0, 1]."""
     x = _sg_inputs()
     count = len(x["sharpness"])
     rows = _f32(fuzz.rng.normal(size=(count, 12)))
@@ -616,13 +628,14 @@ def test_lobe_visibility_stress(glsl, fuzz):
     body = """
     visibility_rows[0] = c0; visibility_rows[1] = c1; visibility_rows[2] = c2;
     set_visibility_frame(s.xyz);
-    result = vec4(lobe_visibility(p.xyz, p.w, n.xyz), 0.0, 0.0, 0.0);
+    result = vec4(lobe_visibility(p.xyz, p.w, n.xyz), light_cap_visibility(p.xyz, abs(n.w)), 0.0, 0.0);
     """
     library = LIBRARY_ORDER + ["hemisphere_map.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl", source]
-    inputs = {"p": np.c_[x["axis1"], x["sharpness"]], "n": x["normal"], "s": ssdf_normal,
+    radius = _f32(np.concatenate([[0.0, 1e-30, 1e-6, 4.0], fuzz.rng.uniform(0.0, 1.6, count - 4)]))
+    inputs = {"p": np.c_[x["axis1"], x["sharpness"]], "n": np.c_[x["normal"], radius], "s": ssdf_normal,
               "c0": rows[:, :4], "c1": rows[:, 4:8], "c2": rows[:, 8:]}
-    out = glsl(library, body, inputs, 1, textures={"visibility_basis": _ssdf_basis(fuzz.rng)})
-    _assert_finite(out, "lobe_visibility")
+    out = glsl(library, body, inputs, 2, textures={"visibility_basis": _ssdf_basis(fuzz.rng)})
+    _assert_finite(out, "lobe_visibility / light_cap_visibility")
     assert out.min() >= 0 and out.max() <= 1
 
 
@@ -1038,7 +1051,7 @@ def test_shadow_maps_stress(glsl, fuzz):
 
 COVERED = {
     test_sg_stress: ["sg_product", "sg_inner_product", "sg_evaluate", "sg_sphere_integral",
-                     "sg_axis_hemisphere_integral", "one_minus_exp_over_x"],
+                     "sg_axis_hemisphere_integral", "one_minus_exp_over_x", "precise_asin"],
     test_safe_normalize_stress: ["safe_normalize"],
     test_hemisphere_stress: ["fh_normalized_from_sine", "fh", "hemisphere_integral", "visibility_product_amplitude",
                              "visibility_product_integral_preserving_amplitude"],
@@ -1060,7 +1073,7 @@ COVERED = {
     test_warp_stress: ["warp_lobes_split2", "warp_lobes_split3", "warp_lobes_paper", "brdf_slice_amplitude"],
     test_env_prefilter_stress: ["env_prefilter_lookup", "env_prefilter_lookup_integral"],
     test_sg_helpers_stress: ["sg_rotate", "sg_support_area", "sg_sharpness_from_area"],
-    test_hemisphere_helpers_stress: ["erf_approx", "fh_k", "fh_normalized"],
+    test_hemisphere_helpers_stress: ["erf_approx", "fh_k", "fh_normalized", "disc_coverage"],
     test_clamped_cosine_helpers_stress: ["clamped_cosine_lobe", "clamped_cosine_pole_integrals",
                                          "clamped_cosine_langevin_moments", "clamped_cosine_gaussian_positive_mean",
                                          "clamped_cosine_sharpness_terms", "clamped_cosine_from_terms"],
@@ -1070,13 +1083,13 @@ COVERED = {
                                "beckmann_ndf", "ward_isotropic_m_factor", "ggx_alpha", "ggx_smith_lambda"],
     test_warp_helpers_stress: ["warp_at", "warp_split_frame", "warp_split_node"],
     test_lights_helpers_stress: ["blender_point_light_intensity", "light_cap_energy_lobe", "sphere_light_cap",
-                                 "point_light_sg"],
+                                 "point_light_sg", "light_cap_radius"],
     test_env_prefilter_helpers_stress: ["env_sign_not_zero", "oct_encode", "env_prefilter_blend_parameter"],
     test_ssdf_stress: ["hemisphere_map_disc_to_square", "hemisphere_map_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",
                        "ssdf_to_local", "ssdf_decode", "ssdf_visibility_amplitude", "ssdf_shadowed_integral"],
     test_ssdf_quadrature_stress: ["ssdf_quadrature_point", "ssdf_cell_radius", "ssdf_cell_coverage",
                                   "ssdf_quadrature_weight"],
-    test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility"],
+    test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility", "light_cap_visibility"],
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
     test_factored_brdf_stress: ["parabolic_uv", "factored_brdf"],
     test_sh_library_stress: ["sh_basis", "sh_rotate_z", "sh_rotate", "sh_cap_factors", "sh_sg_factors",

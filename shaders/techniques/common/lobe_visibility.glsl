@@ -1,7 +1,8 @@
-/* SSDF visibility of one SG lobe against the clamped cosine (wang2009 eq. 39-43 with eq. 30-31), shared by
- * the SG surface shader (techniques/sg/sg_shading.glsl), its per-vertex pass of the broad diffuse lobes
- * (techniques/sg/vertex_visibility.frag.glsl) and the factored technique (techniques/factored).  Needs sg.glsl, hemisphere.glsl, clamped_cosine.glsl, ssdf.glsl
- * and the `visibility_basis` sampler. */
+/* SSDF visibility of one SG lobe against the clamped cosine (wang2009 eq. 39-43 with eq. 30-31), and of a
+ * light's cap, shared by the SG surface shader (techniques/sg/sg_shading.glsl), its per-vertex pass of the
+ * broad diffuse lobes (techniques/sg/vertex_visibility.frag.glsl) and the factored technique
+ * (techniques/factored); mirrored by techniques/sg_shading.py's lobe_visibility and light_cap_visibility.  Needs
+ * sg.glsl, hemisphere.glsl, clamped_cosine.glsl, ssdf.glsl and the `visibility_basis` sampler. */
 
 /* The pixel's (or vertex's) SSDF coefficient rows and the bake's local frame of its SSDF normal
  * (ssdf_local_frame, rows t, b, n): set once by set_visibility_frame(). */
@@ -41,4 +42,18 @@ float lobe_visibility(vec3 axis, float sharpness, vec3 n)
   float visible = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_d), 0.0, 1.0);
   float unshadowed = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_h), 0.0, 1.0);
   return clamp(visible / max(unshadowed, 1.0e-30), 0.0, 1.0);
+}
+
+/* Visible fraction of a light's cap of half-angle `radius` (lighting.lights: the uniform disc its SG stands for,
+ * light_cap_radius): the disc's share beyond the SSDF's boundary at its centre (the boundary taken straight,
+ * as eq. 30 takes it), over its share above the horizon (I(G, n) clamps the horizon already).  eq. 30's fh
+ * of the light's SG would give the Gaussian's penumbra, about 1.3 times as wide as the disc's and with tails
+ * past it. */
+float light_cap_visibility(vec3 axis, float radius)
+{
+  vec3 local = axis * visibility_frame;            /* ssdf_to_local */
+  float theta_d = ssdf_decode(visibility_basis, visibility_rows, SSDF_MAX_LAYERS, local);
+  float theta_h = precise_asin(safe_normalize(local).z);
+  float unshadowed = disc_coverage(theta_h, radius);
+  return clamp(disc_coverage(theta_d, radius) / max(unshadowed, 1.0e-30), 0.0, 1.0);
 }

@@ -32,8 +32,10 @@ vec3 factored_brdf(vec3 o, vec3 i)
 
 #ifdef HAS_VISIBILITY
 #define FACTORED_VISIBILITY(axis, sharpness) lobe_visibility(axis, sharpness, n)
+#define FACTORED_LIGHT_VISIBILITY(axis, sharpness) light_cap_visibility(axis, light_cap_radius(sharpness))
 #else
 #define FACTORED_VISIBILITY(axis, sharpness) 1.0
+#define FACTORED_LIGHT_VISIBILITY(axis, sharpness) 1.0
 #endif
 #ifdef DIFFUSE_VISIBILITY_ROWS
 /* the broad diffuse lobes' visible fractions from the vertices (the SG techniques' per-vertex pass:
@@ -61,7 +63,7 @@ void shade_factored(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color
     vec3 light_amplitude;
     scene_light_sg(l, position, light_axis, light_sharpness, light_amplitude);
     vec3 light_energy = light_amplitude * (sg_clamped_cosine_integral(light_axis, light_sharpness, 1.0, n) *
-                                           FACTORED_VISIBILITY(light_axis, light_sharpness));
+                                           FACTORED_LIGHT_VISIBILITY(light_axis, light_sharpness));
     irradiance += light_energy;
     radiance += light_energy * factored_brdf(o, light_axis * frame);      /* eq. 20 */
   }

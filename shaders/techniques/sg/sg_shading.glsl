@@ -17,11 +17,13 @@
 
 #ifdef HAS_VISIBILITY
 #define LOBE_VISIBILITY(axis, sharpness) lobe_visibility(axis, sharpness, n)
+#define LIGHT_VISIBILITY(axis, sharpness) light_cap_visibility(axis, light_cap_radius(sharpness))
 #if defined(HAS_SPECULAR) && !defined(SHARED_LIGHT_VISIBILITY)
 #define PRODUCT_VISIBILITY      /* a decode for each NDF lobe's light x slice products */
 #endif
 #else
 #define LOBE_VISIBILITY(axis, sharpness) 1.0
+#define LIGHT_VISIBILITY(axis, sharpness) 1.0
 #endif
 #ifdef DIFFUSE_VISIBILITY_ROWS
 /* environment lobe e (the constant world: 0), 4 a row */
@@ -343,14 +345,14 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef HAS_VISIBILITY
     float light_visibility = 1.0;
     if (shadow.y > 0.0) {
-      light_visibility = LOBE_VISIBILITY(light_axis, light_sharpness);
+      light_visibility = LIGHT_VISIBILITY(light_axis, light_sharpness);
     }
     light_visibility = mix(shadow.x, light_visibility, shadow.y);
 #else
     float light_visibility = shadow.x;
 #endif
 #elif defined(HAS_DIFFUSE) || defined(SHARED_LIGHT_VISIBILITY) || defined(LIGHT_TAIL)
-    float light_visibility = LOBE_VISIBILITY(light_axis, light_sharpness);
+    float light_visibility = LIGHT_VISIBILITY(light_axis, light_sharpness);
 #endif
 #ifdef HAS_DIFFUSE
     irradiance += light_amplitude * (light_cosine * light_visibility * BISCALE_DIFFUSE(light_axis));   /* eq. 42 */
