@@ -1,25 +1,20 @@
 """visibility.buried: points inside other geometry found by their back-face hits and given their neighbours'
-rows, measured against rays at the visible points of the triangles they share."""
+rows, measured against rays at the visible points of the triangles they share (validation.visibility_cases)."""
 import numpy as np
 import pytest
 
-from benchmarks.bake_speed import grid, icosphere
+from benchmarks.bake_speed import grid
 from sg_prt_addon.visibility import BakeOptions, bake_visibility, buried, hemisphere_map
-from sg_prt_addon.visibility.pipeline import bake_ssdf
 from sg_prt_addon.visibility.raytrace import RayTracer
+from validation import visibility_cases
 
-DOME_RADIUS = 0.35
+DOME_RADIUS = visibility_cases.SPHERE_RADIUS
 
 
 @pytest.fixture(scope="module")
 def sunk_sphere():
-    """A floor of 21 x 21 vertices (spacing 0.1) through a sphere of radius 0.35 centred on it: the floor's
-    vertices inside the sphere are buried.  (floor vertices, floor triangles, all vertices, all triangles)."""
-    floor_v, floor_t = grid(21, 1.0)
-    sphere_v, sphere_t = icosphere(4)
-    vertices = np.concatenate([floor_v, sphere_v * DOME_RADIUS])
-    triangles = np.concatenate([floor_t, sphere_t + len(floor_v)])
-    return floor_v, floor_t, vertices, triangles
+    """validation.visibility_cases.floor_through_sphere: the floor's vertices inside the sphere are buried."""
+    return visibility_cases.floor_through_sphere()
 
 
 def _share(points, normals, vertices, triangles):
@@ -72,46 +67,16 @@ def test_fill_buried_goes_ring_by_ring_and_keeps_unreachable_rows():
         assert samples[index, 0] == pytest.approx(2.0)
 
 
-def _open_fraction(ssdf_rows, directions):
-    """Cosine-weighted share of a hemisphere's stored samples with a positive SSDF."""
-    z = directions[..., 2].ravel()
-    return ((np.asarray(ssdf_rows) > 0) * z).sum(axis=-1) / z.sum()
-
-
-def test_filled_rows_give_the_visible_side_of_a_seam_its_visibility(sunk_sphere):
-    """At points of floor triangles that leave the sphere (one or two buried corners, the point itself outside
-    it), the cosine-weighted open share of the SSDF interpolated from the corners against rays cast from the
-    point: the buried corners' rows ("no sky at all") darken the visible side; filled, they do not."""
-    floor_v, floor_t, vertices, triangles = sunk_sphere
-    normals = np.tile([0.0, 0.0, 1.0], (len(floor_v), 1))
-    options = BakeOptions(resolution=16, refinement=3)
-    tracer = RayTracer(vertices, triangles, threads=1)
-    try:
-        raw = bake_ssdf(floor_v, normals, tracer, options).astype(np.float32)
-        share = buried.backface_share(tracer, floor_v + tracer.offset * normals,
-                                      hemisphere_map.local_frame(normals))
-        filled = raw.copy()
-        buried.fill_buried(filled, share >= buried.BURIED_SHARE, buried.adjacency(floor_t, len(floor_v)))
-        # sample points on the seam's triangles, outside the sphere
-        seam = floor_t[np.any(share[floor_t] >= buried.BURIED_SHARE, axis=1)
-                       & np.any(share[floor_t] < buried.BURIED_SHARE, axis=1)]
-        weights = np.random.default_rng(3).dirichlet(np.ones(3), size=(len(seam), 8))        # (T, 8, 3)
-        points = np.einsum("tsk,tkc->tsc", weights, floor_v[seam])
-        keep = np.linalg.norm(points, axis=-1) > DOME_RADIUS + 0.01
-        points, weights, corners = points[keep], weights[keep], np.repeat(seam[:, None], 8, axis=1)[keep]
-        assert len(points) >= 50
-        directions = hemisphere_map.sample_directions(options.resolution)
-        truth = _open_fraction(bake_ssdf(points, np.tile([0.0, 0.0, 1.0], (len(points), 1)), tracer,
-                                         BakeOptions(resolution=16, refinement=3)), directions)
-    finally:
-        tracer.close()
-    errors = {}
-    for name, rows in (("raw", raw), ("filled", filled)):
-        interpolated = np.einsum("sk,skn->sn", weights, rows[corners])
-        errors[name] = np.abs(_open_fraction(interpolated, directions) - truth).mean()
-    print("mean |open share error| at the seam's visible points:", errors)
-    assert errors["filled"] <= 0.07                                   # measured 0.048 (the wall near them)
-    assert errors["raw"] >= 5 * errors["filled"]                      # measured 0.50: ten times
+def test_filled_rows_give_the_visible_side_of_a_seam_its_visibility():
+    """At points of the floor's triangles that leave the sphere (buried and unburied corners, the point itself
+    outside it), the cosine-weighted open share of the SSDF interpolated from the corners against rays cast
+    from the point: the buried corners' rows ("no sky at all") darken the visible side; filled, they do not."""
+    errors = visibility_cases.seam_open_share_errors()
+    assert len(errors["baked"]) >= 50
+    mean = {name: float(value.mean()) for name, value in errors.items()}
+    print("mean |open share error| at the seam's visible points:", mean)
+    assert mean["filled"] <= 0.07                                     # measured 0.048 (the sphere's wall near them)
+    assert mean["baked"] >= 5 * mean["filled"]                        # measured 0.50: ten times
 
 
 def test_the_bake_fills_buried_points_when_given_their_triangles(sunk_sphere):
