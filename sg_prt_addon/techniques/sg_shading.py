@@ -236,8 +236,8 @@ def environment_tail(albedo, slice_axis, slice_sharpness, slice_cosine, warp_mod
     ENVIRONMENT_TAIL): (albedo (N,), axis (N, 3), sharpness (N,)).  The albedo is max(0, E(o) - sum_j
     I(S_j, n)), E(o) the model's exact directional albedo (model_albedo), the sum the slice lobes' own
     clamped-cosine integrals (unshadowed); the lobe lies on the broader NDF lobe's centre node with
-    TAIL_SHARPNESS_RATIO of its sharpness (GGX's tail is wider than either lobe) and takes that node's
-    visibility."""
+    TAIL_SHARPNESS_RATIO of its sharpness (GGX's tail is wider than either lobe); with visibility it takes
+    its own (_add_environment), read where that node's visible part is."""
     node = visibility_node_indices(slice_sharpness.shape[1], warp_mode)[0]
     missing = np.maximum(albedo - np.sum(slice_cosine, axis=1), FLOAT(0))
     return missing.astype(FLOAT), slice_axis[:, node], (slice_sharpness[:, node] * FLOAT(TAIL_SHARPNESS_RATIO))
@@ -597,8 +597,9 @@ def _add_environment(px, environment, irradiance, specular):
         if environment.has_texture:
             lookup_axis = visible_part_axes(px.slice_axis, px.slice_sharpness, slice_visible, px.view, centre,
                                             px.nodes)
-        if tail is not None:
-            tail = (tail[0] * slice_visible[:, 0], lookup_axis[:, centre[0]], tail[2])
+        if tail is not None:     # the tail's own visibility: broader than the slice lobe, it sees past more
+            tail_visible = px.visible(tail[1][:, None], tail[2][:, None])[:, 0]
+            tail = (tail[0] * tail_visible, lookup_axis[:, centre[0]], tail[2])
     if environment.has_texture:
         if len(environment.lobe_sharpness):
             lobe_count_env = len(environment.lobe_sharpness)

@@ -422,7 +422,6 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
 
 #ifdef HAS_SPECULAR
-  float tail_visibility = 1.0;
   vec3 tail_axis = slice_axis[VISIBILITY_NODE];
   for (int k = 0; k < NDF_LOBES; k++) {
     int centre = WARP_NODES * k + VISIBILITY_NODE;
@@ -446,7 +445,6 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
                     pivot * (dot(pivot, lookup_axis) * (1.0 - turn_cos));
 #endif
       if (j == VISIBILITY_NODE) {
-        tail_visibility = visibility;
         tail_axis = lookup_axis;
       }
 #ifdef HAS_ENVIRONMENT
@@ -460,10 +458,12 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
 #ifdef ENVIRONMENT_TAIL
   /* GGX's energy beyond its slice lobes: its exact albedo minus theirs, as a broad lobe on the broader NDF
-   * lobe's centre node (techniques.sg_shading.environment_tail) */
+   * lobe's centre node (techniques.sg_shading.environment_tail), with its own visibility (broader than the
+   * node's, it sees past more of an occluder), read where the node's visible part lies */
+  float tail_sharpness = slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO;
+  float tail_visibility = LOBE_VISIBILITY(slice_axis[VISIBILITY_NODE], tail_sharpness);
   float tail_albedo = max(model_albedo - slice_albedo, 0.0) * tail_visibility;
 #ifdef HAS_ENVIRONMENT
-  float tail_sharpness = slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO;
   cosine_weighted_lookup(tail_axis, tail_sharpness, n, true);
   radiance += tail_albedo * environment_radiance(tail_axis, tail_sharpness);
 #else
