@@ -104,7 +104,7 @@ def run(target_vertices, options=None):
     vertices, triangles, normals = sphere_over_floor(target_vertices)
     options = options or BakeOptions()
     raw = raw_rate(vertices, triangles, normals)
-    result = bake_visibility(vertices, triangles, normals, vertices, triangles, options)
+    result = bake_visibility(vertices, triangles, normals, vertices, triangles, options, point_triangles=triangles)
     figures = {"vertices": len(vertices), "triangles": len(triangles), "seconds": result.seconds,
                "rays_per_vertex": result.rays_traced / len(vertices), "bake_rate": result.rays_traced / result.seconds,
                "raw_rate": raw, "terms": result.terms, "pca_rms": result.rms_error,
@@ -146,14 +146,15 @@ def section(sizes, rows, errors):
     intro = (f"`.venv/bin/python -m benchmarks.bake_speed {' '.join(map(str, sizes))} --update-doc` "
              f"({time.strftime('%Y-%m-%d')}; written by the benchmark): an icosphere over a floor grid, every vertex "
              "baked, the whole scene occludes, operator defaults (resolution 32, refinement 5, PCA error target "
-             "0.02 rad).  Raw rate: RayTracer.occluded on 2M random hemisphere rays from the same vertices, both "
+             "0.02 rad), its triangles passed as the operator passes them (64 probe rays a vertex for buried points, "
+             "visibility.buried: none here).  Raw rate: RayTracer.occluded on 2M random hemisphere rays from the same vertices, both "
              "cores, in the same run.  SSDF error: the bake's decompressed SSDF at 64 vertices against the SSDF of "
              "a dense 160 x 160 ray grid there.  Casting: Embree's rate inside the bake (its rays over the "
              "thread-seconds spent in its queries, times the 2 threads) and the share of the two cores' bake time "
              "spent there (the rest is the SSDF's boundary search, the PCA and numpy).  Peak memory: the "
              "process's (it grows with the largest size run).")
     lines = [SECTION_TITLE, "", textwrap.fill(intro, 110), "",
-             "| vertices | bake (rays + SSDF + PCA) | rays/vertex | bake rays/s | raw rays/s | bake / raw | casting "
+             "| vertices | bake (rays + SSDF + buried probe + PCA) | rays/vertex | bake rays/s | raw rays/s | bake / raw | casting "
              "rays/s (/ raw) | time in Embree | PCA terms, RMS | SSDF error vs dense rays | peak memory | load |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:

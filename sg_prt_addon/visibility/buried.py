@@ -26,6 +26,9 @@ from . import hemisphere_map
 BURIED_SHARE = 0.9       # share of the hemisphere's probe rays that must hit back faces
 PROBE_RAYS = 64          # probe directions a point (spiral points, equal solid angle)
 MAX_RINGS = 64           # edge rings a fill may cross; beyond, points keep their own rows
+# Points that saw more of their hemisphere open than this in the bake are not probed: twice what a buried point
+# can see (1 - BURIED_SHARE), a margin for the bake's directions differing from the probe's
+CANDIDATE_OPEN_SHARE = 2.0 * (1.0 - BURIED_SHARE)
 
 _GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
 
@@ -97,12 +100,22 @@ def fill_buried(samples, buried, neighbours, max_rings=MAX_RINGS):
     return filled
 
 
-def fill_buried_points(samples, tracer, points, normals, point_triangles, threads=1):
+def fill_buried_points(samples, tracer, points, normals, point_triangles, open_share=None, threads=1):
     """The bakes' step: rows (P, N) of the baked points (world points and normals (P, 3)) whose hemispheres
     are buried (backface_share against ``tracer``'s occluders) replaced in place by their neighbours' along
-    point_triangles (T, 3); returns how many were filled."""
+    point_triangles (T, 3); returns how many were filled.  open_share (P,): the share of each hemisphere the
+    bake found open, when it knows it: only points that saw at most CANDIDATE_OPEN_SHARE of theirs are probed
+    (a buried point sees at most 1 - BURIED_SHARE), which spares the probe's rays on meshes that pass through
+    nothing."""
     frames = hemisphere_map.local_frame(np.asarray(normals, np.float64).reshape(-1, 3))
     origins = np.asarray(points, np.float64).reshape(-1, 3) + tracer.offset * frames[:, 2]
-    share = backface_share(tracer, origins, frames, threads=threads)
-    filled = fill_buried(samples, share >= BURIED_SHARE, adjacency(point_triangles, len(origins)))
+    candidates = np.ones(len(origins), bool) if open_share is None else \
+        np.asarray(open_share) <= CANDIDATE_OPEN_SHARE
+    is_buried = np.zeros(len(origins), bool)
+    if candidates.any():
+        share = backface_share(tracer, origins[candidates], frames[candidates], threads=threads)
+        is_buried[candidates] = share >= BURIED_SHARE
+    if not is_buried.any():
+        return 0
+    filled = fill_buried(samples, is_buried, adjacency(point_triangles, len(origins)))
     return int(filled.sum())

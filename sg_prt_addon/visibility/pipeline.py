@@ -136,7 +136,8 @@ def bake_visibility(vertices, triangles, normals, occluder_vertices, occluder_tr
     try:
         samples = bake_ssdf(vertices, normals, tracer, options, progress, tangents)
         buried_points = 0 if point_triangles is None else buried.fill_buried_points(
-            samples, tracer, vertices, normals, point_triangles, options.threads)
+            samples, tracer, vertices, normals, point_triangles, open_share=(samples > 0).mean(axis=1),
+            threads=options.threads)
         rays, seconds_tracing = tracer.rays_traced, tracer.seconds_tracing
     finally:
         tracer.close()

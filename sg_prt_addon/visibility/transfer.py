@@ -157,8 +157,10 @@ def bake_transfer(vertices, triangles, normals, occluder_vertices, occluder_tria
         def scaled(fraction, message):
             return progress is not None and progress(0.9 * fraction, message)
         samples = transfer_vectors(vertices, normals, tracer, options.order, options.directions, scaled)
+        # the glossy matrix's first entry is the visible solid angle over 4 pi (band 0: the same in any frame)
+        open_share = samples[:, options.order ** 2] / open_sky(options.order)[1][0, 0]
         buried_points = 0 if point_triangles is None else buried.fill_buried_points(
-            samples, tracer, vertices, normals, point_triangles, options.threads)
+            samples, tracer, vertices, normals, point_triangles, open_share=open_share, threads=options.threads)
         rays = tracer.rays_traced
     finally:
         tracer.close()

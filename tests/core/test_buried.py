@@ -89,3 +89,22 @@ def test_the_bake_fills_buried_points_when_given_their_triangles(sunk_sphere):
     assert plain.buried_points == 0 and filled.buried_points >= inside.sum()
     # buried rows: "occluded everywhere" (the SSDF's mean below zero) before, the open floor's after
     assert plain.ssdf(np.flatnonzero(inside)).mean() < 0 < filled.ssdf(np.flatnonzero(inside)).mean()
+
+
+def test_the_transfer_bake_fills_buried_points_too(sunk_sphere):
+    """The SH transfer bake (kautz2002) finds the same points, their candidates by the visible solid angle its
+    glossy matrix holds, and gives them their neighbours' vectors."""
+    from sg_prt_addon.visibility import transfer
+
+    floor_v, floor_t, vertices, triangles = sunk_sphere
+    normals = np.tile([0.0, 0.0, 1.0], (len(floor_v), 1))
+    options = transfer.TransferOptions(order=3, directions=256, terms=4)
+    plain = transfer.bake_transfer(floor_v, floor_t, normals, vertices, triangles, options)
+    filled = transfer.bake_transfer(floor_v, floor_t, normals, vertices, triangles, options, point_triangles=floor_t)
+    inside = np.linalg.norm(floor_v, axis=1) < DOME_RADIUS - 0.02
+    assert plain.buried_points == 0 and filled.buried_points >= inside.sum()
+    # their diffuse transfer's band-0 term: none of the sky before, the open floor's after
+    def band0(result):
+        return (result.coefficients @ result.basis + result.mean)[np.flatnonzero(inside), 0]
+    assert np.abs(band0(plain)).max() < 0.05 * transfer.open_sky(3)[0][0]
+    assert band0(filled).mean() > 0.5 * transfer.open_sky(3)[0][0]
