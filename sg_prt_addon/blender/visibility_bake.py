@@ -176,8 +176,6 @@ class Receiver(NamedTuple):
     point_triangles: Optional[np.ndarray] = None    # (T, 3) over the points: neighbours (visibility.buried)
 
 
-
-
 @dataclass
 class BakeTarget:
     """Where a receiver's rows are stored: on its mesh datablock (`evaluated` None: its modifiers keep the faces),

@@ -252,7 +252,6 @@ def visibility_product_integral_preserving(axis, sharpness, amplitude, theta_d):
     return axis, sharpness, (np.asarray(amplitude) * scale).astype(normalized.dtype, copy=False)
 
 
-
 def disc_coverage(signed_distance, radius):
     """Visible share of a disc of angular ``radius`` whose centre lies ``signed_distance`` (+ visible) from a
     straight boundary: the disc's area beyond a chord (a small disc's, as on a plane)."""
