@@ -24,7 +24,7 @@ DEPENDENCIES = {
     "env_prefilter.glsl": ["sg.glsl"],
     "hemisphere_map.glsl": ["sg.glsl"],
     "ssdf.glsl": ["sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n"],
-    "ssdf_quadrature.glsl": ["sg.glsl", QUADRATURE_DEFINES],
+    "ssdf_quadrature.glsl": ["sg.glsl", "hemisphere.glsl", QUADRATURE_DEFINES],
     "shadow_maps.glsl": [shader_sources.shadow_map_constants()],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
