@@ -117,19 +117,26 @@ def ssdf_decode_packed(rows, basis_texture, local_direction):
     return (value - below).astype(FLOAT)
 
 
+def _ssdf_at(axis, visibility):
+    """(local (N, K, 3), theta_d (N, K)): world directions (N, K, 3) in the SSDF's frame of each pixel's normal
+    and the SSDF there (lobe_visibility.glsl's `axis * visibility_frame` and ssdf_decode)."""
+    from ..visibility import hemisphere_map
+
+    frame = hemisphere_map.local_frame(np.asarray(visibility.normal, np.float64))      # (N, 3, 3)
+    local = np.einsum("nij,nkj->nki", frame, np.asarray(axis, np.float64))
+    return local, ssdf_decode_packed(visibility.rows, visibility.basis_texture, local)
+
+
 def lobe_visibility(axis, sharpness, n, visibility):
     """Visible fraction (N, K) of I(G, n) for lobes G with axis (N, K, 3), sharpness (N, K); n (N, 3)
     (sg_shading.glsl's lobe_visibility)."""
     from ..spherical import hemisphere
-    from ..visibility import hemisphere_map
 
     cosine_sharpness, _ = clamped_cosine.clamped_cosine_lobe()
     product_axis, product_sharpness, _ = sg.product(
         np.asarray(axis, FLOAT), np.asarray(sharpness, FLOAT), FLOAT(1),
         np.asarray(n, FLOAT)[:, None, :], FLOAT(cosine_sharpness), FLOAT(1))
-    frame = hemisphere_map.local_frame(np.asarray(visibility.normal, np.float64))      # (N, 3, 3)
-    local = np.einsum("nij,nkj->nki", frame, np.asarray(product_axis, np.float64))
-    theta_d = ssdf_decode_packed(visibility.rows, visibility.basis_texture, local)
+    local, theta_d = _ssdf_at(product_axis, visibility)
     product_sharpness = np.asarray(product_sharpness, FLOAT)
     visible = hemisphere.fh_normalized(theta_d, product_sharpness)
     unshadowed = hemisphere.fh_normalized_from_sine(sg.normalize(local.astype(FLOAT))[..., 2], product_sharpness)
@@ -140,11 +147,8 @@ def light_cap_visibility(axis, sharpness, visibility):
     """Visible fraction (N, K) of lights' caps: axis (N, K, 3), sharpness (N, K) of their SGs, whose caps are
     lights.cap_radius wide (lobe_visibility.glsl's light_cap_visibility with sg_shading.glsl's light_cap_radius)."""
     from ..spherical import hemisphere
-    from ..visibility import hemisphere_map
 
-    frame = hemisphere_map.local_frame(np.asarray(visibility.normal, np.float64))      # (N, 3, 3)
-    local = np.einsum("nij,nkj->nki", frame, np.asarray(axis, np.float64))
-    theta_d = ssdf_decode_packed(visibility.rows, visibility.basis_texture, local)
+    local, theta_d = _ssdf_at(axis, visibility)
     radius = lights.cap_radius(sharpness)
     theta_h = np.arcsin(np.clip(sg.normalize(local.astype(FLOAT))[..., 2], -1, 1))
     unshadowed = hemisphere.disc_coverage(theta_h, radius)
