@@ -4,6 +4,10 @@ tests/core/test_buried.py) and by docs/ACCURACY.md's ssdf rows (benchmarks/accur
 - A light's cap crossing the edge of a half-plane: the share of the cap (cosine-weighted) the SSDF's
   reading leaves visible (techniques.sg_shading.light_cap_visibility), and eq. 30's fh of the light's SG,
   against the exact share.
+- A glossy lobe crossing the same edge under an environment brighter on the edge's open side: the radiance the
+  lobe's visible part receives, read at the lobe's axis and at its visible part (techniques.sg_shading.
+  visible_part_axes: turned to the side lobe_visibility_side finds in the baked SSDF, narrowed), against
+  quadrature over the sphere.
 - A floor through a sphere: floor vertices inside the sphere are buried (visibility.buried); at visible
   points of the triangles they share, the open share of the SSDF interpolated from the corners against rays
   cast from the point, with the buried rows as baked and filled from their neighbours.
@@ -59,6 +63,68 @@ def baked_half_plane_ssdf(axes, resolution=32, refinement=5):
         tracer.close()
     frame = hemisphere_map.local_frame(np.array([[0.0, 0.0, 1.0]]))[0]
     return decode.decode_image(image.reshape(resolution, resolution).astype(np.float64), axes @ frame.T)
+
+
+def half_plane_visibility(count, resolution=32, refinement=5):
+    """techniques.sg_shading.Visibility of ``count`` pixels at the origin (normal +z) under the half-plane, its
+    baked SSDF as the mean image of a basis without terms."""
+    from sg_prt_addon.techniques import sg_shading
+
+    quad = np.array([[-20.0, -20.0, 1.0], [0.0, -20.0, 1.0], [0.0, 20.0, 1.0], [-20.0, 20.0, 1.0]])
+    tracer = RayTracer(quad, np.array([[0, 1, 2], [0, 2, 3]]), threads=1)
+    try:
+        image = bake_ssdf(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), tracer,
+                          BakeOptions(resolution, refinement))[0]
+    finally:
+        tracer.close()
+    basis = decode.pack_basis_texture(image.reshape(resolution, resolution), np.zeros((0, resolution, resolution)))
+    return sg_shading.Visibility(rows=np.tile(decode.pack_coefficients(np.zeros((1, 0))), (count, 1)),
+                                 normal=np.tile(np.float32([0.0, 0.0, 1.0]), (count, 1)), basis_texture=basis)
+
+
+def _edge_environment(directions):
+    """Radiance brighter on the edge's open side (+x) and towards the zenith: exp(2 x + z)."""
+    return np.exp(2.0 * directions[..., 0] + directions[..., 2])
+
+
+def _lobe_mean(directions, weights, axis, sharpness):
+    """Mean of _edge_environment over G(axis, sharpness) times weights (quadrature over ``directions``)."""
+    lobe = np.exp(sharpness[:, None] * (axis @ directions.T - 1.0)) * weights
+    return (lobe * _edge_environment(directions)).sum(-1) / lobe.sum(-1)
+
+
+def lobe_edge_radiance(sharpness, steps=41):
+    """{"exact", "axis", "visible part", "visible", "side angle"} (K,) over a sweep of lobes of ``sharpness``
+    across the half-plane's edge (cap_sweep's, in lobe widths): the mean radiance of the lobe's visible part,
+    G V max(0, z) (quadrature over 4e5 directions), read at the lobe's axis, and at its visible part (the baked
+    SSDF's side, offset and narrowing: visible_part_axes); the exact visible fraction; the angle between the side
+    lobe_visibility_side finds and the edge's open side across the axis."""
+    from sg_prt_addon.lighting.env_fit import fibonacci_sphere
+    from sg_prt_addon.techniques import sg_shading
+
+    tilt = np.array([[1, 0, 0], [0, np.cos(CAP_TILT), -np.sin(CAP_TILT)], [0, np.sin(CAP_TILT), np.cos(CAP_TILT)]])
+    alpha = np.linspace(-2.0, 2.0, steps) / np.sqrt(sharpness)
+    axes = np.stack([np.sin(alpha), np.zeros_like(alpha), np.cos(alpha)], -1) @ tilt.T
+    directions = fibonacci_sphere(400_000)
+    cosine = np.maximum(directions[:, 2], 0.0)
+    lam = np.full(steps, float(sharpness))
+    lobe = np.exp(lam[:, None] * (axes @ directions.T - 1.0)) * cosine
+    visible = (lobe * (directions[:, 0] > 0)).sum(-1) / lobe.sum(-1)
+    pixels = half_plane_visibility(steps)
+    normal = np.tile(np.float32([0.0, 0.0, 1.0]), (steps, 1))
+    shaded, side = sg_shading.lobe_visibility_side(axes[:, None].astype(np.float32), lam[:, None].astype(np.float32),
+                                                  normal, pixels)
+    part_axis, part_sharpness = sg_shading.visible_part_axes(axes[:, None].astype(np.float32),
+                                                             lam[:, None].astype(np.float32), shaded, side, [0], 1)
+    part_axis = part_axis[:, 0] / np.linalg.norm(part_axis[:, 0], axis=-1, keepdims=True)
+    across = np.array([1.0, 0.0, 0.0]) - axes * axes[:, :1]          # the edge's open side, across each axis
+    across /= np.linalg.norm(across, axis=-1, keepdims=True)
+    return {"exact": _lobe_mean(directions, cosine * (directions[:, 0] > 0), axes, lam),
+            "axis": _lobe_mean(directions, cosine, axes, lam),
+            "visible part": _lobe_mean(directions, cosine, part_axis.astype(np.float64),
+                                       part_sharpness[:, 0].astype(np.float64)),
+            "visible": visible,
+            "side angle": np.arccos(np.clip(np.sum(side[:, 0] * across, -1), -1.0, 1.0))}
 
 
 def cap_share_errors(radius, baked=False):

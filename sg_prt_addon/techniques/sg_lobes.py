@@ -151,6 +151,11 @@ def _constants_source():
             f"const float VISIBILITY_SKIP_FRACTION = {literal(sg_shading.VISIBILITY_SKIP_FRACTION)};\n"
             f"const float COSINE_LOOKUP_FULL = {literal(sg_shading.COSINE_LOOKUP_SHARPNESS[0])};\n"
             f"const float COSINE_LOOKUP_NONE = {literal(sg_shading.COSINE_LOOKUP_SHARPNESS[1])};\n"
+            f"const float VISIBLE_SIDE_STEP = {literal(sg_shading.VISIBLE_SIDE_STEP)};\n"
+            f"const float VISIBLE_SIDE_MAX_FRACTION = {literal(sg_shading.VISIBLE_SIDE_MAX_FRACTION)};\n"
+            f"const int VISIBLE_SIDE_LAYERS = {int(sg_shading.VISIBLE_SIDE_LAYERS)};\n"
+            f"const float VISIBLE_PART_MAX_TURN = {literal(sg_shading.VISIBLE_PART_MAX_TURN)};\n"
+            f"const float VISIBLE_PART_MIN_VARIANCE = {literal(sg_shading.VISIBLE_PART_MIN_VARIANCE)};\n"
             + shader_sources.shadow_map_constants())
 
 

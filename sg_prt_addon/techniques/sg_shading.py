@@ -75,6 +75,19 @@ SHADING_FRAME_MIN_SINE = 1e-3
 # sphere over a floor (tests/gpu/test_shadows_reference.py): the image moves by 1e-4 relative RMSE up to
 # 0.2 rad, 1.6% at 0.3-0.5 rad, 18% beyond.
 SHARED_LIGHT_VISIBILITY_MAX_RADIUS = 0.15
+# A partly occluded slice lobe reads the environment where its visible part lies (visible_part_axes): towards the
+# side where the SSDF grows (lobe_visibility_side) for lobes keeping less than VISIBLE_SIDE_MAX_FRACTION, read off
+# its leading VISIBLE_SIDE_LAYERS coefficient rows (the mean and 7 PCA terms: the occluders' broad shape) by forward
+# differences VISIBLE_SIDE_STEP radians across the lobe's axis (about two texels of the default 32 x 32 SSDF);
+# turned at most VISIBLE_PART_MAX_TURN, narrowed to a visible part's width of at least VISIBLE_PART_MIN_VARIANCE
+# (squared widths) across the boundary.  Truth suite ggx035_metal_hdri at 128 px: every row 0.1043, 1, 2 or 3 rows
+# 0.0988, 0.0989, 0.0984 (the higher terms' detail turns lobes towards the nearest edge); step 0.04, 0.08, 0.16:
+# 0.0988, 0.0989, 0.0992.
+VISIBLE_SIDE_STEP = 0.08
+VISIBLE_SIDE_MAX_FRACTION = 0.999
+VISIBLE_SIDE_LAYERS = 2
+VISIBLE_PART_MAX_TURN = 0.5 * np.pi
+VISIBLE_PART_MIN_VARIANCE = 0.05
 
 
 def _clamped_cosine_integral(axis, sharpness, amplitude, normal):
@@ -127,20 +140,62 @@ def _ssdf_at(axis, visibility):
     return local, ssdf_decode_packed(visibility.rows, visibility.basis_texture, local)
 
 
-def lobe_visibility(axis, sharpness, n, visibility):
-    """Visible fraction (N, K) of I(G, n) for lobes G with axis (N, K, 3), sharpness (N, K); n (N, 3)
-    (sg_shading.glsl's lobe_visibility)."""
-    from ..spherical import hemisphere
-
+def _visibility_product(axis, sharpness, n, visibility):
+    """(local (N, K, 3), theta_d (N, K), product sharpness (N, K)): eq. 40's product lobe P = G (x) C*(n) of lobes G
+    with axis (N, K, 3), sharpness (N, K) on normals n (N, 3), its axis in the SSDF's frame and the SSDF there
+    (lobe_visibility.glsl's visibility_product and the decode)."""
     cosine_sharpness, _ = clamped_cosine.clamped_cosine_lobe()
     product_axis, product_sharpness, _ = sg.product(
         np.asarray(axis, FLOAT), np.asarray(sharpness, FLOAT), FLOAT(1),
         np.asarray(n, FLOAT)[:, None, :], FLOAT(cosine_sharpness), FLOAT(1))
     local, theta_d = _ssdf_at(product_axis, visibility)
-    product_sharpness = np.asarray(product_sharpness, FLOAT)
+    return local, theta_d, np.asarray(product_sharpness, FLOAT)
+
+
+def _product_visible_fraction(theta_d, local, product_sharpness):
+    """eq. 30-31's fh(theta_d) / fh(theta_h) of the product lobes, clamped to [0, 1] (lobe_visibility.glsl's
+    product_visible_fraction)."""
+    from ..spherical import hemisphere
+
     visible = hemisphere.fh_normalized(theta_d, product_sharpness)
     unshadowed = hemisphere.fh_normalized_from_sine(sg.normalize(local.astype(FLOAT))[..., 2], product_sharpness)
     return np.clip(visible / np.maximum(unshadowed, FLOAT(1e-30)), 0, 1).astype(FLOAT)
+
+
+def lobe_visibility(axis, sharpness, n, visibility):
+    """Visible fraction (N, K) of I(G, n) for lobes G with axis (N, K, 3), sharpness (N, K); n (N, 3)
+    (sg_shading.glsl's lobe_visibility)."""
+    local, theta_d, product_sharpness = _visibility_product(axis, sharpness, n, visibility)
+    return _product_visible_fraction(theta_d, local, product_sharpness)
+
+
+def lobe_visibility_side(axis, sharpness, n, visibility):
+    """(visible (N, K), side (N, K, 3)): lobe_visibility, and for lobes keeping less than VISIBLE_SIDE_MAX_FRACTION
+    the side their visible part lies on -- the direction in which the SSDF's leading VISIBLE_SIDE_LAYERS rows grow
+    at the product lobe's axis, by forward differences VISIBLE_SIDE_STEP radians across it, as a unit world
+    direction perpendicular to the lobe's axis (zero where the lobe is unoccluded or the SSDF flat;
+    sg_shading.glsl's lobe_visibility_side)."""
+    from ..visibility import hemisphere_map
+
+    axis = np.asarray(axis, FLOAT)
+    local, theta_d, product_sharpness = _visibility_product(axis, sharpness, n, visibility)
+    local = sg.normalize(local)
+    visible = _product_visible_fraction(theta_d, local, product_sharpness)
+    layers = min(VISIBLE_SIDE_LAYERS, visibility.basis_texture.shape[0])
+    rows, basis = np.asarray(visibility.rows)[:, :4 * layers], visibility.basis_texture[:layers]
+    reference = np.where(np.abs(local[..., 2:]) < 0.9, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]))
+    across1 = sg.normalize(np.cross(local, reference))
+    across2 = np.cross(local, across1)
+    centre = ssdf_decode_packed(rows, basis, local)
+    rise = [ssdf_decode_packed(rows, basis, local + VISIBLE_SIDE_STEP * across) - centre for across in (across1, across2)]
+    gradient_local = rise[0][..., None] * across1 + rise[1][..., None] * across2
+    frame = hemisphere_map.local_frame(np.asarray(visibility.normal, np.float64))      # rows t, b, n
+    world = np.einsum("nji,nkj->nki", frame, gradient_local)
+    world -= axis * np.sum(axis * world, axis=-1, keepdims=True)
+    length = np.linalg.norm(world, axis=-1, keepdims=True)
+    side = np.where((length > 1e-12) & (visible[..., None] < VISIBLE_SIDE_MAX_FRACTION),
+                    world / np.maximum(length, 1e-30), 0.0)
+    return visible, side.astype(FLOAT)
 
 
 def light_cap_visibility(axis, sharpness, visibility):
@@ -189,34 +244,66 @@ def vertex_diffuse_visibility(environment, vertices):
     return (weight * quadrature + (1.0 - weight) * lobe_visibility(axis, sharpness, n, vertices)).astype(FLOAT)
 
 
+def probit(p):
+    """Phi^-1(p), the standard normal's quantile, for p in (0, 1): Abramowitz and Stegun 26.2.23's rational form in
+    t = sqrt(-2 ln min(p, 1 - p)), absolute error below 4.5e-4 (sg_shading.glsl's probit)."""
+    p = np.asarray(p, FLOAT)
+    tail = np.minimum(p, FLOAT(1) - p)
+    t = np.sqrt(FLOAT(-2) * np.log(np.maximum(tail, FLOAT(1e-30))))
+    x = t - (FLOAT(2.515517) + t * (FLOAT(0.802853) + t * FLOAT(0.010328))) / (
+        FLOAT(1) + t * (FLOAT(1.432788) + t * (FLOAT(0.189269) + t * FLOAT(0.001308))))
+    return np.where(p < FLOAT(0.5), -x, x).astype(FLOAT)
+
+
+def _truncated_moments(visible):
+    """(m, variance across) of the part a straight boundary keeps, the fraction ``visible``, of a unit Gaussian:
+    z = Phi^-1(v), m = phi(z) / v the kept part's mean beyond the axis, 1 - z m - m^2 its variance across."""
+    v = np.clip(np.asarray(visible, FLOAT), FLOAT(1e-4), FLOAT(1 - 1e-6))
+    z = probit(v)
+    m = np.exp(FLOAT(-0.5) * z * z) * FLOAT(1 / np.sqrt(2 * np.pi)) / v
+    return m.astype(FLOAT), (FLOAT(1) - z * m - m * m).astype(FLOAT)
+
+
 def visible_part_offset(visible):
     """Angle, in lobe widths 1 / sqrt(lambda), from the axis of a Gaussian lobe cut by a straight boundary
-    that keeps the fraction ``visible`` of it to the mean of the kept part: phi(z) / v, z = Phi^-1(v) by
-    the logistic Phi(z) = 1 / (1 + e^(-1.702 z)) (within 2% for v in [0.1, 0.9], below it in the tails)."""
-    v = np.clip(np.asarray(visible, FLOAT), FLOAT(1e-4), FLOAT(1 - 1e-6))
-    z = np.log(v / (FLOAT(1) - v)) / FLOAT(1.702)
-    return (np.exp(FLOAT(-0.5) * z * z) * FLOAT(1 / np.sqrt(2 * np.pi)) / v).astype(FLOAT)
+    that keeps the fraction ``visible`` of it to the mean of the kept part: phi(z) / v, z = Phi^-1(v)
+    (probit)."""
+    return _truncated_moments(visible)[0]
 
 
-def visible_part_axes(slice_axis, slice_sharpness, slice_visible, view, centre, nodes):
-    """Where each slice lobe reads the environment when the SSDF occludes part of it (sg_shading.glsl's
-    VISIBLE_PART_LOOKUP): its NDF lobe's nodes turned together towards the viewer (a direction the point
-    sees) by visible_part_offset of the centre node's visible fraction, in its widths, at most onto the
-    view.  The visible and the occluded part of a lobe see different light (the glossy sphere over a
-    floor: its lower half's lobes point into the floor, their visible part at the horizon), which the
-    product of the visible fraction and the radiance at the lobe's axis ignores."""
+def visible_part_narrowing(visible):
+    """Factor on a lobe's sharpness that gives it the width of its visible part (sg_shading.glsl's
+    visible_part_narrowing): the part a straight boundary keeps of a Gaussian has variance 1 - z m - m^2 (in
+    squared widths; _truncated_moments) across the boundary, at least VISIBLE_PART_MIN_VARIANCE, and 1 along it;
+    2 / (1 + that), their mean, since the lookup is isotropic."""
+    across = np.clip(_truncated_moments(visible)[1], FLOAT(VISIBLE_PART_MIN_VARIANCE), FLOAT(1))
+    return (FLOAT(2) / (FLOAT(1) + across)).astype(FLOAT)
+
+
+def _turn(axis, side, angle):
+    """Unit axes (..., 3) turned by angle (...) towards unit directions ``side`` perpendicular to them."""
+    angle = np.asarray(angle, FLOAT)[..., None]
+    return (axis * np.cos(angle) + side * np.sin(angle)).astype(FLOAT)
+
+
+def visible_part_axes(slice_axis, slice_sharpness, slice_visible, side, centre, nodes):
+    """Where and how sharp each slice lobe reads the environment when the SSDF occludes part of it
+    (sg_shading.glsl's VISIBLE_PART_LOOKUP): (axis (N, J, 3), sharpness (N, J)).  Its NDF lobe's nodes are turned
+    together towards the visible side of the centre node (lobe_visibility_side: where the SSDF grows) by
+    visible_part_offset of the centre node's visible fraction, in its widths (at most VISIBLE_PART_MAX_TURN), and
+    sharpened by visible_part_narrowing.  The visible and the occluded part of a lobe see different light (a lobe
+    pointing into a floor: its visible part sees the horizon; one below Suzanne's ear: the sky past the ear),
+    which the product of the visible fraction and the radiance at the lobe's axis ignores."""
     axis = slice_axis[:, centre]                                                             # (N, K, 3)
-    view = np.asarray(view, FLOAT)[:, None, :]
-    pivot = np.cross(axis, view)
-    length = np.linalg.norm(pivot, axis=-1, keepdims=True)
-    pivot = np.where(length > FLOAT(1e-6), pivot / np.maximum(length, FLOAT(1e-30)), FLOAT(0)).astype(FLOAT)
+    pivot = np.cross(axis, side)                  # unit: side is perpendicular to the axis (or zero)
     turn = np.minimum(visible_part_offset(slice_visible) / np.sqrt(np.maximum(slice_sharpness[:, centre], FLOAT(1e-6))),
-                      np.arccos(np.clip(np.sum(axis * view, axis=-1), -1, 1)))
+                      FLOAT(VISIBLE_PART_MAX_TURN))
     pivot, turn = np.repeat(pivot, nodes, axis=1), np.repeat(turn, nodes, axis=1)[..., None]
     c, s = np.cos(turn), np.sin(turn)
     rotated = slice_axis * c + np.cross(pivot, slice_axis) * s + pivot * (np.sum(pivot * slice_axis, -1, keepdims=True)
                                                                           * (FLOAT(1) - c))
-    return rotated.astype(FLOAT)
+    sharpness = slice_sharpness * np.repeat(visible_part_narrowing(slice_visible), nodes, axis=1)
+    return rotated.astype(FLOAT), sharpness.astype(FLOAT)
 
 
 def model_albedo(model, params, view_local):
@@ -593,17 +680,30 @@ def _add_environment(px, environment, irradiance, specular):
     slice_cosine, slice_colour = px.slice_cosine, px.slice_colour
     tail = None if px.albedo is None else environment_tail(px.albedo, px.slice_axis, px.slice_sharpness,
                                                            slice_cosine, px.warp_mode)
-    lookup_axis = px.slice_axis
+    lookup_axis, lookup_sharpness = px.slice_axis, px.slice_sharpness
     if visibility is not None:
         centre = px.centre
-        slice_visible = px.visible(px.slice_axis[:, centre], px.slice_sharpness[:, centre])            # (N, K)
+        # the first NDF lobe's visible side (GGX's broader), shared with the others (they see the same occluders)
+        # and the tail
+        broad_visible, broad_side = lobe_visibility_side(px.slice_axis[:, centre[:1]], px.slice_sharpness[:, centre[:1]],
+                                                         n, visibility)                         # (N, 1), (N, 1, 3)
+        slice_visible = np.concatenate([broad_visible, px.visible(px.slice_axis[:, centre[1:]],
+                                                                  px.slice_sharpness[:, centre[1:]])], axis=1)
+        side = px.slice_axis[:, centre]
+        side = sg.normalize(broad_side - side * np.sum(broad_side * side, axis=-1, keepdims=True),
+                            fallback=(0.0, 0.0, 0.0)).astype(FLOAT)
         slice_cosine = slice_cosine * px.per_node(slice_visible)
         if environment.has_texture:
-            lookup_axis = visible_part_axes(px.slice_axis, px.slice_sharpness, slice_visible, px.view, centre,
-                                            px.nodes)
+            lookup_axis, lookup_sharpness = visible_part_axes(px.slice_axis, px.slice_sharpness, slice_visible, side,
+                                                              centre, px.nodes)
         if tail is not None:     # the tail's own visibility: broader than the slice lobe, it sees past more
             tail_visible = px.visible(tail[1][:, None], tail[2][:, None])[:, 0]
-            tail = (tail[0] * tail_visible, lookup_axis[:, centre[0]], tail[2])
+            tail_axis = tail[1]
+            if environment.has_texture:    # its own visible part: turned by its offset to the node's visible side
+                tail_axis = _turn(tail_axis, side[:, 0], np.minimum(
+                    visible_part_offset(tail_visible) / np.sqrt(np.maximum(tail[2], FLOAT(1e-6))),
+                    FLOAT(VISIBLE_PART_MAX_TURN)))
+            tail = (tail[0] * tail_visible, tail_axis, tail[2])
     if environment.has_texture:
         if len(environment.lobe_sharpness):
             lobe_count_env = len(environment.lobe_sharpness)
@@ -615,7 +715,7 @@ def _add_environment(px, environment, irradiance, specular):
             irradiance += np.sum(environment.lobe_amplitude[None] * (clamped_cosine.sg_clamped_cosine_integral(
                 environment.lobe_axis[None], environment.lobe_sharpness[None], FLOAT(1), n_lobe) *
                 env_visible * px.diffuse_factor(sg.normalize(env_axis)))[..., None], axis=1)
-        radiance = environment_radiance(environment, *cosine_weighted_lookup(lookup_axis, px.slice_sharpness,
+        radiance = environment_radiance(environment, *cosine_weighted_lookup(lookup_axis, lookup_sharpness,
                                                                              n_lobe))            # (N, J, 3)
         specular += np.sum(radiance * (slice_cosine[..., None] * slice_colour), axis=1)
         if tail is not None:

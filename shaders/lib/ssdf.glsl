@@ -4,6 +4,7 @@
  *   ssdf_horizon_lookup            <- hemisphere_map.horizon_lookup (vec3(square.xy, angle below horizon))
  *   ssdf_local_frame, ssdf_to_local <- hemisphere_map.local_frame (default tangent)
  *   ssdf_decode                    <- decode.decode, in the packed layout of decode.pack_basis_texture
+ *   ssdf_decode_leading            <- the same, and decode.decode of the leading rows alone
  *   ssdf_visibility_amplitude      <- hemisphere.visibility_product_integral_preserving (its amplitude)
  *   ssdf_shadowed_integral         <- decode.shadowed_integral
  *
@@ -57,17 +58,30 @@ vec3 ssdf_to_local(vec3 world_direction, vec3 normal)
 }
 
 /* SSDF value (radians, + visible) at a local direction (normalized here; zero -> +z): one bilinear
- * fetch per four PCA images. */
-float ssdf_decode(sampler2DArray basis, vec4 coefficients[SSDF_MAX_LAYERS], int layer_count, vec3 local_direction)
+ * fetch per four PCA images; and in `leading` the same from the first `leading_layers` rows alone (the
+ * mean and the leading PCA terms: the SSDF's broad shape), on the way. */
+float ssdf_decode_leading(sampler2DArray basis, vec4 coefficients[SSDF_MAX_LAYERS], int layer_count, int leading_layers,
+                          vec3 local_direction, out float leading)
 {
   vec3 lookup = ssdf_horizon_lookup(safe_normalize(local_direction));
   float resolution = float(textureSize(basis, 0).x);
   vec2 texcoord = ((lookup.xy + 1.0) * (0.5 * (resolution - 1.0)) + 0.5) / resolution;
+  int first = min(leading_layers, layer_count);
   float value = 0.0;
-  for (int layer = 0; layer < layer_count; ++layer) {
+  for (int layer = 0; layer < first; ++layer) {
+    value += dot(texture(basis, vec3(texcoord, float(layer))), coefficients[layer]);
+  }
+  leading = value - lookup.z;
+  for (int layer = first; layer < layer_count; ++layer) {
     value += dot(texture(basis, vec3(texcoord, float(layer))), coefficients[layer]);
   }
   return value - lookup.z;
+}
+
+float ssdf_decode(sampler2DArray basis, vec4 coefficients[SSDF_MAX_LAYERS], int layer_count, vec3 local_direction)
+{
+  float leading;
+  return ssdf_decode_leading(basis, coefficients, layer_count, layer_count, local_direction, leading);
 }
 
 /* eq. 31, integral-preserving: the lobe's amplitude after the product with the SSDF visibility

@@ -41,18 +41,3 @@ def test_bilinear_fetch_lands_on_the_texel_centres():
     s, t = ggx_albedo.table_coordinates(grid[[3, 17, 31]], grid[[0, 9, 30]])
     fetched = sample_texture(table[..., None], np.stack([s, t], -1))[:, 0]
     np.testing.assert_allclose(fetched, table[[0, 9, 30], [3, 17, 31]], rtol=1e-5)
-
-
-def test_visible_part_offset_is_the_truncated_gaussian_mean():
-    """techniques.sg_shading.visible_part_offset against phi(Phi^-1(v)) / v, the mean of a unit Gaussian cut so that
-    the fraction v is kept: within 2.5% for v in [0.1, 0.9], never above it in the tails (a smaller turn)."""
-    from scipy.stats import norm
-
-    from sg_prt_addon.techniques.sg_shading import visible_part_offset
-
-    v = np.linspace(0.1, 0.9, 81)
-    exact = norm.pdf(norm.ppf(v)) / v
-    assert np.max(np.abs(visible_part_offset(v) / exact - 1)) < 0.025
-    tails = np.array([1e-3, 0.01, 0.05, 0.95, 0.99, 0.999])
-    assert np.all(visible_part_offset(tails) <= norm.pdf(norm.ppf(tails)) / tails)
-    assert visible_part_offset(1.0) < 1e-12 and np.isfinite(visible_part_offset(0.0))

@@ -64,10 +64,10 @@ def _score(scene, samples):
     ("glossy_courtyard_r010", 0.10, "courtyard", 48, 0.30, 0.03, False),
     # the environment tail: 0.140, bias +0.015; without it 0.157, bias -0.067
     ("glossy_courtyard_r035", 0.35, "courtyard", 48, 0.16, 0.03, False),
-    # over a baked floor, the visible-part lookup (techniques.sg_shading.visible_part_axes): 0.150, bias -0.020;
-    # reading the radiance at the occluded lobes' axes 0.158, -0.040 (their visible fraction is right: 0.54
-    # against 0.51 ray-traced at the horizon band)
-    ("glossy_floor_courtyard_r035", 0.35, "courtyard", 32, 0.165, 0.03, True),
+    # over a baked floor, the visible-part lookup (techniques.sg_shading.visible_part_axes, towards the side the
+    # SSDF grows, narrowed): 0.090, bias -0.010; turned towards the viewer 0.134, -0.023; reading the radiance at
+    # the occluded lobes' axes 0.158, -0.040 (their visible fraction is right: 0.54 against 0.51 ray-traced)
+    ("glossy_floor_courtyard_r035", 0.35, "courtyard", 32, 0.11, 0.02, True),
 ])
 def test_glossy_ggx_matches_the_reference(engine, name, roughness, world, samples, rmse_bound, bias_bound, floor):
     try:

@@ -45,16 +45,22 @@ def test_decode_and_shadowed_integral(glsl, fuzz, record_error):
     vec4 c[SSDF_MAX_LAYERS];
     c[0] = c0; c[1] = c1; c[2] = c2;
     float value = ssdf_decode(ssdf_basis, c, 3, d.xyz);
+    float leading;
+    float same = ssdf_decode_leading(ssdf_basis, c, 3, 1, d.xyz, leading);
     result = vec4(value, ssdf_shadowed_integral(d.xyz, d.w, 1.0, ssdf_basis, c, 3),
-                  ssdf_visibility_amplitude(d.w, 1.0, value), 0.0);
+                  ssdf_visibility_amplitude(d.w, 1.0, value) + 1000.0 * abs(same - value), leading);
     """
     out = glsl(LIB, call, {"d": np.c_[d, sharpness], "c0": packed[:, 0:4], "c1": packed[:, 4:8], "c2": packed[:, 8:12]},
-               3, textures={"ssdf_basis": decode.pack_basis_texture(mean, basis)})
+               4, textures={"ssdf_basis": decode.pack_basis_texture(mean, basis)})
     expected = decode.decode(coefficients, basis, mean, d)
     # bilinear weights on llvmpipe: the sum of |w| |image| bounds float32 rounding
     scale = 1.0 + np.abs(coefficients).sum(axis=1) * 0.3
     assert record_error("ssdf decode, relative to sum |w_j| |B_j|",
                         (np.abs(out[:, 0] - expected) / scale).max()) <= 1e-4
+    # the leading layer alone (the mean and 3 terms), and the full value again on the way
+    leading = decode.decode(coefficients[:, :3], basis[:3], mean, d)
+    assert record_error("ssdf decode_leading, relative to sum |w_j| |B_j|",
+                        (np.abs(out[:, 3] - leading) / scale).max()) <= 1e-4
     integral = decode.shadowed_integral(d, sharpness, 1.0, coefficients, basis, mean)
     # compare at GLSL's own decoded value: fh's float32 error alone, relative to fh(pi/2)
     at_glsl_value = hemisphere.fh(out[:, 0].astype(np.float64), sharpness)

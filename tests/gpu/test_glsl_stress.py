@@ -518,8 +518,9 @@ def test_ssdf_stress(glsl, fuzz):
     vec3 local = ssdf_to_local(d.xyz, n.xyz);
     vec3 lookup = ssdf_horizon_lookup(u.xyz);
     vec2 square = hemisphere_map_disc_to_square(q.xy) + hemisphere_map_to_square(vec3(u.xy, abs(u.z)));
-    float theta_d = ssdf_decode(ssdf_basis, c, 3, local);
-    result = vec4(dot(t + b + unit_normal + local + lookup, vec3(1.0)) + square.x + square.y,
+    float leading;
+    float theta_d = ssdf_decode(ssdf_basis, c, 3, local) + 0.0 * ssdf_decode_leading(ssdf_basis, c, 3, 2, local, leading);
+    result = vec4(dot(t + b + unit_normal + local + lookup, vec3(1.0)) + square.x + square.y + leading,
                   theta_d,
                   ssdf_visibility_amplitude(d.w, q.z, n.w) + ssdf_visibility_amplitude(d.w, q.z, theta_d),
                   ssdf_shadowed_integral(local, d.w, q.z, ssdf_basis, c, 3));
@@ -600,7 +601,8 @@ def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
 
 RESOURCE_KERNELS = {
     "../common/lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility", "light_cap_visibility"],
-    "sg_shading.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_m_factor"],
+    "sg_shading.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_m_factor", "probit", "visible_part_offset",
+                        "visible_part_narrowing", "lobe_visibility_side"],
     "../common/fitted_texels.glsl": ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
                                      "fitted_shadowing_at", "fitted_shadowing_of"],
     "anisotropic_lobes.glsl": ["anisotropic_lobes"],
@@ -637,6 +639,52 @@ def test_lobe_visibility_stress(glsl, fuzz):
     out = glsl(library, body, inputs, 2, textures={"visibility_basis": _ssdf_basis(fuzz.rng)})
     _assert_finite(out, "lobe_visibility / light_cap_visibility")
     assert out.min() >= 0 and out.max() <= 1
+
+
+def test_visible_part_stress(glsl, fuzz):
+    """sg_shading.glsl's visible-part lookup (VISIBLE_PART_LOOKUP): lobe_visibility_side after set_visibility_frame
+    for any lobe, normal and SSDF normal, random bake rows -- a fraction in [0, 1] and a side of length 0 or 1
+    perpendicular to a unit axis; probit, visible_part_offset and visible_part_narrowing for any fraction
+    (0, tiny, 1, beyond) -- finite, the narrowing in [1, 2 / (1 + VISIBLE_PART_MIN_VARIANCE)], and the numpy
+    mirror's within float32's reach."""
+    from sg_prt_addon.techniques import sg_lobes, sg_shading
+
+    x = _sg_inputs()
+    count = len(x["sharpness"])
+    rows = _f32(fuzz.rng.normal(size=(count, 12)))
+    rows[:, 0] = 1.0
+    ssdf_normal = fuzz.stress_vectors(count)
+    ssdf_normal[::3] = x["normal"][::3]
+    fractions = _f32(np.concatenate([[0.0, 1e-30, 1e-6, 1e-4, 0.5, 1.0 - 1e-7, 1.0, 2.0, -1.0],
+                                     fuzz.rng.uniform(0.0, 1.0, count - 9)]))
+    shading = _resource("sg_shading.glsl")
+    source = (sg_lobes._constants_source() + _resource("lobe_visibility.glsl", "common")
+              + "".join(_glsl_function(shading, name) for name in ("probit", "truncated_moments", "visible_part_offset",
+                                                                  "visible_part_narrowing", "lobe_visibility_side")))
+    body = """
+    visibility_rows[0] = c0; visibility_rows[1] = c1; visibility_rows[2] = c2;
+    set_visibility_frame(s.xyz);
+    vec3 axis = safe_normalize(p.xyz);
+    vec3 side;
+    float visible = lobe_visibility_side(axis, p.w, n.xyz, side);
+    float v = n.w;
+    result = vec4(visible, length(side) + abs(dot(side, axis)), visible_part_offset(v) + probit(clamp(v, 1e-4, 0.9999)),
+                  visible_part_narrowing(v));
+    """
+    library = LIBRARY_ORDER + ["hemisphere_map.glsl", "#define SSDF_MAX_LAYERS 3\n", "ssdf.glsl", source]
+    inputs = {"p": np.c_[x["axis1"], x["sharpness"]], "n": np.c_[x["normal"], fractions], "s": ssdf_normal,
+              "c0": rows[:, :4], "c1": rows[:, 4:8], "c2": rows[:, 8:]}
+    out = glsl(library, body, inputs, 4, textures={"visibility_basis": _ssdf_basis(fuzz.rng)})
+    _assert_finite(out, "lobe_visibility_side / visible_part_offset / visible_part_narrowing")
+    assert out[:, 0].min() >= 0 and out[:, 0].max() <= 1
+    side = out[:, 1]
+    assert np.all((side < 1e-6) | (np.abs(side - 1) < 1e-3)), "a side neither zero nor unit across the axis"
+    assert ((side > 0.5) & (out[:, 0] < sg_shading.VISIBLE_SIDE_MAX_FRACTION)).mean() > 0.3   # the random rows occlude
+    top = 2 / (1 + sg_shading.VISIBLE_PART_MIN_VARIANCE)
+    assert out[:, 3].min() >= 1 - 1e-5 and out[:, 3].max() <= top + 1e-5
+    expected = sg_shading.visible_part_offset(fractions) + sg_shading.probit(np.clip(fractions, 1e-4, 0.9999))
+    np.testing.assert_allclose(out[:, 2], expected, rtol=2e-3, atol=2e-3)
+    np.testing.assert_allclose(out[:, 3], sg_shading.visible_part_narrowing(fractions), rtol=2e-3)
 
 
 def test_factored_brdf_stress(glsl, fuzz):
@@ -1086,10 +1134,12 @@ COVERED = {
                                  "point_light_sg", "light_cap_radius"],
     test_env_prefilter_helpers_stress: ["env_sign_not_zero", "oct_encode", "env_prefilter_blend_parameter"],
     test_ssdf_stress: ["hemisphere_map_disc_to_square", "hemisphere_map_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",
-                       "ssdf_to_local", "ssdf_decode", "ssdf_visibility_amplitude", "ssdf_shadowed_integral"],
+                       "ssdf_to_local", "ssdf_decode", "ssdf_decode_leading", "ssdf_visibility_amplitude",
+                       "ssdf_shadowed_integral"],
     test_ssdf_quadrature_stress: ["ssdf_quadrature_point", "ssdf_cell_radius", "ssdf_cell_coverage",
                                   "ssdf_quadrature_weight"],
     test_lobe_visibility_stress: ["set_visibility_frame", "lobe_visibility", "light_cap_visibility"],
+    test_visible_part_stress: ["probit", "visible_part_offset", "visible_part_narrowing", "lobe_visibility_side"],
     test_shading_frame_stress: ["shading_frame", "apply_normal_map", "rotate_tangent"],
     test_factored_brdf_stress: ["parabolic_uv", "factored_brdf"],
     test_sh_library_stress: ["sh_basis", "sh_rotate_z", "sh_rotate", "sh_cap_factors", "sh_sg_factors",

@@ -16,22 +16,25 @@ void set_visibility_frame(vec3 ssdf_normal)
   visibility_frame = mat3(t, b, n);             /* columns: local = world * visibility_frame */
 }
 
-/* Visible fraction of the clamped-cosine integral I(G, n) of a lobe G (wang2009 eq. 39-43 with
- * eq. 30-31): the product lobe P = G (x) C*(n) (eq. 40's cosine lobe), theta_d = SSDF at P's axis in
- * the vertex's local frame, and the fraction fh(theta_d, lambda_P) / fh(theta_h, lambda_P), where
- * theta_h is the axis's angle to the horizon of the SSDF normal: what eq. 31 keeps of P relative to
- * what the horizon alone keeps (the SSDF includes the horizon, I(G, n) already clamps it).
- * Unoccluded (theta_d = theta_h) it is 1: the unshadowed shading; clamped to [0, 1].
- * The two fh_normalized_from_sine (hemisphere.glsl) share k(lambda), erf(k) and e^-lambda. */
-float lobe_visibility(vec3 axis, float sharpness, vec3 n)
+/* eq. 40's product lobe P = G (x) C*(n) of a lobe G, its axis in the SSDF's local frame (not normalized) and its
+ * sharpness: where lobe_visibility reads the SSDF and how broad the lobe it reads it for is. */
+void visibility_product(vec3 axis, float sharpness, vec3 n, out vec3 local, out float product_sharpness)
 {
   vec2 cosine_lobe = clamped_cosine_lobe();
   vec3 product_axis;
-  float product_sharpness, product_amplitude;
+  float product_amplitude;
   sg_product(axis, sharpness, 1.0, n, cosine_lobe.x, 1.0, product_axis, product_sharpness, product_amplitude);
-  vec3 local = product_axis * visibility_frame;            /* ssdf_to_local */
-  float theta_d = ssdf_decode(visibility_basis, visibility_rows, SSDF_MAX_LAYERS, local);
-  float lam = max(product_sharpness, 0.0);
+  local = product_axis * visibility_frame;            /* ssdf_to_local */
+}
+
+/* eq. 30-31's visible fraction of the product lobe P (local axis, sharpness lam) at SSDF value theta_d:
+ * fh(theta_d, lam) / fh(theta_h, lam), theta_h the axis's angle to the horizon of the SSDF normal -- what
+ * eq. 31 keeps of P relative to what the horizon alone keeps (the SSDF includes the horizon, I(G, n) already
+ * clamps it).  Unoccluded (theta_d = theta_h) it is 1: the unshadowed shading; clamped to [0, 1].  The two
+ * fh_normalized_from_sine (hemisphere.glsl) share k(lambda), erf(k) and e^-lambda. */
+float product_visible_fraction(float theta_d, vec3 local, float lam)
+{
+  lam = max(lam, 0.0);
   float k = fh_k(lam);
   float erf_k = erf_approx(k);
   float lower = exp(-lam);
@@ -42,6 +45,17 @@ float lobe_visibility(vec3 axis, float sharpness, vec3 n)
   float visible = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_d), 0.0, 1.0);
   float unshadowed = clamp(lower + (1.0 - lower) * (0.5 + 0.5 * g_h), 0.0, 1.0);
   return clamp(visible / max(unshadowed, 1.0e-30), 0.0, 1.0);
+}
+
+/* Visible fraction of the clamped-cosine integral I(G, n) of a lobe G (wang2009 eq. 39-43 with eq. 30-31):
+ * the SSDF read at the axis of its product lobe P (visibility_product), theta_d, and P's visible fraction
+ * there (product_visible_fraction). */
+float lobe_visibility(vec3 axis, float sharpness, vec3 n)
+{
+  vec3 local;
+  float lam;
+  visibility_product(axis, sharpness, n, local, lam);
+  return product_visible_fraction(ssdf_decode(visibility_basis, visibility_rows, SSDF_MAX_LAYERS, local), local, lam);
 }
 
 /* Visible fraction of a light's cap of half-angle `radius` (lighting.lights: the uniform disc its SG stands for,

@@ -178,19 +178,73 @@ float model_specular(vec3 wo, vec3 wi, vec4 p, vec4 q)
 #endif
 
 #if defined(HAS_VISIBILITY) && defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
-/* A partly occluded slice lobe reads the environment at the mean of its visible part (techniques.sg_shading.
- * visible_part_offset): its visible and occluded parts see different light, which the product of the
- * visible fraction and the radiance at the lobe's axis ignores. */
+/* A partly occluded slice lobe reads the environment where its visible part lies (techniques.sg_shading.
+ * visible_part_axes): its visible and occluded parts see different light, which the product of the visible
+ * fraction and the radiance at the lobe's axis ignores. */
 #define VISIBLE_PART_LOOKUP
 
-/* Angle, in lobe widths 1/sqrt(lambda), from the axis of a Gaussian lobe cut by a straight boundary that
- * keeps the fraction v of it to the mean of the kept part: phi(z) / v, z = Phi^-1(v) by the logistic
- * Phi(z) = 1 / (1 + e^(-1.702 z)) (within 2% for v in [0.1, 0.9], below it in the tails). */
-float visible_part_offset(float v)
+/* Phi^-1(p), the standard normal's quantile, for p in (0, 1) (techniques.sg_shading.probit: Abramowitz and
+ * Stegun 26.2.23, absolute error below 4.5e-4) */
+float probit(float p)
+{
+  float t = sqrt(-2.0 * log(max(min(p, 1.0 - p), 1.0e-30)));
+  float x = t - (2.515517 + t * (0.802853 + t * 0.010328)) / (1.0 + t * (1.432788 + t * (0.189269 + t * 0.001308)));
+  return p < 0.5 ? -x : x;
+}
+
+/* The part a straight boundary keeps, the fraction v, of a unit Gaussian (techniques.sg_shading.
+ * _truncated_moments): its mean beyond the axis m = phi(z) / v, z = Phi^-1(v), and its variance across the
+ * boundary, 1 - z m - m^2. */
+vec2 truncated_moments(float v)
 {
   v = clamp(v, 1.0e-4, 1.0 - 1.0e-6);
-  float z = log(v / (1.0 - v)) / 1.702;
-  return exp(-0.5 * z * z) * 0.3989422804014327 / v;
+  float z = probit(v);
+  float m = exp(-0.5 * z * z) * 0.3989422804014327 / v;
+  return vec2(m, 1.0 - z * m - m * m);
+}
+
+/* Angle, in lobe widths 1/sqrt(lambda), from the axis of a lobe cut by a straight boundary that keeps the
+ * fraction v of it to the mean of the kept part (techniques.sg_shading.visible_part_offset). */
+float visible_part_offset(float v)
+{
+  return truncated_moments(v).x;
+}
+
+/* Factor on a lobe's sharpness that gives it the width of its visible part (techniques.sg_shading.
+ * visible_part_narrowing): the kept part's variance across the boundary (at least VISIBLE_PART_MIN_VARIANCE) and
+ * 1 along it, averaged (the lookup is isotropic). */
+float visible_part_narrowing(float v)
+{
+  return 2.0 / (1.0 + clamp(truncated_moments(v).y, VISIBLE_PART_MIN_VARIANCE, 1.0));
+}
+
+/* lobe_visibility, and the side of the lobe its visible part lies on (techniques.sg_shading.
+ * lobe_visibility_side): the direction in which the SSDF's leading VISIBLE_SIDE_LAYERS rows (the occluders'
+ * broad shape, not the nearest edge's detail) grow at the product lobe's axis, by forward differences
+ * VISIBLE_SIDE_STEP radians across it (two more decodes of those rows), as a world direction perpendicular to
+ * `axis` (unit; zero for an unoccluded lobe, or where the SSDF is flat). */
+float lobe_visibility_side(vec3 axis, float sharpness, vec3 n, out vec3 side)
+{
+  vec3 local;
+  float lam;
+  visibility_product(axis, sharpness, n, local, lam);
+  local = safe_normalize(local);
+  float centre;
+  float visible = product_visible_fraction(ssdf_decode_leading(visibility_basis, visibility_rows, SSDF_MAX_LAYERS,
+                                                               VISIBLE_SIDE_LAYERS, local, centre), local, lam);
+  side = vec3(0.0);
+  if (visible < VISIBLE_SIDE_MAX_FRACTION) {
+    int layers = min(SSDF_MAX_LAYERS, VISIBLE_SIDE_LAYERS);
+    vec3 across1 = safe_normalize(cross(local, abs(local.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0)));
+    vec3 across2 = cross(local, across1);
+    float rise1 = ssdf_decode(visibility_basis, visibility_rows, layers, local + VISIBLE_SIDE_STEP * across1) - centre;
+    float rise2 = ssdf_decode(visibility_basis, visibility_rows, layers, local + VISIBLE_SIDE_STEP * across2) - centre;
+    vec3 world = visibility_frame * (rise1 * across1 + rise2 * across2);
+    world -= axis * dot(axis, world);
+    float world_length = length(world);
+    side = world_length > 1.0e-12 ? world / world_length : vec3(0.0);
+  }
+  return visible;
 }
 #endif
 #if defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
@@ -423,18 +477,31 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 
 #ifdef HAS_SPECULAR
   vec3 tail_axis = slice_axis[VISIBILITY_NODE];
+#ifdef VISIBLE_PART_LOOKUP
+  /* the first NDF lobe's visible side (GGX's broader), shared with the others (they see the same occluders) and
+   * the tail; out of the loop over the lobes (llvmpipe's frame: 1.1 times that of the call inside it) */
+  vec3 visible_side;
+  float first_visibility = lobe_visibility_side(slice_axis[VISIBILITY_NODE], slice_sharpness[VISIBILITY_NODE], n,
+                                                visible_side);                                          /* eq. 41 */
+#endif
   for (int k = 0; k < NDF_LOBES; k++) {
     int centre = WARP_NODES * k + VISIBILITY_NODE;
-    float visibility = LOBE_VISIBILITY(slice_axis[centre], slice_sharpness[centre]);      /* eq. 41 */
 #ifdef VISIBLE_PART_LOOKUP
-    /* the environment is read where the visible part of the lobe lies: turned towards the viewer */
-    vec3 pivot = cross(slice_axis[centre], view);
-    float pivot_length = length(pivot);
-    pivot = pivot_length > 1.0e-6 ? pivot / pivot_length : vec3(0.0);
+    /* the environment is read where the visible part of the lobe lies: its nodes turned together towards the
+     * visible side by the part's mean, and narrowed to its width */
+    float visibility = first_visibility;
+    if (k > 0) {
+      visibility = LOBE_VISIBILITY(slice_axis[centre], slice_sharpness[centre]);                       /* eq. 41 */
+    }
+    vec3 side = safe_normalize(visible_side - slice_axis[centre] * dot(visible_side, slice_axis[centre]), vec3(0.0));
+    vec3 pivot = cross(slice_axis[centre], side);      /* unit (or zero): side is perpendicular to the axis */
     float turn = min(visible_part_offset(visibility) * inversesqrt(max(slice_sharpness[centre], 1.0e-6)),
-                     acos(clamp(dot(slice_axis[centre], view), -1.0, 1.0)));
+                     VISIBLE_PART_MAX_TURN);
     float turn_cos = cos(turn);
     float turn_sin = sin(turn);
+    float narrowing = visible_part_narrowing(visibility);
+#else
+    float visibility = LOBE_VISIBILITY(slice_axis[centre], slice_sharpness[centre]);      /* eq. 41 */
 #endif
     for (int node = 0; node < WARP_NODES; node++) {
       int j = WARP_NODES * k + node;
@@ -444,11 +511,11 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
       lookup_axis = lookup_axis * turn_cos + cross(pivot, lookup_axis) * turn_sin +
                     pivot * (dot(pivot, lookup_axis) * (1.0 - turn_cos));
 #endif
-      if (j == VISIBILITY_NODE) {
-        tail_axis = lookup_axis;
-      }
 #ifdef HAS_ENVIRONMENT
       float lookup_sharpness = slice_sharpness[j];
+#ifdef VISIBLE_PART_LOOKUP
+      lookup_sharpness *= narrowing;
+#endif
       cosine_weighted_lookup(lookup_axis, lookup_sharpness, n, false);
       radiance += slice_cosine * slice_colour[j] * environment_radiance(lookup_axis, lookup_sharpness);
 #else
@@ -459,10 +526,16 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #ifdef ENVIRONMENT_TAIL
   /* GGX's energy beyond its slice lobes: its exact albedo minus theirs, as a broad lobe on the broader NDF
    * lobe's centre node (techniques.sg_shading.environment_tail), with its own visibility (broader than the
-   * node's, it sees past more of an occluder), read where the node's visible part lies */
+   * node's, it sees past more of an occluder), read where its own visible part lies: turned by its offset
+   * towards the node's visible side */
   float tail_sharpness = slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO;
   float tail_visibility = LOBE_VISIBILITY(slice_axis[VISIBILITY_NODE], tail_sharpness);
   float tail_albedo = max(model_albedo - slice_albedo, 0.0) * tail_visibility;
+#ifdef VISIBLE_PART_LOOKUP
+  float tail_turn = min(visible_part_offset(tail_visibility) * inversesqrt(max(tail_sharpness, 1.0e-6)),
+                        VISIBLE_PART_MAX_TURN);
+  tail_axis = tail_axis * cos(tail_turn) + visible_side * sin(tail_turn);
+#endif
 #ifdef HAS_ENVIRONMENT
   cosine_weighted_lookup(tail_axis, tail_sharpness, n, true);
   radiance += tail_albedo * environment_radiance(tail_axis, tail_sharpness);
