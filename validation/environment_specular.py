@@ -1,7 +1,7 @@
 """The SG technique's environment specular on a sphere's visible half against the exact integral (numpy).
 
 Used by tests/core/test_environment_specular.py (a procedural sky) and benchmarks/accuracy/warp.py
-(courtyard.exr): a GGX surface seen from every angle of a sphere's visible half (an orthographic camera),
+(courtyard.exr): a GGX (or anisotropic GGX) surface seen from every angle of a sphere's visible half (an orthographic camera),
 the reference summing L(i) rho(o, i) max(0, n.i) over every texel of the map (single-scattering GGX, what
 the slice lobes, their energy cap and the environment tail model), the engine reading its prefiltered
 layers at the slice lobes (techniques.sg_shading.shade, the mirror of sg_shading.glsl).  The shading alone:
@@ -48,16 +48,30 @@ def visible_normals(count=36, view=VIEW):
     return x[:, None] * right + y[:, None] * up - np.sqrt(1 - x ** 2 - y ** 2)[:, None] * forward, forward
 
 
-def exact_specular(image, normals, forward, roughness, chunk=64):
-    """Sum over the map's texels of L(i) rho_GGX(o, i) max(0, n.i) d omega, per normal: (N, 3)."""
+def tangent_frames(normals, axis):
+    """(N, 3, 3) local frames (rows t, b, n) whose tangent is ``axis`` on the surface (an anisotropic material's
+    object axis; it must not be parallel to a normal)."""
+    axis = np.asarray(axis, np.float64) / np.linalg.norm(axis)
+    tangent = axis - normals * (normals @ axis)[:, None]
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    return np.stack([tangent, np.cross(normals, tangent), normals], axis=1)
+
+
+def exact_specular(image, normals, forward, roughness, chunk=64, alphas=None, tangent_axis=None):
+    """Sum over the map's texels of L(i) rho(o, i) max(0, n.i) d omega, per normal: (N, 3).  rho: GGX of the
+    roughness, or with ``alphas`` (alpha_x, alpha_y) anisotropic GGX with its tangent along ``tangent_axis``."""
     height, width = image.shape[:2]
     directions = equirect.texel_directions(height, width).reshape(-1, 3)
     solid_angle = np.broadcast_to(equirect.texel_solid_angles(height, width), (height, width)).reshape(-1)
     radiance = image.reshape(-1, 3).astype(np.float64) * solid_angle[:, None]
-    model = brdf.GGX(roughness=roughness)
+    if alphas is None:
+        model, all_frames = brdf.GGX(roughness=roughness), hemisphere_map.local_frame(normals)
+    else:
+        model = brdf.GGXAnisotropic(alpha_x=alphas[0], alpha_y=alphas[1])
+        all_frames = tangent_frames(normals, tangent_axis)
     out = np.empty((len(normals), 3))
     for start in range(0, len(normals), chunk):
-        frames = hemisphere_map.local_frame(normals[start:start + chunk])          # rows t, b, n
+        frames = all_frames[start:start + chunk]                                     # rows t, b, n
         wo = np.einsum("kij,j->ki", frames, -forward)
         wi = np.einsum("kij,dj->kdi", frames, directions)
         weight = model.specular(np.broadcast_to(wo[:, None], wi.shape), wi) * np.maximum(wi[..., 2], 0)
@@ -65,13 +79,19 @@ def exact_specular(image, normals, forward, roughness, chunk=64):
     return out
 
 
-def engine_specular(environment_data, normals, forward, roughness):
-    """The SG technique's specular (GGX, its two NDF lobes, the default warp) at the normals: (N, 3)."""
-    frames = hemisphere_map.local_frame(normals)
+def engine_specular(environment_data, normals, forward, roughness, alphas=None, tangent_axis=None, lobe_count=4):
+    """The SG technique's specular at the normals (the default warp): (N, 3).  GGX of the roughness (its two NDF
+    lobes), or with ``alphas`` anisotropic GGX of ``lobe_count`` lobes, its tangent along ``tangent_axis``."""
     count = len(normals)
-    _, specular = sg_shading.shade(normals, normals, frames[:, 0], forward, False, "GGX",
-                                   {"roughness": np.full(count, roughness, np.float32)}, np.zeros((count, 3)),
-                                   np.ones((count, 3)), LightData(), environment_data, lobe_count=2)
+    if alphas is None:
+        model, lobe_count, frames = "GGX", 2, hemisphere_map.local_frame(normals)
+        params = {"roughness": np.full(count, roughness, np.float32)}
+    else:
+        model, frames = "GGX_ANISO", tangent_frames(normals, tangent_axis)
+        params = {"alpha_x": np.full(count, alphas[0], np.float32), "alpha_y": np.full(count, alphas[1], np.float32)}
+    _, specular = sg_shading.shade(normals, normals, frames[:, 0], forward, False, model, params,
+                                   np.zeros((count, 3)), np.ones((count, 3)), LightData(), environment_data,
+                                   lobe_count=lobe_count)
     return specular.astype(np.float64)
 
 

@@ -568,8 +568,9 @@ class GGXAnisotropic(_Microfacet):
     tangent, alpha_y along the bitangent; reflectance.principled.anisotropic_alphas):
     D = 1 / (pi ax ay ((hx/ax)^2 + (hy/ay)^2 + hz^2)^2), height-correlated Smith with
     Lambda(w) = (sqrt(1 + (ax^2 wx^2 + ay^2 wy^2) / wz^2) - 1) / 2, no Fresnel (reflectance.layering adds it).
-    SG lobes: the anisotropy table of ndf_fit at the widths (ax, ay) and the peak 1 / (pi ax ay), as Ward's;
-    what they miss of GGX's tails the SG technique returns through its light and environment tails."""
+    SG lobes: GGX's core and broad tail, each stretched to the alphas and made of the anisotropy table's lobes
+    (ndf_fit.ggx_anisotropic_lobes); what they miss of GGX's tails the SG technique returns through its light and
+    environment tails."""
     alpha_x: object = 0.2
     alpha_y: object = 0.05
 
@@ -599,7 +600,7 @@ class GGXAnisotropic(_Microfacet):
 
     def ndf_lobes(self, lobe_count=4):
         ax, ay = self._alphas(_dtype(self.alpha_x, self.alpha_y))
-        return ndf_fit.anisotropic_lobes(ax, ay, 1 / (np.pi * ax * ay), lobe_count)
+        return ndf_fit.ggx_anisotropic_lobes(ax, ay, lobe_count)
 
     def half_vector_pdf(self, h):
         return self.ndf(h) * np.maximum(h[..., 2], 0)

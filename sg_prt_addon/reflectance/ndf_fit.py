@@ -611,6 +611,40 @@ def anisotropic_lobes(width_x, width_y, peak, lobe_count, mapping_kind=None):
     return axis, sharpness.astype(dtype), amplitude.astype(dtype)
 
 
+def ggx_anisotropic_lobe_counts(lobe_count):
+    """(lobes in all, lobes a component) of ggx_anisotropic_lobes: one lobe alone, else pairs (an odd count
+    takes one more)."""
+    if lobe_count <= 1:
+        return 1, 1
+    per_component = (lobe_count + 1) // 2
+    return 2 * per_component, per_component
+
+
+def ggx_anisotropic_lobes(alpha_x, alpha_y, lobe_count):
+    """SG lobes of anisotropic GGX (alphas along x and y; arrays broadcast): GGX is a sharp core and a broad
+    tail (its isotropic two-lobe fit, ggx_two_lobes, at the geometric-mean alpha ag), each stretched to
+    (alpha_x, alpha_y) -- an anisotropic Gaussian of widths alpha * sqrt(2 / (sharpness ag^2)) -- and made of
+    the anisotropy table's lobes, half the count each, the broad one's first.  Exact for the isotropic case
+    (the two-lobe fit); one lobe: the table's, scaled by GGX's one-lobe mapping.  The table's single
+    Gaussian of width alpha missed GGX's tail: relative L2 of D at (0.17, 0.048), 4 lobes, 0.31 -> 0.31, 8
+    lobes 0.27 -> 0.14; isotropic 0.26 -> 0.03.  Returns axis (..., K, 3), sharpness (..., K), amplitude
+    (..., K) with K = ggx_anisotropic_lobe_counts(lobe_count)[0]."""
+    alpha_x, alpha_y = np.broadcast_arrays(np.asarray(alpha_x), np.asarray(alpha_y))
+    dtype = np.result_type(alpha_x, alpha_y, np.float32)
+    _, per_component = ggx_anisotropic_lobe_counts(lobe_count)
+    if lobe_count <= 1:
+        return anisotropic_lobes(alpha_x, alpha_y, 1 / (np.pi * alpha_x * alpha_y), 1, "GGX")
+    geometric = np.sqrt(alpha_x * alpha_y)
+    _, sharpness, amplitude = ggx_two_lobes(geometric)          # (..., 2), broader first
+    lobes = []
+    for component in range(2):
+        scale = np.sqrt(2 / (sharpness[..., component] * geometric * geometric))
+        # the stretched component's peak D(n) is the isotropic one's amplitude: ag^2 = alpha_x alpha_y
+        lobes.append(anisotropic_lobes(alpha_x * scale, alpha_y * scale, amplitude[..., component], per_component))
+    return tuple(np.concatenate(parts, axis=-2 if index == 0 else -1).astype(dtype)
+                 for index, parts in enumerate(zip(*lobes)))
+
+
 # ----------------------------------------------------------------------------- error measures
 
 def ndf_l2_error(model, lobes, nodes_per_segment=24, phi_count=192):

@@ -27,6 +27,17 @@ def uses_ggx_table(key):
     return key.model == "GGX" and key.ndf_lobes == 2 and key.has_specular
 
 
+def uses_ggx_anisotropic_pairs(key):
+    """Anisotropic GGX of two lobes or more: GGX's two lobes from ggx_table, each of half the count from the
+    anisotropy table (ndf_fit.ggx_anisotropic_lobes)."""
+    return key.model == "GGX_ANISO" and key.ndf_lobes >= 2
+
+
+def anisotropy_table_lobes(key):
+    """Lobes a row of the anisotropy table the variant reads."""
+    return key.ndf_lobes // 2 if uses_ggx_anisotropic_pairs(key) else key.ndf_lobes
+
+
 def uses_albedo_table(key):
     """The environment tail and energy cap from GGX's albedo: GGX's two lobes, and anisotropic GGX's lobes at
     its equivalent roughness (reflectance.layering.equivalent_roughness)."""
@@ -65,6 +76,8 @@ class SGParametric(SGLobes):
         lobes = int(params.lobe_count) if model in models.ANISOTROPIC else 1
         if model == "GGX":
             lobes = sg_shading.GGX_NDF_LOBES
+        elif model == "GGX_ANISO":
+            lobes = ndf_fit.ggx_anisotropic_lobe_counts(lobes)[0]
         has_diffuse, has_specular = material_terms(params)
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS
                                 and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
@@ -81,23 +94,25 @@ class SGParametric(SGLobes):
                 "TAIL_SHARPNESS_RATIO": f"{sg_shading.TAIL_SHARPNESS_RATIO!r}"}
 
     def model_files(self, key):
-        if key.model in models.ANISOTROPIC:
-            return ("anisotropic_lobes.glsl",)
-        return ("ggx_two_lobes.glsl",) if uses_ggx_table(key) else ()
+        files = ("anisotropic_lobes.glsl",) if key.model in models.ANISOTROPIC else ()
+        if uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key):
+            files += ("ggx_two_lobes.glsl",)
+        return files
 
     def model_samplers(self, key):
-        if key.model in models.ANISOTROPIC:
-            return [("FLOAT_2D", "anisotropy_table")] + ([("FLOAT_2D", "ggx_albedo_table")]
-                                                         if uses_albedo_table(key) else [])
-        if uses_ggx_table(key):
-            return [("FLOAT_2D", "ggx_table"), ("FLOAT_2D", "ggx_albedo_table")]      # ENVIRONMENT_TAIL
-        return []
+        samplers = [("FLOAT_2D", "anisotropy_table")] if key.model in models.ANISOTROPIC else []
+        if uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key):
+            samplers.append(("FLOAT_2D", "ggx_table"))
+        if uses_albedo_table(key):
+            samplers.append(("FLOAT_2D", "ggx_albedo_table"))     # ENVIRONMENT_TAIL
+        return samplers
 
     def bind_model(self, shader, key, context):
         if key.model in models.ANISOTROPIC:
-            shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", key.ndf_lobes),
-                                                                     lambda: anisotropy_table(key.ndf_lobes)))
-        if uses_ggx_table(key):
+            lobes = anisotropy_table_lobes(key)
+            shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", lobes),
+                                                                     lambda: anisotropy_table(lobes)))
+        if uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key):
             shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", ggx_table))
         if uses_albedo_table(key):
             shader.uniform_sampler("ggx_albedo_table", context.table("ggx_albedo", ggx_albedo_texture))

@@ -13,8 +13,8 @@ def test_every_model_has_an_exact_form_and_glsl_lobes():
         exact = brdf.model_from_name(model.name)
         assert exact is not None and f"defined(MODEL_{model.name})" in shading, model.name
         assert set(model.parameters) <= set(models.SCALAR_PARAMETERS)
-        if model.anisotropic:       # several lobes from the anisotropy table
-            assert exact.ndf_lobes(3)[1].shape[-1] == 3
+        if model.anisotropic:       # several lobes from the anisotropy table (anisotropic GGX's in pairs)
+            assert exact.ndf_lobes(3)[1].shape[-1] == (4 if model.name == "GGX_ANISO" else 3)
     assert models.ANISOTROPIC == ("WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX_ANISO")
     assert [item[0] for item in models.enum_items()] == list(models.NAMES)
     assert all(model.panel_parameters[-1] == "lobe_count" for model in models.MODELS if model.anisotropic)
@@ -27,13 +27,20 @@ def test_the_model_enum_keeps_its_order():
 
 
 def test_anisotropic_ggx_lobes_against_its_ndf():
-    """The anisotropy table's lobes at GGX's alphas (relative L2 of the NDF; measured 0.416, 0.295, 0.263 at 4
-    lobes): GGX's tails stay out of them, as for the isotropic GGX's lobes."""
+    """GGX's core and tail, each stretched to the alphas and made of the anisotropy table's lobes (relative L2 of
+    the NDF at 4 and 8 lobes; measured 0.490 / 0.309, 0.277 / 0.163, 0.036 / 0.036 (the isotropic two-lobe fit),
+    0.305 / 0.138, where the table's single Gaussian of width alpha gave 0.416 / 0.296, 0.295 / 0.279,
+    0.263 / 0.263, 0.312 / 0.267: the image error is what moved, test_environment_specular.py)."""
     from sg_prt_addon.reflectance import ndf_fit
 
-    for (alpha_x, alpha_y), measured in (((0.35, 0.06), 0.416), ((0.5, 0.2), 0.295), ((0.16, 0.16), 0.263)):
+    for (alpha_x, alpha_y), measured in (((0.35, 0.06), (0.490, 0.309)), ((0.5, 0.2), (0.277, 0.163)),
+                                         ((0.16, 0.16), (0.036, 0.036)), ((0.17, 0.0476), (0.305, 0.138))):
         model = brdf.GGXAnisotropic(alpha_x=alpha_x, alpha_y=alpha_y)
-        assert ndf_fit.ndf_l2_error(model, model.ndf_lobes(4)) < measured + 0.01
+        for lobe_count, bound in zip((4, 8), measured):
+            assert ndf_fit.ndf_l2_error(model, model.ndf_lobes(lobe_count)) < bound + 0.01
+    isotropic = ndf_fit.ndf_l2_error(brdf.GGX(roughness=0.4), brdf.GGX(roughness=0.4).ndf_lobes(2))
+    anisotropic = brdf.GGXAnisotropic(alpha_x=0.16, alpha_y=0.16)
+    assert ndf_fit.ndf_l2_error(anisotropic, anisotropic.ndf_lobes(2)) < isotropic + 0.002
     isotropic, anisotropic = brdf.GGX(roughness=0.4), brdf.GGXAnisotropic(alpha_x=0.16, alpha_y=0.16)
     import numpy as np
     directions = np.random.default_rng(0).normal(size=(1000, 3))

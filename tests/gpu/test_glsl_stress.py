@@ -942,7 +942,7 @@ def test_shading_frame_stress(glsl, fuzz):
 
 
 MODEL_VARIANTS = [("GGX", 1), ("GGX", 2), ("COOK_TORRANCE", 1), ("BLINN_PHONG", 1), ("WARD_ISO", 1),
-                  ("WARD_ANISO", 3), ("ASHIKHMIN_SHIRLEY", 3)]
+                  ("WARD_ANISO", 3), ("ASHIKHMIN_SHIRLEY", 3), ("GGX_ANISO", 1), ("GGX_ANISO", 4)]
 
 
 @pytest.mark.parametrize("model,lobes", MODEL_VARIANTS, ids=[f"{m}-{k}" for m, k in MODEL_VARIANTS])
@@ -963,12 +963,13 @@ def test_model_lobes_stress(glsl, model, lobes):
     defines = f"#define MODEL_{model} 1\n#define NDF_LOBES {lobes}\n"
     pieces = [defines]
     textures = {}
-    if model == "GGX" and lobes == 2:
+    if lobes >= 2 and model in ("GGX", "GGX_ANISO"):      # GGX's two lobes; anisotropic GGX's in pairs
         pieces.append(_resource("ggx_two_lobes.glsl"))
         textures["ggx_table"] = sg_parametric.ggx_table()
-    if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY"):
+    if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX_ANISO"):
         pieces.append(_resource("anisotropic_lobes.glsl"))
-        textures["anisotropy_table"] = sg_parametric.anisotropy_table(lobes)
+        textures["anisotropy_table"] = sg_parametric.anisotropy_table(
+            lobes // 2 if model == "GGX_ANISO" and lobes >= 2 else lobes)
     pieces += [_glsl_function(shading, "model_ndf_lobe"), _glsl_function(shading, "model_m_factor")]
     body = """
     vec3 axis_sum = vec3(0.0);
