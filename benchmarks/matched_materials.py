@@ -28,20 +28,22 @@ Mapping per model (ours -> nodes) and the mismatches left:
 - ASHIKHMIN_SHIRLEY (ours: (n.h)^e lobe, exponents nu along the tangent, nv along the
   bitangent, Schlick Fresnel rf0 = 0.05, 1/(4 (h.k) max(n.i, n.o))) -> Glossy BSDF,
   Ashikhmin-Shirley distribution (Cycles' own A-S lobe: exponent 2/alpha^2 - 2 per axis),
-  alpha_t = sqrt(2/(nu + 2)), alpha_b = sqrt(2/(nv + 2)) through Blender's anisotropy
-  mapping (alpha_x = r^2/aspect, alpha_y = r^2 aspect, aspect = sqrt(1 - 0.9 anisotropy)),
-  colour ks x Fresnel(IOR (1 + sqrt(rf0))/(1 - sqrt(rf0)) = 1.58) (dielectric at n.o in
-  place of Schlick at h.k).  Tangent: the object axis (tangent_source OBJECT_AXIS) through a
-  Vector Transform to world space (the BSDF projects it onto the surface, as we do), or the
-  UV map's tangent; tangent_rotation becomes the node's Rotation.  Measured (Cycles 64 spp,
-  brushed_metal at 96 px, torus pixels, relative RMSE against the reference in the engine's
-  object-axis frame): 3.25 with this quarter turn,
-  3.67 without it, but 2.18 with anisotropy 0 (the geometric-mean width) and 0.55 for SG-PRT
-  unshadowed: Cycles' anisotropic lobe here does not match ours (its highlight spreads into a
-  ring around the torus) and we could not find the mapping that does; kept anisotropic as
-  asked, so treat the Cycles torus figures as an upper bound.  EEVEE supports neither the A-S
-  distribution (Blender manual) nor, as far as we could tell, anisotropy: it shades this
-  material as a GGX lobe of the node roughness, a large mismatch reported as it is.
+  alpha_t = sqrt(2/(nu + 2)), alpha_b = sqrt(2/(nv + 2)) as the node's roughness and Anisotropy
+  (glossy_node_anisotropy, the inverse of the Glossy node's own mapping), colour ks x
+  Fresnel(IOR (1 + sqrt(rf0))/(1 - sqrt(rf0)) = 1.58) (dielectric at n.o in place of Schlick at
+  h.k).  Tangent: the object axis (tangent_source OBJECT_AXIS) through a Vector Transform to
+  world space (the BSDF projects it onto the surface, as we do), or the UV map's tangent;
+  tangent_rotation becomes the node's Rotation.  The Glossy node's Anisotropy is not the
+  Principled BSDF's: alpha_x = r^2 (1 - a), alpha_y = r^2 / (1 - a) along its tangent for a > 0
+  (the lobe widened across the tangent), the other way for a < 0
+  (reflectance.principled.glossy_anisotropic_alphas); until session 20 the Principled mapping
+  was used here, with a quarter turn found by trial, which made the widths wrong (0.017 and
+  0.57 in Cycles for our 0.05 and 0.196) and the torus figures an upper bound.  EEVEE supports
+  neither the A-S distribution (Blender manual) nor, as far as we could tell, anisotropy: it
+  shades this material as a GGX lobe of the node roughness, a large mismatch reported as it is.
+- GGX_ANISO (ours: Cycles' anisotropic GGX, alpha_x along the tangent) -> Glossy BSDF, GGX,
+  the roughness and Anisotropy whose alphas the node makes are ours (glossy_node_anisotropy),
+  colour ks, the tangent wired as for Ashikhmin-Shirley.  Exact up to Cycles' own Smith form, as GGX.
 - Others (not in the example scenes): BLINN_PHONG -> Beckmann alpha = sqrt(2/(n + 2));
   WARD_ISO / WARD_ANISO -> Beckmann of the same alphas (anisotropic as above), colour ks.
 - Textures: diffuse and specular colour textures multiply the colours (sRGB images decoded
@@ -58,19 +60,17 @@ RF0_ASHIKHMIN_SHIRLEY = 0.05          # reflectance.brdf.AshikhminShirley's defa
 DIELECTRIC_IOR_OF_RF0 = (1 + math.sqrt(RF0_ASHIKHMIN_SHIRLEY)) / (1 - math.sqrt(RF0_ASHIKHMIN_SHIRLEY))
 
 
-def anisotropic_node_roughness(alpha_t, alpha_b):
-    """(roughness, anisotropy, extra rotation in turns) of a Glossy BSDF whose alphas along our
-    tangent and bitangent are alpha_t, alpha_b: widths r^2 / aspect and r^2 aspect,
-    aspect = sqrt(1 - 0.9 anisotropy) (anisotropy clamped to [0, 0.99]).  A positive anisotropy
-    widens the lobe across the node's tangent (Blender's manual: highlights elongated orthogonal
-    to the tangent; measured below), so the node's tangent is turned a quarter turn from ours when
-    our tangent is the wide axis."""
-    wide, narrow, rotation = (alpha_t, alpha_b, 0.25) if alpha_t >= alpha_b else (alpha_b, alpha_t, 0.0)
-    anisotropy = min(max((1.0 - narrow / wide) / 0.9, 0.0), 0.99)
-    aspect = math.sqrt(1.0 - 0.9 * anisotropy)
-    # r^2 = sqrt(alpha_x alpha_y) when the aspect ratio is reachable; otherwise keep the wide axis
-    r_squared = math.sqrt(wide * narrow) if anisotropy < 0.99 else wide * aspect
-    return math.sqrt(r_squared), anisotropy, rotation
+def glossy_node_anisotropy(alpha_t, alpha_b):
+    """(roughness, Anisotropy) of a Glossy BSDF whose alphas along our tangent and bitangent (its Tangent
+    input, Rotation 0) are alpha_t, alpha_b: the inverse of Cycles' Glossy mapping
+    (reflectance.principled.glossy_anisotropic_alphas), r^2 = sqrt(alpha_t alpha_b) and
+    1 -+ a = sqrt of the alphas' ratio; exact while the ratio is within 0.99^2 (and r <= 1)."""
+    roughness = math.sqrt(math.sqrt(alpha_t * alpha_b))
+    if alpha_t <= alpha_b:
+        anisotropy = 1.0 - math.sqrt(alpha_t / alpha_b)
+    else:
+        anisotropy = math.sqrt(alpha_b / alpha_t) - 1.0
+    return min(roughness, 1.0), min(max(anisotropy, -0.99), 0.99)
 
 
 def phong_alpha(exponent):
@@ -211,8 +211,12 @@ def match_material(material):
         factor = builder.math("MULTIPLY", fresnel.outputs["Fac"], peak)
         builder.link(builder.scale_colour(specular, factor), glossy.inputs["Color"])
         description = "Glossy Beckmann alpha m, colour ks x 4 m^2 x Fresnel(ior)"
-    elif model in ("ASHIKHMIN_SHIRLEY", "WARD_ANISO", "WARD_ISO", "BLINN_PHONG"):
-        if model == "ASHIKHMIN_SHIRLEY":
+    elif model in ("ASHIKHMIN_SHIRLEY", "WARD_ANISO", "WARD_ISO", "BLINN_PHONG", "GGX_ANISO"):
+        if model == "GGX_ANISO":
+            alpha_t, alpha_b = float(settings.alpha_x), float(settings.alpha_y)
+            glossy.distribution = "GGX"
+            builder.link(specular, glossy.inputs["Color"])
+        elif model == "ASHIKHMIN_SHIRLEY":
             alpha_t, alpha_b = phong_alpha(settings.nu), phong_alpha(settings.nv)
             glossy.distribution = "ASHIKHMIN_SHIRLEY"
             fresnel = builder.nodes.new("ShaderNodeFresnel")
@@ -226,11 +230,11 @@ def match_material(material):
                 alpha_t = float(settings.alpha_x)
                 alpha_b = float(settings.alpha_y) if model == "WARD_ANISO" else alpha_t
             builder.link(specular, glossy.inputs["Color"])
-        roughness, anisotropy, rotation = anisotropic_node_roughness(alpha_t, alpha_b)
+        roughness, anisotropy = glossy_node_anisotropy(alpha_t, alpha_b)
         glossy.inputs["Roughness"].default_value = roughness
         glossy.inputs["Anisotropy"].default_value = anisotropy
-        glossy.inputs["Rotation"].default_value = rotation + float(settings.tangent_rotation) / (2 * math.pi)
-        if anisotropy > 0:
+        glossy.inputs["Rotation"].default_value = float(settings.tangent_rotation) / (2 * math.pi)
+        if anisotropy != 0:
             if settings.tangent_source == "OBJECT_AXIS":
                 transform = builder.nodes.new("ShaderNodeVectorTransform")
                 transform.vector_type, transform.convert_from, transform.convert_to = "VECTOR", "OBJECT", "WORLD"

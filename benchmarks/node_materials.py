@@ -160,10 +160,29 @@ def anisotropic():
     return material
 
 
+def glossy_anisotropic(anisotropy):
+    """A Glossy BSDF (GGX) with Anisotropy along the UV map's tangent: the Glossy node's own mapping (positive:
+    the lobe widened across the tangent; negative: along it), not the Principled BSDF's."""
+    def build():
+        material, tree, output = _nodes(f"glossy_anisotropic_{anisotropy:+.1f}")
+        glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+        glossy.distribution = "GGX"
+        glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+        glossy.inputs["Roughness"].default_value = 0.4
+        glossy.inputs["Anisotropy"].default_value = anisotropy
+        tangent = tree.nodes.new("ShaderNodeTangent")
+        tangent.direction_type = "UV_MAP"
+        tree.links.new(tangent.outputs["Tangent"], glossy.inputs["Tangent"])
+        tree.links.new(glossy.outputs[0], output.inputs["Surface"])
+        return material
+    return build
+
+
 SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),
           "principled_gold_r030": gold, "principled_textured": textured, "principled_pbr_metallic_map": pbr_metallic_map,
           "principled_tiled": tiled, "mix_diffuse_glossy": mix_diffuse_glossy,
-          "principled_anisotropic": anisotropic}
+          "principled_anisotropic": anisotropic, "glossy_anisotropic": glossy_anisotropic(0.6),
+          "glossy_anisotropic_negative": glossy_anisotropic(-0.6)}
 
 
 def build(name, size):

@@ -2,9 +2,10 @@
 colours and reflectance.layering's settings (pure: plain numbers in, a dict of export.MaterialParams fields
 out; blender/node_reader.py reads the nodes).
 
-What Cycles does (intern/cycles/kernel/svm/closure.h, read for Blender 4.2-5.x): alpha = roughness^2; with
-Anisotropic a > 0, aspect = sqrt(1 - 0.9 a), alpha_x = alpha / aspect, alpha_y = alpha aspect, the tangent
-turned by Anisotropic Rotation x 2 pi; the metal (weight Metallic) has Schlick-like Fresnel from F0 = the base
+What Cycles does (intern/cycles/kernel/svm/closure.h, read for Blender 4.2-5.x): alpha = roughness^2; the
+Principled BSDF with Anisotropic a > 0: aspect = sqrt(1 - 0.9 a), alpha_x = alpha / aspect along the tangent,
+alpha_y = alpha aspect, the tangent turned by Anisotropic Rotation x 2 pi; the Glossy BSDF maps its Anisotropy
+its own way (glossy_anisotropic_alphas: a > 0 widens the lobe across the tangent, a < 0 along it); the metal (weight Metallic) has Schlick-like Fresnel from F0 = the base
 colour (F82 tint, white tint: Schlick); what remains is a dielectric of F0 = ((ior - 1)/(ior + 1))^2 x
 2 Specular IOR Level, tinted by Specular Tint, over the diffuse base (weighted by 1 - Transmission), which
 loses the dielectric's directional albedo.  Both glossy lobes share one GGX, so their Fresnel terms add to one
@@ -40,6 +41,17 @@ def anisotropic_alphas(roughness, anisotropic):
     return alpha / aspect, alpha * aspect
 
 
+def glossy_anisotropic_alphas(roughness, anisotropy):
+    """(alpha_x, alpha_y) of Cycles' Glossy BSDF (and the Anisotropic BSDF before it): Anisotropy clamped to
+    [-0.99, 0.99]; a >= 0: alpha_x = alpha (1 - a), alpha_y = alpha / (1 - a) (highlights stretched across the
+    tangent, as Blender's manual says); a < 0: alpha_x = alpha / (1 + a), alpha_y = alpha (1 + a)."""
+    alpha = float(np.clip(roughness, 0.0, 1.0)) ** 2
+    anisotropy = float(np.clip(anisotropy, -0.99, 0.99))
+    if anisotropy < 0.0:
+        return alpha / (1.0 + anisotropy), alpha * (1.0 + anisotropy)
+    return alpha * (1.0 - anisotropy), alpha / (1.0 - anisotropy)
+
+
 def _plain(value):
     """A constant Expression as its number (scalar: the red channel) or colour; anything else as it is."""
     if not isinstance(value, Expression) or value.as_constant() is None:
@@ -59,21 +71,31 @@ def _colour(value):
     return value if isinstance(value, Expression) else tuple(float(c) for c in _rgb(value))
 
 
-def _roughness_fields(roughness, anisotropic, distribution_model):
-    """The model and its width fields for a GGX-family roughness (anisotropic GGX for anisotropy).
-    A textured roughness (an Expression) is GGX's own: the caller gives the others a number."""
+def _ashikhmin_shirley_exponent(alpha):
+    """Cycles' Ashikhmin-Shirley exponent of an alpha: 2 / alpha^2 - 2."""
+    alpha = max(float(alpha), 1e-3)
+    return float(np.clip(2.0 / (alpha * alpha) - 2.0, 1.0, 1e5))
+
+
+def _roughness_fields(roughness, distribution_model, alphas=None):
+    """The model and its width fields for a roughness; alphas: (alpha_x, alpha_y) along the tangent and the
+    bitangent where the node is anisotropic (anisotropic GGX, Ward for Beckmann, Ashikhmin-Shirley's two
+    exponents).  A textured roughness (an Expression) is GGX's own: the caller gives the others a number."""
     if isinstance(roughness, Expression):
         return {"model": "GGX", "roughness": roughness}
     roughness = float(np.clip(roughness, 0.0, 1.0))
-    if anisotropic > 0.0 and distribution_model == "GGX":
-        alpha_x, alpha_y = anisotropic_alphas(roughness, anisotropic)
-        return {"model": "GGX_ANISO", "alpha_x": float(np.clip(alpha_x, MIN_ROUGHNESS, 1.0)),
-                "alpha_y": float(np.clip(alpha_y, MIN_ROUGHNESS, 1.0))}
+    if alphas is not None and alphas[0] != alphas[1]:
+        alpha_x, alpha_y = (float(np.clip(alpha, MIN_ROUGHNESS, 1.0)) for alpha in alphas)
+        if distribution_model == "ASHIKHMIN_SHIRLEY":
+            return {"model": "ASHIKHMIN_SHIRLEY", "nu": _ashikhmin_shirley_exponent(alpha_x),
+                    "nv": _ashikhmin_shirley_exponent(alpha_y)}
+        if distribution_model == "WARD_ISO":
+            return {"model": "WARD_ANISO", "alpha_x": alpha_x, "alpha_y": alpha_y}
+        return {"model": "GGX_ANISO", "alpha_x": alpha_x, "alpha_y": alpha_y}
     if distribution_model == "WARD_ISO":
         return {"model": "WARD_ISO", "alpha_x": float(np.clip(roughness ** 2, MIN_ROUGHNESS, 1.0))}
     if distribution_model == "ASHIKHMIN_SHIRLEY":
-        alpha = max(roughness ** 2, 1e-3)
-        exponent = float(np.clip(2.0 / (alpha * alpha) - 2.0, 1.0, 1e5))
+        exponent = _ashikhmin_shirley_exponent(roughness ** 2)
         return {"model": "ASHIKHMIN_SHIRLEY", "nu": exponent, "nv": exponent}
     return {"model": "GGX", "roughness": max(roughness, MIN_ROUGHNESS)}
 
@@ -104,7 +126,10 @@ def principled(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, ior=1.5,
            "ior": ior_of_f0(f0) if f0 > 0 else 1.0,
            "tangent_rotation": float(anisotropic_rotation) * 2.0 * np.pi,
            "emission": tuple(float(c) * float(emission_strength) for c in _rgb(emission_color))}
-    out.update(_roughness_fields(roughness, float(anisotropic), "GGX"))
+    anisotropic = float(anisotropic)
+    alphas = anisotropic_alphas(roughness, anisotropic) if anisotropic > 0.0 and not isinstance(
+        roughness, Expression) else None
+    out.update(_roughness_fields(roughness, "GGX", alphas))
     return out
 
 
@@ -117,5 +142,8 @@ def glossy(color=(0.8, 0.8, 0.8), roughness=0.5, distribution="GGX", anisotropy=
     out = {"specular_color": _colour(color),
            "fresnel": "NONE",
            "multiscatter": multiscatter, "tangent_rotation": float(rotation) * 2.0 * np.pi}
-    out.update(_roughness_fields(roughness, float(anisotropy), model))
+    # Cycles makes the Glossy node isotropic at |Anisotropy| <= 1e-4
+    alphas = glossy_anisotropic_alphas(roughness, anisotropy) if abs(float(anisotropy)) > 1e-4 and not isinstance(
+        roughness, Expression) else None
+    out.update(_roughness_fields(roughness, model, alphas))
     return out

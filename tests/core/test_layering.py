@@ -126,6 +126,27 @@ def test_glossy_mapping():
     assert shirley["nu"] == shirley["nv"] == pytest.approx(2 / 0.0625 - 2)
 
 
+@pytest.mark.parametrize("anisotropy, alpha_x, alpha_y", [
+    (0.5, 0.125, 0.5),              # positive: narrow along the tangent, the highlight stretched across it
+    (-0.5, 0.5, 0.125),             # negative: the other way
+    (2.0, 0.0025, 1.0),             # clamped to 0.99 (Cycles' alpha_y 25, beyond the model's 1)
+])
+def test_glossy_anisotropy_is_cycles_glossy_mapping(anisotropy, alpha_x, alpha_y):
+    """The Glossy BSDF's Anisotropy is not the Principled BSDF's (alpha (1 -+ a) and alpha / (1 -+ a) along the
+    tangent, not alpha / sqrt(1 - 0.9 a)): a Principled mapping here turned the lobe a quarter turn and
+    narrowed it (Cycles' highlight on a plane at Anisotropy 1: 2 pixels across where ours was 6)."""
+    ggx = principled.glossy((1, 1, 1), 0.5, "GGX", anisotropy)
+    assert ggx["model"] == "GGX_ANISO"
+    assert (ggx["alpha_x"], ggx["alpha_y"]) == pytest.approx((max(alpha_x, principled.MIN_ROUGHNESS), alpha_y))
+    ward = principled.glossy((1, 1, 1), 0.5, "BECKMANN", anisotropy)
+    assert ward["model"] == "WARD_ANISO" and (ward["alpha_x"], ward["alpha_y"]) == pytest.approx(
+        (ggx["alpha_x"], ggx["alpha_y"]))
+    shirley = principled.glossy((1, 1, 1), 0.5, "ASHIKHMIN_SHIRLEY", anisotropy)
+    assert shirley["nu"] == pytest.approx(min(2 / ggx["alpha_x"] ** 2 - 2, 1e5))
+    assert shirley["nv"] == pytest.approx(max(2 / ggx["alpha_y"] ** 2 - 2, 1.0))
+    assert principled.glossy((1, 1, 1), 0.5, "GGX", 5e-5)["model"] == "GGX"     # Cycles: isotropic below 1e-4
+
+
 def test_equivalent_roughness():
     assert layering.equivalent_roughness("GGX", {"roughness": 0.4}) == pytest.approx(0.4)
     assert layering.equivalent_roughness("WARD_ANISO", {"alpha_x": 0.25, "alpha_y": 0.04}) == pytest.approx(0.316, 1e-2)
@@ -156,3 +177,13 @@ def test_the_mirror_replaces_the_specular_colour():
     assert np.all(ks[1] > colour[1])                                      # towards grazing: whiter
     kd, ks = layered(fresnel="SCHLICK", layered_f0=0.04)
     assert np.all(kd < diffuse) and np.all(kd > 0.9 * diffuse)
+
+
+@pytest.mark.parametrize("alpha_t, alpha_b", [(0.196, 0.05), (0.05, 0.196), (0.17, 0.048), (0.3, 0.3)])
+def test_matched_glossy_node_makes_our_alphas(alpha_t, alpha_b):
+    """The truth suite's Cycles materials (benchmarks.matched_materials): the Glossy node's roughness and
+    Anisotropy it chooses give back our alphas through Cycles' mapping."""
+    from benchmarks import matched_materials
+
+    roughness, anisotropy = matched_materials.glossy_node_anisotropy(alpha_t, alpha_b)
+    assert principled.glossy_anisotropic_alphas(roughness, anisotropy) == pytest.approx((alpha_t, alpha_b))

@@ -18,7 +18,7 @@ def test_importing_the_suite_does_not_import_bpy():
 
 
 def test_every_scene_records_its_kind_and_roughness():
-    assert len(ts.SCENES) == 14
+    assert len(ts.SCENES) == 15
     for name, scene in ts.SCENES.items():
         assert scene.kind in ("diffuse", "glossy"), name
         assert (scene.roughness is None) == (scene.kind == "diffuse"), name
