@@ -5,11 +5,12 @@ out; blender/node_reader.py reads the nodes).
 What Cycles does (intern/cycles/kernel/svm/closure.h, read for Blender 4.2-5.x): alpha = roughness^2; the
 Principled BSDF with Anisotropic a > 0: aspect = sqrt(1 - 0.9 a), alpha_x = alpha / aspect along the tangent,
 alpha_y = alpha aspect, the tangent turned by Anisotropic Rotation x 2 pi; the Glossy BSDF maps its Anisotropy
-its own way (glossy_anisotropic_alphas: a > 0 widens the lobe across the tangent, a < 0 along it); the metal (weight Metallic) has Schlick-like Fresnel from F0 = the base
-colour (F82 tint, white tint: Schlick); what remains is a dielectric of F0 = ((ior - 1)/(ior + 1))^2 x
-2 Specular IOR Level, tinted by Specular Tint, over the diffuse base (weighted by 1 - Transmission), which
-loses the dielectric's directional albedo.  Both glossy lobes share one GGX, so their Fresnel terms add to one
-Schlick term with F0 = Metallic base + (1 - Metallic) F0_dielectric tint (Schlick is linear in F0).
+its own way (glossy_anisotropic_alphas: a > 0 widens the lobe across the tangent, a < 0 along it); the metal
+(weight Metallic) has Schlick-like Fresnel from F0 = the base colour (F82 tint, white tint: Schlick); what
+remains is a dielectric of F0 = ((ior - 1)/(ior + 1))^2 x 2 Specular IOR Level, tinted by Specular Tint, over
+the diffuse base (weighted by 1 - Transmission), which loses the dielectric's directional albedo.  Both glossy
+lobes share one GGX, so their Fresnel terms add to one Schlick term with F0 = Metallic base + (1 - Metallic)
+F0_dielectric tint (Schlick is linear in F0).
 """
 import numpy as np
 

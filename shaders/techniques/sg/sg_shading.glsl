@@ -53,23 +53,12 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
 #endif
   sharpness = lobe.x;
   amplitude = lobe.y;
-#if defined(MODEL_WARD_ANISO)
+#if defined(MODEL_WARD_ANISO) || defined(MODEL_GGX_ANISO)
   float ax = max(p.w, 1.0e-6);
   float ay = max(q.x, 1.0e-6);
-  anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
-#elif defined(MODEL_GGX_ANISO) && NDF_LOBES == 1
-  /* one lobe: the table's Gaussian scaled by GGX's one-lobe mapping at the geometric-mean alpha */
-  float ax = max(p.w, 1.0e-6);
-  float ay = max(q.x, 1.0e-6);
-  anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
-  vec2 ggx_scale = isotropic_mapping_ggx(sqrt(ax * ay));
-  sharpness *= 0.5 * ggx_scale.x;
-  amplitude *= ggx_scale.y;
-#elif defined(MODEL_GGX_ANISO)
+#if defined(MODEL_GGX_ANISO) && NDF_LOBES > 1
   /* ndf_fit.ggx_anisotropic_lobes: GGX's broad tail and sharp core (its two isotropic lobes at the
    * geometric-mean alpha), each stretched to the alphas and made of NDF_LOBES / 2 of the table's lobes */
-  float ax = max(p.w, 1.0e-6);
-  float ay = max(q.x, 1.0e-6);
   float geometric = sqrt(ax * ay);
   int component = k / (NDF_LOBES / 2);
   float component_sharpness, component_amplitude;
@@ -78,6 +67,17 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
   /* the component's peak D(n) is its amplitude: ag^2 = ax ay */
   anisotropic_lobes(anisotropy_table, ax * scale, ay * scale, component_amplitude, k - component * (NDF_LOBES / 2),
                     axis, sharpness, amplitude);
+#else
+  anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
+#endif
+#ifdef MODEL_GGX_ANISO
+#if NDF_LOBES == 1
+  /* one lobe: the table's Gaussian scaled by GGX's one-lobe mapping at the geometric-mean alpha */
+  vec2 ggx_scale = isotropic_mapping_ggx(sqrt(ax * ay));
+  sharpness *= 0.5 * ggx_scale.x;
+  amplitude *= ggx_scale.y;
+#endif
+#endif
 #elif defined(MODEL_ASHIKHMIN_SHIRLEY)
   float nu = max(q.y, 0.0);
   float nv = max(q.z, 0.0);
