@@ -86,17 +86,18 @@ def _anisotropic_rows():
 
 
 def _ggx_anisotropic_rows():
-    """Anisotropic GGX (the Principled BSDF's anisotropy) from the same table as Ward's: its tails are what the
-    lobes miss (the SG technique's light and environment tails return them)."""
+    """Anisotropic GGX (the Principled BSDF's anisotropy): GGX's core and tail each stretched to the alphas and
+    made of half the lobes from Ward's table (ndf_fit.ggx_anisotropic_lobes); what the lobes miss of its tails
+    the SG technique's light and environment tails return."""
     rows = []
     for alpha_x, alpha_y in ((0.35, 0.06), (0.5, 0.2), (0.16, 0.16)):
         model = brdf.GGXAnisotropic(alpha_x=alpha_x, alpha_y=alpha_y)
         for lobe_count in (2, 4, 8):
             lobes = model.ndf_lobes(lobe_count)
             rows.append(_row(f"GGX aniso ax={alpha_x} ay={alpha_y}, {lobe_count} lobes", QUADRATURE, L2,
-                             ndf_fit.ndf_l2_error(model, lobes), "the anisotropy table at the alphas"))
+                             ndf_fit.ndf_l2_error(model, lobes), "GGX's core and tail, half the lobes each from the table"))
             rows.append(_row(f"GGX aniso ax={alpha_x} ay={alpha_y}, {lobe_count} lobes", MONTE_CARLO, RMSE,
-                             ndf_fit.brdf_relative_rmse(model, lobes, 100_000), "table"))
+                             ndf_fit.brdf_relative_rmse(model, lobes, 100_000), "core and tail"))
     return rows
 
 
