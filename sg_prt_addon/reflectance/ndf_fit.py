@@ -632,9 +632,9 @@ def ggx_anisotropic_lobes(alpha_x, alpha_y, lobe_count):
     (..., K) with K = ggx_anisotropic_lobe_counts(lobe_count)[0]."""
     alpha_x, alpha_y = np.broadcast_arrays(np.asarray(alpha_x), np.asarray(alpha_y))
     dtype = np.result_type(alpha_x, alpha_y, np.float32)
-    _, per_component = ggx_anisotropic_lobe_counts(lobe_count)
     if lobe_count <= 1:
         return anisotropic_lobes(alpha_x, alpha_y, 1 / (np.pi * alpha_x * alpha_y), 1, "GGX")
+    _, per_component = ggx_anisotropic_lobe_counts(lobe_count)
     geometric = np.sqrt(alpha_x * alpha_y)
     _, sharpness, amplitude = ggx_two_lobes(geometric)          # (..., 2), broader first
     lobes = []

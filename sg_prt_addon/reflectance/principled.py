@@ -45,9 +45,12 @@ def anisotropic_alphas(roughness, anisotropic):
 def glossy_anisotropic_alphas(roughness, anisotropy):
     """(alpha_x, alpha_y) of Cycles' Glossy BSDF (and the Anisotropic BSDF before it): Anisotropy clamped to
     [-0.99, 0.99]; a >= 0: alpha_x = alpha (1 - a), alpha_y = alpha / (1 - a) (highlights stretched across the
-    tangent, as Blender's manual says); a < 0: alpha_x = alpha / (1 + a), alpha_y = alpha (1 + a)."""
+    tangent, as Blender's manual says); a < 0: alpha_x = alpha / (1 + a), alpha_y = alpha (1 + a); isotropic at
+    |a| <= 1e-4, as Cycles makes it."""
     alpha = float(np.clip(roughness, 0.0, 1.0)) ** 2
     anisotropy = float(np.clip(anisotropy, -0.99, 0.99))
+    if abs(anisotropy) <= 1e-4:
+        return alpha, alpha
     if anisotropy < 0.0:
         return alpha / (1.0 + anisotropy), alpha * (1.0 + anisotropy)
     return alpha * (1.0 - anisotropy), alpha / (1.0 - anisotropy)
@@ -78,13 +81,15 @@ def _ashikhmin_shirley_exponent(alpha):
     return float(np.clip(2.0 / (alpha * alpha) - 2.0, 1.0, 1e5))
 
 
-def _roughness_fields(roughness, distribution_model, alphas=None):
-    """The model and its width fields for a roughness; alphas: (alpha_x, alpha_y) along the tangent and the
-    bitangent where the node is anisotropic (anisotropic GGX, Ward for Beckmann, Ashikhmin-Shirley's two
-    exponents).  A textured roughness (an Expression) is GGX's own: the caller gives the others a number."""
+def _roughness_fields(roughness, distribution_model, anisotropic_alphas_of=None):
+    """The model and its width fields for a roughness; anisotropic_alphas_of(roughness): the node's (alpha_x,
+    alpha_y) along the tangent and the bitangent, unequal where it is anisotropic (anisotropic GGX, Ward for
+    Beckmann, Ashikhmin-Shirley's two exponents).  A textured roughness (an Expression) is GGX's own: the
+    caller gives the others a number."""
     if isinstance(roughness, Expression):
         return {"model": "GGX", "roughness": roughness}
     roughness = float(np.clip(roughness, 0.0, 1.0))
+    alphas = None if anisotropic_alphas_of is None else anisotropic_alphas_of(roughness)
     if alphas is not None and alphas[0] != alphas[1]:
         alpha_x, alpha_y = (float(np.clip(alpha, MIN_ROUGHNESS, 1.0)) for alpha in alphas)
         if distribution_model == "ASHIKHMIN_SHIRLEY":
@@ -127,10 +132,7 @@ def principled(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, ior=1.5,
            "ior": ior_of_f0(f0) if f0 > 0 else 1.0,
            "tangent_rotation": float(anisotropic_rotation) * 2.0 * np.pi,
            "emission": tuple(float(c) * float(emission_strength) for c in _rgb(emission_color))}
-    anisotropic = float(anisotropic)
-    alphas = anisotropic_alphas(roughness, anisotropic) if anisotropic > 0.0 and not isinstance(
-        roughness, Expression) else None
-    out.update(_roughness_fields(roughness, "GGX", alphas))
+    out.update(_roughness_fields(roughness, "GGX", lambda width: anisotropic_alphas(width, float(anisotropic))))
     return out
 
 
@@ -143,8 +145,5 @@ def glossy(color=(0.8, 0.8, 0.8), roughness=0.5, distribution="GGX", anisotropy=
     out = {"specular_color": _colour(color),
            "fresnel": "NONE",
            "multiscatter": multiscatter, "tangent_rotation": float(rotation) * 2.0 * np.pi}
-    # Cycles makes the Glossy node isotropic at |Anisotropy| <= 1e-4
-    alphas = glossy_anisotropic_alphas(roughness, anisotropy) if abs(float(anisotropy)) > 1e-4 and not isinstance(
-        roughness, Expression) else None
-    out.update(_roughness_fields(roughness, model, alphas))
+    out.update(_roughness_fields(roughness, model, lambda width: glossy_anisotropic_alphas(width, float(anisotropy))))
     return out

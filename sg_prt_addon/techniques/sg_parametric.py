@@ -33,6 +33,11 @@ def uses_ggx_anisotropic_pairs(key):
     return key.model == "GGX_ANISO" and key.ndf_lobes >= 2
 
 
+def reads_ggx_table(key):
+    """GGX's two-lobe table: GGX's lobes, or anisotropic GGX's pairs."""
+    return uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key)
+
+
 def anisotropy_table_lobes(key):
     """Lobes a row of the anisotropy table the variant reads."""
     return key.ndf_lobes // 2 if uses_ggx_anisotropic_pairs(key) else key.ndf_lobes
@@ -95,13 +100,13 @@ class SGParametric(SGLobes):
 
     def model_files(self, key):
         files = ("anisotropic_lobes.glsl",) if key.model in models.ANISOTROPIC else ()
-        if uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key):
+        if reads_ggx_table(key):
             files += ("ggx_two_lobes.glsl",)
         return files
 
     def model_samplers(self, key):
         samplers = [("FLOAT_2D", "anisotropy_table")] if key.model in models.ANISOTROPIC else []
-        if uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key):
+        if reads_ggx_table(key):
             samplers.append(("FLOAT_2D", "ggx_table"))
         if uses_albedo_table(key):
             samplers.append(("FLOAT_2D", "ggx_albedo_table"))     # ENVIRONMENT_TAIL
@@ -112,7 +117,7 @@ class SGParametric(SGLobes):
             lobes = anisotropy_table_lobes(key)
             shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", lobes),
                                                                      lambda: anisotropy_table(lobes)))
-        if uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key):
+        if reads_ggx_table(key):
             shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", ggx_table))
         if uses_albedo_table(key):
             shader.uniform_sampler("ggx_albedo_table", context.table("ggx_albedo", ggx_albedo_texture))

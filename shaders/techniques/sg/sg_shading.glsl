@@ -70,13 +70,11 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
 #else
   anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
 #endif
-#ifdef MODEL_GGX_ANISO
-#if NDF_LOBES == 1
+#if defined(MODEL_GGX_ANISO) && NDF_LOBES == 1
   /* one lobe: the table's Gaussian scaled by GGX's one-lobe mapping at the geometric-mean alpha */
   vec2 ggx_scale = isotropic_mapping_ggx(sqrt(ax * ay));
   sharpness *= 0.5 * ggx_scale.x;
   amplitude *= ggx_scale.y;
-#endif
 #endif
 #elif defined(MODEL_ASHIKHMIN_SHIRLEY)
   float nu = max(q.y, 0.0);
