@@ -7,6 +7,8 @@ the slice lobes, their energy cap and the environment tail model), the engine re
 layers at the slice lobes (techniques.sg_shading.shade, the mirror of sg_shading.glsl).  The shading alone:
 the warp's lobe shape, the prefiltered lookups, the tail; no visibility.
 """
+from dataclasses import dataclass
+
 import numpy as np
 
 from sg_prt_addon.lighting import env_prefilter, equirect
@@ -57,9 +59,23 @@ def tangent_frames(normals, axis):
     return np.stack([tangent, np.cross(normals, tangent), normals], axis=1)
 
 
-def exact_specular(image, normals, forward, roughness, chunk=64, alphas=None, tangent_axis=None):
+@dataclass(frozen=True, eq=False)
+class LobeNDFAnisotropic(brdf.GGXAnisotropic):
+    """Anisotropic GGX with its NDF replaced by SG lobes (axis (K, 3), sharpness (K,), amplitude (K,)) in the
+    local frame, everything else exact: what the lobes alone cost, without the warp or the prefiltered reads."""
+    lobes: tuple = ()
+
+    def ndf(self, h):
+        h = np.asarray(h)
+        axis, sharpness, amplitude = (np.asarray(a, np.float64) for a in self.lobes)
+        value = np.sum(amplitude * np.exp(sharpness * (h @ axis.T - 1)), axis=-1)
+        return np.where(h[..., 2] > 0, value, 0)
+
+
+def exact_specular(image, normals, forward, roughness, chunk=64, alphas=None, tangent_axis=None, ndf_lobes=None):
     """Sum over the map's texels of L(i) rho(o, i) max(0, n.i) d omega, per normal: (N, 3).  rho: GGX of the
-    roughness, or with ``alphas`` (alpha_x, alpha_y) anisotropic GGX with its tangent along ``tangent_axis``."""
+    roughness, or with ``alphas`` (alpha_x, alpha_y) anisotropic GGX with its tangent along ``tangent_axis``,
+    its NDF replaced by ``ndf_lobes`` if given (LobeNDFAnisotropic)."""
     height, width = image.shape[:2]
     directions = equirect.texel_directions(height, width).reshape(-1, 3)
     solid_angle = np.broadcast_to(equirect.texel_solid_angles(height, width), (height, width)).reshape(-1)
@@ -67,7 +83,8 @@ def exact_specular(image, normals, forward, roughness, chunk=64, alphas=None, ta
     if alphas is None:
         model, all_frames = brdf.GGX(roughness=roughness), hemisphere_map.local_frame(normals)
     else:
-        model = brdf.GGXAnisotropic(alpha_x=alphas[0], alpha_y=alphas[1])
+        model = brdf.GGXAnisotropic(alpha_x=alphas[0], alpha_y=alphas[1]) if ndf_lobes is None else \
+            LobeNDFAnisotropic(alpha_x=alphas[0], alpha_y=alphas[1], lobes=tuple(ndf_lobes))
         all_frames = tangent_frames(normals, tangent_axis)
     out = np.empty((len(normals), 3))
     for start in range(0, len(normals), chunk):
