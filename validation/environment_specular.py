@@ -68,6 +68,8 @@ class LobeNDFAnisotropic(brdf.GGXAnisotropic):
     def ndf(self, h):
         h = np.asarray(h)
         axis, sharpness, amplitude = (np.asarray(a, np.float64) for a in self.lobes)
+        # the dot-product form, not sg.mixture_evaluate: its difference vectors would hold three times the
+        # memory over a chunk of normals times every texel of the map
         value = np.sum(amplitude * np.exp(sharpness * (h @ axis.T - 1)), axis=-1)
         return np.where(h[..., 2] > 0, value, 0)
 
