@@ -162,9 +162,10 @@ def _environment_rows(roughnesses=(0.35, 0.6)):
 
 def _anisotropic_environment_rows(alphas=(0.17, 0.0476), tangent_axis=(0.3, 0.2, 0.93)):
     """Anisotropic GGX (a Principled BSDF of roughness 0.3, Anisotropic 0.8) the same way, its tangent an axis
-    projected on the surface, at 4 and 8 lobes; the note gives the same with the table's single Gaussian of
-    width alpha in place of GGX's core and tail (before ndf_fit.ggx_anisotropic_lobes), without the environment
-    tail, and the lobes' own share: the exact sum with D replaced by the lobes (no warp, no prefiltered reads)."""
+    projected on the surface, at 4 and 8 lobes; the note gives the same with the anisotropy table fitted to the
+    plain L2 of D (ndf_fit.PLANE_L2, before LIGHT_WEIGHTED), with the table's single Gaussian of width alpha in
+    place of GGX's core and tail (before ndf_fit.ggx_anisotropic_lobes), without the environment tail, and the
+    lobes' own share: the exact sum with D replaced by the lobes (no warp, no prefiltered reads)."""
     from benchmarks.accuracy.lighting import load_world
     from sg_prt_addon.reflectance import brdf, ndf_fit
     from validation import environment_specular as es
@@ -188,6 +189,9 @@ def _anisotropic_environment_rows(alphas=(0.17, 0.0476), tangent_axis=(0.3, 0.2,
             np.float64(model.alpha_x), np.float64(model.alpha_y), 1 / (np.pi * model.alpha_x * model.alpha_y), count)
         try:
             single = errors(lobe_count)
+            brdf.GGXAnisotropic.ndf_lobes = lambda model, count=4: ndf_fit.ggx_anisotropic_lobes(
+                np.float64(model.alpha_x), np.float64(model.alpha_y), count, ndf_fit.PLANE_L2)
+            plane_l2 = errors(lobe_count)
         finally:
             brdf.GGXAnisotropic.ndf_lobes = shipped
         tail = sg_shading.environment_tail
@@ -200,13 +204,15 @@ def _anisotropic_environment_rows(alphas=(0.17, 0.0476), tangent_axis=(0.3, 0.2,
         lobes_alone = es.band_errors(es.exact_specular(small, normals, forward, None, alphas=alphas,
                                                        tangent_axis=tangent_axis, ndf_lobes=lobes),
                                      reference, normals, forward)
-        for (low, high), error, before, untailed, alone in zip(es.VIEW_BANDS, ours, single, no_tail, lobes_alone):
+        for (low, high), error, plain, before, untailed, alone in zip(es.VIEW_BANDS, ours, plane_l2, single, no_tail,
+                                                                      lobes_alone):
             rows.append({"name": f"environment specular, anisotropic GGX {alphas[0]}/{alphas[1]}, {lobe_count} lobes, "
                                  f"views {low}-{high} deg",
                          "reference": "sum over courtyard.exr's texels (256 x 512) of L rho max(0, n.i)",
                          "metric": "relative RMSE over a sphere's pixels in the band", "max_error": error,
                          "mean_error": error,
-                         "note": (f"the table's single Gaussian of width alpha in place of GGX's core and tail: "
+                         "note": (f"the anisotropy table fitted to the plain L2 of D: {plain:.3g}; "
+                                  f"the table's single Gaussian of width alpha in place of GGX's core and tail: "
                                   f"{before:.3g}; without the environment tail: {untailed:.3g}; the lobes alone "
                                   f"(the exact sum with D replaced by them): {alone:.3g}")})
     return rows

@@ -43,6 +43,11 @@ def anisotropy_table_lobes(key):
     return key.ndf_lobes // 2 if uses_ggx_anisotropic_pairs(key) else key.ndf_lobes
 
 
+def anisotropy_table_weighting(key):
+    """The error the variant's anisotropy table was fitted to (ndf_fit.PLANE_L2 or LIGHT_WEIGHTED)."""
+    return ndf_fit.LIGHT_WEIGHTED if uses_ggx_anisotropic_pairs(key) else ndf_fit.PLANE_L2
+
+
 def uses_albedo_table(key):
     """The environment tail and energy cap from GGX's albedo: GGX's two lobes, and anisotropic GGX's lobes at
     its equivalent roughness (reflectance.layering.equivalent_roughness)."""
@@ -64,9 +69,9 @@ def ggx_albedo_texture():
     return np.repeat(ggx_albedo.albedo_table()[..., None], 4, axis=-1)
 
 
-def anisotropy_table(lobe_count):
+def anisotropy_table(lobe_count, weighting=ndf_fit.PLANE_L2):
     """ndf_fit's table as an (R, K, 4) float32 texture: texel (k, row)."""
-    return np.ascontiguousarray(ndf_fit.anisotropy_table_array(lobe_count), np.float32)
+    return np.ascontiguousarray(ndf_fit.anisotropy_table_array(lobe_count, weighting), np.float32)
 
 
 class SGParametric(SGLobes):
@@ -114,9 +119,9 @@ class SGParametric(SGLobes):
 
     def bind_model(self, shader, key, context):
         if key.model in models.ANISOTROPIC:
-            lobes = anisotropy_table_lobes(key)
-            shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", lobes),
-                                                                     lambda: anisotropy_table(lobes)))
+            lobes, weighting = anisotropy_table_lobes(key), anisotropy_table_weighting(key)
+            shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", lobes, weighting),
+                                                                     lambda: anisotropy_table(lobes, weighting)))
         if reads_ggx_table(key):
             shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", ggx_table))
         if uses_albedo_table(key):

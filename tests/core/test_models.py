@@ -28,13 +28,15 @@ def test_the_model_enum_keeps_its_order():
 
 def test_anisotropic_ggx_lobes_against_its_ndf():
     """GGX's core and tail, each stretched to the alphas and made of the anisotropy table's lobes (relative L2 of
-    the NDF at 4 and 8 lobes; measured 0.490 / 0.309, 0.277 / 0.163, 0.036 / 0.036 (the isotropic two-lobe fit),
-    0.305 / 0.138, where the table's single Gaussian of width alpha gave 0.416 / 0.296, 0.295 / 0.279,
-    0.263 / 0.263, 0.312 / 0.267: the image error is what moved, test_environment_specular.py)."""
+    the NDF at 4 and 8 lobes; measured 0.530 / 0.328, 0.271 / 0.154, 0.036 / 0.036 (the isotropic two-lobe fit),
+    0.345 / 0.150.  The table is fitted to what an environment shows (ndf_fit.LIGHT_WEIGHTED), which costs the
+    plain L2 of D a little where the alphas differ most: the plane-L2 table gave 0.490 / 0.309, 0.277 / 0.163,
+    0.036 / 0.036, 0.305 / 0.138, and the table's single Gaussian of width alpha 0.416 / 0.296, 0.295 / 0.279,
+    0.263 / 0.263, 0.312 / 0.267; the image error is what moved, test_environment_specular.py)."""
     from sg_prt_addon.reflectance import ndf_fit
 
-    for (alpha_x, alpha_y), measured in (((0.35, 0.06), (0.490, 0.309)), ((0.5, 0.2), (0.277, 0.163)),
-                                         ((0.16, 0.16), (0.036, 0.036)), ((0.17, 0.0476), (0.305, 0.138))):
+    for (alpha_x, alpha_y), measured in (((0.35, 0.06), (0.530, 0.328)), ((0.5, 0.2), (0.271, 0.154)),
+                                         ((0.16, 0.16), (0.036, 0.036)), ((0.17, 0.0476), (0.345, 0.150))):
         model = brdf.GGXAnisotropic(alpha_x=alpha_x, alpha_y=alpha_y)
         for lobe_count, bound in zip((4, 8), measured):
             assert ndf_fit.ndf_l2_error(model, model.ndf_lobes(lobe_count)) < bound + 0.01

@@ -80,14 +80,37 @@ def test_fit_anisotropic_recovers_free_axes():
     np.testing.assert_allclose(np.abs(np.sum(fitted_axes * axes, -1)), 1, atol=1e-4)
 
 
-def test_plane_fit_gradient_is_exact():
+@pytest.mark.parametrize("weighting", [ndf_fit.PLANE_L2, ndf_fit.LIGHT_WEIGHTED])
+def test_plane_fit_gradient_is_exact(weighting):
     rng = np.random.default_rng(0)
     for lobe_count in (1, 2, 5, 8):
         pairs, unique, _, _ = ndf_fit._row_layout(lobe_count)
         params = np.concatenate([rng.uniform(0.1, 1, pairs), rng.uniform(0, 3, unique)])
-        analytic = ndf_fit._plane_fit(params, 0.2, lobe_count)[1]
-        numeric = approx_fprime(params, lambda x: ndf_fit._plane_fit(x, 0.2, lobe_count)[0], 1e-7)
+        analytic = ndf_fit._plane_fit(params, 0.2, lobe_count, weighting)[1]
+        numeric = approx_fprime(params, lambda x: ndf_fit._plane_fit(x, 0.2, lobe_count, weighting)[0], 1e-7)
         np.testing.assert_allclose(analytic, numeric, atol=1e-5)
+
+
+def test_blurred_plane_fit_matches_a_grid():
+    """The closed-form blurred error of _plane_fit against the same on a fine grid: T and the row (its
+    amplitudes as the fit solved them) sampled, each term's residual and T blurred by a Gaussian of that
+    variance (scipy.ndimage), squared and summed."""
+    from scipy.ndimage import gaussian_filter
+
+    ratio, lobe_count = 0.25, 4
+    params = np.array([0.6, 0.2, np.log(12.0), np.log(30.0)])
+    error, _, p, b, mu = ndf_fit._plane_fit(params, ratio, lobe_count, ndf_fit.LIGHT_WEIGHTED)
+    step = 0.01
+    x, y = np.meshgrid(np.arange(-5, 5, step), np.arange(-3, 3, step), indexing="ij")
+    target = np.exp(-(x ** 2 + y ** 2 / ratio ** 2))
+    row = sum(m * np.exp(-bb * ((x - pp) ** 2 + y ** 2)) for pp, bb, m in zip(p, b, mu))
+    total = 0.0
+    for variance, weight in ndf_fit.LIGHT_WEIGHTED:
+        def blur(field):
+            return gaussian_filter(field, np.sqrt(variance) / step, mode="constant") if variance else field
+        total += weight * np.sum(blur(target - row) ** 2) / np.sum(blur(target) ** 2)
+    grid_error = total / sum(weight for _, weight in ndf_fit.LIGHT_WEIGHTED)
+    assert error == pytest.approx(grid_error, rel=2e-3), (error, grid_error)
 
 
 def test_anisotropic_table_errors_fall_with_lobe_count():
