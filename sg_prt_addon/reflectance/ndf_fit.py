@@ -27,8 +27,8 @@
   (about 0.2-1 s).  ``weighting`` chooses the error a row is fitted to: the
   plain L2 (PLANE_L2) or mostly the L2 after a blur, what an environment shows
   (LIGHT_WEIGHTED, anisotropic GGX's).  The scale step is exact only for
-  narrow lobes: measured relative L2 of D with 4 lobes, A-S (75, 1200) 0.178 (direct sphere fit 0.178),
-  Ward (0.3, 0.05) 0.303 (0.302), but Ward (0.8, 0.4) 0.28 where a sphere fit
+  narrow lobes: measured relative L2 of D with 4 lobes, A-S (75, 1200) 0.178
+  (direct sphere fit 0.178), Ward (0.3, 0.05) 0.303 (0.302), but Ward (0.8, 0.4) 0.28 where a sphere fit
   reaches 0.035; the optional broad-lobe correction (``mapping_kind``) brings
   that to 0.15.  A table over (ratio, width) fitted on the sphere would close
   the rest.
@@ -514,20 +514,20 @@ def _plane_fit(params, ratio, lobe_count, weighting=PLANE_L2):
     separation = p[:, None] - p[None, :]
     terms = []
     for variance, weight in weighting:
-        # both blurred by variance v: their overlap sees the kernel twice, and its precision sum a1 + a2
-        # becomes a1 + a2 + 2 (2 v) a1 a2 per axis
-        variance = 2 * variance
-        x_precision = 1 + b * (1 + 2 * variance)
-        y_precision = target_precision + b * (1 + 2 * variance * target_precision)
+        # both blurred by variance v: their overlap sees the kernel twice (variance 2 v), and its precision
+        # sum a1 + a2 becomes a1 + a2 + 2 (2 v) a1 a2 per axis
+        twice = 2 * variance
+        x_precision = 1 + b * (1 + 2 * twice)
+        y_precision = target_precision + b * (1 + 2 * twice * target_precision)
         overlap = np.pi / np.sqrt(x_precision * y_precision) * np.exp(-b * p * p / x_precision)
-        b_sum = b[:, None] + b[None, :] + 2 * variance * b_product
+        b_sum = b[:, None] + b[None, :] + 2 * twice * b_product
         gram = np.pi / b_sum * np.exp(-b_product * separation ** 2 / b_sum)
-        target_norm = np.pi / np.sqrt((2 + 2 * variance) * target_precision * (2 + 2 * variance * target_precision))
+        target_norm = np.pi / np.sqrt((2 + 2 * twice) * target_precision * (2 + 2 * twice * target_precision))
         d_log_overlap_p = -2 * b * p / x_precision
-        d_log_overlap_b = (-0.5 * (1 + 2 * variance) / x_precision - 0.5 * (1 + 2 * variance * target_precision)
+        d_log_overlap_b = (-0.5 * (1 + 2 * twice) / x_precision - 0.5 * (1 + 2 * twice * target_precision)
                            / y_precision - p * p / x_precision ** 2)
         d_log_gram_p = -2 * b_product * separation / b_sum
-        d_log_gram_b = -(1 + 2 * variance * b[None, :]) / b_sum - separation ** 2 * b[None, :] ** 2 / b_sum ** 2
+        d_log_gram_b = -(1 + 2 * twice * b[None, :]) / b_sum - separation ** 2 * b[None, :] ** 2 / b_sum ** 2
         terms.append((weight / target_norm, overlap, gram, d_log_overlap_p, d_log_overlap_b, d_log_gram_p,
                       d_log_gram_b))
     overlap_u = sum(scale * (membership @ overlap) for scale, overlap, *_ in terms)
@@ -552,8 +552,8 @@ def _fit_row(ratio, lobe_count, start, weighting):
     bounds = [(0.0, 4.0)] * pairs + [(-8.0, 14.0)] * unique
     # bounded truncated Newton: scipy's L-BFGS-B calls multi-threaded BLAS on tiny arrays and
     # runs 10x slower than TNC on a busy machine for these <= 8 parameters
-    result = _optimize().minimize(lambda x: _plane_fit(x, ratio, lobe_count, weighting)[:2], start, jac=True, method="TNC",
-                      bounds=bounds, options={"maxfun": 2000})
+    result = _optimize().minimize(lambda x: _plane_fit(x, ratio, lobe_count, weighting)[:2], start, jac=True,
+                                  method="TNC", bounds=bounds, options={"maxfun": 2000})
     return result.x, np.sqrt(result.fun)
 
 
@@ -659,8 +659,8 @@ def ggx_anisotropic_lobes(alpha_x, alpha_y, lobe_count, weighting=LIGHT_WEIGHTED
     (tests/core/test_environment_specular.py).  The table is the one fitted to ``weighting``'s error,
     LIGHT_WEIGHTED by default: the tail's few wide lobes put side by side show as repeated images of a window
     under an environment, and fitted to what an environment sees they cost 0.81x the image error of the
-    plane-L2 table, for 1.08-1.13x its L2 of D (tests/core/test_environment_specular.py, test_models.py).  Returns axis (..., K, 3), sharpness (..., K), amplitude
-    (..., K) with K = ggx_anisotropic_lobe_counts(lobe_count)[0]."""
+    plane-L2 table, for 0.98-1.13x its L2 of D (tests/core/test_environment_specular.py, test_models.py).
+    Returns axis (..., K, 3), sharpness (..., K), amplitude (..., K) with K = ggx_anisotropic_lobe_counts(lobe_count)[0]."""
     alpha_x, alpha_y = np.broadcast_arrays(np.asarray(alpha_x), np.asarray(alpha_y))
     dtype = np.result_type(alpha_x, alpha_y, np.float32)
     if lobe_count <= 1:
