@@ -81,7 +81,6 @@ def test_anisotropic_ggx_error_is_the_lobes(sky, lobe_count, lobe_bounds):
     assert all(ours < lobes_only + 0.04 for ours, lobes_only in zip(engine, alone)), (engine, alone)
 
 
-
 @pytest.mark.parametrize("alphas, lobe_count", [((0.17, 0.0476), 4), ((0.17, 0.0476), 8), ((0.35, 0.06), 8)])
 def test_light_weighted_table_beats_plane_l2_under_an_environment(sky, alphas, lobe_count):
     """The anisotropy table anisotropic GGX reads is fitted to the error an environment shows

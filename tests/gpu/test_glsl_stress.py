@@ -949,7 +949,8 @@ MODEL_VARIANTS = [("GGX", 1), ("GGX", 2), ("COOK_TORRANCE", 1), ("BLINN_PHONG", 
 def test_model_lobes_stress(glsl, model, lobes):
     """sg_shading.glsl's model_ndf_lobe (through ggx_two_lobes / anisotropic_lobes and their tables)
     and model_m_factor, per model, over the numpy suite's parameters (0 included) and directions."""
-    from sg_prt_addon.reflectance import ndf_fit
+    import types
+
     from sg_prt_addon.techniques import sg_parametric
 
     wo, wi, h, roughness, exponent, rng = _brdf_inputs()
@@ -969,9 +970,10 @@ def test_model_lobes_stress(glsl, model, lobes):
         textures["ggx_table"] = sg_parametric.ggx_table()
     if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX_ANISO"):
         pieces.append(_resource("anisotropic_lobes.glsl"))
-        pairs = model == "GGX_ANISO" and lobes >= 2          # ndf_fit.ggx_anisotropic_lobes' components
-        textures["anisotropy_table"] = sg_parametric.anisotropy_table(
-            lobes // 2 if pairs else lobes, ndf_fit.LIGHT_WEIGHTED if pairs else ndf_fit.PLANE_L2)
+        # the table the engine binds for this model and count (what a variant key's model and lobes decide)
+        key = types.SimpleNamespace(model=model, ndf_lobes=lobes)
+        textures["anisotropy_table"] = sg_parametric.anisotropy_table(sg_parametric.anisotropy_table_lobes(key),
+                                                                      sg_parametric.anisotropy_table_weighting(key))
     pieces += [_glsl_function(shading, "model_ndf_lobe"), _glsl_function(shading, "model_m_factor")]
     body = """
     vec3 axis_sum = vec3(0.0);
