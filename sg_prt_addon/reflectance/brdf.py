@@ -568,9 +568,9 @@ class GGXAnisotropic(_Microfacet):
     tangent, alpha_y along the bitangent; reflectance.principled.anisotropic_alphas):
     D = 1 / (pi ax ay ((hx/ax)^2 + (hy/ay)^2 + hz^2)^2), height-correlated Smith with
     Lambda(w) = (sqrt(1 + (ax^2 wx^2 + ay^2 wy^2) / wz^2) - 1) / 2, no Fresnel (reflectance.layering adds it).
-    SG lobes: GGX's core and broad tail, each stretched to the alphas and made of the anisotropy table's lobes
-    (ndf_fit.ggx_anisotropic_lobes); what they miss of GGX's tails the SG technique returns through its light and
-    environment tails."""
+    SG lobes: all fitted together to GGX's two isotropic lobes stretched to the alphas, from its own table over
+    ratio and alpha (ndf_fit.ggx_anisotropic_lobes); what they miss of GGX's tails the SG technique returns
+    through its light and environment tails."""
     alpha_x: object = 0.2
     alpha_y: object = 0.05
 

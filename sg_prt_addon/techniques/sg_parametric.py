@@ -27,25 +27,22 @@ def uses_ggx_table(key):
     return key.model == "GGX" and key.ndf_lobes == 2 and key.has_specular
 
 
-def uses_ggx_anisotropic_pairs(key):
-    """Anisotropic GGX of two lobes or more: GGX's two lobes from ggx_table, each of half the count from the
-    anisotropy table (ndf_fit.ggx_anisotropic_lobes)."""
+def uses_ggx_anisotropy_table(key):
+    """Anisotropic GGX of two lobes or more: its own table over ratio and alpha (ndf_fit.ggx_anisotropy_table);
+    one lobe reads Ward's."""
     return key.model == "GGX_ANISO" and key.ndf_lobes >= 2
-
-
-def reads_ggx_table(key):
-    """GGX's two-lobe table: GGX's lobes, or anisotropic GGX's pairs."""
-    return uses_ggx_table(key) or uses_ggx_anisotropic_pairs(key)
-
-
-def anisotropy_table_lobes(key):
-    """Lobes a row of the anisotropy table the variant reads."""
-    return key.ndf_lobes // 2 if uses_ggx_anisotropic_pairs(key) else key.ndf_lobes
 
 
 def anisotropy_table_weighting(key):
     """The error the variant's anisotropy table was fitted to (ndf_fit.PLANE_L2 or LIGHT_WEIGHTED)."""
-    return ndf_fit.LIGHT_WEIGHTED if uses_ggx_anisotropic_pairs(key) else ndf_fit.PLANE_L2
+    return ndf_fit.LIGHT_WEIGHTED if uses_ggx_anisotropy_table(key) else ndf_fit.PLANE_L2
+
+
+def anisotropy_table_texture(key):
+    """The (rows, K, 4) float32 texture of the variant's anisotropy table: texel (k, row)."""
+    if uses_ggx_anisotropy_table(key):
+        return ndf_fit.ggx_anisotropy_table_array(key.ndf_lobes, ndf_fit.LIGHT_WEIGHTED)
+    return ndf_fit.anisotropy_table_array(key.ndf_lobes, ndf_fit.PLANE_L2)
 
 
 def uses_albedo_table(key):
@@ -69,11 +66,6 @@ def ggx_albedo_texture():
     return np.repeat(ggx_albedo.albedo_table()[..., None], 4, axis=-1)
 
 
-def anisotropy_table(lobe_count, weighting=ndf_fit.PLANE_L2):
-    """ndf_fit's table as an (R, K, 4) float32 texture: texel (k, row)."""
-    return np.ascontiguousarray(ndf_fit.anisotropy_table_array(lobe_count, weighting), np.float32)
-
-
 class SGParametric(SGLobes):
     name = NAME
     label = "SG Lobes (Wang 2009)"
@@ -86,8 +78,6 @@ class SGParametric(SGLobes):
         lobes = int(params.lobe_count) if model in models.ANISOTROPIC else 1
         if model == "GGX":
             lobes = sg_shading.GGX_NDF_LOBES
-        elif model == "GGX_ANISO":
-            lobes = ndf_fit.ggx_anisotropic_lobe_counts(lobes)[0]
         has_diffuse, has_specular = material_terms(params)
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS
                                 and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
@@ -97,21 +87,27 @@ class SGParametric(SGLobes):
                           **scene_fields(inputs, has_diffuse, has_specular))
 
     def model_defines(self, key):
-        if not uses_albedo_table(key):
-            return {}
-        # GGX's energy beyond its two lobes, from its albedo table (reflectance.ggx_albedo)
-        return {"ENVIRONMENT_TAIL": 1, "GGX_ALBEDO_SIZE": ggx_albedo.TABLE_SIZE,
-                "TAIL_SHARPNESS_RATIO": f"{sg_shading.TAIL_SHARPNESS_RATIO!r}"}
+        defines = {}
+        if uses_ggx_anisotropy_table(key):
+            log_alphas = np.log(ndf_fit.GGX_ANISOTROPY_ALPHAS)
+            defines.update({"GGX_ANISOTROPY_ALPHAS": len(log_alphas),
+                            "GGX_ANISOTROPY_LOG_ALPHA_MIN": f"{log_alphas[0]!r}",
+                            "GGX_ANISOTROPY_LOG_ALPHA_MAX": f"{log_alphas[-1]!r}"})
+        if uses_albedo_table(key):
+            # GGX's energy beyond its two lobes, from its albedo table (reflectance.ggx_albedo)
+            defines.update({"ENVIRONMENT_TAIL": 1, "GGX_ALBEDO_SIZE": ggx_albedo.TABLE_SIZE,
+                            "TAIL_SHARPNESS_RATIO": f"{sg_shading.TAIL_SHARPNESS_RATIO!r}"})
+        return defines
 
     def model_files(self, key):
         files = ("anisotropic_lobes.glsl",) if key.model in models.ANISOTROPIC else ()
-        if reads_ggx_table(key):
+        if uses_ggx_table(key):
             files += ("ggx_two_lobes.glsl",)
         return files
 
     def model_samplers(self, key):
         samplers = [("FLOAT_2D", "anisotropy_table")] if key.model in models.ANISOTROPIC else []
-        if reads_ggx_table(key):
+        if uses_ggx_table(key):
             samplers.append(("FLOAT_2D", "ggx_table"))
         if uses_albedo_table(key):
             samplers.append(("FLOAT_2D", "ggx_albedo_table"))     # ENVIRONMENT_TAIL
@@ -119,10 +115,10 @@ class SGParametric(SGLobes):
 
     def bind_model(self, shader, key, context):
         if key.model in models.ANISOTROPIC:
-            lobes, weighting = anisotropy_table_lobes(key), anisotropy_table_weighting(key)
-            shader.uniform_sampler("anisotropy_table", context.table(("anisotropy", lobes, weighting),
-                                                                     lambda: anisotropy_table(lobes, weighting)))
-        if reads_ggx_table(key):
+            name = ("ggx_anisotropy" if uses_ggx_anisotropy_table(key) else "anisotropy", key.ndf_lobes,
+                    anisotropy_table_weighting(key))
+            shader.uniform_sampler("anisotropy_table", context.table(name, lambda: anisotropy_table_texture(key)))
+        if uses_ggx_table(key):
             shader.uniform_sampler("ggx_table", context.table("ggx_two_lobes", ggx_table))
         if uses_albedo_table(key):
             shader.uniform_sampler("ggx_albedo_table", context.table("ggx_albedo", ggx_albedo_texture))

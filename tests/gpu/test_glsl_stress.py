@@ -965,15 +965,18 @@ def test_model_lobes_stress(glsl, model, lobes):
     defines = f"#define MODEL_{model} 1\n#define NDF_LOBES {lobes}\n"
     pieces = [defines]
     textures = {}
-    if lobes >= 2 and model in ("GGX", "GGX_ANISO"):      # GGX's two lobes; anisotropic GGX's in pairs
+    if lobes >= 2 and model == "GGX":      # GGX's two lobes
         pieces.append(_resource("ggx_two_lobes.glsl"))
         textures["ggx_table"] = sg_parametric.ggx_table()
     if model in ("WARD_ANISO", "ASHIKHMIN_SHIRLEY", "GGX_ANISO"):
+        # the table and defines the engine binds for this model and count (what a variant key's model and lobes
+        # decide)
+        key = types.SimpleNamespace(model=model, ndf_lobes=lobes, has_specular=True)
+        pieces[0] += "".join(f"#define {name} {value}\n"
+                             for name, value in sg_parametric.TECHNIQUE.model_defines(key).items()
+                             if name.startswith("GGX_ANISOTROPY"))
         pieces.append(_resource("anisotropic_lobes.glsl"))
-        # the table the engine binds for this model and count (what a variant key's model and lobes decide)
-        key = types.SimpleNamespace(model=model, ndf_lobes=lobes)
-        textures["anisotropy_table"] = sg_parametric.anisotropy_table(sg_parametric.anisotropy_table_lobes(key),
-                                                                      sg_parametric.anisotropy_table_weighting(key))
+        textures["anisotropy_table"] = sg_parametric.anisotropy_table_texture(key)
     pieces += [_glsl_function(shading, "model_ndf_lobe"), _glsl_function(shading, "model_m_factor")]
     body = """
     vec3 axis_sum = vec3(0.0);
@@ -991,7 +994,11 @@ def test_model_lobes_stress(glsl, model, lobes):
 
 
 def test_table_lobes_stress(glsl, fuzz):
-    """ggx_two_lobes and anisotropic_lobes called alone: roughness / widths 0..1e3, any peak."""
+    """ggx_two_lobes, anisotropic_lobes and ggx_anisotropic_lobes called alone: roughness / widths 0..1e3, any
+    peak."""
+    import types
+
+    from sg_prt_addon.reflectance import ndf_fit
     from sg_prt_addon.techniques import sg_parametric
 
     roughness = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 10.0, SMALL_ROWS)))
@@ -1004,13 +1011,20 @@ def test_table_lobes_stress(glsl, fuzz):
     ggx_two_lobes(ggx_table, a.x, 1, s1, a1);
     vec3 axis; float sharpness, amplitude;
     anisotropic_lobes(anisotropy_table, a.y, a.z, a.w, 1, axis, sharpness, amplitude);
-    result = vec4(s0 + s1, a0 + a1, sharpness + amplitude, length(axis));
+    vec3 ggx_axis; float ggx_sharpness, ggx_amplitude;
+    ggx_anisotropic_lobes(ggx_anisotropy_table, a.y, a.z, 1, ggx_axis, ggx_sharpness, ggx_amplitude);
+    result = vec4(s0 + s1, a0 + a1, sharpness + amplitude + ggx_sharpness + ggx_amplitude,
+                  length(axis) + length(ggx_axis));
     """
-    library = ["sg.glsl", "brdf.glsl", _resource("ggx_two_lobes.glsl"), _resource("anisotropic_lobes.glsl")]
+    defines = "".join(f"#define {name} {value}\n" for name, value in sg_parametric.TECHNIQUE.model_defines(
+        types.SimpleNamespace(model="GGX_ANISO", ndf_lobes=2, has_specular=False)).items())
+    library = ["sg.glsl", "brdf.glsl", _resource("ggx_two_lobes.glsl"), defines, _resource("anisotropic_lobes.glsl")]
+    ggx_key = types.SimpleNamespace(model="GGX_ANISO", ndf_lobes=2)
     out = glsl(library, body, {"a": np.c_[roughness, width_x, width_y, peak]}, 4,
-               {"ggx_table": sg_parametric.ggx_table(), "anisotropy_table": sg_parametric.anisotropy_table(2)})
-    _assert_finite(out, "ggx_two_lobes / anisotropic_lobes")
-    assert out[:, :3].min() >= 0 and np.abs(out[:, 3] - 1).max() < 1e-5
+               {"ggx_table": sg_parametric.ggx_table(), "anisotropy_table": ndf_fit.anisotropy_table_array(2),
+                "ggx_anisotropy_table": sg_parametric.anisotropy_table_texture(ggx_key)})
+    _assert_finite(out, "ggx_two_lobes / anisotropic_lobes / ggx_anisotropic_lobes")
+    assert out[:, :3].min() >= 0 and np.abs(out[:, 3] - 2).max() < 2e-5
 
 
 def test_fitted_pieces_stress(glsl, fuzz):

@@ -57,16 +57,8 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
   float ax = max(p.w, 1.0e-6);
   float ay = max(q.x, 1.0e-6);
 #if defined(MODEL_GGX_ANISO) && NDF_LOBES > 1
-  /* ndf_fit.ggx_anisotropic_lobes: GGX's broad tail and sharp core (its two isotropic lobes at the
-   * geometric-mean alpha), each stretched to the alphas and made of NDF_LOBES / 2 of the table's lobes */
-  float geometric = sqrt(ax * ay);
-  int component = k / (NDF_LOBES / 2);
-  float component_sharpness, component_amplitude;
-  ggx_two_lobes(ggx_table, sqrt(geometric), component, component_sharpness, component_amplitude);
-  float scale = sqrt(2.0 / max(component_sharpness * geometric * geometric, 1.0e-30));
-  /* the component's peak D(n) is its amplitude: ag^2 = ax ay */
-  anisotropic_lobes(anisotropy_table, ax * scale, ay * scale, component_amplitude, k - component * (NDF_LOBES / 2),
-                    axis, sharpness, amplitude);
+  /* ndf_fit.ggx_anisotropic_lobes: all lobes fitted together to GGX's two sphere-fitted lobes stretched */
+  ggx_anisotropic_lobes(anisotropy_table, ax, ay, k, axis, sharpness, amplitude);
 #else
   anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
 #endif
