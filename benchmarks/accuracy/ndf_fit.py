@@ -86,9 +86,9 @@ def _anisotropic_rows():
 
 
 def _ggx_anisotropic_rows():
-    """Anisotropic GGX (the Principled BSDF's anisotropy): GGX's core and tail each stretched to the alphas and
-    made of half the lobes from Ward's table (ndf_fit.ggx_anisotropic_lobes); what the lobes miss of its tails
-    the SG technique's light and environment tails return."""
+    """Anisotropic GGX (the Principled BSDF's anisotropy): its lobes fitted together to GGX's two isotropic lobes
+    stretched (ndf_fit.ggx_anisotropic_lobes), beside the same fitted to the plain L2 of D; what the lobes miss of
+    its tails the SG technique's light and environment tails return."""
     rows = []
     for alpha_x, alpha_y in ((0.35, 0.06), (0.5, 0.2), (0.16, 0.16)):
         model = brdf.GGXAnisotropic(alpha_x=alpha_x, alpha_y=alpha_y)
@@ -98,10 +98,10 @@ def _ggx_anisotropic_rows():
                                                      ndf_fit.PLANE_L2)
             rows.append(_row(f"GGX aniso ax={alpha_x} ay={alpha_y}, {lobe_count} lobes", QUADRATURE, L2,
                              ndf_fit.ndf_l2_error(model, lobes),
-                             "GGX's core and tail, half the lobes each from the table fitted to what an environment "
-                             f"shows; from the table fitted to this L2: {ndf_fit.ndf_l2_error(model, plane_l2):.3g}"))
+                             "all lobes fitted together to what an environment shows (GGX's own table); "
+                             f"fitted to this L2: {ndf_fit.ndf_l2_error(model, plane_l2):.3g}"))
             rows.append(_row(f"GGX aniso ax={alpha_x} ay={alpha_y}, {lobe_count} lobes", MONTE_CARLO, RMSE,
-                             ndf_fit.brdf_relative_rmse(model, lobes, 100_000), "core and tail"))
+                             ndf_fit.brdf_relative_rmse(model, lobes, 100_000), "GGX's own table"))
     return rows
 
 

@@ -162,10 +162,10 @@ def _environment_rows(roughnesses=(0.35, 0.6)):
 
 def _anisotropic_environment_rows(alphas=(0.17, 0.0476), tangent_axis=(0.3, 0.2, 0.93)):
     """Anisotropic GGX (a Principled BSDF of roughness 0.3, Anisotropic 0.8) the same way, its tangent an axis
-    projected on the surface, at 4 and 8 lobes; the note gives the same with the anisotropy table fitted to the
-    plain L2 of D (ndf_fit.PLANE_L2, before LIGHT_WEIGHTED), with the table's single Gaussian of width alpha in
-    place of GGX's core and tail (before ndf_fit.ggx_anisotropic_lobes), without the environment tail, and the
-    lobes' own share: the exact sum with D replaced by the lobes (no warp, no prefiltered reads)."""
+    projected on the surface, at 4 and 8 lobes; the note gives the same with GGX's table fitted to the plain L2
+    of D (ndf_fit.PLANE_L2, not LIGHT_WEIGHTED), with Ward's table's single Gaussian of width alpha in place of
+    GGX's lobes (before anisotropic GGX had lobes of its own), without the environment tail, and the lobes' own
+    share: the exact sum with D replaced by the lobes (no warp, no prefiltered reads)."""
     from benchmarks.accuracy.lighting import load_world
     from sg_prt_addon.reflectance import brdf, ndf_fit
     from validation import environment_specular as es
@@ -211,8 +211,8 @@ def _anisotropic_environment_rows(alphas=(0.17, 0.0476), tangent_axis=(0.3, 0.2,
                          "reference": "sum over courtyard.exr's texels (256 x 512) of L rho max(0, n.i)",
                          "metric": "relative RMSE over a sphere's pixels in the band", "max_error": error,
                          "mean_error": error,
-                         "note": (f"the anisotropy table fitted to the plain L2 of D: {plain:.3g}; "
-                                  f"the table's single Gaussian of width alpha in place of GGX's core and tail: "
+                         "note": (f"GGX's table fitted to the plain L2 of D: {plain:.3g}; "
+                                  f"Ward's table's single Gaussian of width alpha in place of GGX's lobes: "
                                   f"{before:.3g}; without the environment tail: {untailed:.3g}; the lobes alone "
                                   f"(the exact sum with D replaced by them): {alone:.3g}")})
     return rows

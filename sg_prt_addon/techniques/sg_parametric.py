@@ -91,8 +91,8 @@ class SGParametric(SGLobes):
         if uses_ggx_anisotropy_table(key):
             log_alphas = np.log(ndf_fit.GGX_ANISOTROPY_ALPHAS)
             defines.update({"GGX_ANISOTROPY_ALPHAS": len(log_alphas),
-                            "GGX_ANISOTROPY_LOG_ALPHA_MIN": f"{log_alphas[0]!r}",
-                            "GGX_ANISOTROPY_LOG_ALPHA_MAX": f"{log_alphas[-1]!r}"})
+                            "GGX_ANISOTROPY_LOG_ALPHA_MIN": repr(float(log_alphas[0])),
+                            "GGX_ANISOTROPY_LOG_ALPHA_MAX": repr(float(log_alphas[-1]))})
         if uses_albedo_table(key):
             # GGX's energy beyond its two lobes, from its albedo table (reflectance.ggx_albedo)
             defines.update({"ENVIRONMENT_TAIL": 1, "GGX_ALBEDO_SIZE": ggx_albedo.TABLE_SIZE,

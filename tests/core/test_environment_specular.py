@@ -87,10 +87,10 @@ def test_anisotropic_ggx_lobes_alone_and_engine(sky, lobe_count, lobe_bounds, en
 
 @pytest.mark.parametrize("alphas, lobe_count", [((0.17, 0.0476), 4), ((0.17, 0.0476), 8), ((0.35, 0.06), 8)])
 def test_light_weighted_table_beats_plane_l2_under_an_environment(sky, alphas, lobe_count):
-    """The anisotropy table anisotropic GGX reads is fitted to the error an environment shows
-    (ndf_fit.LIGHT_WEIGHTED), not the plain L2 of D: the lobes alone (the exact sum with D replaced by them)
-    come closer to the truth over the sphere's whole visible half.  Measured relative RMSE, light-weighted
-    against plane L2: 0.220 / 0.272, 0.117 / 0.144, 0.157 / 0.197 (ratios 0.81, 0.81, 0.80)."""
+    """Anisotropic GGX's table is fitted to the error an environment shows (ndf_fit.LIGHT_WEIGHTED), not the plain
+    L2 of D: the lobes alone (the exact sum with D replaced by them) come closer to the truth over the sphere's
+    whole visible half.  Measured relative RMSE, light-weighted against plane L2: 0.149 / 0.283, 0.103 / 0.148,
+    0.104 / 0.168 (ratios 0.53, 0.70, 0.62)."""
     from sg_prt_addon.reflectance import ndf_fit
 
     image, _ = sky
@@ -104,4 +104,4 @@ def test_light_weighted_table_beats_plane_l2_under_an_environment(sky, alphas, l
         return np.sqrt(np.mean((ours - reference) ** 2)) / np.mean(reference)
 
     weighted, plane = lobes_alone(ndf_fit.LIGHT_WEIGHTED), lobes_alone(ndf_fit.PLANE_L2)
-    assert weighted < 0.85 * plane, (weighted, plane)
+    assert weighted < 0.75 * plane, (weighted, plane)
