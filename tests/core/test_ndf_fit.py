@@ -151,8 +151,8 @@ def test_ggx_anisotropic_lobes_broad_and_near_isotropy(alphas, lobe_count, bound
 
 def test_ggx_anisotropy_table_interpolates_smoothly():
     """Between any two neighbouring rows the interpolated lobes are nearly as close to GGX as the rows
-    themselves: the relative L2 of D at the midpoint ratio at most 1.25x the worse of the two rows' (alpha_x
-    0.2, 4 lobes, every row pair)."""
+    themselves: the relative L2 of D at the midpoint ratio at most 1.12x the worse of the two rows' (alpha_x
+    0.2, 4 lobes, every row pair; measured 1.07x, and 1.26x with half the rows)."""
     model_error = {}
     _, ratios, _ = ndf_fit.ggx_anisotropy_table(4)
     alpha_x = 0.2
@@ -166,7 +166,7 @@ def test_ggx_anisotropy_table_interpolates_smoothly():
                 model_error[ratio] = ndf_fit.ndf_l2_error(model, lobes, 8, 64)
             errors.append(model_error[ratio])
         worst = max(worst, errors[1] / max(errors[0], errors[2]))
-    assert worst < 1.25, worst
+    assert worst < 1.12, worst
 
 
 def test_anisotropic_table_errors_fall_with_lobe_count():
