@@ -336,15 +336,18 @@ def ggx_two_lobe_table():
     return GGX_TABLE_ALPHAS, table
 
 
+def _ggx_two_lobe_entry(alpha):
+    """ggx_two_lobe_table's entry (..., 2, 2) at any (array) alpha, linear in log alpha, in float64."""
+    alphas, table = ggx_two_lobe_table()
+    low, fraction = _interpolation(np.clip(alpha, alphas[0], alphas[-1]), alphas)
+    return (1 - fraction) * table[low] + fraction * table[low + 1]
+
+
 def ggx_two_lobes(alpha):
     """Two SG lobes around z+ for GGX of any (array) alpha, by linear interpolation in log alpha."""
-    alphas, table = ggx_two_lobe_table()
     alpha = np.asarray(alpha)
     dtype = np.result_type(alpha, np.float32)
-    position = np.interp(np.log(np.clip(alpha, alphas[0], alphas[-1])), np.log(alphas), np.arange(len(alphas)))
-    low = np.clip(np.floor(position).astype(int), 0, len(alphas) - 2)
-    fraction = (position - low)[..., None, None]
-    entry = (1 - fraction) * table[low] + fraction * table[low + 1]
+    entry = _ggx_two_lobe_entry(alpha)
     alpha = alpha.astype(dtype)
     sharpness = (entry[..., 0] / (alpha * alpha)[..., None]).astype(dtype)
     amplitude = (entry[..., 1] / (np.pi * alpha * alpha)[..., None]).astype(dtype)
@@ -730,10 +733,7 @@ def ggx_composed_target(ratio, alpha):
     (the long axis), s_c = sharpness_c alpha^2 and a_c = amplitude_c / D(n).  Isotropic (r = 1), a row that
     holds these two lobes is GGX's sphere fit at any alpha; the plain small-angle GGX 1/(1 + x^2 + y^2/r^2)^2
     would lose that for broad lobes (alpha = 0.6: relative L2 of D 0.02 -> 0.36)."""
-    alphas, table = ggx_two_lobe_table()
-    position = np.interp(np.log(np.clip(alpha, alphas[0], alphas[-1])), np.log(alphas), np.arange(len(alphas)))
-    low = min(int(position), len(alphas) - 2)
-    entry = (low + 1 - position) * table[low] + (position - low) * table[low + 1]
+    entry = _ggx_two_lobe_entry(np.float64(alpha))
     half_sharpness = 0.5 * entry[:, 0]
     return entry[:, 1], half_sharpness, half_sharpness / (ratio * ratio)
 

@@ -40,9 +40,8 @@ def anisotropy_table_weighting(key):
 
 def anisotropy_table_texture(key):
     """The (rows, K, 4) float32 texture of the variant's anisotropy table: texel (k, row)."""
-    if uses_ggx_anisotropy_table(key):
-        return ndf_fit.ggx_anisotropy_table_array(key.ndf_lobes, ndf_fit.LIGHT_WEIGHTED)
-    return ndf_fit.anisotropy_table_array(key.ndf_lobes, ndf_fit.PLANE_L2)
+    build = ndf_fit.ggx_anisotropy_table_array if uses_ggx_anisotropy_table(key) else ndf_fit.anisotropy_table_array
+    return build(key.ndf_lobes, anisotropy_table_weighting(key))
 
 
 def uses_albedo_table(key):

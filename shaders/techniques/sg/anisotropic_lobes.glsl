@@ -29,12 +29,20 @@ void lobe_of_entry(vec4 entry, bool long_is_x, float long_width, float peak,
   amplitude = entry.w * peak;
 }
 
+/* Short / long width (<= 1), which axis is the long one and its width. */
+float anisotropy_ratio(float width_x, float width_y, out bool long_is_x, out float long_width)
+{
+  long_is_x = width_x >= width_y;
+  long_width = max(long_is_x ? width_x : width_y, 1.0e-12);
+  return min((long_is_x ? width_y : width_x) / long_width, 1.0);
+}
+
 void anisotropic_lobes(sampler2D table, float width_x, float width_y, float peak, int k,
                        out vec3 axis, out float sharpness, out float amplitude)
 {
-  bool long_is_x = width_x >= width_y;
-  float long_width = max(long_is_x ? width_x : width_y, 1.0e-12);
-  float ratio = min((long_is_x ? width_y : width_x) / long_width, 1.0);
+  bool long_is_x;
+  float long_width;
+  float ratio = anisotropy_ratio(width_x, width_y, long_is_x, long_width);
   vec4 entry = anisotropy_entry(table, 0, textureSize(table, 0).y, ratio, k);
   lobe_of_entry(entry, long_is_x, long_width, peak, axis, sharpness, amplitude);
 }
@@ -46,9 +54,9 @@ void ggx_anisotropic_lobes(sampler2D table, float alpha_x, float alpha_y, int k,
   alpha_x = max(alpha_x, 1.0e-6);   /* D(n) = 1 / (pi ax ay) stays finite */
   alpha_y = max(alpha_y, 1.0e-6);
   int rows = textureSize(table, 0).y / GGX_ANISOTROPY_ALPHAS;
-  bool long_is_x = alpha_x >= alpha_y;
-  float long_width = max(long_is_x ? alpha_x : alpha_y, 1.0e-12);
-  float ratio = min((long_is_x ? alpha_y : alpha_x) / long_width, 1.0);
+  bool long_is_x;
+  float long_width;
+  float ratio = anisotropy_ratio(alpha_x, alpha_y, long_is_x, long_width);
   float position = clamp((log(sqrt(alpha_x * alpha_y)) - GGX_ANISOTROPY_LOG_ALPHA_MIN)
                          / (GGX_ANISOTROPY_LOG_ALPHA_MAX - GGX_ANISOTROPY_LOG_ALPHA_MIN)
                          * float(GGX_ANISOTROPY_ALPHAS - 1), 0.0, float(GGX_ANISOTROPY_ALPHAS - 1));
