@@ -146,7 +146,7 @@ def section(sizes, rows, errors):
     intro = (f"`.venv/bin/python -m benchmarks.bake_speed {' '.join(map(str, sizes))} --update-doc` "
              f"({time.strftime('%Y-%m-%d')}; written by the benchmark): an icosphere over a floor grid, every vertex "
              "baked, the whole scene occludes, operator defaults (resolution 32, refinement 5, PCA error target "
-             "0.02 rad), its triangles passed as the operator passes them (64 probe rays a vertex for buried points, "
+             f"{BakeOptions().error_target} rad), its triangles passed as the operator passes them (64 probe rays a vertex for buried points, "
              "visibility.buried: none here).  Raw rate: RayTracer.occluded on 2M random hemisphere rays from the same vertices, both "
              "cores, in the same run.  SSDF error: the bake's decompressed SSDF at 64 vertices against the SSDF of "
              "a dense 160 x 160 ray grid there.  Casting: Embree's rate inside the bake (its rays over the "

@@ -933,7 +933,8 @@ class SceneRun:
         if not self.methods & {"SG-PRT", "SG-PRT 2x2", "Cycles equal time"}:
             return
         start = time.perf_counter()
-        result = bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL")
+        options = {} if self.config.get("error_target") is None else {"error_target": self.config["error_target"]}
+        result = bpy.ops.sgprt.bake_visibility("EXEC_DEFAULT", target="ALL", **options)
         bake_seconds = time.perf_counter() - start
         if result != {"FINISHED"}:
             raise RuntimeError(f"the visibility bake did not finish: {result}")
@@ -946,7 +947,8 @@ class SceneRun:
                     raise RuntimeError(f"{obj.name}: no usable bake after baking ({bake and bake.message})")
                 terms[obj.name] = int(bake.terms)
         resolution = self.scene.sgprt_bake.resolution
-        self.info.update(bake_seconds=bake_seconds, bake_resolution=resolution, bake_terms=terms)
+        self.info.update(bake_seconds=bake_seconds, bake_resolution=resolution, bake_terms=terms,
+                         bake_error_target=round(self.scene.sgprt_bake.error_target, 6))
         self.log(f"  bake: {bake_seconds:.1f} s at resolution {resolution}, terms {terms}")
         settings = self.scene.sgprt
         seconds, image, warm = self.engine_render()
@@ -1130,6 +1132,8 @@ def main(argv=None):
                         + ", ".join(SCENES))
     parser.add_argument("--quick", action="store_true",
                         help="size 64, Cycles 32 spp, EEVEE 1 and 16 only (writes under out/)")
+    parser.add_argument("--error-target", type=float, default=None,
+                        help="the visibility bake's PCA error target, radians (default: the operator's)")
     parser.add_argument("--json", default=None, help=f"output JSON (default {JSON_PATH.relative_to(ROOT)}; "
                         f"--quick: {QUICK_JSON_PATH.relative_to(ROOT)})")
     parser.add_argument("--markdown", action="store_true", help="print the ACCURACY.md section from the JSON")
@@ -1166,6 +1170,7 @@ def main(argv=None):
         config["size"] = args.size
     if args.cycles_samples:
         config["cycles_samples"] = args.cycles_samples
+    config["error_target"] = args.error_target
     started = time.perf_counter()
     load_start = round(os.getloadavg()[0], 2)
 

@@ -78,7 +78,7 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from ..visibility import decode, per_vertex
+from ..visibility import decode, pca, per_vertex
 from ..visibility.per_vertex import MAX_ROWS, MAX_TERMS
 from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
 from . import export, modifier_stack, occluders, per_vertex_store
@@ -473,7 +473,7 @@ def _option_properties():
                                            "and occluded rays"),
         term_mode=EnumProperty(name="Terms", items=TERM_MODES, default="ERROR_TARGET",
                                description="How many PCA terms to keep"),
-        error_target=FloatProperty(name="Error Target", default=0.02, min=0.001, max=0.5, subtype="ANGLE",
+        error_target=FloatProperty(name="Error Target", default=pca.DEFAULT_ERROR_TARGET, min=0.001, max=0.5, subtype="ANGLE",
                                    description="RMS angular error of the compressed SSDFs"),
         terms=IntProperty(name="Fixed Terms", default=24, min=0, max=MAX_TERMS,
                           description="PCA terms when the number is fixed"),

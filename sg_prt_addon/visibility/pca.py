@@ -14,6 +14,10 @@ import numpy as np
 CHUNK_ROWS = 4096
 # Full eigendecomposition (LAPACK syevd, faster here than the subset driver) up to 48 x 48 texels.
 FULL_EIGH_MAX_DIMS = 2304
+# The bake's default RMS angular error target, radians.  0.015 rather than the 0.02 it was: against Cycles
+# the sharp glossy scenes lose a fifth of their error with the terms it keeps (docs/ACCURACY.md, ssdf), and
+# a subdivided Suzanne or a torus takes every term (MAX_TERMS) while simple meshes still stop early.
+DEFAULT_ERROR_TARGET = 0.015
 
 
 class PcaModel(NamedTuple):
@@ -36,7 +40,7 @@ def _chunks(count):
     return (slice(start, min(start + CHUNK_ROWS, count)) for start in range(0, count, CHUNK_ROWS))
 
 
-def fit(samples, terms=None, error_target=0.02, max_terms=48):
+def fit(samples, terms=None, error_target=DEFAULT_ERROR_TARGET, max_terms=48):
     """PCA of ``samples`` (V, D) (any float dtype, e.g. float16) -> PcaModel.
 
     terms: fixed number of terms; None chooses the fewest terms whose RMS error

@@ -26,7 +26,7 @@ class BakeOptions:
     resolution: int = 32            # stored SSDF samples per side = coarse rays per side
     refinement: int = 5             # odd supersampling factor of mixed coarse cells (fine grid 160 x 160)
     terms: Optional[int] = None     # PCA terms; None: the fewest reaching error_target
-    error_target: float = 0.02      # RMS angular error of the PCA, radians (used when terms is None)
+    error_target: float = pca.DEFAULT_ERROR_TARGET  # RMS angular error of the PCA, radians (when terms is None)
     max_terms: int = MAX_TERMS      # wang2009 uses 48; these and the mean fill MAX_ROWS vec4 (pack_coefficients)
     batch_vertices: int = 256       # vertices traced per RayTracer call (amortizes Python overhead)
     threads: int = 2
