@@ -19,7 +19,7 @@ from bpy.props import (
 from .. import techniques
 from ..lighting import shadow_maps
 from ..lighting.lights import AREA_PATCHES_PER_SIDE
-from ..reflectance import models
+from ..reflectance import models, ndf_fit
 
 # How each NDF lobe is warped to the view slice: spherical.warp's modes, upper case (figures from its docstring).
 SH_WINDOWS = (("NONE", "None", "The bands as projected (sharpest; rings around small bright lights)"),
@@ -231,7 +231,8 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                       description="Ashikhmin-Shirley exponent along the tangent")
     nv: FloatProperty(update=_tag_changed, name="Nv", default=1000.0, min=1.0, max=1e5,
                       description="Ashikhmin-Shirley exponent along the bitangent")
-    lobe_count: IntProperty(update=_tag_changed, name="Lobes", default=4, min=1, max=8,
+    lobe_count: IntProperty(update=_tag_changed, name="Lobes", default=ndf_fit.DEFAULT_LOBES, min=1,
+                            max=ndf_fit.MAX_LOBES,
                             description="Spherical Gaussian lobes fitted to an anisotropic NDF")
 
     diffuse_color_texture: _texture("diffuse_color")
