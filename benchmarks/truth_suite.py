@@ -85,7 +85,8 @@ from benchmarks.error_vs_time import _number, _signed  # noqa: E402  (the same c
 
 JSON_PATH = ROOT / "docs" / "truth_suite.json"
 QUICK_JSON_PATH = ROOT / "out" / "truth_suite_quick.json"
-BEFORE_JSON_PATH = ROOT / "docs" / "truth_suite_before.json"     # {"description": ..., "rows": [...]}
+# {"description": ..., "rows": [...], "cycles_samples": the truth's, optional}
+BEFORE_JSON_PATH = ROOT / "docs" / "truth_suite_before.json"
 DOC_PATH = ROOT / "docs" / "ACCURACY.md"
 PNG_DIR = ROOT / "out" / "truth"
 SECTION_TITLE = "## Truth suite (against Cycles)"
@@ -274,19 +275,27 @@ def error_budget_table(rows, scenes):
     """One line per scene of what SG-PRT's error is made of: the shading alone (the unshadowed engine against
     Cycles without visibility) and the rest, visibility's share in quadrature (the two are far from
     independent, so it is a guide, not a split)."""
-    lines = ["| scene | kind | SG-PRT RMSE | shading alone: RMSE / bias | visibility's share | "
-             "unshadowed truth's noise floor |", "|---|---|---|---|---|---|"]
+    lines = ["| scene | kind | SG-PRT RMSE / less the truth's noise | shading alone: RMSE / bias | "
+             "visibility's share | unshadowed truth's noise floor |", "|---|---|---|---|---|---|"]
     for name, info in scenes.items():
         engine = find_row(rows, name, "SG-PRT") or {}
         unshadowed = find_row(rows, name, "SG-PRT unshadowed") or {}
         truth = find_row(rows, name, "Cycles unshadowed") or {}
         total, shading = engine.get("relative_rmse"), unshadowed.get("shading_relative_rmse")
-        share = None if total is None or shading is None else math.sqrt(max(total * total - shading * shading, 0.0))
+        share = None if total is None or shading is None else quadrature_difference(total, shading)
+        floor = engine.get("noise_floor")
+        own = None if total is None or floor is None else quadrature_difference(total, floor)
         kind = kind_label(info)
-        lines.append(f"| {name} | {kind} | {_number(total)} | {_number(shading)} / "
+        lines.append(f"| {name} | {kind} | {_number(total)} / {_number(own)} | {_number(shading)} / "
                      f"{_signed(unshadowed.get('shading_relative_bias'))} | {_number(share)} | "
                      f"{_number(truth.get('unshadowed_noise_floor'))} |")
     return "\n".join(lines)
+
+
+def quadrature_difference(total, part):
+    """sqrt(total^2 - part^2), 0 where part is the larger: what is left of an RMSE without an independent
+    part, such as the truth's own noise (their squares add)."""
+    return math.sqrt(max(total * total - part * part, 0.0))
 
 
 def goal_lines(checks):
@@ -330,7 +339,7 @@ def before_after_table(before_rows, after_rows, scenes):
 
 def markdown_section(data, before=None):
     """The "Truth suite (against Cycles)" section of docs/ACCURACY.md, from the JSON this module writes;
-    ``before``: (description, rows) of an earlier engine on the same scenes, shown beside."""
+    ``before``: (description, rows[, its truth's samples]) of an earlier run on the same scenes, shown beside."""
     machine = data["machine"]
     checks = [goal_check(data["rows"], name, info.get("kind"), info.get("roughness"))
               for name, info in data["scenes"].items()]
@@ -370,14 +379,18 @@ def markdown_section(data, before=None):
         "What SG-PRT's error is made of: the shading alone is the unshadowed engine (no bake, no shadow maps) "
         "against Cycles with every mesh seen by camera rays alone (no shadow, diffuse, glossy, transmission or "
         "volume rays: the truth without visibility, the same samples and seeds); visibility's share is "
-        "sqrt(RMSE^2 - shading^2), the rest:", "",
+        "sqrt(RMSE^2 - shading^2), the rest; less the truth's noise: sqrt(RMSE^2 - noise floor^2), the engine's "
+        "own error as far as the floor is the truth's noise (independent of the engine's, so their squares "
+        "add):", "",
         error_budget_table(data["rows"], data["scenes"]), "",
         f"Goals (relative RMSE < {GLOSSY_RMSE_GOAL:.2f} glossy of roughness >= {GLOSSY_MIN_ROUGHNESS:g}, "
         f"< {DIFFUSE_RMSE_GOAL:.2f} diffuse): {goal_summary(checks)}.", ""]
     lines += [f"- {line}" for line in goal_lines(checks)]
     if before is not None:
-        description, before_rows = before
-        lines += ["", f"SG-PRT before and after ({description}; the same scenes, size and truth samples):", "",
+        description, before_rows, *samples = before
+        same = ("the same scenes, size and truth samples" if not samples or samples[0] in (None, data.get("cycles_samples"))
+                else f"the same scenes and size; the truth at {samples[0]} spp a seed then, {data.get('cycles_samples')} now")
+        lines += ["", f"SG-PRT before and after ({description}; {same}):", "",
                   before_after_table(before_rows, data["rows"], list(data["scenes"]))]
     return "\n".join(lines) + "\n"
 
@@ -1151,7 +1164,7 @@ def main(argv=None):
         before = None
         if before_path.exists():
             recorded = json.loads(before_path.read_text())
-            before = (recorded["description"], recorded["rows"])
+            before = (recorded["description"], recorded["rows"], recorded.get("cycles_samples"))
         section = markdown_section(data, before)
         if args.update_doc:
             from benchmarks import markdown_sections

@@ -156,6 +156,15 @@ def test_markdown_section_and_its_replacement_in_accuracy_md():
     assert "old" not in middle and middle.index(ts.SECTION_TITLE) < middle.index("## warp")
 
 
+def test_before_sentence_names_a_change_of_truth_samples():
+    rows = _rows()
+    same = ts.markdown_section(_data(), ("4 lobes", rows, 32))
+    assert "SG-PRT before and after (4 lobes; the same scenes, size and truth samples):" in same
+    assert "(4 lobes; the same scenes, size and truth samples)" in ts.markdown_section(_data(), ("4 lobes", rows))
+    other = ts.markdown_section(_data(), ("the same engine", rows, 8))
+    assert "(the same engine; the same scenes and size; the truth at 8 spp a seed then, 32 now):" in other
+
+
 def test_tone_map_and_side_by_side():
     image = np.array([[[0.0, 0.5, 1.0], [2.0, -1.0, np.nan]]])
     mapped = ts.tone_map(image)
@@ -212,12 +221,14 @@ def test_before_after_table_lists_both_versions():
 
 
 def test_error_budget_splits_the_shading_from_the_rest():
-    rows = [ts.make_row("s", "SG-PRT", "bake", 0.1, relative_rmse=0.5),
+    rows = [ts.make_row("s", "SG-PRT", "bake", 0.1, relative_rmse=0.5, noise_floor=0.14),
             ts.make_row("s", "SG-PRT unshadowed", "no bake", 0.1, relative_rmse=0.9, shading_relative_rmse=0.3,
                         shading_relative_bias=-0.02),
             ts.make_row("s", "Cycles unshadowed", "truth", 1.0, unshadowed_noise_floor=0.01),
             ts.make_row("t", "SG-PRT", "bake", 0.1, relative_rmse=0.1)]          # no unshadowed truth
     table = ts.error_budget_table(rows, {"s": {"kind": "glossy", "roughness": 0.3}, "t": {"kind": "diffuse"}})
     lines = table.splitlines()
-    assert lines[2] == "| s | glossy 0.3 | 0.500 | 0.300 / -0.020 | 0.400 | 0.010 |"      # sqrt(0.5^2 - 0.3^2)
-    assert lines[3] == "| t | diffuse | 0.100 | - / - | - | - |"
+    # visibility's share sqrt(0.5^2 - 0.3^2); less the truth's noise sqrt(0.5^2 - 0.14^2)
+    assert lines[2] == "| s | glossy 0.3 | 0.500 / 0.480 | 0.300 / -0.020 | 0.400 | 0.010 |"
+    assert lines[3] == "| t | diffuse | 0.100 / - | - / - | - | - |"
+    assert ts.quadrature_difference(0.1, 0.2) == 0.0           # a floor above the RMSE leaves nothing, not NaN
