@@ -21,7 +21,7 @@ T L and the diffuse term is t . L (the paper's section 5 after Sloan 2002), the 
 compressed transfer's terms computed once per lighting per object (visibility.transfer.transferred_radiance)
 and weighed by the PCA weights: at the vertices, once per lighting (vertex_transfer_values), the pixels
 interpolating the sums, where the varyings hold them (vertex_transfer_rows: order 5 and below); else per
-pixel by the interpolated weights (up to 47 terms of N^2 + 1 fetches a pixel: 4-5x the unshadowed frame
+pixel by the interpolated weights (up to 63 terms of N^2 + 1 fetches a pixel: 4-5x the unshadowed frame
 at order 5, the vertices' sums about 1x; docs/PERFORMANCE.md).  A light's diffuse term is t . (its SH) and its
 glossy term is scaled by the same visible fraction of the light (t . L_light over the unshadowed
 clamped-cosine integral); the shading order is at most the transfer's.

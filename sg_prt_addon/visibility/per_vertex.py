@@ -13,9 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# vec4 rows a vertex of one kind: each becomes a varying of the surface shader (llvmpipe and the GL
-# minimum give 32 vec4; the surface uses 5 of its own and a pass's rows may follow: 12 leaves room)
-MAX_ROWS = 12
+# vec4 rows a vertex of one kind: each becomes a varying of the surface shader (llvmpipe and desktop GL
+# give 32 vec4; the surface uses 5 of its own and the diffuse pass's rows, at most 4, may follow: 25).
+# 16 rather than 12: a Suzanne's SSDF takes 63 terms at the bake's error target (visibility.pca).
+MAX_ROWS = 16
 # PCA terms of an SSDF bake that fit them: the rows hold [1, w_0, ..., w_{N-1}] (the mean's weight first)
 MAX_TERMS = 4 * MAX_ROWS - 1
 TEXTURE_WIDTH = 4096        # texels a row of a per-vertex texture (a multiple of its vec4 a vertex is used)
