@@ -35,16 +35,10 @@ def set_lobes(count):
 
 
 def measure_scene(name, size, rounds, lobe_counts):
-    import bpy
-
-    from benchmarks import truth_suite
+    from benchmarks import scene_benchmark
     from benchmarks.engine_vs_eevee import bake_all, steady_frame
 
-    bpy.ops.wm.read_homefile(use_empty=True)
-    truth_suite.SCENES[name].build(size)
-    scene = bpy.context.scene
-    scene.render.resolution_x = scene.render.resolution_y = size
-    scene.render.resolution_percentage = 100
+    scene = scene_benchmark.build(name, "truth_suite", size)
     scene.render.engine = "SG_PRT"
     bake_all(name)
     frames = {count: [] for count in lobe_counts}

@@ -37,19 +37,13 @@ def baked(name, error_target):
 
 
 def measure_scene(name, size, rounds, baseline_target):
-    import bpy
-
-    from benchmarks import truth_suite
+    from benchmarks import scene_benchmark
     from benchmarks.engine_vs_eevee import steady_frame
     from benchmarks.error_vs_time import SceneRun
     from sg_prt_addon.engine import scene_state
     from sg_prt_addon.visibility import pca
 
-    bpy.ops.wm.read_homefile(use_empty=True)
-    truth_suite.SCENES[name].build(size)
-    scene = bpy.context.scene
-    scene.render.resolution_x = scene.render.resolution_y = size
-    scene.render.resolution_percentage = 100
+    scene = scene_benchmark.build(name, "truth_suite", size)
     scene.render.engine = "SG_PRT"
     baseline_terms = {key: bake.terms for key, bake in baked(name, baseline_target).items()}
     full = baked(name, pca.DEFAULT_ERROR_TARGET)
