@@ -81,7 +81,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.error_vs_time import _number, _signed  # noqa: E402  (the same cell formats)
+from benchmarks.error_vs_time import _number, _signed, corrected_error  # noqa: E402  (the same cell formats)
 
 JSON_PATH = ROOT / "docs" / "truth_suite.json"
 QUICK_JSON_PATH = ROOT / "out" / "truth_suite_quick.json"
@@ -282,20 +282,14 @@ def error_budget_table(rows, scenes):
         unshadowed = find_row(rows, name, "SG-PRT unshadowed") or {}
         truth = find_row(rows, name, "Cycles unshadowed") or {}
         total, shading = engine.get("relative_rmse"), unshadowed.get("shading_relative_rmse")
-        share = None if total is None or shading is None else quadrature_difference(total, shading)
+        share = None if total is None or shading is None else math.sqrt(max(total * total - shading * shading, 0.0))
         floor = engine.get("noise_floor")
-        own = None if total is None or floor is None else quadrature_difference(total, floor)
+        own = None if floor is None else corrected_error(total, floor)
         kind = kind_label(info)
         lines.append(f"| {name} | {kind} | {_number(total)} / {_number(own)} | {_number(shading)} / "
                      f"{_signed(unshadowed.get('shading_relative_bias'))} | {_number(share)} | "
                      f"{_number(truth.get('unshadowed_noise_floor'))} |")
     return "\n".join(lines)
-
-
-def quadrature_difference(total, part):
-    """sqrt(total^2 - part^2), 0 where part is the larger: what is left of an RMSE without an independent
-    part, such as the truth's own noise (their squares add)."""
-    return math.sqrt(max(total * total - part * part, 0.0))
 
 
 def goal_lines(checks):
@@ -339,7 +333,8 @@ def before_after_table(before_rows, after_rows, scenes):
 
 def markdown_section(data, before=None):
     """The "Truth suite (against Cycles)" section of docs/ACCURACY.md, from the JSON this module writes;
-    ``before``: (description, rows[, its truth's samples]) of an earlier run on the same scenes, shown beside."""
+    ``before``: (description, rows, its truth's samples or None) of an earlier run on the same scenes, shown
+    beside."""
     machine = data["machine"]
     checks = [goal_check(data["rows"], name, info.get("kind"), info.get("roughness"))
               for name, info in data["scenes"].items()]
@@ -387,9 +382,10 @@ def markdown_section(data, before=None):
         f"< {DIFFUSE_RMSE_GOAL:.2f} diffuse): {goal_summary(checks)}.", ""]
     lines += [f"- {line}" for line in goal_lines(checks)]
     if before is not None:
-        description, before_rows, *samples = before
-        same = ("the same scenes, size and truth samples" if not samples or samples[0] in (None, data.get("cycles_samples"))
-                else f"the same scenes and size; the truth at {samples[0]} spp a seed then, {data.get('cycles_samples')} now")
+        description, before_rows, before_samples = before
+        same = ("the same scenes, size and truth samples" if before_samples in (None, data.get("cycles_samples"))
+                else f"the same scenes and size; the truth at {before_samples} spp a seed then, "
+                     f"{data.get('cycles_samples')} now")
         lines += ["", f"SG-PRT before and after ({description}; {same}):", "",
                   before_after_table(before_rows, data["rows"], list(data["scenes"]))]
     return "\n".join(lines) + "\n"

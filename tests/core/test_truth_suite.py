@@ -160,7 +160,7 @@ def test_before_sentence_names_a_change_of_truth_samples():
     rows = _rows()
     same = ts.markdown_section(_data(), ("4 lobes", rows, 32))
     assert "SG-PRT before and after (4 lobes; the same scenes, size and truth samples):" in same
-    assert "(4 lobes; the same scenes, size and truth samples)" in ts.markdown_section(_data(), ("4 lobes", rows))
+    assert "(4 lobes; the same scenes, size and truth samples)" in ts.markdown_section(_data(), ("4 lobes", rows, None))
     other = ts.markdown_section(_data(), ("the same engine", rows, 8))
     assert "(the same engine; the same scenes and size; the truth at 8 spp a seed then, 32 now):" in other
 
@@ -231,4 +231,4 @@ def test_error_budget_splits_the_shading_from_the_rest():
     # visibility's share sqrt(0.5^2 - 0.3^2); less the truth's noise sqrt(0.5^2 - 0.14^2)
     assert lines[2] == "| s | glossy 0.3 | 0.500 / 0.480 | 0.300 / -0.020 | 0.400 | 0.010 |"
     assert lines[3] == "| t | diffuse | 0.100 / - | - / - | - | - |"
-    assert ts.quadrature_difference(0.1, 0.2) == 0.0           # a floor above the RMSE leaves nothing, not NaN
+    assert ts.corrected_error(0.1, 0.2) == 0.0                 # a floor above the RMSE leaves nothing, not NaN
