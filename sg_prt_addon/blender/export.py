@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import techniques
 from ..biscale import effective_brdf
-from ..reflectance import layering, models, ndf_fit, principled
+from ..reflectance import layering, models, principled
 from ..techniques import (
     biscale_shading,
     factored,
@@ -120,7 +120,7 @@ class MaterialParams:
     alpha_y: float = 0.05
     nu: float = 100.0
     nv: float = 1000.0
-    lobe_count: int = ndf_fit.DEFAULT_LOBES
+    lobe_count: int = 0             # an anisotropic model's NDF lobes; 0: its default (models.lobes_of)
     warp_mode: str = "split3"      # spherical.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.view_warp)
     sh_order: int = 5              # the SH technique's order and window (harmonics.projection's names, or "none")
     sh_window: str = "none"

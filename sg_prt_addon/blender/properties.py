@@ -231,9 +231,9 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                       description="Ashikhmin-Shirley exponent along the tangent")
     nv: FloatProperty(update=_tag_changed, name="Nv", default=1000.0, min=1.0, max=1e5,
                       description="Ashikhmin-Shirley exponent along the bitangent")
-    lobe_count: IntProperty(update=_tag_changed, name="Lobes", default=ndf_fit.DEFAULT_LOBES, min=1,
-                            max=ndf_fit.MAX_LOBES,
-                            description="Spherical Gaussian lobes fitted to an anisotropic NDF")
+    lobe_count: IntProperty(update=_tag_changed, name="Lobes", default=0, min=0, max=ndf_fit.MAX_LOBES,
+                            description="Spherical Gaussian lobes fitted to an anisotropic NDF; 0 (Auto): the "
+                                        "model's own count, 6 for anisotropic GGX, 4 for Ward and Ashikhmin-Shirley")
 
     diffuse_color_texture: _texture("diffuse_color")
     specular_color_texture: _texture("specular_color")

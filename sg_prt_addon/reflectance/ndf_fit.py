@@ -55,10 +55,6 @@ HALF_PI = 0.5 * np.pi
 ANISOTROPY_RATIO_MIN = 1.0 / 64.0
 ANISOTROPY_RATIO_COUNT = 25
 MAX_LOBES = 8
-# Lobes of an anisotropic NDF unless a material says otherwise: in the truth suite's anisotropic GGX torus
-# (alpha 0.17 x 0.048) 4 / 6 / 8 lobes measured relative RMSE 0.132 / 0.107 / 0.105 against Cycles at
-# 1 / 1.21 / 1.46x the render() time; 6 is the knee.
-DEFAULT_LOBES = 6
 # What an anisotropy table's fit weighs, as (blur variance in the table's widths squared, weight) terms of
 # _plane_fit.  PLANE_L2: the L2 of D, what a point light's highlight shows.  LIGHT_WEIGHTED: mostly the error
 # blurred by a Gaussian of variance 0.25 alpha_x^2, what an environment's highlight shows (its power falls with

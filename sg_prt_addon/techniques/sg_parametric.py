@@ -74,7 +74,7 @@ class SGParametric(SGLobes):
 
     def variant_key(self, params, inputs):
         model = params.model
-        lobes = int(params.lobe_count) if model in models.ANISOTROPIC else 1
+        lobes = models.lobes_of(model, params.lobe_count)
         if model == "GGX":
             lobes = sg_shading.GGX_NDF_LOBES
         has_diffuse, has_specular = material_terms(params)

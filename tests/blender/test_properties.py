@@ -24,7 +24,7 @@ def test_defaults_are_a_plausible_glossy_material(empty_file):
     assert _value(settings, "diffuse_color") == pytest.approx((0.5, 0.5, 0.5))
     assert _value(settings, "specular_color") == pytest.approx((0.25, 0.25, 0.25))
     assert settings.roughness == pytest.approx(0.3)
-    assert 1 <= settings.lobe_count <= 8
+    assert settings.lobe_count == 0       # Auto: the model's own count (models.lobes_of)
     assert settings.view_warp == "SPLIT3"
     assert all(getattr(settings, f"{name}_texture") is None for name in properties.TEXTURED_PARAMETERS)
     assert settings.normal_map is None

@@ -49,3 +49,12 @@ def test_anisotropic_ggx_lobes_against_its_ndf():
     view = np.broadcast_to([0.3, 0.2, np.sqrt(0.87)], directions.shape)
     np.testing.assert_allclose(anisotropic.specular(view, directions), isotropic.specular(view, directions),
                                rtol=1e-9)
+
+
+def test_lobes_of_gives_an_anisotropic_model_its_default_where_the_material_says_auto():
+    assert models.lobes_of("GGX_ANISO", 0) == 6
+    assert models.lobes_of("ASHIKHMIN_SHIRLEY", 0) == models.lobes_of("WARD_ANISO", 0) == 4
+    assert models.lobes_of("ASHIKHMIN_SHIRLEY", 7) == models.lobes_of("GGX_ANISO", 7) == 7
+    # isotropic models (and names outside the table, as the fitted model's) have one NDF lobe whatever Lobes says
+    assert models.lobes_of("GGX", 5) == models.lobes_of("COOK_TORRANCE", 0) == models.lobes_of("FITTED", 3) == 1
+    assert all(model.default_lobes >= 2 for model in models.MODELS if model.anisotropic)
