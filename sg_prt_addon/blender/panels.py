@@ -49,6 +49,8 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
         for name in ("diffuse_color", "specular_color") + models.BY_NAME[settings.model].panel_parameters:
             row = layout.row(align=True)
             row.prop(settings, name)
+            if name == "lobe_count" and settings.lobe_count == 0:
+                row.label(text=f"Auto: {models.lobes_of(settings.model, 0)}")
             if textured and hasattr(settings, f"{name}_texture"):
                 row.template_ID(settings, f"{name}_texture", open="image.open")
         for name in ("fresnel", "multiscatter", "layered_diffuse", "emission_color", "emission_strength"):

@@ -29,7 +29,7 @@ MODELS = (
     Model("WARD_ISO", "Ward Isotropic", "Isotropic Ward", ("alpha_x",)),
     # Lobes by default (Auto): the anisotropy table's models 4, anisotropic GGX's own table 6.  Against Cycles (the
     # truth suite's tori, docs/ACCURACY.md): anisotropic GGX (alpha 0.17 x 0.048) relative RMSE 0.132 / 0.107 /
-    # 0.105 at 4 / 6 / 8 lobes for 1 / 1.21 / 1.46x the frame, 6 the knee; Ashikhmin-Shirley (nu 50, nv 800)
+    # 0.105 at 4 / 6 / 8 lobes for 1 / 1.21 / 1.46x the render() time, 6 the knee; Ashikhmin-Shirley (nu 50, nv 800)
     # 0.0502 at 4 and 0.0500 at 6, which cost 1.32x the frame (Ward, the same table, is not scored against Cycles)
     Model("WARD_ANISO", "Ward Anisotropic", "Anisotropic Ward, fitted with several SG lobes", ("alpha_x", "alpha_y"),
           anisotropic=True, default_lobes=4),

@@ -2,6 +2,7 @@
 import bpy
 import numpy as np
 import pytest
+import recording_layout
 
 from sg_prt_addon.blender import properties
 
@@ -109,3 +110,17 @@ def test_edits_from_python_reach_the_depsgraph(empty_file):
     finally:
         bpy.app.handlers.depsgraph_update_post.remove(record)
     assert "Tagged" in updated
+
+
+@pytest.mark.parametrize("model, auto", [("ASHIKHMIN_SHIRLEY", 4), ("WARD_ANISO", 4), ("GGX_ANISO", 6)])
+def test_the_panel_says_what_auto_lobes_are_and_only_at_auto(empty_file, model, auto):
+    from sg_prt_addon.blender import panels
+
+    material = bpy.data.materials.new(f"Lobes {model}")
+    material.sgprt.source = "SETTINGS"
+    material.sgprt.model = model
+    context = type("Context", (), {"material": material})()
+    assert ("label", f"Auto: {auto}") in recording_layout.draw(panels.SGPRT_PT_material, context)
+    material.sgprt.lobe_count = 5
+    calls = recording_layout.draw(panels.SGPRT_PT_material, context)
+    assert ("prop", "lobe_count") in calls and not any(kind == "label" and text.startswith("Auto") for kind, text in calls)
