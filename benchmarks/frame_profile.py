@@ -84,8 +84,7 @@ def edited(source, edits):
 @contextlib.contextmanager
 def fragment_edits(edits_of_run):
     """Within: the SG techniques' fragment sources go through `edited` with the edits the list `edits_of_run`
-    holds at the time (set it between renders; the shader cache's per-key hashes are dropped so each render
-    assembles its sources again)."""
+    holds at the time (set it between renders, then shader_cache.forget_assembled_sources)."""
     from sg_prt_addon.engine import shader_cache
     from sg_prt_addon.techniques import sg_lobes
 
@@ -116,7 +115,7 @@ def measure_scene(name, size, rounds, redraws):
 
     def frame(edits):
         current[:] = edits
-        shader_cache._content_hashes.clear()
+        shader_cache.forget_assembled_sources()
         steady_frame(2)                     # compile, JIT and first draw off the clock
         return steady_frame(redraws)
 

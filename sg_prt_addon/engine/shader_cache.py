@@ -185,6 +185,12 @@ def clear_cache():
     _content_hashes.clear()
 
 
+def forget_assembled_sources():
+    """Assemble each variant's sources again at its next get_shader (the compiled shaders stay, by content hash):
+    for a caller that changes what a technique assembles between renders (benchmarks/frame_profile.py)."""
+    _content_hashes.clear()
+
+
 # Shaders left in the cache when Python shuts down would be freed while the interpreter tears its modules
 # down, after Blender's GPU module may be gone (a crash at exit, measured with pip bpy 5.0): free them first.
 atexit.register(clear_cache)
