@@ -141,8 +141,8 @@ def table(results):
              "| (the grid off) | | | " + " | ".join(f"{results[name][2]:.4f} s" for name in names) + " |"]
     for part, what, edits in PARTS:
         against = "the grid off" if base_of(edits) else "the whole shader"
-        cells = [f"{results[name][0][part][0]:.2f} ({results[name][0][part][1]:.2f}-{results[name][0][part][2]:.2f})"
-                 for name in names]
+        cells = [f"{ratio:.2f} ({low:.2f}-{high:.2f})"
+                 for ratio, low, high in (results[name][0][part] for name in names)]
         lines.append(f"| {part} | {what} | {against} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 

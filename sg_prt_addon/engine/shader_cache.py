@@ -180,15 +180,15 @@ def _remember(key, shader):
         _cache.popitem(last=False)
 
 
-def clear_cache():
-    _cache.clear()
-    _content_hashes.clear()
-
-
 def forget_assembled_sources():
     """Assemble each variant's sources again at its next get_shader (the compiled shaders stay, by content hash):
     for a caller that changes what a technique assembles between renders (benchmarks/frame_profile.py)."""
     _content_hashes.clear()
+
+
+def clear_cache():
+    _cache.clear()
+    forget_assembled_sources()
 
 
 # Shaders left in the cache when Python shuts down would be freed while the interpreter tears its modules
