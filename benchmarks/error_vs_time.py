@@ -73,12 +73,17 @@ QUICK = dict(size=64, noise=0.06, max_reference_spp=32, reference_seconds=20, re
 
 # ----------------------------------------------------------------------------- pure logic (tested)
 
+def quadrature_difference(total, part):
+    """sqrt(total^2 - part^2), 0 where the part explains it all; None if either is None."""
+    if total is None or part is None:
+        return None
+    return math.sqrt(max(total * total - part * part, 0.0))
+
+
 def corrected_error(relative_rmse, noise_floor):
     """Relative RMSE with the reference's own noise removed in quadrature: E|x - r|^2 = |x - truth|^2 +
     noise^2 for an image x independent of the reference's noise r; 0 if the noise explains it all."""
-    if relative_rmse is None:
-        return None
-    return math.sqrt(max(relative_rmse * relative_rmse - noise_floor * noise_floor, 0.0))
+    return quadrature_difference(relative_rmse, noise_floor)
 
 
 def pareto_front(points):

@@ -81,7 +81,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.error_vs_time import _number, _signed, corrected_error  # noqa: E402  (the same cell formats)
+from benchmarks.error_vs_time import _number, _signed, corrected_error, quadrature_difference  # noqa: E402  (the same cell formats)
 
 JSON_PATH = ROOT / "docs" / "truth_suite.json"
 QUICK_JSON_PATH = ROOT / "out" / "truth_suite_quick.json"
@@ -282,9 +282,8 @@ def error_budget_table(rows, scenes):
         unshadowed = find_row(rows, name, "SG-PRT unshadowed") or {}
         truth = find_row(rows, name, "Cycles unshadowed") or {}
         total, shading = engine.get("relative_rmse"), unshadowed.get("shading_relative_rmse")
-        share = None if total is None or shading is None else math.sqrt(max(total * total - shading * shading, 0.0))
-        floor = engine.get("noise_floor")
-        own = None if floor is None else corrected_error(total, floor)
+        share = quadrature_difference(total, shading)
+        own = corrected_error(total, engine.get("noise_floor"))
         kind = kind_label(info)
         lines.append(f"| {name} | {kind} | {_number(total)} / {_number(own)} | {_number(shading)} / "
                      f"{_signed(unshadowed.get('shading_relative_bias'))} | {_number(share)} | "

@@ -12,6 +12,7 @@ def test_corrected_error_removes_the_noise_floor_in_quadrature():
     assert evt.corrected_error(0.02, 0.03) == 0.0          # the reference's noise explains it all
     assert evt.corrected_error(0.1, 0.0) == pytest.approx(0.1)
     assert evt.corrected_error(None, 0.03) is None
+    assert evt.quadrature_difference(0.05, None) is None     # a missing part: nothing to take out
 
 
 def test_pareto_front_keeps_the_points_nothing_beats():
