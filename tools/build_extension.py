@@ -25,7 +25,7 @@ import bpy
 ROOT = Path(__file__).resolve().parents[1]
 BUILD = ROOT / "build"
 REQUIREMENTS = ROOT / "requirements.txt"
-RUNTIME_PACKAGES = ("embreex", "scipy")
+RUNTIME_PACKAGES = ("embreex", "scipy", "threadpoolctl")
 # Blender 4.2-5.0 embed Python 3.11, Blender 5.1+ Python 3.13.
 PYTHON_VERSIONS = ("3.11", "3.13")
 # pip platform tag that each manifest platform's wheels carry.
@@ -57,7 +57,7 @@ def pinned_requirements():
 
 def download_wheels(target, platforms, python_versions):
     """One folder per (platform, Python) so exactly the wheels asked for are bundled."""
-    wheels = []
+    wheels = {}
     for platform in platforms:
         for python_version in python_versions:
             folder = target / f"{platform}-py{python_version}"
@@ -67,8 +67,9 @@ def download_wheels(target, platforms, python_versions):
                        "--python-version", python_version, "--dest", str(folder), *pinned_requirements()]
             print(f"build_extension: wheels for {platform}, Python {python_version}", flush=True)
             subprocess.run(command, check=True)
-            wheels += sorted(folder.glob("*.whl"))
-    return wheels
+            for wheel in sorted(folder.glob("*.whl")):
+                wheels.setdefault(wheel.name, wheel)    # a pure-Python wheel is in every folder: bundle it once
+    return list(wheels.values())
 
 
 def stage(stage_dir, wheels, platforms):

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Optional
 
 import numpy as np
+import threadpoolctl
 
 from . import binary_visibility, buried, hemisphere_map, pca, ssdf
 from .per_vertex import MAX_TERMS
@@ -71,6 +72,13 @@ def _report(progress, fraction, message):
         raise BakeCancelled(message)
 
 
+def one_blas_thread():
+    """Context: numpy's BLAS (and scipy's) on one thread.  The bake's own threads already fill the cores, and
+    the SSDF's products (``ssdf.signed_distance``) are too small for BLAS's threads to pay: on 2 cores they
+    took the second core from the other batch's rays, and the whole bake ran 1.3x slower."""
+    return threadpoolctl.threadpool_limits(limits=1, user_api="blas")
+
+
 def bake_ssdf(vertices, normals, tracer, options, progress=None, tangents=None):
     """Uncompressed SSDFs (V, R * R) float16 of vertices (rays only; no PCA).
 
@@ -94,14 +102,15 @@ def bake_ssdf(vertices, normals, tracer, options, progress=None, tangents=None):
     # cores idle between its steps.  Batches write disjoint rows, in any order; progress follows the first ones.
     parts = [slice(start, min(start + options.batch_vertices, count))
              for start in range(0, count, options.batch_vertices)]
-    pool = ThreadPoolExecutor(max(1, options.threads))
-    try:
-        futures = [pool.submit(bake_batch, part) for part in parts]
-        for part, future in zip(parts, futures):
-            future.result()
-            _report(progress, 0.9 * part.stop / max(count, 1), f"visibility {part.stop}/{count} vertices")
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)      # a cancel or an error: no batch keeps running
+    with one_blas_thread():
+        pool = ThreadPoolExecutor(max(1, options.threads))
+        try:
+            futures = [pool.submit(bake_batch, part) for part in parts]
+            for part, future in zip(parts, futures):
+                future.result()
+                _report(progress, 0.9 * part.stop / max(count, 1), f"visibility {part.stop}/{count} vertices")
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)      # a cancel or an error: no batch keeps running
     return out
 
 

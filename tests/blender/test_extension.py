@@ -42,15 +42,40 @@ print("RESULT " + json.dumps({"enabled": enabled, "max": max(pixels[0::4]), "siz
 """
 
 
-def test_extension_builds_validates_installs_and_renders(tmp_path):
+def _build_extension_module():
     sys.path.insert(0, str(ROOT / "tools"))
     try:
         import build_extension
     finally:
         sys.path.pop(0)
+    return build_extension
+
+
+def test_a_pure_python_wheel_is_bundled_once_for_every_platform_and_python(tmp_path, monkeypatch):
+    """download_wheels asks pip once a (platform, Python): a py3-none-any wheel lands in every folder."""
+    build_extension = _build_extension_module()
+
+    def pip_download(command, check):
+        folder = Path(command[command.index("--dest") + 1])
+        python = command[command.index("--python-version") + 1].replace(".", "")
+        (folder / f"scipy-1.0-cp{python}-{command[command.index('--platform') + 1]}.whl").touch()
+        (folder / "threadpoolctl-3.8.0-py3-none-any.whl").touch()
+
+    monkeypatch.setattr(build_extension.subprocess, "run", pip_download)
+    names = [wheel.name for wheel in build_extension.download_wheels(tmp_path, ["linux-x64", "windows-x64"],
+                                                                     ["3.11", "3.13"])]
+    assert len(names) == 5 and names.count("threadpoolctl-3.8.0-py3-none-any.whl") == 1, names
+
+
+def test_extension_builds_validates_installs_and_renders(tmp_path):
+    build_extension = _build_extension_module()
     [zip_path] = build_extension.build(local_only=True, output_dir=tmp_path / "dist")  # raises unless validated
     assert zip_path.name.endswith("-linux_x64.zip")             # one zip a platform
     _check_contents(zip_path)
+    with zipfile.ZipFile(zip_path) as archive:
+        wheels = [name.rsplit("/", 1)[-1] for name in archive.namelist() if name.endswith(".whl")]
+    for package in build_extension.RUNTIME_PACKAGES:        # one wheel each (a pure-Python one too, once)
+        assert len([wheel for wheel in wheels if wheel.startswith(package + "-")]) == 1, (package, wheels)
 
     environment = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
     environment.pop("PYTHONPATH", None)

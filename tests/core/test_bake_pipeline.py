@@ -1,6 +1,7 @@
 """sg_prt_addon.visibility: adaptive visibility vs the dense fine grid, the bake API, cancellation."""
 import numpy as np
 import pytest
+import threadpoolctl
 
 from benchmarks.bake_speed import grid, icosphere, sphere_over_floor
 from sg_prt_addon.visibility import (
@@ -97,6 +98,37 @@ def test_cancelled_bake_raises_and_returns_nothing(scene, cancel_at_call):
         bake_visibility(vertices, triangles, normals, vertices, triangles,
                         BakeOptions(resolution=8, refinement=3, batch_vertices=64), progress=progress)
     assert len(calls) == cancel_at_call
+
+
+def _blas_threads():
+    return {info["filepath"]: info["num_threads"] for info in threadpoolctl.threadpool_info()
+            if info["user_api"] == "blas"}
+
+
+def test_the_batches_run_blas_on_one_thread_and_the_bake_gives_its_threads_back(scene):
+    """The bake's own threads fill the cores; BLAS threads inside them only fight for them
+    (visibility.pipeline.one_blas_thread).  A cancel gives them back too."""
+    vertices, triangles, normals = scene
+    before = _blas_threads()
+    if max(before.values(), default=1) == 1:
+        pytest.skip("BLAS runs on one thread here already: nothing to limit")
+    during = []
+
+    def progress(fraction, message):
+        during.append(_blas_threads())
+        return len(during) == 7          # the first bake: 4 batches; cancel the second at its third
+
+    tracer = RayTracer(vertices, triangles, threads=1)
+    try:
+        bake_ssdf(vertices[:256], normals[:256], tracer, BakeOptions(resolution=8, refinement=3, batch_vertices=64),
+                  progress=progress)
+        with pytest.raises(BakeCancelled):
+            bake_ssdf(vertices[:256], normals[:256], tracer,
+                      BakeOptions(resolution=8, refinement=3, batch_vertices=64), progress=progress)
+    finally:
+        tracer.close()
+    assert len(during) == 7 and all(set(threads.values()) == {1} for threads in during)
+    assert _blas_threads() == before
 
 
 def test_bad_options_are_refused(scene):
