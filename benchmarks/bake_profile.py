@@ -87,13 +87,14 @@ def run(target_vertices):
             "load": os.getloadavg()[0]}
 
 
-def section(figures):
+def section(figures, requested):
     stages, count = figures["stages"], figures["vertices"]
     total = sum(stages.values())
     embree_share = stages["rays (Embree)"] / total
     speedup = figures["threads"][1] / figures["threads"][2]
-    intro = (f"`.venv/bin/python -m benchmarks.bake_profile {count} --update-doc` ({time.strftime('%Y-%m-%d')}; "
-             "written by the benchmark): bake_speed's scene, operator defaults, one thread, the pipeline's "
+    intro = (f"`.venv/bin/python -m benchmarks.bake_profile {requested} --update-doc` ({time.strftime('%Y-%m-%d')}; "
+             f"written by the benchmark): bake_speed's scene ({count:,} vertices), operator defaults, one thread, "
+             "the pipeline's "
              "batches; Embree's seconds read from the tracer, the rest of `adaptive_visibility` (directions, "
              "the horizon probe's edges, which fine texels to trace, the fine grid) is the refinement's "
              "bookkeeping, `ssdf_from_fine` the SSDF's distances.  Two threads: `bake_ssdf` whole on one "
@@ -108,8 +109,8 @@ def section(figures):
               f"{figures['embree_rate'] / 1e6:.2f} M rays/s on one thread, raw Embree "
               f"{figures['raw_rate'] / 1e6:.2f} M rays/s on two (random rays).  On one thread the bake's rate is "
               f"{embree_share:.0%} of its Embree rate; the second core makes `bake_ssdf` {speedup:.2f}x faster "
-              f"({figures['threads'][1]:.1f} s -> {figures['threads'][2]:.1f} s), where Embree alone would "
-              f"double.  Load average at the end {figures['load']:.1f}.", ""]
+              f"({figures['threads'][1]:.1f} s -> {figures['threads'][2]:.1f} s).  Load average at the end "
+              f"{figures['load']:.1f}.", ""]
     return "\n".join(lines)
 
 
@@ -117,7 +118,7 @@ def main(argv=None):
     arguments = sys.argv[1:] if argv is None else argv
     sizes = [int(a) for a in arguments if not a.startswith("--")] or [20000]
     figures = run(sizes[0])
-    text = section(figures)
+    text = section(figures, sizes[0])
     print(text)
     if "--update-doc" in arguments:
         from benchmarks import markdown_sections

@@ -27,7 +27,7 @@ def test_section_states_the_shares_and_the_second_cores_gain():
     figures = {"vertices": 1000, "rays_per_vertex": 2600.0, "raw_rate": 10e6, "embree_rate": 8e6, "load": 1.0,
                "stages": {"rays (Embree)": 0.4, "refinement bookkeeping": 0.3, "SSDF distances": 0.3, "PCA": 0.0},
                "threads": {1: 1.0, 2: 0.8}}
-    text = bake_profile.section(figures)
+    text = bake_profile.section(figures, 1000)
     assert "| rays (Embree) | 0.400 | 40% |" in text
     assert "| all | 1.000 | 100% |" in text
     assert "1.25x faster" in text and "40% of its Embree rate" in text
