@@ -11,12 +11,12 @@ The default commit is where session 27's bake changes began.
 """
 import argparse
 import json
-import statistics
 import subprocess
 import sys
 import tempfile
 
-from benchmarks.frame_against_commit import REPO_ROOT, export_tree
+from benchmarks.bake_speed import sphere_over_floor
+from benchmarks.frame_against_commit import REPO_ROOT, alternated, export_tree, ratio_table
 
 DEFAULT_COMMIT = "fef3bc1"
 
@@ -28,7 +28,7 @@ from benchmarks.bake_speed import sphere_over_floor
 from sg_prt_addon.visibility import BakeOptions, bake_visibility
 vertices, triangles, normals = sphere_over_floor(int(sys.argv[2]))
 result = bake_visibility(vertices, triangles, normals, vertices, triangles, BakeOptions(), point_triangles=triangles)
-print(json.dumps({"seconds": result.seconds, "vertices": len(vertices)}))
+print(json.dumps({"seconds": result.seconds}))
 """
 
 
@@ -38,7 +38,7 @@ def bake_seconds(tree, size):
                           cwd=tree)
     if done.returncode != 0:
         raise RuntimeError(f"the bake of {size} vertices on {tree} failed:\n{done.stderr[-2000:]}")
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    return json.loads(done.stdout.strip().splitlines()[-1])["seconds"]
 
 
 def measure(commit, sizes, rounds):
@@ -47,24 +47,11 @@ def measure(commit, sizes, rounds):
     with tempfile.TemporaryDirectory(prefix="sgprt-tree-") as folder:
         export_tree(commit, folder)
         for size in sizes:
-            before, now = [], []
-            for _ in range(rounds):
-                before.append(bake_seconds(folder, size)["seconds"])
-                baked = bake_seconds(REPO_ROOT, size)
-                now.append(baked["seconds"])
-                print(f"{baked['vertices']} vertices: {commit} {before[-1]:.1f} s, this tree {now[-1]:.1f} s",
-                      flush=True)
-            ratios = [b / a for a, b in zip(before, now)]
-            results[baked["vertices"]] = (statistics.median(before), statistics.median(now),
-                                          statistics.median(ratios), min(ratios), max(ratios))
+            vertices = f"{len(sphere_over_floor(size)[0]):,}"       # this tree's scene: both build the same one
+            results[vertices] = alternated(rounds, f"{vertices} vertices", commit,
+                                           lambda: bake_seconds(folder, size),
+                                           lambda: bake_seconds(REPO_ROOT, size), digits=1)
     return results
-
-
-def table(results, commit):
-    lines = [f"| vertices | bake {commit} | bake now | now / {commit} (range) |", "|---|---|---|---|"]
-    for vertices, (before, now, ratio, low, high) in results.items():
-        lines.append(f"| {vertices:,} | {before:.1f} s | {now:.1f} s | {ratio:.2f} ({low:.2f}-{high:.2f}) |")
-    return "\n".join(lines)
 
 
 def main(argv=None):
@@ -75,7 +62,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     results = measure(args.commit, args.sizes, args.rounds)
     print()
-    print(table(results, args.commit))
+    print(ratio_table(results, args.commit, "vertices", "bake", digits=1))
 
 
 if __name__ == "__main__":

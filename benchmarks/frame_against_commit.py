@@ -58,28 +58,40 @@ def export_tree(commit, folder):
     subprocess.run(["tar", "-x", "-C", folder], input=archive, check=True)
 
 
+def alternated(rounds, label, commit, commit_seconds, tree_seconds, digits):
+    """Runs commit_seconds() and tree_seconds() in turn, `rounds` times, printing each pair under `label`:
+    (commit's median, this tree's median, median of this tree's over the commit's, its low, its high)."""
+    before, now = [], []
+    for _ in range(rounds):
+        before.append(commit_seconds())
+        now.append(tree_seconds())
+        print(f"{label}: {commit} {before[-1]:.{digits}f} s, this tree {now[-1]:.{digits}f} s", flush=True)
+    ratios = [b / a for a, b in zip(before, now)]
+    return statistics.median(before), statistics.median(now), statistics.median(ratios), min(ratios), max(ratios)
+
+
+def ratio_table(results, commit, key_header, what, digits):
+    """Markdown table of ``alternated``'s results by key: `what` (the frame, the bake) on both trees."""
+    lines = [f"| {key_header} | {what} {commit} | {what} now | now / {commit} (range) |", "|---|---|---|---|"]
+    for key, (before, now, ratio, low, high) in results.items():
+        lines.append(f"| {key} | {before:.{digits}f} s | {now:.{digits}f} s | {ratio:.2f} ({low:.2f}-{high:.2f}) |")
+    return "\n".join(lines)
+
+
 def measure(commit, scenes, size, rounds, redraws):
     """{scene: (commit's frame, this tree's frame, ratio median, low, high)} (medians over the rounds)."""
     results = {}
     with tempfile.TemporaryDirectory(prefix="sgprt-tree-") as folder:
         export_tree(commit, folder)
         for scene in scenes:
-            before, now = [], []
-            for _ in range(rounds):
-                before.append(frame_seconds(folder, scene, size, redraws))
-                now.append(frame_seconds(REPO_ROOT, scene, size, redraws))
-                print(f"{scene}: {commit} {before[-1]:.4f} s, this tree {now[-1]:.4f} s", flush=True)
-            ratios = [b / a for a, b in zip(before, now)]
-            results[scene] = (statistics.median(before), statistics.median(now), statistics.median(ratios),
-                              min(ratios), max(ratios))
+            results[scene] = alternated(rounds, scene, commit,
+                                        lambda: frame_seconds(folder, scene, size, redraws),
+                                        lambda: frame_seconds(REPO_ROOT, scene, size, redraws), digits=4)
     return results
 
 
 def table(results, commit):
-    lines = [f"| scene | frame {commit} | frame now | now / {commit} (range) |", "|---|---|---|---|"]
-    for scene, (before, now, ratio, low, high) in results.items():
-        lines.append(f"| {scene} | {before:.3f} s | {now:.3f} s | {ratio:.2f} ({low:.2f}-{high:.2f}) |")
-    return "\n".join(lines)
+    return ratio_table(results, commit, "scene", "frame", digits=3)
 
 
 def main(argv=None):
