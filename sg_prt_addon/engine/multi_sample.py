@@ -15,10 +15,10 @@ PASSES = shader_sources.output_names(False)     # ("combined", "diffuse", "specu
 MAX_TILE_PIXELS = 2048      # side of a supersampled tile's targets (3 RGBA32F + depth: 208 MB at 2048)
 
 
-def tile_side(grid_side, width, height):
-    """Image pixels a side of Edges Only's tiles: their supersampled targets at most MAX_TILE_PIXELS a side, and
-    no larger than the image needs."""
-    return max(1, min(MAX_TILE_PIXELS // grid_side, max(width, height)))
+def tile_side(grid_side, width, height, max_side=MAX_TILE_PIXELS):
+    """Image pixels a side of Edges Only's tiles: their supersampled targets at most MAX_TILE_PIXELS and
+    max_side (the GPU's) a side, and no larger than the image needs."""
+    return max(1, min(min(MAX_TILE_PIXELS, max_side) // grid_side, max(width, height)))
 
 
 def _frame_samplers():

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..blender import export, properties
 from ..techniques.shader_sources import GBUFFER_OUTPUTS, MAX_POINT_LIGHTS, MAX_SUNS
-from . import anti_aliasing, multi_sample, scene_state
+from . import anti_aliasing, gpu_limits, multi_sample, scene_state
 from . import renderer as renderer_module
 from .shader_cache import ShaderCompileError
 
@@ -59,6 +59,13 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
                                    "and orthographic cameras only (switch its Type, or render it with Cycles)")
             last_render.clear()
             last_render["error"] = "panoramic camera"
+            return
+        side = gpu_limits.max_texture_size()
+        if max(width, height) > side:
+            self.report({"ERROR"}, f"SG-PRT: the render is {width} x {height} pixels, over this GPU's limit of "
+                                   f"{side} a side: lower the Resolution or its %")
+            last_render.clear()
+            last_render["error"] = "render size over the GPU's limit"
             return
         self.update_stats("", "SG-PRT: exporting the scene, drawing")
         try:
@@ -321,7 +328,7 @@ def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, t
     sums.start_at_edges(renderer, threshold, floor)
     edges = sums.read_mask()
     side = anti_aliasing.grid_side(samples)
-    tile = multi_sample.tile_side(side, width, height)
+    tile = multi_sample.tile_side(side, width, height, gpu_limits.max_texture_size())
     tiles = anti_aliasing.edge_tiles(edges, tile)
     drawn = 0
     for origin in tiles:
@@ -405,4 +412,6 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
         passes["after_frame"] = debug["after_frame"](depsgraph, state, renderer, camera)
     passes["camera"] = camera
     passes["material_ids"] = dict(renderer.material_ids)
+    # what the upload could not make within the GPU's limits, said with the export's warnings
+    state.warnings.extend(line for line in renderer.upload_warnings(state) if line not in state.warnings)
     return passes, state, timings

@@ -16,9 +16,8 @@ from ..lighting import shadow_maps
 from ..spherical import clamped_cosine
 from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
-from ..visibility.per_vertex import texture_of as per_vertex_texture  # the layout of every per-vertex texture
-from ..visibility.per_vertex import vertices_per_row
-from . import disk_cache, multi_sample, shader_cache, shadow_pass
+from ..visibility import per_vertex as per_vertex_layout  # the layout of every per-vertex texture
+from . import disk_cache, gpu_limits, multi_sample, scene_state, shader_cache, shadow_pass
 
 PASS_NAMES = ("Combined", "Diffuse", "Specular")
 
@@ -38,6 +37,19 @@ def _texture_2d(pixels):
     data = np.ascontiguousarray(pixels, np.float32)
     return gpu.types.GPUTexture((data.shape[1], data.shape[0]), format="RGBA32F",
                                 data=gpu.types.Buffer("FLOAT", data.size, data.ravel()))
+
+
+def within_side(pixels, side):
+    """(pixels, factor): an (H, W, C) image no larger than `side` a side, box-averaged by the smallest whole
+    factor that fits it (edge texels repeated to fill the last box); factor 1: the image as it is."""
+    height, width = pixels.shape[:2]
+    factor = -(-max(height, width) // side)
+    if factor <= 1:
+        return pixels, 1
+    rows, columns = -(-height // factor), -(-width // factor)
+    padded = np.pad(pixels, ((0, rows * factor - height), (0, columns * factor - width), (0, 0)), mode="edge")
+    boxes = padded.reshape(rows, factor, columns, factor, -1).mean(axis=(1, 3), dtype=np.float64)
+    return boxes.astype(np.float32), factor
 
 
 def _texture_2d_array(layers):
@@ -132,24 +144,18 @@ def material_block(params, material_id=0):
     ], np.float32)
 
 
-MAX_TEXTURE_SIZE = 16384            # GPUTexture side limit measured with llvmpipe (2D; 2048 array layers)
-
-
-def per_vertex_texture_shape(vertex_count, layers):
-    """(rows, texels a row) of the rows texture of vertex_count vertices."""
-    per_row = vertices_per_row(layers)
-    return max(1, -(-vertex_count // per_row)), per_row * layers
-
-
-def per_vertex_fits(mesh, data):
-    """Whether visibility.per_vertex data can be uploaded for a MeshExport: scene_state checked it when it was
-    read; checked again right before the upload, since texelFetch must never read past the rows uploaded."""
+def per_vertex_refusal(mesh, data, max_side):
+    """Why visibility.per_vertex data cannot be uploaded for a MeshExport, or None: scene_state checked the
+    counts when it read it; checked again right before the upload, since texelFetch must never read past the
+    rows uploaded, and against the GPU's texture side."""
     if mesh.corner_vertex is None or len(mesh.corner_vertex) != len(mesh.positions):
-        return False
+        return "stale bake: the mesh's corners changed"
     rows = data.corner_rows(mesh.corner_vertex)
     expected = len(mesh.positions) if data.domain == "CORNER" else mesh.vertex_count
-    return not (data.rows.shape[0] != expected or (len(rows) and int(rows.max()) >= data.rows.shape[0])
-                or per_vertex_texture_shape(data.rows.shape[0], data.layers)[0] > MAX_TEXTURE_SIZE)
+    if data.rows.shape[0] != expected or (len(rows) and int(rows.max()) >= data.rows.shape[0]):
+        return f"stale bake: {data.rows.shape[0]} rows for {expected}"
+    return per_vertex_layout.texture_refusal(data.rows.shape[0], max_side,
+                                             "corners" if data.domain == "CORNER" else "vertices")
 
 
 def row_normals(mesh, data):
@@ -162,14 +168,14 @@ class PerVertexBuffers:
     """GPU copy of one kind of per-vertex data (visibility.per_vertex.PerVertexData): its rows texture, the
     vertex normal texture in the same rows (one texel a vertex) and the basis texture."""
 
-    def __init__(self, mesh, data):
+    def __init__(self, mesh, data, per_row):
         self.data = data                # the numpy PerVertexData (base.ObjectInputs.per_vertex_data)
         self.layers = data.layers
-        self.vertices_per_row = vertices_per_row(data.layers)
-        self.rows_texture = _texture_2d(per_vertex_texture(data.rows, data.layers, self.vertices_per_row))
+        self.vertices_per_row = per_row  # every texture and target of the mesh's per-vertex layout
+        self.rows_texture = _texture_2d(per_vertex_layout.texture_of(data.rows, data.layers, per_row))
         normals = np.zeros((data.rows.shape[0], 4), np.float32)
         normals[:, :3] = row_normals(mesh, data)
-        self.normal_texture = _texture_2d(per_vertex_texture(normals, 1, self.vertices_per_row))
+        self.normal_texture = _texture_2d(per_vertex_layout.texture_of(normals, 1, per_row))
         self.basis_texture = _texture_2d_array(data.basis_texture)
 
 
@@ -183,16 +189,31 @@ class MeshBuffers:
 
         self.batches = []               # (material slot index, first triangle, GPUBatch)
         self.per_vertex = {}            # kind -> PerVertexBuffers
+        self.refused = {}               # kind -> why its per-vertex data was not uploaded (the render says so)
         self.bounds = None              # (2, 3) local box
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
         self.bounds = np.stack([mesh.positions.min(axis=0), mesh.positions.max(axis=0)])
-        usable = {kind: data for kind, data in (per_vertex or {}).items() if per_vertex_fits(mesh, data)}
+        max_side = gpu_limits.max_texture_size()
+        usable = {}
+        for kind, data in (per_vertex or {}).items():
+            reason = per_vertex_refusal(mesh, data, max_side)
+            if reason is None:
+                usable[kind] = data
+            else:
+                self.refused[kind] = reason
         if len({data.domain for data in usable.values()}) > 1:
             # the corners read every kind's rows by one index: the kinds must agree on vertices or corners
             # (scene_state warns of the kind left out); the visibility bake wins
             first = "ssdf" if "ssdf" in usable else next(iter(usable))
             usable = {kind: data for kind, data in usable.items() if data.domain == usable[first].domain}
+        per_row = per_vertex_layout.vertices_per_row(max_side)
+        for kind, data in usable.items():
+            try:
+                self.per_vertex[kind] = PerVertexBuffers(mesh, data, per_row)
+            except RuntimeError as error:       # the driver's own refusal (memory): the mesh drawn without them
+                self.refused[kind] = f"the GPU could not make its per-vertex textures ({error})"
+        usable = {kind: data for kind, data in usable.items() if kind in self.per_vertex}
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="normal", comp_type="F32", len=3, fetch_mode="FLOAT")
@@ -211,7 +232,6 @@ class MeshBuffers:
             rows = data.corner_rows(mesh.corner_vertex)
             vertices.attr_fill("vertex_index", np.ascontiguousarray(rows, np.int32))
             vertices.attr_fill("vertex_normal", np.ascontiguousarray(row_normals(mesh, data)[rows], np.float32))
-            self.per_vertex = {kind: PerVertexBuffers(mesh, data) for kind, data in usable.items()}
         for material_index, first, count in mesh.material_ranges:
             indices = gpu.types.GPUIndexBuf(type="TRIS", seq=mesh.triangles[first:first + count])
             self.batches.append((material_index, first, gpu.types.GPUBatch(type="TRIS", buf=vertices, elem=indices)))
@@ -245,7 +265,7 @@ def environment_textures(environment, equirect):
     # the map itself for the background, in Blender's row order (texture t = 0 at the bottom)
     rgba = np.ones(equirect.shape[:2] + (4,), np.float32)
     rgba[..., :3] = equirect[::-1]
-    entry = (environment, _texture_2d_array(padded), _texture_2d(rgba))
+    entry = (environment, _texture_2d_array(padded), _texture_2d(within_side(rgba, gpu_limits.max_texture_size())[0]))
     _environment_textures[id(environment)] = entry
     while len(_environment_textures) > ENVIRONMENT_TEXTURE_CACHE_SIZE:
         _environment_textures.popitem(last=False)        # freed here, in the caller's GPU context
@@ -361,6 +381,7 @@ class Renderer:
         self.material_buffers = {}      # material name -> GPUUniformBuf
         self.material_ids = {}          # material name -> id written to the G-buffer (uv.z)
         self.textures = {}              # (image name, slot is a colour) -> GPUTexture
+        self.texture_warnings = {}      # image name -> why it was uploaded smaller than it is
         self.tables = {}                # a technique's tables (DrawContext.table): name -> GPUTexture
         self.environment_tables = {}    # name -> (EnvironmentData, GPUTexture) (DrawContext.environment_table)
         self.material_tables = {}       # material name -> {name: GPUTexture} (DrawContext.material_table)
@@ -410,11 +431,18 @@ class Renderer:
             for slot, value in params.textures.items():
                 key = _texture_key(value, slot, params)
                 if key not in self.textures and all(name in bpy.data.images for name in texture_sources(value)):
-                    self.textures[key] = _texture_2d(slot_pixels(value, slot, decode=key[1]))
+                    self.textures[key] = self._image_texture(slot_pixels(value, slot, decode=key[1]),
+                                                             " x ".join(texture_sources(value)))
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)
             self.environment_source = state.environment
+            height, width = state.world.equirect.shape[:2]
+            if self.equirect_texture.width < width:
+                self.texture_warnings["world"] = (
+                    f"the world's map is {width} x {height}, over this GPU's limit of "
+                    f"{gpu_limits.max_texture_size()} texels a side: its background and reflections are drawn "
+                    f"from a {self.equirect_texture.width} x {self.equirect_texture.height} copy")
         light_data = state.light_data()
         self.shadow_plan = self._plan_shadows(state, light_data, shadow_camera or camera)
         block = scene_block(camera, light_data, state.environment, self.shadow_plan)
@@ -422,6 +450,28 @@ class Renderer:
             self.scene_buffer = _uniform_buffer(block)
         else:
             self.scene_buffer.update(gpu_buffer(block))
+
+    def _image_texture(self, pixels, name):
+        """The GPU texture of an image's pixels, made smaller where it passes the GPU's side (said once)."""
+        side = gpu_limits.max_texture_size()
+        fitted, factor = within_side(pixels, side)
+        if factor > 1:
+            self.texture_warnings[name] = (f"image '{name}' is {pixels.shape[1]} x {pixels.shape[0]}, over this "
+                                           f"GPU's limit of {side} texels a side: rendered at 1/{factor} of its size")
+        return _texture_2d(fitted)
+
+    def upload_warnings(self, state):
+        """The render report's lines for objects whose per-vertex data the upload refused (MeshBuffers.refused):
+        each object once a kind, naming why."""
+        lines, seen = [], set()
+        for entry in state.objects.values():
+            buffers = self.mesh_buffers.get(entry.mesh_key)
+            for kind, reason in (buffers.refused.items() if buffers is not None else ()):
+                if (entry.mesh_key, kind) not in seen:
+                    seen.add((entry.mesh_key, kind))
+                    lines.append(f"object '{entry.name.split('#')[0]}' renders without its "
+                                 f"{scene_state.BAKE_NAMES.get(kind, kind)}: {reason}")
+        return lines + list(self.texture_warnings.values())
 
     def _plan_shadows(self, state, light_data, camera):
         """The frame's lighting.shadow_maps.ShadowPlan over the uploaded objects (a sun's tile over what the camera
@@ -432,7 +482,7 @@ class Renderer:
         view = None
         if bounds is not None and len(light_data.sun_sharpness):
             view = shadow_maps.view_corners(camera.projection @ camera.view, bounds)
-        shadow_plan = shadow_maps.plan(light_data, bounds, state.shadow_map_size, view)
+        shadow_plan = shadow_maps.plan(light_data, bounds, state.shadow_map_size, view, gpu_limits.max_texture_size())
         return shadow_plan if shadow_plan.active else None
 
     # ----------------------------------------------------------------- targets

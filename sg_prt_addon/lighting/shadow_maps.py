@@ -25,7 +25,7 @@ import numpy as np
 FLOAT = np.float32
 MARGIN = 16                     # texels of guard band around each face
 MAX_SHADOW_MAPS = 8             # lights with a map: the shader's shadow slots (common/surface_common.glsl)
-MAX_SIDE = 16384                # GPUTexture side limit (llvmpipe's)
+MAX_SIDE = 16384                # the atlas' side where the GPU's limit is not given (llvmpipe's)
 MAX_TEXELS = 64 * 1024 * 1024   # 256 MB of DEPTH_COMPONENT32F
 DEFAULT_SIZE = 1024
 SEARCH_TAPS = 4                 # blocker search: SEARCH_TAPS^2 nearest texels over the search square
@@ -176,12 +176,12 @@ def _sun_extent(coordinate_of_bounds, coordinate_of_view):
     return low, high
 
 
-def plan(light_data, bounds, size=DEFAULT_SIZE, view=None):
+def plan(light_data, bounds, size=DEFAULT_SIZE, view=None, max_side=MAX_SIDE):
     """The ShadowPlan of lighting.scene_lighting.LightData for casters within world `bounds` ((2, 3) or None: no
     geometry, no maps); view: view_corners' frustum or None: a sun's tile covers only what of the box it may show
     (its casters are those above, within the box's depth).  Suns first, then point and spot lights in LightData's
     order (the brightest first), MAX_SHADOW_MAPS in all; area light patches and lights wider than MAX_LIGHT_ANGLE
-    get none.  The tile side is `size` unless the atlas would pass MAX_SIDE or MAX_TEXELS."""
+    get none.  The tile side is `size` unless the atlas would pass max_side (the GPU's) or MAX_TEXELS."""
     points, suns = len(light_data.point_radius), len(light_data.sun_sharpness)
     result = ShadowPlan(point_slot=np.full(points, -1, np.int32), point_first_tile=np.zeros(points, np.int32),
                         point_near_far=np.zeros((points, 2), FLOAT), sun_slot=np.full(suns, -1, np.int32),
@@ -209,7 +209,7 @@ def plan(light_data, bounds, size=DEFAULT_SIZE, view=None):
         return result
     columns = math.ceil(math.sqrt(tile_count))
     rows = math.ceil(tile_count / columns)
-    side = min(int(size), MAX_SIDE // max(columns, rows), int(math.sqrt(MAX_TEXELS / (columns * rows))))
+    side = min(int(size), int(max_side) // max(columns, rows), int(math.sqrt(MAX_TEXELS / (columns * rows))))
     side -= side % 4
     if side <= 2 * MARGIN:
         return result

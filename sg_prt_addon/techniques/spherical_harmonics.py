@@ -34,8 +34,7 @@ import numpy as np
 
 from ..harmonics import brdf_table, fitted_table, projection
 from ..reflectance import models
-from ..visibility import transfer
-from ..visibility.per_vertex import texture_of as per_vertex_texture
+from ..visibility import per_vertex, transfer
 from . import fitted_texels, sh_glsl, sh_shading, shader_sources, surface_layering
 from .base import Technique
 
@@ -166,7 +165,8 @@ def vertex_transfer_rows(order, has_lights):
     shader_sources.max_varyings() (order 6 and above on llvmpipe) or VERTEX_TRANSFER is off."""
     count = order * order
     rows = -(-(3 * (count + 1) + (count if has_lights else 0)) // 4)
-    fits = shader_sources.SURFACE_VARYINGS + rows <= shader_sources.max_varyings()
+    fits = (shader_sources.SURFACE_VARYINGS + rows <= shader_sources.max_varyings()
+            and rows <= per_vertex.TEXELS_PER_VERTEX_LIMIT)
     return rows if VERTEX_TRANSFER and fits else 0
 
 
@@ -291,14 +291,14 @@ class SphericalHarmonics(Technique):
         if key.fitted_lobes:
             sources.append(shader_sources.technique_source("common", "fitted_texels.glsl"))
         sources.append(sh_glsl.constants_source(key.order, key.window))
-        per_vertex = self.per_vertex_inputs(key)
-        if per_vertex:
-            sources.append(f"vec4 transfer_rows[{per_vertex[0].rows}];\n"
-                           + shader_sources.per_vertex_copy_source(per_vertex))
+        fetched = self.per_vertex_inputs(key)
+        if fetched:
+            sources.append(f"vec4 transfer_rows[{fetched[0].rows}];\n"
+                           + shader_sources.per_vertex_copy_source(fetched))
         sources += [shader_sources.technique_source(GLSL_DIR, name)
                     for name in ("sh_library.glsl", "sh_shading.glsl", "surface.frag.glsl")]
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
-                                            per_vertex, push_constants=(("VEC4", "sh_axis"),))
+                                            fetched, push_constants=(("VEC4", "sh_axis"),))
 
     def bind_reads_object(self, key):
         # the transfer bake's rows and radiance table (the mesh's); the environment's row is the scene's
@@ -330,11 +330,13 @@ class SphericalHarmonics(Technique):
 
         shader.uniform_sampler("sh_environment", context.environment_table("sh_environment", environment_row))
         if key.vertex_transfer:          # remade when the bake or the lighting changes, not a frame
-            data = context.per_vertex(TRANSFER_KIND).data
+            buffers = context.per_vertex(TRANSFER_KIND)
+            data = buffers.data
             shader.uniform_sampler("sh_vertex_transfer", context.object_table(
                 f"sh_vertex_transfer_{key.order}_{key.window}_{key.vertex_transfer}", (data, environment),
-                lambda: per_vertex_texture(vertex_transfer_values(data, environment, key.order, key.window,
-                                                                  key.vertex_transfer), key.vertex_transfer)))
+                lambda: per_vertex.texture_of(vertex_transfer_values(data, environment, key.order, key.window,
+                                                                     key.vertex_transfer), key.vertex_transfer,
+                                              buffers.vertices_per_row)))
         elif key.transfer_layers:
             buffers = context.per_vertex(TRANSFER_KIND)
             data = buffers.data

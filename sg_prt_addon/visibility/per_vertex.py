@@ -19,25 +19,41 @@ import numpy as np
 MAX_ROWS = 16
 # PCA terms of an SSDF bake that fit them: the rows hold [1, w_0, ..., w_{N-1}] (the mean's weight first)
 MAX_TERMS = 4 * MAX_ROWS - 1
-TEXTURE_WIDTH = 4096        # texels a row of a per-vertex texture (a multiple of its vec4 a vertex is used)
+# One layout for every per-vertex texture and target of a mesh: a vertex takes at most TEXELS_PER_VERTEX_LIMIT
+# vec4 texels of a row (a kind's rows, at most MAX_ROWS; a per-object pass's, 8 for the SSDF quadrature's
+# coverage; values summed at the vertices, no more than the 32 vec4 varyings of llvmpipe and desktop GL), so a
+# row of vertices_per_row(side) vertices fits a texture `side` texels wide whatever it holds.
+TEXELS_PER_VERTEX_LIMIT = 32
 
 
-def vertices_per_row(texels_per_vertex):
-    """Vertices a row of a per-vertex texture of `texels_per_vertex` vec4 a vertex."""
-    return max(1, TEXTURE_WIDTH // texels_per_vertex)
+def vertices_per_row(max_side):
+    """Vertices a row of a mesh's per-vertex textures, each at most `max_side` texels wide (the GPU's limit)."""
+    return max(1, int(max_side) // TEXELS_PER_VERTEX_LIMIT)
 
 
-def texture_of(values, texels_per_vertex, per_row=None):
+def rows_needed(count, per_row):
+    """Texture rows of `count` vertices at `per_row` vertices a row."""
+    return max(1, -(-int(count) // int(per_row)))
+
+
+def texture_of(values, texels_per_vertex, per_row):
     """(rows, per_row * texels_per_vertex, 4) float32 texture of per-vertex values (V, 4 * texels_per_vertex):
     vertex v's texel k at (column (v % per_row) * texels_per_vertex + k, row v // per_row)
-    (techniques/shader_sources.py per_vertex_fetch_source reads it back with texelFetch); per_row: default
-    vertices_per_row(texels_per_vertex)."""
-    per_row = per_row or vertices_per_row(texels_per_vertex)
+    (techniques/shader_sources.py per_vertex_fetch_source reads it back with texelFetch)."""
     count = values.shape[0]
-    rows = max(1, -(-count // per_row))
+    rows = rows_needed(count, per_row)
     out = np.zeros((rows * per_row, texels_per_vertex, 4), np.float32)
     out[:count] = np.asarray(values, np.float32).reshape(count, texels_per_vertex, 4)
     return out.reshape(rows, per_row * texels_per_vertex, 4)
+
+
+def texture_refusal(count, max_side, what="vertices"):
+    """Why `count` vertices' per-vertex textures cannot be made on a GPU of `max_side` texels a side, or None."""
+    rows = rows_needed(count, vertices_per_row(max_side))
+    if rows <= max_side:
+        return None
+    return (f"its {count:,} {what} need per-vertex textures of {rows:,} rows, over this GPU's limit of "
+            f"{max_side:,} texels a side (at most {vertices_per_row(max_side) * max_side:,})")
 
 
 @dataclass
