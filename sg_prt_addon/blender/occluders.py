@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..visibility import raytrace
 from . import export
 from .per_vertex_store import mesh_triangles
 
@@ -64,6 +65,18 @@ def occluder_arrays(depsgraph, geometry=None):
         return np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32)
     return (np.ascontiguousarray(np.concatenate(vertices), np.float32),
             np.ascontiguousarray(np.concatenate(triangles), np.int32))
+
+
+def untraceable(geometry):
+    """{object name: vertices (summed over its instances) that are NaN, Inf or beyond raytrace.COORDINATE_LIMIT in
+    world space} of scene_geometry's objects that have any: their triangles there cast no shadow."""
+    counts = {}
+    for name, occluder in geometry.items():
+        bad = sum(int(np.count_nonzero(~raytrace.traceable(
+            occluder.vertices.astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]))) for matrix in occluder.matrices)
+        if bad:
+            counts[name] = bad
+    return counts
 
 
 def fingerprints(geometry):

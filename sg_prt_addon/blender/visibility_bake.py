@@ -78,7 +78,7 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from ..visibility import decode, pca, per_vertex
+from ..visibility import decode, pca, per_vertex, raytrace
 from ..visibility.per_vertex import MAX_ROWS, MAX_TERMS
 from ..visibility.pipeline import BakeCancelled, BakeOptions, bake_visibility
 from . import export, modifier_stack, occluders, per_vertex_store
@@ -147,6 +147,10 @@ def receiver_arrays(obj, depsgraph):
     mesh = _evaluated_mesh(obj, depsgraph)
     matrix = _matrix(obj.evaluated_get(depsgraph).matrix_world)
     vertices = _vertex_array(mesh, "co")
+    bad = int(np.count_nonzero(~raytrace.traceable(_to_world(vertices, matrix))))
+    if bad:
+        raise ValueError(f"'{obj.name}': {bad} of its vertices are NaN, Inf or beyond "
+                         f"{raytrace.COORDINATE_LIMIT:.0e} m")
     normals = _vertex_array(mesh, "normal")
     corner_vertex = np.empty(len(mesh.loops), np.int64)
     mesh.loops.foreach_get("vertex_index", corner_vertex)
@@ -536,6 +540,9 @@ def bake_inputs(operator, context, objects, what):
             operator.report({"ERROR"}, f"SG-PRT {what}: none of the objects can be baked (see the warnings)")
             return None
         geometry = occluders.scene_geometry(depsgraph)
+        for name, bad in occluders.untraceable(geometry).items():
+            operator.report({"WARNING"}, f"SG-PRT {what}: '{name}' has {bad} vertices that are NaN, Inf or beyond "
+                                         f"{raytrace.COORDINATE_LIMIT:.0e} m: its faces there cast no shadow")
         occluder_vertices, occluder_triangles = occluder_arrays(depsgraph, geometry)
     return receivers, occluder_vertices, occluder_triangles, targets, occluders.fingerprints(geometry)
 

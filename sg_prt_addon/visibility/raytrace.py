@@ -20,6 +20,16 @@ from embreex.mesh_construction import TriangleMesh
 # embreex's "no limit" tfar; distances of missed rays are reported as inf.
 _EMBREE_FAR = np.float32(1e37)
 _CHUNK_RAYS = 1 << 16
+# Coordinates a bake traces: a vertex beyond them, NaN or Inf is bad input (one such vertex made the scene's
+# size, and so every ray's origin offset, NaN or huge, and every bake empty); its triangles are not traced.
+COORDINATE_LIMIT = 1e10
+
+
+def traceable(vertices):
+    """(V,) bool: which vertices (V, 3) are finite and within COORDINATE_LIMIT."""
+    vertices = np.asarray(vertices, np.float64).reshape(-1, 3)
+    with np.errstate(invalid="ignore"):
+        return np.all(np.abs(vertices) <= COORDINATE_LIMIT, axis=1)
 
 
 class RayHits(NamedTuple):
@@ -59,7 +69,15 @@ class RayTracer:
         self.triangles = np.ascontiguousarray(triangles, dtype=np.int32).reshape(-1, 3)
         if len(self.triangles) and (self.triangles.min() < 0 or self.triangles.max() >= len(self.vertices)):
             raise ValueError("triangle indices out of range")
-        extent = np.ptp(self.vertices, axis=0) if len(self.vertices) else np.zeros(3)
+        good = traceable(self.vertices)
+        if not good.all():
+            # a triangle of a bad vertex becomes a point (no area: never hit), so hits keep the callers' indices
+            bad = ~good[self.triangles].all(axis=1)
+            self.triangles = self.triangles.copy()
+            self.triangles[bad] = self.triangles[bad, :1]
+            self.vertices = np.where(good[:, None], self.vertices, np.float32(0.0))
+        used = self.vertices[good]
+        extent = np.ptp(used, axis=0) if len(used) else np.zeros(3)
         self.scene_size = float(max(np.linalg.norm(extent), 1e-6))
         # Origin offset: well above float32 rounding of scene coordinates
         # (~1e-7 of their magnitude), well below any feature we care about.

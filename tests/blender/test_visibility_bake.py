@@ -294,6 +294,38 @@ def test_bad_input_reports_instead_of_raising_tracebacks(scene, capfd):
     assert vb.load_visibility_bake(suzanne.data).usable and vb.load_visibility_bake(points.data) is None
 
 
+@pytest.mark.parametrize("bad_value", [float("nan"), float("inf"), 1e30])
+def test_a_bad_vertex_refuses_its_object_alone(scene, capfd, bad_value):
+    """One NaN, Inf or huge vertex in one object: that object is refused, named; every other object bakes as it
+    would without the bad vertex (its good faces still cast shadows)."""
+    _, floor, suzanne = scene
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(1.5, 1.5, 0.5))
+    broken = bpy.context.active_object
+    broken.name = "Broken"
+    broken.data.vertices[0].co = (bad_value, 0.0, 0.0)
+    _select(floor, suzanne, broken)
+    capfd.readouterr()
+    assert bpy.ops.sgprt.bake_visibility(target="SELECTED") == {"FINISHED"}
+    printed = "".join(capfd.readouterr())
+    assert "skips 'Broken': 1 of its vertices are NaN, Inf or beyond 1e+10 m" in printed, printed
+    assert "'Broken' has 1 vertices that are NaN, Inf or beyond 1e+10 m: its faces there cast no shadow" in printed
+    assert vb.load_visibility_bake(broken.data) is None
+    with_bad = {obj.name: vb.load_visibility_bake(obj.data) for obj in (floor, suzanne)}
+    assert all(bake.usable and bake.terms == SMALL["terms"] for bake in with_bad.values())
+    # the cube's five good faces (of six) still occlude: the floor under it is darker than without the cube
+    broken.data.vertices[0].co = (0.25, 0.25, 0.25)
+    bpy.data.objects.remove(broken)
+    _select(floor)
+    assert bpy.ops.sgprt.bake_visibility(target="SELECTED") == {"FINISHED"}
+    without = vb.load_visibility_bake(floor.data)
+    below = np.linalg.norm(np.array([v.co for v in floor.data.vertices])[:, :2] - 1.5, axis=1) < 0.3
+    assert below.any()
+
+    def mean_ssdf(bake):        # the SSDF (radians to the nearest boundary, negative where occluded) under the cube
+        return (bake.coefficients[below] @ bake.basis.reshape(bake.terms, -1) + bake.mean.ravel()).mean()
+    assert mean_ssdf(with_bad["Floor"]) < mean_ssdf(without) - 0.05
+
+
 def test_damaged_storage_is_invalid_not_out_of_bounds(scene):
     _, floor, suzanne = scene
     _select(suzanne)

@@ -33,6 +33,20 @@ def test_intersect_picks_nearest_of_two_triangles():
     np.testing.assert_allclose(hits.distance, [2.0, 3.0], atol=1e-6)
 
 
+@pytest.mark.parametrize("bad_value", [np.nan, np.inf, 1e30])
+def test_a_bad_vertex_drops_its_triangles_alone(bad_value):
+    """A NaN, Inf or huge vertex: its triangles are never hit, the others keep their indices and the scene's size
+    (the rays' origin offset) is the good vertices'."""
+    good = RayTracer(np.concatenate([TRIANGLE, TRIANGLE + [0, 0, 1.0]]), [[0, 1, 2], [3, 4, 5]])
+    vertices = np.concatenate([TRIANGLE, TRIANGLE + [0, 0, 1.0], [[bad_value, 0.0, 0.0]]])
+    tracer = RayTracer(vertices, [[6, 1, 2], [0, 1, 2], [3, 4, 5], [3, 6, 5]])
+    assert tracer.scene_size == good.scene_size and np.isfinite(tracer.offset)
+    hits = tracer.intersect([[0.2, 0.2, 3.0], [0.2, 0.2, -3.0], [0.05, 0.05, 0.5]], [[0, 0, -1.0], [0, 0, 1.0],
+                                                                                         [-1.0, 0.0, 0.0]])
+    assert hits.triangle.tolist() == [2, 1, -1]
+    np.testing.assert_allclose(hits.distance[:2], [2.0, 3.0], atol=1e-6)
+
+
 def test_occluded_respects_max_distance():
     tracer = RayTracer(TRIANGLE, [[0, 1, 2]])
     origins = np.array([[0.2, 0.2, 1.0]] * 3 + [[2.0, 2.0, 1.0]])
