@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import techniques
 from ..blender import export
 from ..lighting import lights as core_lights
 from ..lighting import shadow_maps
@@ -94,6 +95,7 @@ SSDF = "ssdf"
 TRANSFER = "transfer"
 PER_VERTEX_KINDS = {SSDF: (visibility_for, ssdf_data), TRANSFER: (transfer_for, transfer_data)}
 BAKE_NAMES = {SSDF: "visibility bake", TRANSFER: "transfer bake"}
+BAKE_BUTTONS = {SSDF: "Bake Visibility", TRANSFER: "Bake Transfer"}      # in Render Properties
 
 
 @dataclass
@@ -255,15 +257,27 @@ class SceneState:
 
     def unshadowed_warnings(self):
         """The render report's lines for objects that render unshadowed: one per object whose bake cannot
-        shade it (stale, unusable...) naming it and why; the objects with no bake at all in one line, when
-        the scene has bakes (a scene never baked renders unshadowed by design)."""
+        shade it (stale, unusable...) naming it and why, or whose materials' technique reads a kind of bake
+        (Technique.shadow_kind) it lacks while it has another; the objects with no bake at all in one line,
+        when the scene has bakes (a scene never baked renders unshadowed by design)."""
         lines, unbaked, seen = [], [], set()
         # both read once: each property builds a dict over every mesh (a read per object: quadratic)
         visibility, visibility_status = self.visibility, self.visibility_status
         for entry in self.objects.values():
-            if entry.mesh_key in seen or entry.mesh_key in visibility:
+            if entry.mesh_key in seen:
                 continue
             seen.add(entry.mesh_key)
+            kinds = self._shadow_kinds(entry)
+            found = self.per_vertex.get(entry.mesh_key, {})
+            missing = [kind for kind in kinds if kind not in found and found
+                       and self.per_vertex_status.get(entry.mesh_key, {}).get(kind) == f"no {BAKE_NAMES[kind]}"]
+            for kind in missing:        # baked, but not what this material's technique reads
+                others = " and ".join(BAKE_NAMES[other] for other in found)
+                lines.append(f"object '{entry.name}' renders unshadowed: material '{kinds[kind] or '(none)'}' is "
+                             f"shadowed by a {BAKE_NAMES[kind]} and the object has a {others} only: press "
+                             f"{BAKE_BUTTONS[kind]} in Render Properties")
+            if entry.mesh_key in visibility or SSDF not in kinds or SSDF in missing:
+                continue
             status = visibility_status.get(entry.mesh_key, "no visibility bake")
             if status == "no visibility bake":
                 unbaked.append(entry.name)
@@ -280,6 +294,16 @@ class SceneState:
                 lines.append(f"object '{entry.name}' renders without its transfer bake: {status}")
             seen.add(entry.mesh_key)
         return lines
+
+    def _shadow_kinds(self, entry):
+        """{per-vertex kind: the first material shadowed by it} of an object's material slots (their techniques'
+        shadow_kind)."""
+        kinds = {}
+        for name in entry.material_names or [""]:
+            kind = techniques.for_material(self.materials.get(name) or self.materials[""]).shadow_kind
+            if kind:
+                kinds.setdefault(kind, name)
+        return kinds
 
     @staticmethod
     def _mesh_key(obj):

@@ -97,6 +97,7 @@ class Technique:
     number = 0           # the enum value stored in .blend files: unique and never reused
     paper = ""           # the reference it implements, e.g. "wang2009"
     mirror = None        # numpy function of what its shader computes (tests compare the two)
+    shadow_kind = "ssdf"  # the per-vertex kind its shadows come from (engine/scene_state.py), "" for none
 
     def variant_key(self, params, inputs):
         raise NotImplementedError

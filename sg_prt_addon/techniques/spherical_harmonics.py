@@ -215,6 +215,7 @@ class SphericalHarmonics(Technique):
                    "shading as their dot product (Kautz et al. 2002): any BRDF under low-frequency light")
     number = 3
     paper = "kautz2002"
+    shadow_kind = TRANSFER_KIND
 
     mirror = staticmethod(sh_shading.shade_fragments)
 

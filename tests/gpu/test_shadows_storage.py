@@ -193,3 +193,20 @@ def test_a_subdivided_floor_bakes_and_renders_shadowed_until_its_level_changes(e
     per_vertex_store.clear_object_record(floor, visibility_bake.KIND)
     unbaked, _ = render()
     np.testing.assert_array_equal(stale, unbaked)
+
+
+def test_a_material_on_spherical_harmonics_with_a_visibility_bake_only_says_what_to_bake(engine):
+    """The SH technique shadows from a transfer bake: an object baked for visibility alone renders unshadowed and
+    the render says which bake its material needs; the SG floor beside it keeps its shadows and no such line."""
+    scene, sphere, floor = _scene("sh_visibility_only")
+    sphere.data.materials.append(fx.material("sh_visibility_only", technique="SH"))
+    try:
+        fx.bake_objects(scene, [sphere, floor], resolution=8)
+        result = fx.render(scene)
+    finally:
+        fx.clear_bakes()
+    assert "error" not in result, result.get("error")
+    warnings = result["state"].unshadowed_warnings()
+    assert warnings == [f"object '{sphere.name}' renders unshadowed: material 'sh_visibility_only' is shadowed by a "
+                        "transfer bake and the object has a visibility bake only: press Bake Transfer in Render "
+                        "Properties"], warnings
