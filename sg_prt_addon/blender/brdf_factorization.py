@@ -111,16 +111,20 @@ def image_name(material, role):
 
 
 def clear_factorization(material):
-    """Remove stored factors (metadata, references, and their images if nothing else uses them)."""
+    """Remove stored factors (metadata, references, and their images if nothing else uses them); a material on
+    the factored technique gets back the technique it had before the factors were stored (the default if that
+    is unknown)."""
     settings = material.sgprt.factorization
     images = [item.image for item in settings.images if item.image is not None]
     found = settings.format_version != 0 or bool(images)
     settings.images.clear()
+    previous = settings.previous_technique
     for name in ("format_version", "source_file", "source_path", "source_texel", "form", "resolution", "alpha_scale",
-                 "lobe_sharpness", "samples", "masked", "error", "date", "seconds"):
+                 "lobe_sharpness", "samples", "masked", "error", "date", "seconds", "previous_technique"):
         settings.property_unset(name)
     if techniques.of_settings(material.sgprt) == factored.NAME:
-        material.sgprt.technique = techniques.DEFAULT
+        usable = previous in techniques.names() and previous != factored.NAME
+        material.sgprt.technique = previous if usable else techniques.DEFAULT
     for image in images:
         if image.users == 0:
             bpy.data.images.remove(image)
@@ -131,8 +135,11 @@ def store_factorization(material, result, path, form, texel=-1):
     """Write a finished job's factors to a material, replacing any previous ones."""
     made = [(role, lobe_fit.new_float_image(image_name(material, role), result["arrays"][role]))
             for role in ROLES if role in result["arrays"]]
-    clear_factorization(material)
     settings = material.sgprt.factorization
+    current = techniques.of_settings(material.sgprt)
+    previous = settings.previous_technique if current == factored.NAME else current
+    clear_factorization(material)
+    settings.previous_technique = previous
     for role, image in made:
         image.name = image_name(material, role)
         item = settings.images.add()
@@ -245,8 +252,13 @@ class SGPRT_OT_clear_factorization(bpy.types.Operator):
         return active_material(context) is not None and not SGPRT_OT_factor_brdf._running
 
     def execute(self, context):
-        if not clear_factorization(active_material(context)):
+        material = active_material(context)
+        before = techniques.of_settings(material.sgprt)
+        if not clear_factorization(material):
             self.report({"INFO"}, "SG-PRT: no stored factors")
+        after = techniques.of_settings(material.sgprt)
+        if after != before:
+            self.report({"INFO"}, f"SG-PRT: '{material.name}' renders with {techniques.get(after).label} again")
         return {"FINISHED"}
 
 

@@ -158,6 +158,9 @@ class SGPRT_PG_factorization(bpy.types.PropertyGroup):
     date: StringProperty(name="Date", description="When the factors were stored (ISO 8601 UTC)")
     seconds: FloatProperty(name="Seconds", default=0.0)
     images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
+    previous_technique: StringProperty(name="Technique Before",
+                                       description="The material's technique before the factors set theirs: "
+                                                   "Clear BRDF Factors gives it back")
 
 
 def _is_mesh(self, obj):

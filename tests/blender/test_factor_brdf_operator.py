@@ -141,3 +141,18 @@ def test_clear_removes_the_images_and_the_technique(material, data):
     assert bpy.ops.sgprt.clear_factorization() == {"FINISHED"}
     assert bf.factorization_status(material)[0] == "NONE" and material.sgprt.technique == "SG_PARAMETRIC"
     assert not any(name in bpy.data.images for name in names)
+
+
+@pytest.mark.parametrize("technique", ["SG_BISCALE", "SH"])
+def test_clear_gives_back_the_technique_the_factors_replaced(material, data, capfd, technique):
+    """Factor BRDF then Clear BRDF Factors on a bi-scale (or SH) material: it renders as before, and says so;
+    factoring twice keeps the first technique."""
+    material.sgprt.technique = technique
+    assert bpy.ops.sgprt.factor_brdf(filepath=data["merl"], resolution=16) == {"FINISHED"}
+    assert bpy.ops.sgprt.factor_brdf(filepath=data["clean"], resolution=16) == {"FINISHED"}
+    assert material.sgprt.technique == "FACTORED"
+    capfd.readouterr()
+    assert bpy.ops.sgprt.clear_factorization() == {"FINISHED"}
+    assert material.sgprt.technique == technique
+    assert f"'{material.name}' renders with" in "".join(capfd.readouterr())
+    assert material.sgprt.factorization.previous_technique == ""
