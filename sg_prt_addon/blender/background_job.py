@@ -100,10 +100,14 @@ def time_text(seconds):
 class ModalJobOperator:
     """Mixin for a bpy.types.Operator whose invoke() starts a BackgroundJob: call
     start_modal(context, job); implement _finish(context, job) -> the operator's result.
-    The class attribute `_running` is shared by all instances: one job of a kind at a time."""
+    The class attribute `_running` is shared by all instances: one job of a kind at a time.
+
+    Esc cancels: a job that has not stopped CANCEL_GRACE seconds later (a solve it cannot interrupt) is left
+    to end in its thread, its result never read, and the operator ends at once with nothing written."""
 
     job_label = "SG-PRT job"
     _running = False
+    CANCEL_GRACE = 0.5
 
     def start_modal(self, context, job, interval=0.25):
         self._job = job
@@ -140,6 +144,7 @@ class ModalJobOperator:
         try:
             if event.type == "ESC" and event.value == "PRESS":
                 job.cancel()
+                self._cancelled_at = time.monotonic()
                 self._status(context, f"{self.job_label}: cancelling...")
                 return {"RUNNING_MODAL"}
             if event.type == "TIMER":
@@ -150,6 +155,10 @@ class ModalJobOperator:
                     job.join()
                     self._cleanup(context)
                     return self._finish(context, job)
+                if job.cancelling and time.monotonic() - getattr(self, "_cancelled_at", 0.0) >= self.CANCEL_GRACE:
+                    self._cleanup(context)      # the thread ends on its own; nothing reads what it made
+                    self.report({"WARNING"}, f"{self.job_label} cancelled: nothing written, the previous result kept")
+                    return {"CANCELLED"}
             return {"PASS_THROUGH"}
         except Exception as error:      # never leave the thread running or the button disabled
             job.cancel()
