@@ -686,6 +686,9 @@ def texture_pixels(image, slot, decode=None):
                                     else "scalar"]
         warn(f"image '{image.name}': {_no_pixels_reason(image)}: {what} used for {slot}")
         return np.array(texel, np.float32).reshape(1, 1, 4)
+    if image.source == "TILED" and len(image.tiles) > 1:
+        warn(f"image '{image.name}': a UDIM set of {len(image.tiles)} tiles, of which SG-PRT reads tile "
+             f"{image.tiles[0].number} alone over every UV (Cycles reads each tile where the UVs reach it)")
     pixels = finite_texels(image_pixels(image), f"image '{image.name}'")
     if decode is None:
         decode = slot in COLOUR_SLOTS

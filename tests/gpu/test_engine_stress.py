@@ -378,6 +378,23 @@ def test_nan_inf_texels(engine, model):
     assert np.all(np.isfinite(environment.lobe_amplitude))
 
 
+def test_a_udim_image_is_named(engine):
+    """A UDIM set of tiles: its first tile is read over every UV, and the render says so (Cycles reads them
+    all); a single-tile image says nothing."""
+    import bpy
+
+    scene = _new_scene("stress_udim", 16, 16)
+    fx.world_colour(scene, (0.2, 0.2, 0.2))
+    sphere = _uv_sphere(scene, "stress_udim_sphere", (0.0, 0.0, 1.0), segments=8, rings=4)
+    image = bpy.data.images.new("stress_udim", 4, 4, tiled=True)
+    material = fx.material("stress_udim", model="GGX", diffuse_color_texture=image)
+    sphere.data.materials.append(material)
+    assert not any("UDIM" in line for line in _warnings(_render(scene)))
+    image.tiles.new(tile_number=1002)
+    assert _warned(_render(scene), "image 'stress_udim': a UDIM set of 2 tiles, of which SG-PRT reads tile 1001 "
+                                   "alone over every UV"), _warnings(_render(scene))
+
+
 def test_warnings_reset_per_render(engine):
     """A second render of a repaired scene does not keep the first one's warnings twice, and a
     clean scene has none."""
