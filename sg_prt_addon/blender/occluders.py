@@ -3,10 +3,10 @@ world-space triangle soup (the occluders), and a fingerprint of each, stored wit
 name the objects that moved or changed since (SceneState.outdated_bake_warnings).
 
 A fingerprint is (placement, vertex count, shape): a digest of the world matrices of the object's instances,
-the evaluated vertex count, and a digest of its evaluated local vertex positions.  The viewport evaluates
-modifiers at their viewport levels and a final render at their render levels, so a shape is compared only
-where the vertex counts agree: a Subdivision Surface with a higher render level is not reported as changed (nor
-is an occluder edited to a new vertex count; the receiver's own edits are caught by its topology check).
+the evaluated vertex count, and a digest of its evaluated local vertex positions.  A bake traces the scene as a
+final render evaluates it, and so does a final render's check; the viewport evaluates modifiers at their
+viewport levels, so there an object whose modifiers differ between the two (modifier_stack.viewport_differences)
+is compared by shape only where the vertex counts agree: its higher render level is no change.
 """
 import hashlib
 from dataclasses import dataclass
@@ -88,9 +88,11 @@ def fingerprints(geometry):
             for name, occluder in geometry.items()}
 
 
-def changed_since(baked, current):
+def changed_since(baked, current, counts_may_differ=()):
     """Sentences naming the objects whose fingerprints differ between a bake's (`baked`) and the scene's now
-    (`current`): moved, changed shape, added, or gone; [] when the scene is as it was baked."""
+    (`current`): moved, changed shape (its vertices moved, or their count changed), added, or gone; [] when the
+    scene is as it was baked.  counts_may_differ: names whose vertex count is evaluated otherwise now than at
+    the bake (the viewport's levels): a count change alone is no change for them."""
     moved, reshaped, added, gone = [], [], [], []
     for name in sorted(set(baked) | set(current)):
         then, now = baked.get(name), current.get(name)
@@ -100,7 +102,7 @@ def changed_since(baked, current):
             gone.append(name)
         elif then[0] != now[0]:
             moved.append(name)
-        elif then[1] == now[1] and then[2] != now[2]:
+        elif then[1] != now[1] and name not in counts_may_differ or then[1] == now[1] and then[2] != now[2]:
             reshaped.append(name)
 
     def names(items):

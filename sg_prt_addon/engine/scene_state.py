@@ -198,13 +198,18 @@ class SceneState:
         shape, appeared or went since (blender/occluders.py).  Its shadows are still drawn, as they were baked."""
         if not any(self.bake_occluders.values()):
             return
-        from ..blender import occluders
+        from ..blender import modifier_stack, occluders
 
-        current = occluders.fingerprints(occluders.scene_geometry(depsgraph))
+        geometry = occluders.scene_geometry(depsgraph)
+        current = occluders.fingerprints(geometry)
+        # a final render evaluates as the bake did; the viewport at its own modifier levels
+        counts_may_differ = set() if depsgraph.mode == "RENDER" else {
+            name for name in geometry if name in depsgraph.scene.objects
+            and modifier_stack.viewport_differences(depsgraph.scene.objects[name])}
         named = set()
         for entry in self.objects.values():
             for kind, baked in self.bake_occluders.get(entry.mesh_key, {}).items():
-                changes = occluders.changed_since(baked, current)
+                changes = occluders.changed_since(baked, current, counts_may_differ)
                 if changes and (entry.mesh_key, kind) not in named:
                     named.add((entry.mesh_key, kind))
                     export.warn(f"object '{entry.name.split('#')[0]}': its {BAKE_NAMES[kind]} was made before "

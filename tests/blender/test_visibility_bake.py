@@ -493,6 +493,22 @@ def test_render_names_what_moved_since_the_bake(scene):
     assert _render_warnings() == []
 
 
+def test_render_names_an_occluder_whose_vertex_count_changed(scene):
+    """An occluder's Array count 5 -> 3 after the floor's bake: the floor's shadows of the two copies gone stay
+    in its bake, and the render names the occluder; back at 5, nothing."""
+    _, floor, suzanne = scene
+    array = suzanne.modifiers.new("Array", "ARRAY")
+    array.count = 5
+    assert bpy.ops.sgprt.bake_visibility(target="ALL") == {"FINISHED"}
+    assert _render_warnings() == []
+    array.count = 3
+    warnings = _render_warnings()
+    assert any(warning.startswith("object 'Floor'") and "'Suzanne' changed shape" in warning
+               for warning in warnings), warnings
+    array.count = 5
+    assert not any("changed shape" in warning for warning in _render_warnings())
+
+
 def test_a_bake_per_vertex_of_a_flat_mesh_asks_for_a_rebake(scene):
     """A visibility bake made per vertex before flat faces were baked per corner still renders, and the render
     says to re-bake; a smooth mesh's bake per vertex says nothing."""
