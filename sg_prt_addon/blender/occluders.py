@@ -22,31 +22,34 @@ GEOMETRY_TYPES = ("MESH", "CURVE", "SURFACE", "META", "FONT")
 
 @dataclass
 class OccluderObject:
-    """One object's evaluated geometry: local vertices (P, 3), triangles (T, 3), its instances' world matrices."""
+    """One evaluated geometry of an object: local vertices (P, 3), triangles (T, 3), its instances' world matrices.
+    An object may have several: its own mesh and the geometry it instances (Geometry Nodes' Instance on Points)."""
     vertices: np.ndarray
     triangles: np.ndarray
     matrices: list
 
 
 def scene_geometry(depsgraph):
-    """{object name: OccluderObject} of every object with geometry a render shows (visible and not disabled in
-    renders: export.render_roles)."""
+    """{(object name, geometry key): OccluderObject} of every object with geometry a render shows (visible and not
+    disabled in renders: export.render_roles), its instances included: each geometry an object draws is keyed
+    apart (an object's own, often empty, mesh and what its Geometry Nodes instance share its name)."""
     objects = {}
     hidden = export.render_roles(depsgraph.view_layer).hidden
     for instance in depsgraph.object_instances:
         obj = instance.object
         if obj.type not in GEOMETRY_TYPES or obj.name in hidden:
             continue
-        if obj.name not in objects:
+        key = (obj.name, obj.data.as_pointer() if obj.data is not None else 0)
+        if key not in objects:
             mesh = obj.to_mesh()
             try:
                 count = len(mesh.vertices)
                 local = np.empty(count * 3, np.float32)
                 mesh.vertices.foreach_get("co", local)
-                objects[obj.name] = OccluderObject(local.reshape(-1, 3), mesh_triangles(mesh), [])
+                objects[key] = OccluderObject(local.reshape(-1, 3), mesh_triangles(mesh), [])
             finally:
                 obj.to_mesh_clear()
-        objects[obj.name].matrices.append(np.array([list(row) for row in instance.matrix_world], np.float64))
+        objects[key].matrices.append(np.array([list(row) for row in instance.matrix_world], np.float64))
     return objects
 
 
@@ -71,21 +74,33 @@ def untraceable(geometry):
     """{object name: vertices (summed over its instances) that are NaN, Inf or beyond raytrace.COORDINATE_LIMIT in
     world space} of scene_geometry's objects that have any: their triangles there cast no shadow."""
     counts = {}
-    for name, occluder in geometry.items():
+    for (name, _), occluder in geometry.items():
         bad = sum(int(np.count_nonzero(~raytrace.traceable(
             occluder.vertices.astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]))) for matrix in occluder.matrices)
         if bad:
-            counts[name] = bad
+            counts[name] = counts.get(name, 0) + bad
     return counts
 
 
+def _digest(data):
+    return hashlib.blake2b(data, digest_size=8).hexdigest()
+
+
 def fingerprints(geometry):
-    """{object name: [placement digest, vertex count, shape digest]} of scene_geometry (JSON-ready)."""
-    def digest(data):
-        return hashlib.blake2b(data, digest_size=8).hexdigest()
-    return {name: [digest(b"".join(sorted(np.asarray(m, np.float32).tobytes() for m in occluder.matrices))),
-                   int(len(occluder.vertices)), digest(np.ascontiguousarray(occluder.vertices).tobytes())]
-            for name, occluder in geometry.items()}
+    """{object name: [placement digest, vertex count, shape digest]} of scene_geometry (JSON-ready), an object's
+    geometries together: the digest of all their instances' matrices, their vertices summed, the digest of their
+    shapes' digests (an object of one geometry: the digest of its vertices)."""
+    parts = {}
+    for (name, _), occluder in geometry.items():
+        parts.setdefault(name, []).append(occluder)
+    prints = {}
+    for name, occluders in parts.items():
+        placement = _digest(b"".join(sorted(np.asarray(m, np.float32).tobytes()
+                                            for occluder in occluders for m in occluder.matrices)))
+        shapes = [_digest(np.ascontiguousarray(occluder.vertices).tobytes()) for occluder in occluders]
+        shape = shapes[0] if len(shapes) == 1 else _digest("".join(sorted(shapes)).encode())
+        prints[name] = [placement, int(sum(len(occluder.vertices) for occluder in occluders)), shape]
+    return prints
 
 
 def changed_since(baked, current, counts_may_differ=()):

@@ -134,6 +134,9 @@ def _evaluated_mesh(obj, depsgraph):
         raise ValueError(f"'{obj.name}' is in Edit Mode: leave it before baking")
     mesh = obj.evaluated_get(depsgraph).data
     if len(mesh.polygons) == 0:
+        if any(modifier.type == "NODES" and modifier.show_render for modifier in obj.modifiers):
+            raise ValueError(f"'{obj.name}' has no faces of its own: its Geometry Nodes output is instances (a "
+                             "Realize Instances node makes them its faces, to bake; they cast shadows as they are)")
         raise ValueError(f"'{obj.name}' has no faces: nothing to bake")
     return mesh
 
@@ -507,12 +510,25 @@ def mesh_objects(context, target):
     return [obj for obj in context.selected_objects if obj.type == "MESH"]
 
 
+def collection_instancers(context):
+    """The visible objects that instance a collection (an Empty's Instancing > Collection)."""
+    hidden = export.render_roles(context.view_layer).hidden
+    return [obj for obj in context.scene.objects if obj.instance_type == "COLLECTION"
+            and obj.instance_collection is not None and obj.visible_get() and obj.name not in hidden]
+
+
 def bake_inputs(operator, context, objects, what):
     """(receivers [Receiver] (receiver_arrays),
     occluder vertices, occluder triangles, {target key: BakeTarget}, the occluders' fingerprints
     (occluders.fingerprints, stored with the bake)) of the objects a per-vertex bake writes to, world space, as
     a final render evaluates the scene (modifier_stack.as_rendered); None after the operator reported why not.
     what: the bake's name in messages ("bake", "transfer bake")."""
+    if operator.target == "ALL":
+        for instancer in collection_instancers(context):
+            operator.report({"WARNING"}, f"SG-PRT {what}: collection instance '{instancer.name}' is not baked: its "
+                                         f"instances share the meshes of '{instancer.instance_collection.name}' and "
+                                         "so would share one bake (Make Instances Real to bake each); they cast "
+                                         "shadows on what is baked")
     if not objects:
         operator.report({"ERROR"}, f"SG-PRT {what}: no mesh object selected" if operator.target == "SELECTED"
                         else f"SG-PRT {what}: no visible mesh object")

@@ -204,7 +204,7 @@ class SceneState:
         current = occluders.fingerprints(geometry)
         # a final render evaluates as the bake did; the viewport at its own modifier levels
         counts_may_differ = set() if depsgraph.mode == "RENDER" else {
-            name for name in geometry if name in depsgraph.scene.objects
+            name for name, _ in geometry if name in depsgraph.scene.objects
             and modifier_stack.viewport_differences(depsgraph.scene.objects[name])}
         named = set()
         for entry in self.objects.values():

@@ -742,3 +742,69 @@ def test_a_cancelled_or_failed_rebake_keeps_the_previous_companion(scene):
     assert kept.usable and kept.resolution == SMALL["resolution"] and kept.date == previous.date
     for field in ("packed_coefficients", "basis", "mean"):
         assert np.array_equal(_bits(getattr(kept, field)), _bits(getattr(previous, field))), field
+
+
+def _instance_on_grid(obj, size, cube_size, z):
+    """A Geometry Nodes modifier on obj whose output is only instances: cubes on a 3 x 3 grid, not realized."""
+    modifier = obj.modifiers.new("Scatter", "NODES")
+    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    nodes = tree.nodes
+    grid = nodes.new("GeometryNodeMeshGrid")
+    grid.inputs["Size X"].default_value = grid.inputs["Size Y"].default_value = size
+    grid.inputs["Vertices X"].default_value = grid.inputs["Vertices Y"].default_value = 3
+    cube = nodes.new("GeometryNodeMeshCube")
+    cube.inputs["Size"].default_value = (cube_size, cube_size, cube_size)
+    place = nodes.new("GeometryNodeInstanceOnPoints")
+    lift = nodes.new("GeometryNodeTranslateInstances")
+    lift.inputs["Translation"].default_value = (0.0, 0.0, z)
+    output = nodes.new("NodeGroupOutput")
+    tree.links.new(grid.outputs["Mesh"], place.inputs["Points"])
+    tree.links.new(cube.outputs["Mesh"], place.inputs["Instance"])
+    tree.links.new(place.outputs["Instances"], lift.inputs["Instances"])
+    tree.links.new(lift.outputs["Instances"], output.inputs[0])
+    modifier.node_group = tree
+
+
+def test_instances_cast_shadows_and_instancers_say_why_they_are_not_baked(scene, capfd):
+    """Geometry Nodes instances that are not realized shadow the floor baked under them; their object is refused
+    with what to do; a collection instance is named as not baked, its instances casting shadows too."""
+    _, floor, suzanne = scene
+    bpy.data.objects.remove(suzanne)
+    bpy.ops.mesh.primitive_plane_add(size=0.1, location=(0.0, 0.0, 0.0))
+    scatter = bpy.context.active_object
+    scatter.name = "Scatter"
+    _instance_on_grid(scatter, 2.0, 0.4, 0.5)
+
+    def mean_ssdf(bake, near):
+        points = np.array([v.co for v in floor.data.vertices])
+        chosen = np.min(np.linalg.norm(points[:, None, :2] - np.asarray(near)[None, :, :2], axis=2), axis=1) < 0.25
+        return (bake.coefficients[chosen] @ bake.basis.reshape(bake.terms, -1) + bake.mean.ravel()).mean()
+
+    under = [(x, y) for x in (-1.0, 0.0, 1.0) for y in (-1.0, 0.0, 1.0)]
+    capfd.readouterr()
+    assert bpy.ops.sgprt.bake_visibility(target="ALL") == {"FINISHED"}
+    assert "'Scatter' has no faces of its own: its Geometry Nodes output is instances" in "".join(capfd.readouterr())
+    shadowed = mean_ssdf(vb.load_visibility_bake(floor.data), under)
+    scatter.modifiers["Scatter"].show_render = scatter.modifiers["Scatter"].show_viewport = False
+    _select(floor)
+    assert bpy.ops.sgprt.bake_visibility(target="SELECTED") == {"FINISHED"}
+    open_sky = mean_ssdf(vb.load_visibility_bake(floor.data), under)
+    assert shadowed < open_sky - 0.1, (shadowed, open_sky)
+
+    # the same cubes as a collection instance: named, and casting shadows
+    bpy.data.objects.remove(scatter)
+    source = bpy.data.collections.new("Crates")
+    bpy.ops.mesh.primitive_cube_add(size=0.4, location=(0.0, 0.0, 0.5))
+    crate = bpy.context.active_object
+    for collection in crate.users_collection:
+        collection.objects.unlink(crate)
+    source.objects.link(crate)
+    instancer = bpy.data.objects.new("Crates Instance", None)
+    instancer.instance_type, instancer.instance_collection = "COLLECTION", source
+    bpy.context.scene.collection.objects.link(instancer)
+    capfd.readouterr()
+    assert bpy.ops.sgprt.bake_visibility(target="ALL") == {"FINISHED"}
+    assert "collection instance 'Crates Instance' is not baked" in "".join(capfd.readouterr())
+    assert mean_ssdf(vb.load_visibility_bake(floor.data), [(0.0, 0.0)]) < open_sky - 0.1
