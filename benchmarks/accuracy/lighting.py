@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sg_prt_addon.lighting import env_fit, env_prefilter, equirect, lights
+from sg_prt_addon.lighting import env_fit, env_prefilter, equirect, light_clusters, lights
 from sg_prt_addon.spherical import sg
 
 WORLD_DIR = Path(__file__).resolve().parents[2] / ".venv/lib/python3.11/site-packages/bpy/5.0/datafiles/studiolights/world"
@@ -135,8 +135,33 @@ def _fit_rows():
     return rows
 
 
+def _group_rows():
+    """Point lights merged into groups (light_clusters): a floor's irradiance against the members' exact sum."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for count, groups in ((300, 64), (1000, 128)):
+        position = rng.uniform([-4.0, -4.0, 2.0], [4.0, 4.0, 4.0], (count, 3))
+        intensity = rng.uniform(0.1, 10.0, (count, 1))
+        clusters = light_clusters.cluster_point_lights(position, np.full(count, 0.05), intensity, groups)
+        grid = np.linspace(-4.0, 4.0, 41)
+        points = np.stack(np.meshgrid(grid, grid, [0.0], indexing="ij"), axis=-1).reshape(-1, 3)
+
+        def irradiance(lights_at, lights_intensity):
+            offset = lights_at[None, :, :] - points[:, None, :]
+            distance2 = np.sum(offset ** 2, axis=2)
+            return np.einsum("pl,l->p", np.maximum(offset[..., 2], 0.0) / distance2 ** 1.5, lights_intensity[:, 0])
+        exact = irradiance(position, intensity)
+        relative = np.abs(irradiance(clusters.position, clusters.intensity) - exact) / exact
+        rows.append(dict(
+            name=f"{count} point lights as {groups} groups (light_clusters), 2-4 m over a floor",
+            reference="sum over every light", metric="relative irradiance on the floor below them",
+            max_error=relative.max(), mean_error=relative.mean(), paper=None,
+            note="lightcuts' representative lights, one level"))
+    return rows
+
+
 def measure():
-    return _light_rows() + _prefilter_rows() + _fit_rows()
+    return _light_rows() + _prefilter_rows() + _fit_rows() + _group_rows()
 
 
 if __name__ == "__main__":

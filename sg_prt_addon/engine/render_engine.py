@@ -93,11 +93,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, "SG-PRT: render cancelled; the image holds the samples taken until then")
         for warning in dict.fromkeys(state.warnings + state.unshadowed_warnings()):
             self.report({"WARNING"}, f"SG-PRT: {warning}")
-        dropped = state.dropped_lights(MAX_POINT_LIGHTS, MAX_SUNS)
-        if dropped:
-            self.report({"WARNING"}, f"SG-PRT: {len(dropped)} dimmest light(s) left out (at most "
-                                     f"{MAX_POINT_LIGHTS} point/spot/area and "
-                                     f"{MAX_SUNS} sun lights): {', '.join(dropped[:5])}")
+        for line in state.light_budget_warnings(MAX_POINT_LIGHTS, MAX_SUNS):
+            self.report({"WARNING"}, f"SG-PRT: {line}")
         # one render() per view layer: write into the one being rendered; with a render border Blender's result
         # holds the border's pixels only (cropped or not; begin_result counts from the border's corner), so the
         # frame is cut to it

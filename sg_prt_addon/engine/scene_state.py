@@ -15,8 +15,8 @@ import numpy as np
 
 from .. import techniques
 from ..blender import export
+from ..lighting import light_clusters, shadow_maps
 from ..lighting import lights as core_lights
-from ..lighting import shadow_maps
 from ..lighting.scene_lighting import EnvironmentData, LightData
 from ..techniques.shader_sources import MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility import decode, per_vertex
@@ -465,9 +465,28 @@ class SceneState:
         return light_data(self.lights, self.area_patches)
 
     def dropped_lights(self, max_points, max_suns):
-        """Names of the lights beyond the shader's limits (the dimmest are dropped)."""
-        kept = set(light.name for light in _strongest(self.lights, max_points, max_suns, self.area_patches))
-        return [light.name for light in self.lights if light.name not in kept]
+        """Names of the lights left out to fit the shader's limits (fit_light_budget's last resort)."""
+        return fit_light_budget(self.lights, max_points, max_suns, self.area_patches).dropped
+
+    def light_budget_warnings(self, max_points, max_suns):
+        """The render report's lines for what fitting the shader's limits changed: fewer area light patches,
+        merged point lights, lights left out."""
+        budget = fit_light_budget(self.lights, max_points, max_suns, self.area_patches)
+        limits = f"SG-PRT draws at most {max_points} point, spot and area light patches and {max_suns} suns"
+        lines = []
+        if budget.area_patches < self.area_patches:
+            lines.append(f"area lights cut into {budget.area_patches} x {budget.area_patches} patches instead of "
+                         f"{self.area_patches} x {self.area_patches} ({limits})")
+        if budget.merged:
+            count = sum(len(names) for _, names in budget.merged)
+            lines.append(f"{count} point lights drawn as {len(budget.merged)} groups of nearby lights, each one "
+                         f"light of their summed power ({limits}): "
+                         + ", ".join(group.name for group, _ in budget.merged[:3])
+                         + (" ..." if len(budget.merged) > 3 else ""))
+        if budget.dropped:
+            lines.append(f"{len(budget.dropped)} dimmest light(s) left out ({limits}): "
+                         + ", ".join(budget.dropped[:5]) + (" ..." if len(budget.dropped) > 5 else ""))
+        return lines
 
 
 def _visible(obj):
@@ -506,20 +525,65 @@ def _point_count(light, area_patches):
     return n_u * n_v
 
 
-def _strongest(light_exports, max_points, max_suns, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
-    """The lights kept within max_points point lights (an area light counts its patches) and max_suns suns,
-    the brightest first (by intensity, or an area light's power over 4 pi: a point light of that power)."""
-    def power(light):
-        scale = 1.0 / (4 * np.pi) if light.kind == "AREA" else 1.0
-        return -float(np.sum(light.colour_intensity)) * scale
-    points, used = [], 0
-    for light in sorted((light for light in light_exports if light.kind in ("POINT", "AREA")), key=power):
-        count = _point_count(light, area_patches)
-        if used + count <= max_points:
-            points.append(light)
-            used += count
-    suns = sorted((light for light in light_exports if light.kind == "SUN"), key=power)[:max_suns]
-    return points + suns
+def _power(light):
+    """A light's brightness for the budget: its intensity, an area light's power over 4 pi (a point light's)."""
+    scale = 1.0 / (4 * np.pi) if light.kind == "AREA" else 1.0
+    return float(np.sum(light.colour_intensity)) * scale
+
+
+@dataclass
+class LightBudget:
+    """The scene's lights as the shader takes them (fit_light_budget): `lights` drawn (merged groups as new
+    LightExports), area lights cut into `area_patches` a side, and what was given up for the report."""
+    lights: list
+    area_patches: int
+    merged: list = field(default_factory=list)      # [(the LightExport drawn, [names of the lights it stands for])]
+    dropped: list = field(default_factory=list)     # names of the lights left out
+
+
+def fit_light_budget(light_exports, max_points, max_suns, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
+    """The LightBudget of max_points point lights (an area light counts its patches) and max_suns suns.  Where the
+    lights are more: area lights first get fewer patches (down to one), then nearby omni point lights are merged
+    into one light a group (lighting.light_clusters); only where spot and area lights alone pass the limit are the
+    dimmest left out, as are the dimmest suns past max_suns."""
+    suns = sorted((light for light in light_exports if light.kind == "SUN"), key=_power, reverse=True)
+    points = sorted((light for light in light_exports if light.kind in ("POINT", "AREA")), key=_power, reverse=True)
+    dropped = [light.name for light in suns[max_suns:]]
+    suns = suns[:max_suns]
+
+    def used(lights, patches):
+        return sum(_point_count(light, patches) for light in lights)
+    patches = area_patches
+    while patches > 1 and used(points, patches) > max_points:
+        patches -= 1
+    if used(points, patches) <= max_points:
+        return LightBudget(points + suns, patches, dropped=dropped)
+    omni = [light for light in points if light.kind == "POINT" and not light.is_spot]
+    fixed = [light for light in points if light.kind == "AREA" or light.is_spot]
+    slots = max_points - used(fixed, patches)
+    if slots < 1 or not omni:          # the last resort: the dimmest left out
+        kept, count = [], 0
+        for light in points:
+            if count + _point_count(light, patches) <= max_points:
+                kept.append(light)
+                count += _point_count(light, patches)
+            else:
+                dropped.append(light.name)
+        return LightBudget(kept + suns, patches, dropped=dropped)
+    clusters = light_clusters.cluster_point_lights([light.position for light in omni], [light.radius for light in omni],
+                                                   [light.colour_intensity for light in omni], slots)
+    drawn, merged = list(fixed), []
+    for k in range(len(clusters.radius)):
+        members = [light for light, label in zip(omni, clusters.labels) if label == k]
+        if len(members) == 1:
+            drawn.append(members[0])
+            continue
+        group = export.LightExport(f"{len(members)} lights about '{members[0].name}'", "POINT",
+                                   tuple(clusters.position[k]), (0.0, 0.0, -1.0), tuple(clusters.intensity[k]),
+                                   radius=float(clusters.radius[k]))
+        drawn.append(group)
+        merged.append((group, [light.name for light in members]))
+    return LightBudget(drawn + suns, patches, merged, dropped)
 
 
 def _point_rows(light, area_patches):
@@ -538,10 +602,10 @@ def _point_rows(light, area_patches):
 
 def light_data(light_exports, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
     """LightData (float32) from export.LightExport records, an area light cut into about area_patches^2
-    patches (the shader's limits applied: the dimmest lights beyond them are left out)."""
-    kept = _strongest(light_exports, MAX_POINT_LIGHTS, MAX_SUNS, area_patches)
-    rows = [row for light in kept if light.kind != "SUN" for row in _point_rows(light, area_patches)]
-    suns = [light for light in kept if light.kind == "SUN"]
+    patches, within the shader's limits (fit_light_budget)."""
+    budget = fit_light_budget(light_exports, MAX_POINT_LIGHTS, MAX_SUNS, area_patches)
+    rows = [row for light in budget.lights if light.kind != "SUN" for row in _point_rows(light, budget.area_patches)]
+    suns = [light for light in budget.lights if light.kind == "SUN"]
     data = LightData()
     f = np.float32
     if rows:

@@ -138,21 +138,36 @@ def test_world_space_export_matches_blender(tracked_scene):
     assert np.all(world.tangents[:, 3] == -state.meshes[entry.mesh_key].tangents[:, 3])
 
 
-def test_lights_beyond_the_shader_limit_drop_the_dimmest():
+def test_lights_beyond_the_shader_limit_are_merged_not_dropped():
+    """More omni point lights than the shader takes: nearby ones drawn as one light of their summed power,
+    none left out; area lights first get fewer patches; spot lights alone past the limit: the dimmest left out."""
     from sg_prt_addon.blender import export
     from sg_prt_addon.engine import scene_state
     from sg_prt_addon.techniques import shader_sources
 
+    limit = shader_sources.MAX_POINT_LIGHTS
     lights = [export.LightExport(f"point{i}", "POINT", (0.0, 0.0, float(i)), (0.0, 0.0, -1.0), (float(i),) * 3)
-              for i in range(shader_sources.MAX_POINT_LIGHTS + 3)]
+              for i in range(limit + 3)]
     lights.append(export.LightExport("sun", "SUN", (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), (2.0, 2.0, 2.0), angle=0.1))
     data = scene_state.light_data(lights)
-    assert len(data.point_radius) == shader_sources.MAX_POINT_LIGHTS and len(data.sun_sharpness) == 1
-    assert data.point_intensity[:, 0].min() == 3.0          # points 0, 1, 2 were the dimmest
+    assert len(data.point_radius) == limit and len(data.sun_sharpness) == 1
+    np.testing.assert_allclose(data.point_intensity[:, 0].sum(), sum(range(limit + 3)), rtol=1e-6)
     state = scene_state.SceneState()
     state.lights = lights
-    assert state.dropped_lights(shader_sources.MAX_POINT_LIGHTS, shader_sources.MAX_SUNS) == \
-        ["point0", "point1", "point2"]
+    assert state.dropped_lights(limit, shader_sources.MAX_SUNS) == []
+    assert any("point lights drawn as" in line for line in state.light_budget_warnings(limit, shader_sources.MAX_SUNS))
+
+    areas = [export.LightExport(f"area{i}", "AREA", (float(i), 0.0, 3.0), (0.0, 0.0, -1.0), (10.0,) * 3,
+                                edge_u=(1.0, 0.0, 0.0), edge_v=(0.0, 1.0, 0.0)) for i in range(64)]
+    state.lights = areas
+    assert len(scene_state.light_data(areas).point_radius) == 64
+    assert state.light_budget_warnings(limit, shader_sources.MAX_SUNS)[0].startswith(
+        "area lights cut into 1 x 1 patches instead of 4 x 4")
+
+    spots = [export.LightExport(f"spot{i}", "POINT", (0.0, 0.0, 1.0), (0.0, 0.0, -1.0), (float(i),) * 3,
+                                is_spot=True, spot_size=1.0) for i in range(limit + 2)]
+    state.lights = spots
+    assert state.dropped_lights(limit, shader_sources.MAX_SUNS) == ["spot1", "spot0"]
 
 
 def test_viewport_camera_from_view_matrices_matches_render_camera(tracked_scene):
