@@ -203,8 +203,8 @@ def test_new_object_with_new_material_is_uploaded(tracked_scene):
 
 
 def test_area_lights_count_their_patches_against_the_limit():
-    """An area light takes a point light a patch (about 4 x 4 at the default): only as many as fit are kept,
-    whole, the brightest first, and the rest are named as dropped."""
+    """An area light takes a point light a patch (about 4 x 4 at the default): past the limit every area light gets
+    fewer patches, the same for all (here 3 x 3), and none is left out."""
     from sg_prt_addon.blender import export
     from sg_prt_addon.engine import scene_state
     from sg_prt_addon.techniques import shader_sources
@@ -215,11 +215,11 @@ def test_area_lights_count_their_patches_against_the_limit():
     fitting = shader_sources.MAX_POINT_LIGHTS // 16
     lights = [area(i) for i in range(fitting + 2)]
     data = scene_state.light_data(lights)
-    assert len(data.point_radius) == 16 * fitting
+    assert len(data.point_radius) == 9 * (fitting + 2)
     assert np.all(data.point_emitter[:, 0] == 1) and np.all(data.spot_size < 0)
-    assert np.allclose(data.point_intensity.sum(axis=0), sum(100.0 + i for i in range(2, fitting + 2)) / np.pi,
+    assert np.allclose(data.point_intensity.sum(axis=0), sum(100.0 + i for i in range(fitting + 2)) / np.pi,
                        rtol=1e-5)                       # each light's patches carry P / pi along its normal
     state = scene_state.SceneState()
     state.lights = lights
-    assert state.dropped_lights(shader_sources.MAX_POINT_LIGHTS, shader_sources.MAX_SUNS) == ["area0", "area1"]
+    assert state.dropped_lights(shader_sources.MAX_POINT_LIGHTS, shader_sources.MAX_SUNS) == []
     assert len(scene_state.light_data(lights[:1], area_patches=2).point_radius) == 4
