@@ -132,6 +132,7 @@ class SceneState:
         self.materials = {}         # material name ("" = default) -> export.MaterialParams
         self.lights = []            # export.LightExport
         self.area_patches = core_lights.AREA_PATCHES_PER_SIDE   # scene.sgprt.area_light_patches
+        self._light_budget = None   # (its key, LightBudget): light_budget()
         self.shadow_map_size = shadow_maps.DEFAULT_SIZE     # the lights' shadow maps' tile side (0: SSDF shadows)
         self.world = export.WorldExport()
         self.environment = EnvironmentData()
@@ -462,16 +463,26 @@ class SceneState:
     # ----------------------------------------------------------------- shader-side data
 
     def light_data(self):
-        return light_data(self.lights, self.area_patches)
+        return budget_light_data(self.light_budget(MAX_POINT_LIGHTS, MAX_SUNS))
+
+    def light_budget(self, max_points, max_suns):
+        """fit_light_budget of the scene's lights, made again only when the lights (sync and update replace the
+        list), their patches or the limits change: a frame asks for it per upload and per draw."""
+        key = (self.lights, len(self.lights), self.area_patches, max_points, max_suns)
+        cached = self._light_budget
+        if cached is None or cached[0][0] is not key[0] or cached[0][1:] != key[1:]:
+            cached = self._light_budget = (key, fit_light_budget(self.lights, max_points, max_suns,
+                                                                 self.area_patches))
+        return cached[1]
 
     def dropped_lights(self, max_points, max_suns):
         """Names of the lights left out to fit the shader's limits (fit_light_budget's last resort)."""
-        return fit_light_budget(self.lights, max_points, max_suns, self.area_patches).dropped
+        return self.light_budget(max_points, max_suns).dropped
 
     def light_budget_warnings(self, max_points, max_suns):
         """The render report's lines for what fitting the shader's limits changed: fewer area light patches,
         merged point lights, lights left out."""
-        budget = fit_light_budget(self.lights, max_points, max_suns, self.area_patches)
+        budget = self.light_budget(max_points, max_suns)
         limits = f"SG-PRT draws at most {max_points} point, spot and area light patches and {max_suns} suns"
         lines = []
         if budget.area_patches < self.area_patches:
@@ -603,7 +614,11 @@ def _point_rows(light, area_patches):
 def light_data(light_exports, area_patches=core_lights.AREA_PATCHES_PER_SIDE):
     """LightData (float32) from export.LightExport records, an area light cut into about area_patches^2
     patches, within the shader's limits (fit_light_budget)."""
-    budget = fit_light_budget(light_exports, MAX_POINT_LIGHTS, MAX_SUNS, area_patches)
+    return budget_light_data(fit_light_budget(light_exports, MAX_POINT_LIGHTS, MAX_SUNS, area_patches))
+
+
+def budget_light_data(budget):
+    """LightData (float32) of a LightBudget's lights."""
     rows = [row for light in budget.lights if light.kind != "SUN" for row in _point_rows(light, budget.area_patches)]
     suns = [light for light in budget.lights if light.kind == "SUN"]
     data = LightData()
