@@ -138,7 +138,7 @@ def run_file(models, relative, bake_vertex_limit=None):
     run = FileRun(relative)
     try:
         scene = load(models, relative)
-    except (RuntimeError, Exception) as error:      # the importer's own refusals (broken files) in any form
+    except Exception as error:          # the importer's own refusals (broken files), of any type
         lines = [line for line in str(error).strip().splitlines() if line.strip()] or [""]
         run.refused = next((line for line in lines if line.startswith("Error")), lines[-1])
         run.seconds = time.perf_counter() - start

@@ -53,6 +53,11 @@ def scene_geometry(depsgraph):
     return objects
 
 
+def _in_world(occluder, matrix):
+    """(P, 3) float64: an occluder's local vertices placed by one instance's world matrix."""
+    return occluder.vertices.astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+
+
 def occluder_arrays(depsgraph, geometry=None):
     """(vertices (P, 3) float32, triangles (T, 3) int32) of scene_geometry, world space."""
     geometry = scene_geometry(depsgraph) if geometry is None else geometry
@@ -61,7 +66,7 @@ def occluder_arrays(depsgraph, geometry=None):
         if len(occluder.triangles) == 0:
             continue
         for matrix in occluder.matrices:
-            vertices.append(occluder.vertices.astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3])
+            vertices.append(_in_world(occluder, matrix))
             triangles.append(occluder.triangles + offset)
             offset += len(occluder.vertices)
     if not vertices:
@@ -75,8 +80,8 @@ def untraceable(geometry):
     world space} of scene_geometry's objects that have any: their triangles there cast no shadow."""
     counts = {}
     for (name, _), occluder in geometry.items():
-        bad = sum(int(np.count_nonzero(~raytrace.traceable(
-            occluder.vertices.astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]))) for matrix in occluder.matrices)
+        bad = sum(int(np.count_nonzero(~raytrace.traceable(_in_world(occluder, matrix))))
+                  for matrix in occluder.matrices)
         if bad:
             counts[name] = counts.get(name, 0) + bad
     return counts

@@ -20,7 +20,7 @@ class LightClusters:
     intensity: np.ndarray
 
 
-def cluster_point_lights(position, radius, intensity, count, seed=0):
+def cluster_point_lights(position, radius, intensity, count):
     """`count` clusters of omni point lights (position (N, 3), radius (N,), intensity (N, C) radiant intensity):
     power-weighted k-means on their positions, started at the brightest lights.  A cluster's intensity is its
     members' sum, its position their power-weighted mean, its radius the root mean square of their distances from
@@ -31,29 +31,31 @@ def cluster_point_lights(position, radius, intensity, count, seed=0):
     weight = np.maximum(intensity.sum(axis=1), 0.0) + 1e-12
     count = int(min(max(count, 1), len(position)))
     centres = position[np.argsort(-weight, kind="stable")[:count]].copy()
-    labels = np.zeros(len(position), np.int64)
-    for _ in range(KMEANS_ROUNDS):
+    labels = None
+    for _round in range(KMEANS_ROUNDS):
         distance = np.linalg.norm(position[:, None, :] - centres[None, :, :], axis=2)
         new_labels = np.argmin(distance, axis=1)
-        if _ and np.array_equal(new_labels, labels):
+        if labels is not None and np.array_equal(new_labels, labels):
             break
         labels = new_labels
-        totals = np.bincount(labels, weights=weight, minlength=count)
-        filled = totals > 0
-        for axis in range(3):
-            sums = np.bincount(labels, weights=weight * position[:, axis], minlength=count)
-            centres[filled, axis] = sums[filled] / totals[filled]
+        filled = np.bincount(labels, minlength=count) > 0     # a centre left without lights stays where it was
+        centres[filled] = _weighted_sums(labels, weight, position, count)[filled] / \
+            np.bincount(labels, weights=weight, minlength=count)[filled, None]
     labels = _relabel(labels)
     clusters = labels.max() + 1
     totals = np.bincount(labels, weights=weight, minlength=clusters)
-    centre = np.stack([np.bincount(labels, weights=weight * position[:, axis], minlength=clusters) / totals
-                       for axis in range(3)], axis=1)
+    centre = _weighted_sums(labels, weight, position, clusters) / totals[:, None]
     spread = np.sqrt(np.bincount(labels, weights=weight * np.sum((position - centre[labels]) ** 2, axis=1),
                                  minlength=clusters) / totals)
     mean_radius = np.bincount(labels, weights=weight * radius, minlength=clusters) / totals
-    summed = np.stack([np.bincount(labels, weights=intensity[:, c], minlength=clusters)
-                       for c in range(intensity.shape[1])], axis=1)
+    summed = _weighted_sums(labels, np.ones(len(labels)), intensity, clusters)
     return LightClusters(labels, centre, spread + mean_radius, summed)
+
+
+def _weighted_sums(labels, weight, values, count):
+    """(count, D): the sums of weight x values (N, D) over each label."""
+    return np.stack([np.bincount(labels, weights=weight * values[:, d], minlength=count)
+                     for d in range(values.shape[1])], axis=1)
 
 
 def _relabel(labels):

@@ -20,8 +20,8 @@ from embreex.mesh_construction import TriangleMesh
 # embreex's "no limit" tfar; distances of missed rays are reported as inf.
 _EMBREE_FAR = np.float32(1e37)
 _CHUNK_RAYS = 1 << 16
-# Coordinates a bake traces: a vertex beyond them, NaN or Inf is bad input (one such vertex made the scene's
-# size, and so every ray's origin offset, NaN or huge, and every bake empty); its triangles are not traced.
+# Coordinates a bake traces: a vertex beyond them, NaN or Inf is bad input, and its triangles are not traced
+# (one such vertex would make the scene's size, and so every ray's origin offset, NaN or huge).
 COORDINATE_LIMIT = 1e10
 
 

@@ -66,8 +66,8 @@ def _cycles_mean(scene, path):
 
 @pytest.mark.parametrize("angle", [0.2, 0.6])
 def test_an_unnormalized_sun_matches_cycles(engine, tmp_path, angle):
-    """Normalize off: the strength is the sun disc's radiance (Cycles: S pi sin^2(angle / 2) on the floor; 28x
-    too bright when it was read as the irradiance)."""
+    """Normalize off: the strength is the sun disc's radiance (Cycles: S pi sin^2(angle / 2) on the floor; read as
+    the irradiance it is 28x too bright at 12 degrees)."""
     import bpy
 
     if "normalize" not in bpy.types.SunLight.bl_rna.properties:
