@@ -101,10 +101,10 @@ def engine_figures(size, redraws):
     figures.update({"height edit: export (tables)": export, "height edit: next frame": painted,
                     "material edit: next frame": touched})
     for lobes, warp in ((16, "PAPER"), (8, "SPLIT3"), (8, "PAPER")):
-        material.sgprt.biscale.lobes, material.sgprt.view_warp = lobes, warp
+        material.sgprt.biscale.lobes, material.sgprt.sg.view_warp = lobes, warp
         render_seconds()
         figures[f"bi-scale frame, {lobes} lobes, warp {warp.lower()}"] = steady_frame(redraws)
-    material.sgprt.biscale.lobes, material.sgprt.view_warp = 16, "SPLIT3"
+    material.sgprt.biscale.lobes, material.sgprt.sg.view_warp = 16, "SPLIT3"
     material.sgprt.technique = "SG_PARAMETRIC"
     render_seconds()
     figures["single-scale frame (SG technique)"] = steady_frame(redraws)

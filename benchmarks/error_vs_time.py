@@ -17,7 +17,7 @@ on one machine:
    target for the PCA terms); fixed PCA terms 4 / 8 / 16 / all 47 at resolution 32; prefilter
    layer size 64 / 256 (128 is the default); NDF lobe count 2 / 4 / 8 of the anisotropic
    material (6 is the scene's); every material's view warp with one or two lobes per NDF lobe
-   (material.sgprt.view_warp PAPER and SPLIT2; SPLIT3, three, is the default); every material with the
+   (material.sgprt.sg.view_warp PAPER and SPLIT2; SPLIT3, three, is the default); every material with the
    factored-BRDF technique (mccool2001), unshadowed and baked; every material with the spherical-harmonics
    technique (kautz2002) at SH orders 3 / 5 / 6, unshadowed and with a transfer bake of order 6 (each lower
    order reads its leading block).  Bake time is reported apart (a precomputation);
@@ -537,16 +537,16 @@ class SceneRun:
                 finally:
                     material.sgprt.lobe_count = default
             materials = self._materials()
-            defaults = {material.name: material.sgprt.view_warp for material in materials}
+            defaults = {material.name: material.sgprt.sg.view_warp for material in materials}
             try:
                 for mode in config["warp_modes"]:
                     for material in materials:
-                        material.sgprt.view_warp = mode
+                        material.sgprt.sg.view_warp = mode
                     self.engine_render(f"R={resolution}, view warp {mode.lower()} ({warp.DEFAULT_MODE} default)",
                                        "SG-PRT warp", {"bake_resolution": resolution, "warp_mode": mode})
             finally:
                 for material in materials:
-                    material.sgprt.view_warp = defaults[material.name]
+                    material.sgprt.sg.view_warp = defaults[material.name]
             self.factored_stage(materials, default_bakes, resolution)
             self.harmonics_stage(materials)
         finally:
@@ -578,14 +578,14 @@ class SceneRun:
         from sg_prt_addon.blender import transfer_bake
 
         orders = self.config["sh_orders"]
-        defaults = {material.name: (material.sgprt.technique, material.sgprt.sh_order) for material in materials}
+        defaults = {material.name: (material.sgprt.technique, material.sgprt.sh.order) for material in materials}
         try:
             for material in materials:
                 material.sgprt.technique = "SH"
             self.use_bakes(None)
             for order in orders:
                 for material in materials:
-                    material.sgprt.sh_order = order
+                    material.sgprt.sh.order = order
                 self.engine_render(f"SH order {order} (kautz2002), unshadowed", "Spherical harmonics",
                                    {"technique": "SH", "sh_order": order, "transfer": None})
             start = time.perf_counter()
@@ -595,13 +595,13 @@ class SceneRun:
                 raise RuntimeError(f"the transfer bake did not finish: {result}")
             for order in orders:
                 for material in materials:
-                    material.sgprt.sh_order = order
+                    material.sgprt.sh.order = order
                 self.engine_render(f"SH order {order}, transfer order {max(orders)}", "SH + transfer",
                                    {"technique": "SH", "sh_order": order, "transfer": max(orders)},
                                    bake_seconds=seconds if order == max(orders) else None)
         finally:
             for material in materials:
-                material.sgprt.technique, material.sgprt.sh_order = defaults[material.name]
+                material.sgprt.technique, material.sgprt.sh.order = defaults[material.name]
             for obj in self.scene.objects:
                 if obj.type == "MESH":
                     transfer_bake.clear_transfer_bake(obj.data)

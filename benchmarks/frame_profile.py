@@ -86,7 +86,7 @@ def fragment_edits(edits_of_run):
     """Within: the SG techniques' fragment sources go through `edited` with the edits the list `edits_of_run`
     holds at the time (set it between renders, then shader_cache.forget_assembled_sources)."""
     from sg_prt_addon.engine import shader_cache
-    from sg_prt_addon.techniques import sg_lobes
+    from sg_prt_addon.techniques.sg import sg_lobes
 
     whole = sg_lobes.SGLobes.fragment_source
 

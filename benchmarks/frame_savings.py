@@ -4,7 +4,7 @@ against its own baseline in the same run.
 
 Per scene (examples/build_scenes.py at --size, baked by the operator with its defaults):
 - per-vertex diffuse visibility: steady frame (median of render_engine.debug["timed_redraws"]) with the
-  broad diffuse lobes decoded at the vertices vs per pixel (techniques/sg_lobes.py diffuse_visibility_rows
+  broad diffuse lobes decoded at the vertices vs per pixel (techniques/sg/sg_lobes.py diffuse_visibility_rows
   forced to 0, the variant's per-pixel path); also the Combined difference between the two, relative
   RMSE over the surface pixels;
 - clamped-cosine terms: steady frame with the environment lobes' lambda-only terms read from the scene
@@ -46,7 +46,8 @@ def frame(per_vertex=True, terms=True, table=True, shared_light=True):
     """(steady frame seconds, Combined) of one render with the chosen paths."""
     from benchmarks.engine_vs_eevee import steady_frame
     from sg_prt_addon.engine import render_engine, shader_cache
-    from sg_prt_addon.techniques import sg_lobes, sg_shading, shader_sources
+    from sg_prt_addon.techniques import shader_sources
+    from sg_prt_addon.techniques.sg import sg_lobes, sg_shading
 
     rows, read, shares = (sg_lobes.diffuse_visibility_rows, shader_sources.read, sg_shading.shares_light_visibility)
     substitutions = (([] if terms else [(TERMS_CALL, PER_PIXEL_CALL)])

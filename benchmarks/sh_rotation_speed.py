@@ -35,7 +35,8 @@ def measure(orders, rows, repeats):
     from scipy.spatial.transform import Rotation
 
     from sg_prt_addon.harmonics import rotation
-    from sg_prt_addon.techniques import sh_glsl, shader_sources
+    from sg_prt_addon.techniques import shader_sources
+    from sg_prt_addon.techniques.sh import sh_glsl
     from validation.glsl_harness import run_glsl
 
     frames = Rotation.random(rows, random_state=1).as_matrix().astype(np.float32)

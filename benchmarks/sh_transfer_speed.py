@@ -1,5 +1,5 @@
 """The SH technique's frame with a transfer bake, its terms summed per pixel against summed at the vertices
-(techniques/spherical_harmonics.py VERTEX_TRANSFER), beside the unshadowed frame, in one process.
+(techniques/sh/spherical_harmonics.py VERTEX_TRANSFER), beside the unshadowed frame, in one process.
 
 Per scene (examples/build_scenes.py at --size, every material SH at order 5): the unshadowed frame --repeats
 times, then the transfer bake (operator defaults), then the two ways of summing alternated --repeats times;
@@ -40,7 +40,7 @@ def measure_scene(name, size, repeats, redraws=7):
     import bpy
 
     from examples import build_scenes
-    from sg_prt_addon.techniques import spherical_harmonics
+    from sg_prt_addon.techniques.sh import spherical_harmonics
 
     scene = build_scenes.SCENES[name](size)
     for obj in scene.objects:

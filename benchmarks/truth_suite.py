@@ -367,7 +367,7 @@ def markdown_section(data, before=None):
         markdown_table(data["rows"], data["scenes"]), "",
         "The engine's techniques on the same scenes, each with the same bake (SG lobes: wang2009, the SG-PRT "
         "column above; Factored BRDF: mccool2001's p(o) q(h) p(i) r(o.h) of each material's model, 64 x 64 "
-        "parabolic maps, its environment term as techniques/factored.py says; Spherical harmonics: kautz2002 "
+        "parabolic maps, its environment term as techniques/homomorphic/factored.py says; Spherical harmonics: kautz2002 "
         "at order 5 with a transfer bake of order 5 at the operator's defaults):", "",
         techniques_table(data["rows"], data["scenes"]), "",
         "What SG-PRT's error is made of: the shading alone is the unshadowed engine (no bake, no shadow maps) "

@@ -1,7 +1,7 @@
 """Register and unregister everything the add-on adds to Blender, in dependency order."""
 import bpy
 
-from .blender import brdf_factorization, lobe_fit, node_copy, panels, properties, transfer_bake, visibility_bake
+from .blender import lobe_fit, node_copy, panels, properties, technique_sides, transfer_bake, visibility_bake
 from .engine.render_engine import SGPRT_RenderEngine
 
 ENGINE_CLASSES = (SGPRT_RenderEngine,)
@@ -14,7 +14,7 @@ def register():
     visibility_bake.register()
     transfer_bake.register()
     lobe_fit.register()           # after panels: its panel's parent is SGPRT_PT_material
-    brdf_factorization.register()
+    technique_sides.register(properties.SGPRT_PG_material)     # the techniques' settings, operators and panels
     node_copy.register()
     for cls in ENGINE_CLASSES:
         bpy.utils.register_class(cls)
@@ -25,7 +25,7 @@ def unregister():
     while _registered_engine_classes:
         bpy.utils.unregister_class(_registered_engine_classes.pop())
     node_copy.unregister()
-    brdf_factorization.unregister()
+    technique_sides.unregister()
     lobe_fit.unregister()
     transfer_bake.unregister()
     visibility_bake.unregister()

@@ -4,7 +4,7 @@ Used by tests/core/test_environment_specular.py (a procedural sky) and benchmark
 (courtyard.exr): a GGX (or anisotropic GGX) surface seen from every angle of a sphere's visible half (an orthographic camera),
 the reference summing L(i) rho(o, i) max(0, n.i) over every texel of the map (single-scattering GGX, what
 the slice lobes, their energy cap and the environment tail model), the engine reading its prefiltered
-layers at the slice lobes (techniques.sg_shading.shade, the mirror of sg_shading.glsl).  The shading alone:
+layers at the slice lobes (techniques.sg.sg_shading.shade, the mirror of sg_shading.glsl).  The shading alone:
 the warp's lobe shape, the prefiltered lookups, the tail; no visibility.
 """
 from dataclasses import dataclass
@@ -14,7 +14,7 @@ import numpy as np
 from sg_prt_addon.lighting import env_prefilter, equirect
 from sg_prt_addon.lighting.scene_lighting import EnvironmentData, LightData
 from sg_prt_addon.reflectance import brdf
-from sg_prt_addon.techniques import sg_shading
+from sg_prt_addon.techniques.sg import sg_shading
 from sg_prt_addon.visibility import hemisphere_map
 
 VIEW = np.array([-0.47, 0.83, -0.31])          # the camera's forward direction

@@ -1,5 +1,5 @@
 """The reference the SH tables of a lobe fit (harmonics/fitted_table.py) are checked against: the fitted BRDF x
-cosine, exactly as the SG_FITTED mirror evaluates it (techniques.fitted_texels.fitted_m_factor times the RGB
+cosine, exactly as the SG_FITTED mirror evaluates it (techniques.sg.fitted_texels.fitted_m_factor times the RGB
 lobes), projected into SH on a dense uniform lattice; and the tables' own entries put together the way the
 shader does (colours and the view's S(o) / (pi o.z) applied).  Shared by tests/core/test_sh_fitted_table.py and
 benchmarks/accuracy/harmonics.py."""
@@ -9,7 +9,7 @@ from sg_prt_addon.harmonics import basis, fitted_table
 from sg_prt_addon.measured import microfacet_fit
 from sg_prt_addon.reflectance import brdf
 from sg_prt_addon.spherical.lattice import hemisphere_points
-from sg_prt_addon.techniques import fitted_texels
+from sg_prt_addon.techniques.sg import fitted_texels
 
 DENSE_POINTS = 300000      # against 4,000,000: within 1e-6 of the largest coefficient on the generated fits
 

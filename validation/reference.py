@@ -44,7 +44,7 @@ from typing import Any, Callable, Optional, Sequence
 import numpy as np
 
 from sg_prt_addon.lighting import lights
-from sg_prt_addon.visibility import hemisphere_map
+from sg_prt_addon.spherical import concentric_map
 from sg_prt_addon.visibility.raytrace import RayTracer, offset_origins
 from validation.env_sampling import LUMINANCE_WEIGHTS, EnvironmentSampler
 
@@ -122,7 +122,7 @@ class AreaLight:
         """(N, 3) points uniform over the light's area."""
         square = 2.0 * uniforms - 1.0
         if self.elliptic:
-            square = hemisphere_map.square_to_disc(square)
+            square = concentric_map.square_to_disc(square)
         return (np.asarray(self.centre, float) + 0.5 * square[:, :1] * np.asarray(self.edge_u, float)
                 + 0.5 * square[:, 1:] * np.asarray(self.edge_v, float))
 

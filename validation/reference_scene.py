@@ -10,7 +10,7 @@ import numpy as np
 from sg_prt_addon.biscale import effective_brdf
 from sg_prt_addon.blender import export
 from sg_prt_addon.reflectance import brdf, models
-from sg_prt_addon.techniques import sg_shading
+from sg_prt_addon.techniques.sg import sg_shading
 from validation import biscale_reference, reference
 from validation.camera import Camera
 
@@ -170,7 +170,7 @@ def reference_inputs(depsgraph, width, height):
         return export.slot_pixels(value, slot, decode)
 
     def biscale_geometry(material_name, second):
-        from sg_prt_addon.blender import biscale_source
+        from sg_prt_addon.techniques.sg.blender import biscale_source
 
         return biscale_source.geometry(bpy.data.materials[material_name], second)
 

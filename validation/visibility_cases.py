@@ -2,10 +2,10 @@
 tests/core/test_buried.py) and by docs/ACCURACY.md's ssdf rows (benchmarks/accuracy/ssdf.py).
 
 - A light's cap crossing the edge of a half-plane: the share of the cap (cosine-weighted) the SSDF's
-  reading leaves visible (techniques.sg_shading.light_cap_visibility), and eq. 30's fh of the light's SG,
+  reading leaves visible (techniques.sg.sg_shading.light_cap_visibility), and eq. 30's fh of the light's SG,
   against the exact share.
 - A glossy lobe crossing the same edge under an environment brighter on the edge's open side: the radiance the
-  lobe's visible part receives, read at the lobe's axis and at its visible part (techniques.sg_shading.
+  lobe's visible part receives, read at the lobe's axis and at its visible part (techniques.sg.sg_shading.
   visible_part_axes: turned to the side lobe_visibility_side finds in the baked SSDF, narrowed), against
   quadrature over the sphere.
 - A floor through a sphere: floor vertices inside the sphere are buried (visibility.buried); at visible
@@ -66,9 +66,9 @@ def baked_half_plane_ssdf(axes, resolution=32, refinement=5):
 
 
 def half_plane_visibility(count, resolution=32, refinement=5):
-    """techniques.sg_shading.Visibility of ``count`` pixels at the origin (normal +z) under the half-plane, its
+    """techniques.sg.sg_shading.Visibility of ``count`` pixels at the origin (normal +z) under the half-plane, its
     baked SSDF as the mean image of a basis without terms."""
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     quad = np.array([[-20.0, -20.0, 1.0], [0.0, -20.0, 1.0], [0.0, 20.0, 1.0], [-20.0, 20.0, 1.0]])
     tracer = RayTracer(quad, np.array([[0, 1, 2], [0, 2, 3]]), threads=1)
@@ -100,7 +100,7 @@ def lobe_edge_radiance(sharpness, steps=41):
     SSDF's side, offset and narrowing: visible_part_axes); the exact visible fraction; the angle between the side
     lobe_visibility_side finds and the edge's open side across the axis."""
     from sg_prt_addon.lighting.env_fit import fibonacci_sphere
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     tilt = np.array([[1, 0, 0], [0, np.cos(CAP_TILT), -np.sin(CAP_TILT)], [0, np.sin(CAP_TILT), np.cos(CAP_TILT)]])
     alpha = np.linspace(-2.0, 2.0, steps) / np.sqrt(sharpness)

@@ -1,4 +1,4 @@
-"""Accuracy of what the SG technique adds to its GGX lobes (techniques.sg_shading): the light tail (the model's
+"""Accuracy of what the SG technique adds to its GGX lobes (techniques.sg.sg_shading): the light tail (the model's
 own BRDF at a light's centre), GGX's directional albedo table (the environment tail), the visible-part
 lookup of partly occluded lobes, and environment lookups sharper than the top prefiltered layer.
 
@@ -13,7 +13,7 @@ from sg_prt_addon.lighting import env_prefilter
 from sg_prt_addon.lighting.scene_lighting import EnvironmentData
 from sg_prt_addon.reflectance import brdf, ggx_albedo
 from sg_prt_addon.spherical import sg
-from sg_prt_addon.techniques import sg_shading
+from sg_prt_addon.techniques.sg import sg_shading
 
 ROUGHNESS = (0.1, 0.3, 0.5)
 
@@ -80,7 +80,7 @@ def _albedo_rows():
              max_error=float(np.max(missing)), mean_error=float(np.mean(missing)),
              note="negative where the lobes overshoot (grazing views, cos theta_o 0.05: 1.76 against 0.999 at "
                   "roughness 0.05, 5.0 against 0.85 at 1.0); the shader scales them down to E there "
-                  "(techniques.sg_shading.model_albedo; white furnace within 0.0017 of E, tests/gpu/test_ggx_energy.py)"),
+                  "(techniques.sg.sg_shading.model_albedo; white furnace within 0.0017 of E, tests/gpu/test_ggx_energy.py)"),
     ]
 
 

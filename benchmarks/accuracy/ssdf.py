@@ -52,9 +52,9 @@ def _plane_bake(tilt_degrees, resolution, refinement=5):
 
 def _broad_lobe_rows(model, samples, normals, dense, fine_local, rng):
     """The visible fraction of lobes G(i; axis, lambda) max(0, n.i) at baked vertices against dense rays:
-    the quadrature of visibility.broad_lobes, eq. 30's reading at the axis (techniques.sg_shading.
+    the quadrature of visibility.broad_lobes, eq. 30's reading at the axis (techniques.sg.sg_shading.
     lobe_visibility), and the blend the per-vertex pass of the diffuse lobes uses."""
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     resolution = 32
     coefficients = pca.project(model, samples)

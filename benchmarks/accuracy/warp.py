@@ -16,7 +16,7 @@ import importlib.util
 import numpy as np
 
 from sg_prt_addon.spherical import sg, warp
-from sg_prt_addon.techniques import sg_shading
+from sg_prt_addon.techniques.sg import sg_shading
 
 VIEW_ANGLES = (0, 30, 60, 75, 85)
 ALPHAS = (0.05, 0.1, 0.3, 0.5)

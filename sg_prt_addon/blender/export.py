@@ -1,7 +1,7 @@
 """Blender scene -> plain numpy arrays and small dataclasses (no `gpu` here).
 
 Everything the engine draws goes through this module, so the GPU side and the
-numpy mirror (techniques/sg_shading.py) see exactly the same numbers:
+numpy mirror (techniques/sg/sg_shading.py) see exactly the same numbers:
 
 - meshes: one vertex per face corner (loop), so split normals, UV seams and
   tangent sign flips need no vertex splitting logic; triangles index corners;
@@ -24,17 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import techniques
-from ..biscale import effective_brdf
 from ..reflectance import layering, models, principled
-from ..techniques import (
-    biscale_shading,
-    factored,
-    sg_biscale,
-    sg_fitted,
-    sg_shading,
-    spherical_harmonics,
-    surface_layering,
-)
+from . import technique_sides
 from .images import image_has_pixels, image_pixels
 
 # Mesh exports since import; tests read it to check what an update re-exported.
@@ -121,8 +112,9 @@ class MaterialParams:
     nu: float = 100.0
     nv: float = 1000.0
     lobe_count: int = 0             # an anisotropic model's NDF lobes; 0: its default (models.lobes_of)
-    warp_mode: str = "split3"      # spherical.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.view_warp)
-    sh_order: int = 5              # the SH technique's order and window (harmonics.projection's names, or "none")
+    warp_mode: str = "split3"      # spherical.warp mode (its DEFAULT_MODE) of the view slice (material.sgprt.sg.view_warp)
+    sh_order: int = 5              # the SH technique's order and window (material.sgprt.sh: harmonics.projection's
+                                   # names, or "none")
     sh_window: str = "none"
     # the glossy layer (reflectance.layering): Schlick Fresnel on the specular colour, Multiscatter GGX's gain,
     # the F0 of a dielectric layer over the diffuse (below 0: none); emitted radiance (Combined only)
@@ -143,16 +135,22 @@ class MaterialParams:
     textures: dict = field(default_factory=dict)
     technique: str = techniques.DEFAULT    # the registered technique that renders it (techniques/)
     fitted: object = None          # FittedLobes with the fitted-lobes technique and a VALID stored fit
-    factorization: object = None   # techniques.factored.FactoredTables of VALID stored factors (factored technique)
+    factorization: object = None   # the factored technique's FactoredTables of its VALID stored factors
     biscale: object = None         # biscale.bvndf.BVNDF of the material's small-scale tile (bi-scale technique)
     # datablocks the look is computed from besides its texture images, ("IMAGE" | "OBJECT" | "MESH", name): the
     # scene state exports the material again when one changes (a bi-scale tile's height image or mesh)
     reads: tuple = ()
+    # a technique's own settings without a field above, name -> hashable value (its Blender side's read() sets them)
+    options: dict = field(default_factory=dict)
 
     def values_key(self):
         """Everything but textures, hashable: the material UBO is rebuilt when this changes."""
-        return tuple((k, v.signature if k in ("fitted", "factorization", "biscale") and v is not None else v)
-                     for k, v in self.__dict__.items() if k != "textures")
+        def hashable(name, value):
+            if name == "options":
+                return tuple(sorted(value.items()))
+            return value.signature if name in ("fitted", "factorization", "biscale") and value is not None else value
+
+        return tuple((k, hashable(k, v)) for k, v in self.__dict__.items() if k != "textures")
 
 
 @dataclass(eq=False)
@@ -449,134 +447,6 @@ def matrix_to_numpy(matrix):
 
 # --------------------------------------------------------------------------- materials
 
-def _usable_technique(material, params):
-    """The technique the material picks, when it can render it (the fitted lobes need a VALID stored fit,
-    which goes to params.fitted); else the default, with a warning that says why."""
-    from . import lobe_fit
-
-    name = techniques.of_settings(material.sgprt)
-    if name not in techniques.names():
-        warn(f"material '{material.name}': technique {name!r} is not available in this version "
-             f"(registered: {', '.join(techniques.names())}): rendered with {techniques.DEFAULT}")
-        return techniques.DEFAULT
-    if name == factored.NAME:
-        from . import brdf_factorization
-
-        params.factorization = brdf_factorization.stored_tables(material)
-        state, message = brdf_factorization.factorization_status(material)
-        if state == "INVALID":
-            warn(f"material '{material.name}': stored BRDF factors unusable ({message}): its model is factorized")
-        ignored = sorted(slot for slot in params.textures if slot not in factored.TEXTURE_SLOTS)
-        if ignored:
-            warn(f"material '{material.name}': {factored.TECHNIQUE.label} factorizes the model with uniform "
-                 f"parameters: the textures on {', '.join(ignored)} are not applied")
-    if name == spherical_harmonics.NAME:
-        if material.sgprt.sh_brdf == "LOBE_FIT":
-            name = _usable_sh_lobe_fit(material, params)
-            if name != spherical_harmonics.NAME:
-                return name
-        ignored = sorted(slot for slot in params.textures if slot not in spherical_harmonics.texture_slots(params))
-        if ignored and params.fitted is not None:
-            warn(f"material '{material.name}': {spherical_harmonics.TECHNIQUE.label} tabulates the lobe fit: the "
-                 f"textures on {', '.join(ignored)} are not applied")
-        elif ignored:
-            warn(f"material '{material.name}': {spherical_harmonics.TECHNIQUE.label} tabulates the model with "
-                 f"uniform {', '.join(ignored)}: those textures are not applied")
-    if name == sg_biscale.NAME:
-        return _usable_biscale(material, params)
-    if name == sg_fitted.NAME:
-        params.fitted = export_fitted_lobes(material)
-        if params.fitted is None:
-            state, message = lobe_fit.fit_status(material)
-            warn(f"material '{material.name}': no usable lobe fit ({message or state.lower()}): rendered with "
-                 "its model")
-            return techniques.DEFAULT
-    return name
-
-
-def _usable_sh_lobe_fit(material, params):
-    """SH with the material's stored lobe fit in params.fitted when it can tabulate it; else SH with the model
-    (no usable fit) or the fitted SG lobes (a fit SH cannot tabulate: free axes, too large), with the reason."""
-    from . import lobe_fit
-
-    label = spherical_harmonics.TECHNIQUE.label
-    fitted = export_fitted_lobes(material)
-    if fitted is None:
-        state, message = lobe_fit.fit_status(material)
-        warn(f"material '{material.name}': {label}: no usable lobe fit ({message or state.lower()}): its model is "
-             "tabulated")
-        return spherical_harmonics.NAME
-    reason = _lobe_tilt(fitted) or spherical_harmonics.fitted_refusal(fitted, params.sh_order)
-    if reason is not None:
-        params.fitted = fitted
-        warn(f"material '{material.name}': {label} cannot tabulate its lobe fit ({reason}): rendered with "
-             f"{sg_fitted.TECHNIQUE.label}")
-        return sg_fitted.NAME
-    params.fitted = fitted
-    return spherical_harmonics.NAME
-
-
-def _usable_biscale(material, params):
-    """The bi-scale technique with the material's tile (params.biscale) and small-scale BRDF (its model, or its
-    stored lobe fit in params.fitted), or a single-scale technique with the reason."""
-    from . import biscale_source
-
-    settings = material.sgprt.biscale
-    label = sg_biscale.TECHNIQUE.label
-    if settings.small_scale == "LOBE_FIT":
-        params.fitted, reason = _isotropic_lobe_fit(material)
-        if params.fitted is None:
-            warn(f"material '{material.name}': {label}: no usable small-scale lobe fit ({reason}): rendered as a "
-                 "single scale with its model")
-            return techniques.DEFAULT
-    elif params.model not in biscale_shading.SMALL_SCALE_MODELS:
-        warn(f"material '{material.name}': {label} needs an isotropic small-scale model "
-             f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}: rendered as a single scale")
-        return techniques.DEFAULT
-    params.reads = biscale_source.reads(material)
-    params.biscale, reason = biscale_source.tables(material)
-    if params.biscale is None:
-        fallback = techniques.DEFAULT if params.fitted is None else sg_fitted.NAME
-        warn(f"material '{material.name}': no usable small-scale geometry ({reason}): rendered as a single scale"
-             f"{' with its lobe fit' if params.fitted is not None else ''}")
-        return fallback
-    if biscale_source.masked(settings):
-        params.textures[sg_shading.BISCALE_MASK] = settings.mask.name
-    elif settings.mask is not None:
-        warn(f"material '{material.name}': its bi-scale mask has no second height image: the mask is not applied")
-    layers = surface_layering.flags(params)
-    if layers and params.fitted is None:
-        warn(f"material '{material.name}': {label} does not apply {', '.join(layers)}")
-    ignored = sorted(slot for slot in params.textures if slot not in sg_biscale.texture_slots(params))
-    if ignored:
-        warn(f"material '{material.name}': {label} does not apply the textures on {', '.join(ignored)}"
-             f"{' (the lobe fit holds the small-scale look)' if params.fitted is not None else ''}")
-    return sg_biscale.NAME
-
-
-def _isotropic_lobe_fit(material):
-    """(FittedLobes, None) of the material's stored fit when its lobes lie about the normal (a small-scale BRDF
-    must be isotropic), else (None, the reason)."""
-    from . import lobe_fit
-
-    fitted = export_fitted_lobes(material)
-    if fitted is None:
-        state, message = lobe_fit.fit_status(material)
-        return None, message or state.lower()
-    reason = _lobe_tilt(fitted)
-    if reason is not None:
-        return None, reason + " for an isotropic small-scale BRDF"
-    return fitted, None
-
-
-def _lobe_tilt(fitted):
-    """Why a FittedLobes is not isotropic (its lobes leave the normal: a free-axes fit), or None."""
-    tilt, degrees = effective_brdf.axis_tilt(fitted.layers[1:1 + 2 * fitted.lobe_count:2, ..., :3])
-    if tilt > effective_brdf.AXIS_TOLERANCE:
-        return f"its lobes leave the normal by up to {degrees:.1f} degrees: fit with Axes Auto"
-    return None
-
-
 def export_material(material):
     """MaterialParams of a bpy Material (None, or without `sgprt`: the defaults): its SG-PRT settings, or its
     node tree's reading when its Source is the node tree."""
@@ -595,9 +465,7 @@ def export_material(material):
     for name in SCALAR_PARAMETERS:
         setattr(params, name, float(getattr(settings, name)))
     params.lobe_count = int(settings.lobe_count)
-    params.warp_mode = settings.view_warp.lower()       # properties.VIEW_WARPS: spherical.warp's mode names
-    params.sh_order = int(settings.sh_order)
-    params.sh_window = settings.sh_window.lower()       # properties.SH_WINDOWS: harmonics.projection's names
+    technique_sides.read(material, params)
     params.normal_strength = float(settings.normal_strength)
     params.tangent_source = settings.tangent_source
     params.tangent_axis = tuple(settings.tangent_axis)
@@ -614,7 +482,9 @@ def export_material(material):
         params.textures["normal_map"] = settings.normal_map.name
     if properties.resolved_source(settings) == "NODE_TREE":
         _read_node_tree(material, params)
-    params.technique = _usable_technique(material, params)
+    params.technique, warnings = technique_sides.resolve(material, params)
+    for message in warnings:
+        warn(message)
     _finite_settings(params)
     return params
 

@@ -26,10 +26,10 @@ Storage (format version 1), the engine's input
 cosine-weighted fitted BRDF against the source over an independent direction grid:
 microfacet_fit.relative_rmse, mean / max over texels), ``ndf_error`` (mean relative L2
 of the SG fit of D), ``date`` (ISO 8601 UTC), ``seconds``, and ``images``: a collection of
-(``role``, ``image``).  A fit sets ``material.sgprt.technique`` to the fitted-lobes technique
-(techniques/sg_fitted.py): the engine then renders the fit instead of ``model``; clearing the fit sets
-the default technique back.  A bi-scale material keeps its technique and takes the fit as its small-scale
-BRDF; a spherical-harmonics material keeps its technique and tabulates the fit (``sh_brdf`` LOBE_FIT).
+(``role``, ``image``).  A fit is taken by the material's technique when it reads fits (its Blender side's
+take_lobe_fit: a bi-scale material's small-scale BRDF, a spherical-harmonics material's tabulated BRDF), else
+the technique that renders fits is picked (techniques.rendering_stored("lobe_fit")); clearing the fit sets the
+default technique back from that one.
 
 Every image is a FLOAT RGBA image (32-bit float), packed into the .blend (OpenEXR,
 float32-exact through save and reopen on 4.2 and 5.0), colour space Non-Color,
@@ -69,7 +69,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from .. import techniques
 from ..measured import merl as merl_format
 from ..measured import microfacet_fit, svbrdf_table
-from ..techniques import sg_biscale, sg_fitted, spherical_harmonics
+from . import technique_sides
 from .background_job import BackgroundJob, MaterialFileJobOperator, active_material
 from .panels import MaterialPanel
 
@@ -287,7 +287,8 @@ def clear_lobe_fit(material):
                  "shadowing_components", "shadowing_samples", "width", "height", "fit_error", "fit_error_max",
                  "ndf_error", "date", "seconds"):
         settings.property_unset(name)
-    if techniques.of_settings(material.sgprt) == sg_fitted.NAME:
+    fitted = techniques.rendering_stored("lobe_fit")
+    if fitted is not None and techniques.of_settings(material.sgprt) == fitted.name:
         material.sgprt.technique = techniques.DEFAULT
     if "use_fitted_lobes" in material.sgprt.keys():        # the setting of files before techniques
         del material.sgprt["use_fitted_lobes"]
@@ -336,13 +337,7 @@ def store_lobe_fit(material, result, path, free_axes=None):
     settings.date = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     settings.seconds = float(result["seconds"])
     settings.format_version = FORMAT_VERSION
-    technique = techniques.of_settings(material.sgprt)
-    if technique == sg_biscale.NAME:
-        material.sgprt.biscale.small_scale = "LOBE_FIT"      # a bi-scale material's fit is its small-scale BRDF
-    elif technique == spherical_harmonics.NAME:
-        material.sgprt.sh_brdf = "LOBE_FIT"                  # an SH material tabulates the fit
-    else:
-        material.sgprt.technique = sg_fitted.NAME
+    technique_sides.take_lobe_fit(material)
     material.update_tag()
 
 
@@ -498,19 +493,11 @@ class SGPRT_PT_material_lobe_fit(MaterialPanel, bpy.types.Panel):
         if state == "NONE":
             column.label(text="No fitted lobes: renders the model above", icon="INFO")
             return
-        technique = techniques.of_settings(material.sgprt)
-        if technique == sg_biscale.NAME and material.sgprt.biscale.small_scale == "LOBE_FIT":
-            column.label(text="The small-scale BRDF of the bi-scale material", icon="INFO")
-        elif technique == spherical_harmonics.NAME and material.sgprt.sh_brdf == "LOBE_FIT":
-            if settings.free_axes:
-                column.label(text="Free axes: SH tabulates lobes about the normal only: rendered as SG lobes",
-                             icon="INFO")
-            else:
-                column.label(text="Tabulated per texel by the SH technique", icon="INFO")
-        elif technique == spherical_harmonics.NAME:
-            column.label(text="Renders the model: set SH BRDF to Lobe Fit to render the fit", icon="INFO")
-        elif technique != sg_fitted.NAME:
+        use = technique_sides.lobe_fit_use(material)
+        if use is None:
             column.label(text="Renders the model: pick the fitted technique above to render the fit", icon="INFO")
+        elif use:
+            column.label(text=use, icon="INFO")
         if state == "INVALID":
             column.alert = True
             column.label(text=message, icon="ERROR")

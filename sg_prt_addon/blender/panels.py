@@ -1,9 +1,8 @@
 """Properties-editor panels of the SG-PRT engine."""
 import bpy
 
-from .. import techniques
 from ..reflectance import models
-from ..techniques import sg_biscale, spherical_harmonics
+from . import technique_sides
 
 ENGINE_ID = "SG_PRT"
 
@@ -20,16 +19,6 @@ class MaterialPanel:
         return context.engine in cls.COMPAT_ENGINES and context.material is not None
 
 
-def _draw_technique_settings(layout, settings):
-    """The chosen technique's own settings (whatever the material's source)."""
-    if techniques.of_settings(settings) == spherical_harmonics.NAME:
-        layout.prop(settings, "sh_order")
-        layout.prop(settings, "sh_window")
-        layout.prop(settings, "sh_brdf")
-    else:
-        layout.prop(settings, "view_warp")
-
-
 class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
     bl_label = "SG-PRT Surface"
 
@@ -42,7 +31,7 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
         if settings.source == "NODE_TREE":
             layout.label(text="Shading nodes: Principled, Diffuse, Glossy, Emission, Mix, Add", icon="NODETREE")
             layout.operator("sgprt.copy_from_node_tree")
-            _draw_technique_settings(layout, settings)
+            technique_sides.draw(layout, context.material)
             return
         layout.prop(settings, "model")
         textured = settings.show_textures
@@ -55,45 +44,9 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
                 row.template_ID(settings, f"{name}_texture", open="image.open")
         for name in ("fresnel", "multiscatter", "layered_diffuse", "emission_color", "emission_strength"):
             layout.prop(settings, name)
-        _draw_technique_settings(layout, settings)
+        technique_sides.draw(layout, context.material)
         layout.prop(settings, "show_textures")
 
-
-
-class SGPRT_PT_material_biscale(MaterialPanel, bpy.types.Panel):
-    bl_label = "Small-Scale Geometry"
-    bl_parent_id = "SGPRT_PT_material"
-
-    @classmethod
-    def poll(cls, context):
-        return super().poll(context) and techniques.of_settings(context.material.sgprt) == sg_biscale.NAME
-
-    def draw(self, context):
-        from . import biscale_source
-
-        settings = context.material.sgprt.biscale
-        layout = self.layout
-        layout.use_property_split = True
-        layout.prop(settings, "source")
-        if settings.source == "IMAGE":
-            layout.template_ID(settings, "height_image", open="image.open")
-            layout.prop(settings, "height_scale")
-        else:
-            layout.prop(settings, "tile_object")
-        layout.template_ID(settings, "mask", open="image.open")
-        if settings.mask is not None:
-            layout.template_ID(settings, "second_height_image", open="image.open")
-            layout.prop(settings, "second_height_scale")
-        for name in ("lobes", "resolution", "samples"):
-            layout.prop(settings, name)
-        status = biscale_source.last_status(context.material)
-        if status:
-            layout.label(text=status, icon="INFO")
-        layout.prop(settings, "small_scale")
-        if settings.small_scale == "LOBE_FIT":
-            layout.label(text="The lobe fit below (Measured BRDF): isotropic, Axes Auto", icon="MATERIAL")
-        else:
-            layout.label(text="The model above (isotropic)", icon="MATERIAL")
 
 
 class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
@@ -157,8 +110,7 @@ class SGPRT_PT_shadows(RenderPanel, bpy.types.Panel):
         row.prop(settings, "shadow_map_size")
 
 
-classes = (SGPRT_PT_material, SGPRT_PT_material_biscale, SGPRT_PT_material_geometry, SGPRT_PT_sampling,
-           SGPRT_PT_shadows)
+classes = (SGPRT_PT_material, SGPRT_PT_material_geometry, SGPRT_PT_sampling, SGPRT_PT_shadows)
 
 # Built-in panels that work unchanged with this engine.
 COMPATIBLE_BUILTIN_PANELS = (

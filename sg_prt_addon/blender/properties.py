@@ -20,22 +20,7 @@ from .. import techniques
 from ..lighting import shadow_maps
 from ..lighting.lights import AREA_PATCHES_PER_SIDE
 from ..reflectance import models, ndf_fit
-
-# How each NDF lobe is warped to the view slice: spherical.warp's modes, upper case (figures from its docstring).
-SH_WINDOWS = (("NONE", "None", "The bands as projected (sharpest; rings around small bright lights)"),
-              ("HANNING", "Hanning", "(1 + cos(pi l / N)) / 2 per band: the least ringing, the most blur"),
-              ("LANCZOS", "Lanczos", "sinc(l / N) per band: less blur than Hanning, more ringing"))
-SH_BRDFS = (("MODEL", "Material Model", "The material's model and parameters, tabulated over its parameter axis"),
-            ("LOBE_FIT", "Lobe Fit", "The material's stored lobe fit (Fit Lobes: a measured BRDF or SVBRDF, lobes "
-                                     "about the normal), tabulated per texel"))
-VIEW_WARPS = (
-    ("SPLIT3", "3 Lobes", "Three warped lobes per NDF lobe (default): the most accurate at grazing views "
-                          "(mean energy error 0.09 at 75 degrees)"),
-    ("SPLIT2", "2 Lobes", "Two warped lobes per NDF lobe: about a fifth faster on anisotropic metals, "
-                          "energy error 0.15 at 75 degrees"),
-    ("PAPER", "1 Lobe", "The paper's single warped lobe: fastest, loses energy at grazing views "
-                        "(0.08 at 75 degrees, 0.2 at 85)"),
-)
+from . import technique_sides
 
 FRESNEL_MODES = (("NONE", "None", "The specular colour at every angle (Blender's Glossy BSDF)"),
                  ("SCHLICK", "Schlick", "The specular colour at normal incidence, white at grazing angles "
@@ -70,7 +55,7 @@ def settings_given(settings):
     images = tuple(name + "_texture" for name in TEXTURED_PARAMETERS) + ("normal_map",)
     return (any(settings.is_property_set(name) for name in APPEARANCE_PROPERTIES)
             or any(getattr(settings, name) is not None for name in images)
-            or settings.lobe_fit.format_version > 0 or settings.factorization.format_version > 0)
+            or settings.lobe_fit.format_version > 0 or technique_sides.settings_given(settings.id_data))
 
 
 def has_node_tree(material):
@@ -140,72 +125,6 @@ class SGPRT_PG_lobe_fit(bpy.types.PropertyGroup):
     images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
 
 
-class SGPRT_PG_factorization(bpy.types.PropertyGroup):
-    """A measured BRDF factorized by sgprt.factor_brdf (layout: blender/brdf_factorization.py)."""
-    format_version: IntProperty(name="Format Version", default=0, description="0: no factors stored")
-    source_file: StringProperty(name="Source File", description="File name the factors were made from")
-    source_path: StringProperty(name="Source Path", description="Full path the factors were made from")
-    source_texel: IntProperty(name="Source Texel", default=-1, min=-1,
-                              description="The SVBRDF table texel factorized (row-major); -1: a MERL file")
-    form: StringProperty(name="Form", description="measured.homomorphic.FORMS key")
-    resolution: IntProperty(name="Resolution", default=0, min=0)
-    alpha_scale: FloatVectorProperty(name="Scale", size=3, default=(1.0, 1.0, 1.0),
-                                     description="alpha A of the factored BRDF (RGB)")
-    lobe_sharpness: FloatProperty(name="Lobe Sharpness", default=1.0, description="Of the glossy environment lookup")
-    samples: IntProperty(name="Samples", default=0, min=0)
-    masked: IntProperty(name="Masked Samples", default=0, min=0, description="NaN, Inf and negative samples left out")
-    error: FloatProperty(name="Error", default=0.0, description="Relative RMS against the source, cosine weighted")
-    date: StringProperty(name="Date", description="When the factors were stored (ISO 8601 UTC)")
-    seconds: FloatProperty(name="Seconds", default=0.0)
-    images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
-    previous_technique: StringProperty(name="Technique Before",
-                                       description="The material's technique before the factors set theirs: "
-                                                   "Clear BRDF Factors gives it back")
-
-
-def _is_mesh(self, obj):
-    return obj.type == "MESH"
-
-
-class SGPRT_PG_biscale(bpy.types.PropertyGroup):
-    """A bi-scale material's small-scale geometry (technique SG_BISCALE; blender/biscale_source.py): a tileable
-    height field or a mesh tile, seen under the material's own model."""
-    source: EnumProperty(update=_tag_changed, name="Geometry", default="IMAGE",
-                         items=(("IMAGE", "Height Field", "A tileable height image (its mean of RGB) over one tile"),
-                                ("OBJECT", "Mesh Tile", "A mesh object's faces, one period of the surface across "
-                                                        "its X and Y extent, facing +Z")),
-                         description="What the surface is made of at the small scale")
-    height_image: PointerProperty(update=_tag_changed, type=bpy.types.Image, name="Height",
-                                  description="Tileable height field: heights are its values times Height Scale, "
-                                              "in tile widths")
-    height_scale: FloatProperty(update=_tag_changed, name="Height Scale", default=0.05, min=0.0,
-                                soft_max=0.5, description="Height of an image value of 1, in tile widths")
-    small_scale: EnumProperty(update=_tag_changed, name="Small-Scale BRDF", default="MODEL",
-                              items=(("MODEL", "Material Model", "The material's own isotropic model, colours and "
-                                                                 "textures"),
-                                     ("LOBE_FIT", "Lobe Fit", "The material's stored lobe fit (Fit Lobes: a measured "
-                                                              "BRDF, isotropic, Axes Auto)")),
-                              description="What the small-scale geometry's surface reflects with")
-    tile_object: PointerProperty(update=_tag_changed, type=bpy.types.Object, name="Tile", poll=_is_mesh,
-                                 description="Mesh whose faces are one tile of the surface (object space)")
-    mask: PointerProperty(update=_tag_changed, type=bpy.types.Image, name="Mask",
-                          description="Where the second tile replaces the first: its red channel over the UV map "
-                                      "(0: the first tile, 1: the second, between: both, blended)")
-    second_height_image: PointerProperty(update=_tag_changed, type=bpy.types.Image, name="Second Height",
-                                         description="The second tile's tileable height field, used where the "
-                                                     "mask is 1")
-    second_height_scale: FloatProperty(update=_tag_changed, name="Second Height Scale", default=0.05,
-                                       min=0.0, soft_max=0.5,
-                                       description="Height of an image value of 1 in the second tile, in tile widths")
-    lobes: IntProperty(update=_tag_changed, name="Lobes", default=16, min=1, max=32,
-                       description="SG lobes of the tile's normal distribution (more follow sharp small-scale "
-                                   "BRDFs better; docs/ACCURACY.md, bi-scale)")
-    resolution: IntProperty(update=_tag_changed, name="Directions", default=12, min=4, max=20,
-                            description="Lattice of view and light directions per side (12: 144 each, the paper's)")
-    samples: IntProperty(update=_tag_changed, name="Samples", default=4096, min=256, max=65536,
-                         description="Points on the tile whose shadowing and masking are traced")
-
-
 class SGPRT_PG_material(bpy.types.PropertyGroup):
     source: EnumProperty(name="Source", items=SOURCES, get=_get_source, set=_set_source,
                          description="What the material's look is read from: its shader nodes, or the SG-PRT "
@@ -248,16 +167,6 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
     nu_texture: _texture("nu")
     nv_texture: _texture("nv")
 
-    view_warp: EnumProperty(update=_tag_changed, name="View Warp", items=VIEW_WARPS, default="SPLIT3",
-                            description="Lobes each NDF lobe becomes in the view slice (wang2009 eq. 17-22 and its "
-                                        "split): fewer render faster, more are more accurate at grazing views")
-    sh_order: IntProperty(update=_tag_changed, name="SH Order", default=5, min=2, max=8,
-                          description="Bands of the spherical-harmonic technique (order N: N^2 coefficients; "
-                                      "Kautz 2002 used 5): higher follows sharper lights and glossier lobes")
-    sh_window: EnumProperty(update=_tag_changed, name="SH Window", items=SH_WINDOWS, default="NONE",
-                            description="Smoothing of the lighting's bands against ringing (it blurs)")
-    sh_brdf: EnumProperty(update=_tag_changed, name="SH BRDF", items=SH_BRDFS, default="MODEL",
-                          description="What the spherical-harmonic technique tabulates")
     fresnel: EnumProperty(update=_tag_changed, name="Fresnel", items=FRESNEL_MODES, default="NONE",
                           description="How the specular colour changes with angle (reflectance/layering.py)")
     multiscatter: BoolProperty(update=_tag_changed, name="Multiscatter", default=False,
@@ -287,12 +196,8 @@ class SGPRT_PG_material(bpy.types.PropertyGroup):
                                     description="Rotation of the tangent about the normal")
     show_textures: BoolProperty(update=_tag_changed, name="Show Textures", default=True,
                                 description="Show the texture slot next to each parameter")
-    factorization: PointerProperty(type=SGPRT_PG_factorization, name="BRDF Factors",
-                                   description="A measured BRDF factorized by sgprt.factor_brdf")
     lobe_fit: PointerProperty(type=SGPRT_PG_lobe_fit, name="Lobe Fit",
                               description="SG lobes fitted to a measured BRDF (sgprt.fit_lobes)")
-    biscale: PointerProperty(type=SGPRT_PG_biscale, name="Bi-Scale",
-                             description="Small-scale geometry of the bi-scale technique")
 
 
 # Render Samples' defaults, from the truth suite's scenes and the example scenes (docs/ACCURACY.md and
@@ -348,8 +253,7 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
                                                 "light and cost a light each (16 at 4)")
 
 
-classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_factorization, SGPRT_PG_biscale, SGPRT_PG_material,
-           SGPRT_PG_scene)
+classes = (SGPRT_PG_lobe_fit_image, SGPRT_PG_lobe_fit, SGPRT_PG_material, SGPRT_PG_scene)
 
 
 def register():

@@ -34,8 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..spherical import sg
-from ..visibility import hemisphere_map
+from ..spherical import concentric_map, sg
 
 MAX_SHARPNESS = 1e6  # sg.py kernels are stable up to here; radius 0 lights clamp to it
 _LN10 = np.log(10.0)
@@ -214,7 +213,7 @@ def area_light_patches(centre, edge_u, edge_v, normal, shape, power, per_side, s
     v = (np.arange(n_v) + 0.5) / n_v * 2.0 - 1.0
     square = np.stack(np.meshgrid(u, v, indexing="xy"), -1).reshape(-1, 2)
     if shape in ("DISK", "ELLIPSE"):
-        square = hemisphere_map.square_to_disc(square)
+        square = concentric_map.square_to_disc(square)
     count = len(square)
     position = centre + 0.5 * square[:, :1] * edge_u + 0.5 * square[:, 1:] * edge_v
     patch_area = area_light_area(shape, size_u, size_v) / count

@@ -4,7 +4,7 @@ E(o) = integral over i of rho_s(o, i) (n.i), tabulated over (cos theta_o, roughn
 Two SG lobes hold 0.93-0.97 of GGX's projected NDF area at roughness 0.3-0.5 (the rest is its
 theta^-4 tail), and the warp loses more at grazing views; E(o) minus the slice lobes' own albedo is
 the energy the lobes miss, which the surface shader returns as a broad lobe of environment light
-(techniques.sg_shading.environment_tail).
+(techniques.sg.sg_shading.environment_tail).
 
 Quadrature in the half vector with GGX's own CDF in u = tan^2 / (alpha^2 + tan^2): D(h) (n.h) dh =
 du dphi / (2 pi) exactly, so E = integral of G(o, i) |o.h| / ((n.o)(n.h)) [i above the horizon]

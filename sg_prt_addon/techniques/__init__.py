@@ -6,11 +6,16 @@ the shader cache and the scene state look techniques up here by the material's c
 (sg_parametric) and from a stored lobe fit (sg_fitted); mccool2001's factored BRDF (factored); kautz2002's
 spherical harmonics (spherical_harmonics); iwasaki2012's bi-scale materials on the SG lobes (sg_biscale).
 """
-from . import factored, sg_biscale, sg_fitted, sg_parametric, spherical_harmonics
 from .base import DrawContext, ObjectInputs, Technique
+from .homomorphic import factored
+from .sg import sg_biscale, sg_fitted, sg_parametric
+from .sh import spherical_harmonics
 
 DEFAULT = sg_parametric.NAME
 _registry = {}
+# (on_register, on_unregister) callbacks: the Blender glue registers a technique's settings and panels with
+# Blender when it is registered here (blender/technique_sides.py)
+_watchers = []
 
 
 def register(technique):
@@ -20,13 +25,38 @@ def register(technique):
     if any(other.number == technique.number for other in _registry.values()):
         raise ValueError(f"technique {technique.name}: enum number {technique.number} is taken")
     _registry[technique.name] = technique
+    for on_register, _ in _watchers:
+        on_register(technique)
     return technique
 
 
 def unregister(name):
     if name == DEFAULT:
         raise ValueError("the default technique cannot be unregistered")
-    _registry.pop(name, None)
+    technique = _registry.pop(name, None)
+    if technique is not None:
+        for _, on_unregister in _watchers:
+            on_unregister(technique)
+
+
+def watch(on_register, on_unregister):
+    """Call on_register(technique) for every technique registered from now on and on_unregister(technique) for
+    every one unregistered, until unwatch(on_register)."""
+    _watchers.append((on_register, on_unregister))
+
+
+def unwatch(on_register):
+    _watchers[:] = [pair for pair in _watchers if pair[0] is not on_register]
+
+
+def registered():
+    """The registered techniques, in registration order."""
+    return tuple(_registry.values())
+
+
+def rendering_stored(kind):
+    """The registered technique that renders the stored fit `kind` by itself (Technique.renders_stored), or None."""
+    return next((t for t in _registry.values() if t.renders_stored == kind), None)
 
 
 def get(name):
@@ -52,7 +82,8 @@ def of_settings(settings):
     the default.  A stored technique no longer registered reads as "#<its enum number>"."""
     if settings.is_property_set("technique"):
         return settings.technique or f"#{settings.get('technique')}"
-    return sg_fitted.NAME if settings.get("use_fitted_lobes") else DEFAULT
+    fitted = rendering_stored("lobe_fit")
+    return fitted.name if settings.get("use_fitted_lobes") and fitted is not None else DEFAULT
 
 
 def enum_items():
@@ -67,4 +98,4 @@ register(spherical_harmonics.TECHNIQUE)
 register(sg_biscale.TECHNIQUE)
 
 __all__ = ["DEFAULT", "DrawContext", "ObjectInputs", "Technique", "enum_items", "for_material", "get", "names",
-           "of_settings", "register", "unregister"]
+           "of_settings", "register", "registered", "rendering_stored", "unregister", "unwatch", "watch"]

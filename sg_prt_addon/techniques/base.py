@@ -98,6 +98,13 @@ class Technique:
     paper = ""           # the reference it implements, e.g. "wang2009"
     mirror = None        # numpy function of what its shader computes (tests compare the two)
     shadow_kind = "ssdf"  # the per-vertex kind its shadows come from (engine/scene_state.py), "" for none
+    # Its Blender side, a module relative to its own package ("" for none; blender/technique_sides.py reads it):
+    # SETTINGS {attribute: PropertyGroup} at material.sgprt.<attribute>, draw(layout, material, name) the panel's
+    # rows, read(material, params) its settings into MaterialParams, resolve(material, params, name) -> (technique
+    # name, warnings), CLASSES (its operators and panels); all optional
+    blender_side = ""
+    # A stored fit it renders by itself ("lobe_fit"): storing one picks the technique, clearing it leaves it
+    renders_stored = ""
 
     def variant_key(self, params, inputs):
         raise NotImplementedError

@@ -1,6 +1,6 @@
 /* Shadow-map lookups in the lights' depth atlas, mirroring sg_prt_addon/lighting/shadow_maps.py
  * (tile_visibility, point_visibility, sun_visibility) step for step.  The SHADOW_* constants come from that
- * module (techniques/sg_lobes.py _constants_source).  atlas_info: x tile side (texels), y tiles a row, z the
+ * module (techniques/sg/sg_lobes.py _constants_source).  atlas_info: x tile side (texels), y tiles a row, z the
  * face's share of its tile (inner), w mapped lights. */
 
 /* Window depth of a texel (clamped to its tile). */

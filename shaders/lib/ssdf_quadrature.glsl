@@ -7,7 +7,7 @@
  *   ssdf_quadrature_weight       <- broad_lobes.quadrature_weight
  *
  * The points (SSDF_QUADRATURE_POINTS, equal-area cells of the local upper hemisphere) and the hand-over to
- * eq. 30 come from the module (techniques/sg_lobes.py quadrature_defines); the sums are written where the
+ * eq. 30 come from the module (techniques/sg/sg_lobes.py quadrature_defines); the sums are written where the
  * decoded coverages are read (techniques/sg/vertex_visibility.frag.glsl). */
 
 const float SSDF_GOLDEN_ANGLE = 2.399963229728653;

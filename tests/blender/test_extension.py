@@ -102,6 +102,6 @@ def _check_contents(zip_path):
     assert not [name for name in names if name.split("/")[0] in ("validation", "tests", "benchmarks", "tools")]
     shipped = {name.rsplit("/", 1)[-1] for name in python}
     assert VALIDATION_MODULES and not shipped & VALIDATION_MODULES, sorted(shipped & VALIDATION_MODULES)
-    for required in ("techniques/sg_parametric.py", "techniques/sg_fitted.py", "engine/renderer.py",
+    for required in ("techniques/sg/sg_parametric.py", "techniques/sg/sg_fitted.py", "engine/renderer.py",
                      "shaders/techniques/sg/sg_shading.glsl", "shaders/engine/mesh.vert.glsl", "blender_manifest.toml"):
         assert any(name.endswith(required) for name in names), f"{required} missing from the zip"

@@ -4,8 +4,8 @@ import bpy
 import numpy as np
 import pytest
 
-from sg_prt_addon.blender import brdf_factorization as bf
 from sg_prt_addon.measured import homomorphic, merl, svbrdf_table
+from sg_prt_addon.techniques.homomorphic.blender import factorization as bf
 from validation import brdf_generators
 
 
@@ -104,7 +104,7 @@ def test_corrupt_samples_change_the_count_not_the_factors(material, data):
     wo, wi, _ = homomorphic.sample_brdf(lambda o, i: np.zeros(len(o)), 48, 48)
 
     def evaluate(tables):
-        from sg_prt_addon.techniques import factored_shading
+        from sg_prt_addon.techniques.homomorphic import factored_shading
         factorization = tables.factorization
         return tables.scale * factored_shading.factored_brdf(factorization.log_factors, factorization.form, wo, wi)
 

@@ -10,7 +10,7 @@ EDITED_VALUES = {
     "model": "ASHIKHMIN_SHIRLEY", "diffuse_color": (0.1, 0.2, 0.3), "specular_color": (0.7, 0.6, 0.5),
     "roughness": 0.0625, "ior": 2.25, "exponent": 3500.0, "alpha_x": 0.375, "alpha_y": 0.015625,
     "nu": 12.5, "nv": 40000.0, "lobe_count": 7, "normal_strength": 2.5, "tangent_source": "OBJECT_AXIS",
-    "tangent_axis": (0.0, 0.6, 0.8), "tangent_rotation": 0.75, "show_textures": False, "view_warp": "PAPER",
+    "tangent_axis": (0.0, 0.6, 0.8), "tangent_rotation": 0.75, "show_textures": False,
 }
 
 
@@ -26,7 +26,7 @@ def test_defaults_are_a_plausible_glossy_material(empty_file):
     assert _value(settings, "specular_color") == pytest.approx((0.25, 0.25, 0.25))
     assert settings.roughness == pytest.approx(0.3)
     assert settings.lobe_count == 0       # Auto: the model's own count (models.lobes_of)
-    assert settings.view_warp == "SPLIT3"
+    assert settings.sg.view_warp == "SPLIT3"
     assert all(getattr(settings, f"{name}_texture") is None for name in properties.TEXTURED_PARAMETERS)
     assert settings.normal_map is None
 

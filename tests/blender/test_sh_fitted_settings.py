@@ -27,7 +27,7 @@ def _sh_material(name, **settings):
     bpy.context.active_object.data.materials.append(material)
     material.sgprt.technique = "SH"
     for key, value in settings.items():
-        setattr(material.sgprt, key, value)
+        setattr(material.sgprt.sh, key, value)
     return material
 
 
@@ -45,16 +45,16 @@ def _labels(material):
 def test_a_fit_on_an_sh_material_is_tabulated_and_the_choice_survives_reopening(empty_file, table_path, tmp_path):
     from sg_prt_addon.blender import panels
 
-    material = _sh_material("sh_fit_saved", sh_order=6)
-    assert material.sgprt.sh_brdf == "MODEL"
+    material = _sh_material("sh_fit_saved", order=6)
+    assert material.sgprt.sh.brdf == "MODEL"
     assert _labels(material) == ["No fitted lobes: renders the model above"]
     _fit(material, table_path, lobe_count=2, shadowing_components=4)
-    assert (material.sgprt.technique, material.sgprt.sh_brdf) == ("SH", "LOBE_FIT")
+    assert (material.sgprt.technique, material.sgprt.sh.brdf) == ("SH", "LOBE_FIT")
     params, warnings = export_with_warnings(material)
     assert params.technique == "SH" and params.fitted is not None and not warnings
     assert params.fitted.layers.shape[1:3] == (8, 8)
     calls = recording_layout.draw(panels.SGPRT_PT_material, type("Context", (), {"material": material})())
-    assert {("prop", "sh_order"), ("prop", "sh_window"), ("prop", "sh_brdf")} <= set(calls)
+    assert {("prop", "order"), ("prop", "window"), ("prop", "brdf")} <= set(calls)
     assert ("prop", "view_warp") not in calls
     assert "Tabulated per texel by the SH technique" in _labels(material)
 
@@ -64,12 +64,12 @@ def test_a_fit_on_an_sh_material_is_tabulated_and_the_choice_survives_reopening(
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.wm.open_mainfile(filepath=str(path))
     reopened = bpy.data.materials["sh_fit_saved"]
-    assert (reopened.sgprt.technique, reopened.sgprt.sh_brdf, reopened.sgprt.sh_order) == ("SH", "LOBE_FIT", 6)
+    assert (reopened.sgprt.technique, reopened.sgprt.sh.brdf, reopened.sgprt.sh.order) == ("SH", "LOBE_FIT", 6)
     again, warnings = export_with_warnings(reopened)
     assert again.technique == "SH" and not warnings
     np.testing.assert_array_equal(again.fitted.layers, params.fitted.layers)
 
-    reopened.sgprt.sh_brdf = "MODEL"            # the model again: the fit stays stored and unused
+    reopened.sgprt.sh.brdf = "MODEL"            # the model again: the fit stays stored and unused
     model, _ = export_with_warnings(reopened)
     assert model.technique == "SH" and model.fitted is None
     assert any("set SH BRDF to Lobe Fit" in text for text in _labels(reopened))
@@ -79,7 +79,7 @@ def test_fits_it_cannot_tabulate_are_refused_with_the_reason(empty_file, table_p
     """No fit: SH with the model; a free-axes fit or one whose tables are too large: the fitted SG lobes."""
     from sg_prt_addon.harmonics import fitted_table
 
-    material = _sh_material("sh_fit_refused", sh_brdf="LOBE_FIT")
+    material = _sh_material("sh_fit_refused", brdf="LOBE_FIT")
     params, warnings = export_with_warnings(material)
     assert params.technique == "SH" and params.fitted is None
     assert any("no usable lobe fit (no fitted lobes): its model is tabulated" in w for w in warnings), warnings
@@ -93,7 +93,7 @@ def test_fits_it_cannot_tabulate_are_refused_with_the_reason(empty_file, table_p
     monkeypatch.undo()
 
     _fit(material, table_path, lobe_count=3, axes="FREE", shadowing_components=3)
-    assert material.sgprt.sh_brdf == "LOBE_FIT" and material.sgprt.lobe_fit.free_axes
+    assert material.sgprt.sh.brdf == "LOBE_FIT" and material.sgprt.lobe_fit.free_axes
     params, warnings = export_with_warnings(material)
     assert params.technique == "SG_FITTED" and params.fitted is not None
     assert any("cannot tabulate its lobe fit (its lobes leave the normal by up to" in w for w in warnings), warnings

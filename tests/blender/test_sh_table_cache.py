@@ -55,7 +55,7 @@ def _fit(sharpest=60.0):
 
 def test_a_fitted_table_is_read_from_disk_bit_exact_and_a_changed_fit_is_a_miss(context, monkeypatch, tmp_path):
     from sg_prt_addon.harmonics import fitted_table
-    from sg_prt_addon.techniques import spherical_harmonics
+    from sg_prt_addon.techniques.sh import spherical_harmonics
 
     project = Counted(fitted_table.project_texels)
     monkeypatch.setattr(fitted_table, "project_texels", project)

@@ -56,7 +56,22 @@ def graph():
 
 
 def _layer(module):
+    """A module's layer: its top package, except a technique's Blender side (techniques/<package>/blender/),
+    which is Blender glue."""
     parts = module.split(".")
+    if len(parts) > 3 and parts[1] == "techniques" and parts[3] == "blender":
+        return "blender"
+    return parts[1] if len(parts) > 1 else None
+
+
+def _package(module):
+    """The package a module belongs to for the package graph: the maths packages, each technique's package
+    and its Blender side, and the other layers."""
+    parts = module.split(".")
+    if len(parts) > 2 and parts[1] == "techniques" and (ROOT / PACKAGE / "techniques" / parts[2]).is_dir():
+        return ".".join(parts[1:4] if len(parts) > 3 and parts[3] == "blender" else parts[1:3])
+    if parts[1:] == ["techniques"]:
+        return "techniques registry"        # its __init__: it imports the techniques, they import what they share
     return parts[1] if len(parts) > 1 else None
 
 
@@ -108,15 +123,51 @@ def test_layers_import_downwards(graph):
     assert not bad, "\n".join(bad)
 
 
-def test_maths_packages_form_no_cycle(graph):
-    """The maths packages import each other one way only."""
-    depends = {layer: set() for layer in MATHS}
+def _cycles(edges):
+    """The strongly connected components of more than one node of a graph {node: set of nodes} (Tarjan)."""
+    index, low, stack, on_stack, cycles = {}, {}, [], set(), []
+
+    def connect(node):
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for target in sorted(edges.get(node, ())):
+            if target not in index:
+                connect(target)
+                low[node] = min(low[node], low[target])
+            elif target in on_stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                cycles.append(sorted(component))
+
+    for node in sorted(edges):
+        if node not in index:
+            connect(node)
+    return cycles
+
+
+def test_packages_form_no_cycle(graph):
+    """The packages (the maths ones, each technique's and its Blender side, the glue and the engine) import
+    each other without a cycle of any length, as the modules do."""
+    edges = {}
     for name, imports in graph.items():
-        if _layer(name) in MATHS:
-            depends[_layer(name)] |= {_layer(target) for target, _ in imports
-                                      if target.startswith(PACKAGE + ".") and _layer(target) in MATHS} - {_layer(name)}
-    both_ways = sorted(f"{a} <-> {b}" for a in MATHS for b in depends[a] if a < b and a in depends[b])
-    assert not both_ways, both_ways
+        source = _package(name)
+        if source is None:
+            continue
+        edges.setdefault(source, set())
+        edges[source] |= {_package(target) for target, _ in imports
+                          if target.startswith(PACKAGE + ".") and _package(target) not in (None, source)}
+    assert "techniques.sh" in edges and "techniques.sg.blender" in edges
+    cycles = _cycles(edges)
+    assert not cycles, f"package cycles: {cycles}"
 
 
 def test_maths_and_techniques_need_no_blender(graph):

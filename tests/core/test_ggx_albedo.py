@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from sg_prt_addon.reflectance import brdf, ggx_albedo
-from sg_prt_addon.techniques.sg_shading import sample_texture
+from sg_prt_addon.techniques.sg.sg_shading import sample_texture
 
 
 def _solid_angle_albedo(cos_o, roughness, nodes=700):

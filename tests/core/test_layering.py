@@ -158,7 +158,7 @@ def test_the_mirror_replaces_the_specular_colour():
     F0 gives F_E (about F0 face-on, not F0 times it), the diffuse is scaled."""
     from types import SimpleNamespace
 
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     position = np.array([[0.0, 0.0, 0.0]] * 2, np.float32)
     normal = np.array([[0.0, 0.0, 1.0], [0.0, 0.8, 0.6]], np.float32)

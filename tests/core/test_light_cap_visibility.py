@@ -1,4 +1,4 @@
-"""A light's visible fraction from the SSDF (techniques.sg_shading.light_cap_visibility): the disc of the light's
+"""A light's visible fraction from the SSDF (techniques.sg.sg_shading.light_cap_visibility): the disc of the light's
 cap beyond the boundary at the SSDF's distance, against the exact cosine-weighted share of the cap that a
 half-plane leaves visible (validation.visibility_cases), and beside eq. 30's fh of the light's SG, which it
 replaced."""

@@ -1,4 +1,4 @@
-"""techniques.sg_shading.light_tail: with it, what a point light sees of GGX (the slice lobes plus the tail) is the
+"""techniques.sg.sg_shading.light_tail: with it, what a point light sees of GGX (the slice lobes plus the tail) is the
 model's own rho_s (n.i) over the whole hemisphere of light directions; without it, the lobes' shape error
 and the missing theta^-4 glow (benchmarks/accuracy/glossy_tails.py measures the same for the docs)."""
 

@@ -1,4 +1,4 @@
-"""The SH technique's transfer summed at the vertices (techniques/spherical_harmonics.py vertex_transfer_rows,
+"""The SH technique's transfer summed at the vertices (techniques/sh/spherical_harmonics.py vertex_transfer_rows,
 vertex_transfer_values; shaders/techniques/sh/sh_shading.glsl VERTEX_TRANSFER): which variants the varyings
 hold, the packed layout, and that interpolating the vertices' sums is the sum of the interpolated weights."""
 import numpy as np
@@ -6,7 +6,8 @@ import pytest
 
 from sg_prt_addon.lighting import env_prefilter
 from sg_prt_addon.lighting.scene_lighting import EnvironmentData
-from sg_prt_addon.techniques import sh_shading, shader_sources, spherical_harmonics
+from sg_prt_addon.techniques import shader_sources
+from sg_prt_addon.techniques.sh import sh_shading, spherical_harmonics
 from sg_prt_addon.visibility import transfer
 from sg_prt_addon.visibility.per_vertex import PerVertexData
 

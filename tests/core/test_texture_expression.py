@@ -43,7 +43,7 @@ def test_material_textures_repeat_and_the_uv_transform():
     the material's affine UV transform."""
     from types import SimpleNamespace
 
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     image = RNG.uniform(0, 1, (4, 8, 3)).astype(np.float32)
     uv = np.array([[0.3, 0.6], [1.3, -0.4], [0.01, 0.99]], np.float32)

@@ -1,4 +1,4 @@
-"""A partly occluded lobe reads the environment where its visible part lies (techniques.sg_shading's
+"""A partly occluded lobe reads the environment where its visible part lies (techniques.sg.sg_shading's
 visible_part_axes): the truncated Gaussian's moments it turns and narrows the lobe by, against scipy's; the side
 the SSDF shows it and the radiance it then reads, on a lobe crossing a half-plane's edge under an environment
 brighter past the edge (validation.visibility_cases.lobe_edge_radiance), against quadrature over the sphere."""
@@ -9,10 +9,10 @@ from validation import visibility_cases
 
 
 def test_probit_is_the_normal_quantile():
-    """techniques.sg_shading.probit (Abramowitz and Stegun 26.2.23, float32) against scipy's normal quantile."""
+    """techniques.sg.sg_shading.probit (Abramowitz and Stegun 26.2.23, float32) against scipy's normal quantile."""
     from scipy.stats import norm
 
-    from sg_prt_addon.techniques.sg_shading import probit
+    from sg_prt_addon.techniques.sg.sg_shading import probit
 
     v = np.linspace(1e-4, 1 - 1e-4, 20001)
     assert np.max(np.abs(probit(v) - norm.ppf(v))) < 1e-3          # measured 4.5e-4 (A&S's bound)
@@ -20,11 +20,11 @@ def test_probit_is_the_normal_quantile():
 
 
 def test_visible_part_offset_is_the_truncated_gaussian_mean():
-    """techniques.sg_shading.visible_part_offset against phi(Phi^-1(v)) / v, the mean of a unit Gaussian cut so that
+    """techniques.sg.sg_shading.visible_part_offset against phi(Phi^-1(v)) / v, the mean of a unit Gaussian cut so that
     the fraction v is kept, over v in [1e-3, 1)."""
     from scipy.stats import norm
 
-    from sg_prt_addon.techniques.sg_shading import visible_part_offset
+    from sg_prt_addon.techniques.sg.sg_shading import visible_part_offset
 
     v = np.linspace(1e-3, 1 - 1e-5, 20001)
     exact = norm.pdf(norm.ppf(v)) / v
@@ -35,12 +35,12 @@ def test_visible_part_offset_is_the_truncated_gaussian_mean():
 
 
 def test_visible_part_narrowing_is_the_truncated_gaussian_width():
-    """techniques.sg_shading.visible_part_narrowing against 2 / (1 + var), var = 1 - z m - m^2 the exact variance
+    """techniques.sg.sg_shading.visible_part_narrowing against 2 / (1 + var), var = 1 - z m - m^2 the exact variance
     across the boundary of a unit Gaussian cut to the fraction v (floored at VISIBLE_PART_MIN_VARIANCE): 1 for an
     unoccluded lobe, growing as less of it is kept."""
     from scipy.stats import norm, truncnorm
 
-    from sg_prt_addon.techniques.sg_shading import VISIBLE_PART_MIN_VARIANCE, visible_part_narrowing
+    from sg_prt_addon.techniques.sg.sg_shading import VISIBLE_PART_MIN_VARIANCE, visible_part_narrowing
 
     v = np.linspace(1e-3, 1 - 1e-5, 2001)
     variance = truncnorm.var(-norm.ppf(v), np.inf)

@@ -88,11 +88,16 @@ def plane(scene, name, location, size=6.0):
 
 
 def material(name, **settings):
+    """A new material with these material.sgprt settings; a dict sets a technique's group (sh={"order": 7})."""
     import bpy
 
     mat = bpy.data.materials.new(name)
     for key, value in settings.items():
-        setattr(mat.sgprt, key, value)
+        if isinstance(value, dict):
+            for inner, inner_value in value.items():
+                setattr(getattr(mat.sgprt, key), inner, inner_value)
+        else:
+            setattr(mat.sgprt, key, value)
     return mat
 
 
@@ -373,10 +378,10 @@ def pixel_per_vertex(result, mask, kind):
 
 
 def pixel_visibility(result, mask):
-    """techniques.sg_shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
+    """techniques.sg.sg_shading.Visibility of the G-buffer pixels `mask` (all of one object with a bake), rebuilt
     as the GPU interpolates (_pixel_corners): the corners' vertex rows and SSDF normals, and the broad
     diffuse lobes' visibility decoded at the corners' vertices.  None when the object has no usable bake."""
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     state = result["state"]
     entry, mesh, vertex, weights = _pixel_corners(result, mask)
@@ -401,7 +406,7 @@ def pixel_sh_transfer(result, mask, params):
     """(order, the SH mirror's transfer inputs (sh_shading.transfer_sums' at the pixels)) of the G-buffer pixels
     `mask` (all of one object with a transfer bake), summed as the variant sums them: at the vertices and
     interpolated (spherical_harmonics.vertex_transfer_rows), else of the interpolated weights."""
-    from sg_prt_addon.techniques import sh_shading, spherical_harmonics
+    from sg_prt_addon.techniques.sh import sh_shading, spherical_harmonics
     from sg_prt_addon.visibility import transfer
 
     state = result["state"]

@@ -74,7 +74,7 @@ def test_biscale_against_the_traced_tile(blender):
     noise = image_error.rmse_noise_floor(error, reference, surface)
     scores = {}
     roughness = _fitted_roughness(heights)
-    warp = fx.material("biscale_ref_paper", technique="SG_BISCALE", view_warp="PAPER", **MATERIAL)
+    warp = fx.material("biscale_ref_paper", technique="SG_BISCALE", sg={"view_warp": "PAPER"}, **MATERIAL)
     warp.sgprt.biscale.height_image = material.sgprt.biscale.height_image
     warp.sgprt.biscale.height_scale = 1.0
     for name, candidate in (("bi-scale", material), ("bi-scale, one-lobe warp", warp),("single scale", fx.material("biscale_ref_single", **MATERIAL)),

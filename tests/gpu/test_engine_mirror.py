@@ -1,7 +1,7 @@
-"""The engine's GLSL against its numpy mirror (techniques/sg_shading.py) on the same pixels.
+"""The engine's GLSL against its numpy mirror (techniques/sg/sg_shading.py) on the same pixels.
 
 One render per scene writes the G-buffer (position, normal, tangent input, uv, material id);
-techniques.sg_shading.shade_fragments shades those pixels from the same material, lights and
+techniques.sg.sg_shading.shade_fragments shades those pixels from the same material, lights and
 environment data, and the two must agree to float32 round-off (max relative error 1e-3).
 """
 import engine_fixtures as fx
@@ -21,7 +21,7 @@ def _mirror(result, textures_by_material=None, use_visibility=True, use_shadow_m
     """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask.  With shadow
     maps, their lookups (lighting.shadow_maps.light_visibility) read the frame's atlas."""
     from sg_prt_addon.lighting import shadow_maps
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     passes, state = result["passes"], result["state"]
     camera = passes["camera"]
@@ -217,7 +217,7 @@ def test_visibility_lights_and_world_colour(engine, bakes):
 
 @pytest.mark.parametrize("view_warp", ["PAPER", "SPLIT2"])
 def test_view_warps_with_visibility(engine, bakes, view_warp):
-    """A material's view warp (material.sgprt.view_warp: one or two lobes per NDF lobe instead of three)
+    """A material's view warp (material.sgprt.sg.view_warp: one or two lobes per NDF lobe instead of three)
     reaches the shader (WARP_FUNCTION / WARP_NODES of its variant) and the mirror alike, shadows included."""
     from sg_prt_addon.spherical import warp
 
@@ -226,8 +226,8 @@ def test_view_warps_with_visibility(engine, bakes, view_warp):
     fx.point_light(scene, "warp_point_" + view_warp, (1.5, -1.0, 3.5), 1500.0, radius=0.1)
     sphere.data.materials[0] = fx.material("mirror_warp_as_" + view_warp, model="ASHIKHMIN_SHIRLEY", nu=40.0,
                                            nv=400.0, lobe_count=3, tangent_source="OBJECT_AXIS",
-                                           tangent_axis=(0.0, 0.0, 1.0), view_warp=view_warp)
-    floor.data.materials[0].sgprt.view_warp = view_warp
+                                           tangent_axis=(0.0, 0.0, 1.0), sg={"view_warp": view_warp})
+    floor.data.materials[0].sgprt.sg.view_warp = view_warp
     bakes(scene, [sphere, floor], resolution=12)
     with fx.recorded_variant_keys() as keys:
         result = fx.render(scene, gbuffer=True)

@@ -49,7 +49,7 @@ def test_compile_error_names_variant_and_line(engine, monkeypatch):
     import bpy
 
     from sg_prt_addon.engine import render_engine, shader_cache
-    from sg_prt_addon.techniques import sg_lobes
+    from sg_prt_addon.techniques.sg import sg_lobes
 
     original = sg_lobes.SGLobes.fragment_source
     broken_line = "  vec3 view_local = view * frame_that_does_not_exist;"
@@ -67,7 +67,7 @@ def test_compile_error_names_variant_and_line(engine, monkeypatch):
     assert "frame_that_does_not_exist' undeclared" in str(raised.value)      # what the UI reports
     message = render_engine.last_render["error"]
     from sg_prt_addon import techniques
-    from sg_prt_addon.techniques.sg_shading import GGX_NDF_LOBES
+    from sg_prt_addon.techniques.sg.sg_shading import GGX_NDF_LOBES
     technique = techniques.get("SG_PARAMETRIC")
     lines = broken(technique, sg_lobes.VariantKey(ndf_lobes=GGX_NDF_LOBES)).split("\n")
     number = next(n for n, line in enumerate(lines, 1) if broken_line in line)
@@ -124,7 +124,7 @@ def test_environment_background_follows_blender_mapping(engine):
     """Background pixels = the world image bilinearly sampled along each pixel's view ray with
     Blender's equirect mapping (lighting.equirect): orientation and flips end to end."""
     from sg_prt_addon.lighting import equirect
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     rng = np.random.default_rng(5)
     pixels = np.ones((32, 64, 4), np.float32)

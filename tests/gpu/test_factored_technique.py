@@ -1,5 +1,5 @@
-"""The factored-BRDF technique (techniques/factored.py, mccool2001) on the GPU against its numpy mirror
-(techniques/factored_shading.py), from the G-buffer: lights, a world colour and an environment; and the
+"""The factored-BRDF technique (techniques/homomorphic/factored.py, mccool2001) on the GPU against its numpy mirror
+(techniques/homomorphic/factored_shading.py), from the G-buffer: lights, a world colour and an environment; and the
 material setting that picks it, saved and reopened."""
 import engine_fixtures as fx
 import numpy as np
@@ -17,7 +17,7 @@ def engine(blender):
 def _mirror_errors(result, shadowed=False):
     """Max relative error per (material, pass) of the shader against the mirror, the materials on one object
     each (with shadowed, the pixels' SSDF inputs rebuilt as the GPU interpolates them)."""
-    from sg_prt_addon.techniques import factored, factored_shading
+    from sg_prt_addon.techniques.homomorphic import factored, factored_shading
 
     passes, state = result["passes"], result["state"]
     camera, uv = passes["camera"], passes["gbuffer_uv"]
@@ -116,7 +116,7 @@ def test_stored_factors_of_a_measured_brdf_render(engine, tmp_path):
     on the GPU as in the mirror; its own model's factorization is not used."""
     import bpy
 
-    from sg_prt_addon.techniques import factored
+    from sg_prt_addon.techniques.homomorphic import factored
     from validation import brdf_generators
 
     path = str(tmp_path / "measured.binary")

@@ -1,4 +1,4 @@
-"""The engine's fitted-lobe variant (MODEL_FITTED) against its numpy mirror (techniques.sg_shading).
+"""The engine's fitted-lobe variant (MODEL_FITTED) against its numpy mirror (techniques.sg.sg_shading).
 
 A small generated SVBRDF table (validation.brdf_generators.generate_svbrdf_table, 8 x 8 texels:
 spatially varying kd, eta, roughness) is fitted by ``bpy.ops.sgprt.fit_lobes`` into a
@@ -27,7 +27,7 @@ def fitted_material(blender, tmp_path_factory):
 
 
 def _mirror(result):
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     passes, state = result["passes"], result["state"]
     camera = passes["camera"]

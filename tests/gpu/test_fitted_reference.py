@@ -50,7 +50,7 @@ def fitted_sphere_scores(merl_path, variants, name="fitted_reference", size=SIZE
     for variant in variants:
         material.sgprt.technique = "SG_FITTED" if variant == "SG_FITTED" else "SH"
         if variant != "SG_FITTED":
-            material.sgprt.sh_brdf, material.sgprt.sh_order = "LOBE_FIT", variant
+            material.sgprt.sh.brdf, material.sgprt.sh.order = "LOBE_FIT", variant
         result = fx.render(scene)
         assert "error" not in result, result.get("error")
         params = result["state"].materials[material.name]

@@ -1,8 +1,8 @@
 """Glossy GGX against the Monte Carlo reference where the SG lobes alone fall short (issue: the truth
 suite): a small point light, whose highlight on GGX has a long theta^-4 glow two SG lobes do not hold
-(the light tail, techniques.sg_shading.light_tail); a sharp lobe under an HDRI, which the top prefiltered layer
-blurred (techniques.sg_shading.environment_radiance); and GGX's energy beyond its lobes under an HDRI (the
-environment tail, techniques.sg_shading.environment_tail).  The reference samples pixel centres, as the engine
+(the light tail, techniques.sg.sg_shading.light_tail); a sharp lobe under an HDRI, which the top prefiltered layer
+blurred (techniques.sg.sg_shading.environment_radiance); and GGX's energy beyond its lobes under an HDRI (the
+environment tail, techniques.sg.sg_shading.environment_tail).  The reference samples pixel centres, as the engine
 does, so the scores measure shading, not anti-aliasing.  Bounds sit between the figures measured with
 the fixes and those measured before them (in each case's comment)."""
 import engine_fixtures as fx
@@ -64,7 +64,7 @@ def _score(scene, samples):
     ("glossy_courtyard_r010", 0.10, "courtyard", 48, 0.30, 0.03, False),
     # the environment tail: 0.140, bias +0.015; without it 0.157, bias -0.067
     ("glossy_courtyard_r035", 0.35, "courtyard", 48, 0.16, 0.03, False),
-    # over a baked floor, the visible-part lookup (techniques.sg_shading.visible_part_axes, towards the side the
+    # over a baked floor, the visible-part lookup (techniques.sg.sg_shading.visible_part_axes, towards the side the
     # SSDF grows, narrowed): 0.090, bias -0.010; turned towards the viewer 0.134, -0.023; reading the radiance at
     # the occluded lobes' axes 0.158, -0.040 (their visible fraction is right: 0.54 against 0.51 ray-traced)
     ("glossy_floor_courtyard_r035", 0.35, "courtyard", 32, 0.11, 0.02, True),

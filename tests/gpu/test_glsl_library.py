@@ -6,7 +6,8 @@ import re
 
 import pytest
 
-from sg_prt_addon.techniques import sg_lobes, shader_sources
+from sg_prt_addon.techniques import shader_sources
+from sg_prt_addon.techniques.sg import sg_lobes
 from sg_prt_addon.visibility.per_vertex import MAX_ROWS
 from validation import glsl_harness
 

@@ -92,7 +92,7 @@ def test_decode_degenerate_directions_are_finite(glsl, fuzz):
 
 
 def _quadrature_library():
-    from sg_prt_addon.techniques import sg_lobes
+    from sg_prt_addon.techniques.sg import sg_lobes
 
     defines = "".join(f"#define {name} {value}\n" for name, value in sg_lobes.quadrature_defines().items())
     return ["sg.glsl", "hemisphere.glsl", defines, "ssdf_quadrature.glsl"]

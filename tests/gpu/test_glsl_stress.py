@@ -534,7 +534,7 @@ def test_ssdf_stress(glsl, fuzz):
 def test_ssdf_quadrature_stress(glsl, fuzz):
     """ssdf_quadrature.glsl: every point index, signed distances of any size (theta_d's hostile set, the
     infinities), radii from tiny to wide, any sharpness."""
-    from sg_prt_addon.techniques import sg_lobes
+    from sg_prt_addon.techniques.sg import sg_lobes
 
     x = _sg_inputs()
     count = len(x["sharpness"])
@@ -647,7 +647,7 @@ def test_visible_part_stress(glsl, fuzz):
     perpendicular to a unit axis; probit, visible_part_offset and visible_part_narrowing for any fraction
     (0, tiny, 1, beyond) -- finite, the narrowing in [1, 2 / (1 + VISIBLE_PART_MIN_VARIANCE)], and the numpy
     mirror's within float32's reach."""
-    from sg_prt_addon.techniques import sg_lobes, sg_shading
+    from sg_prt_addon.techniques.sg import sg_lobes, sg_shading
 
     x = _sg_inputs()
     count = len(x["sharpness"])
@@ -691,7 +691,7 @@ def test_factored_brdf_stress(glsl, fuzz):
     """The factored BRDF's lookups (techniques/factored): any view and light (zero, tiny, huge, below the
     horizon, opposite), random log-factor maps: parabolic coordinates in [0, 1]^2, finite values, and the
     numpy mirror's within 1e-4."""
-    from sg_prt_addon.techniques import factored_shading
+    from sg_prt_addon.techniques.homomorphic import factored_shading
 
     wo = fuzz.stress_vectors(SMALL_ROWS)
     wi = fuzz.stress_vectors(SMALL_ROWS)
@@ -735,7 +735,7 @@ def test_sh_library_stress(glsl, fuzz):
     from scipy.spatial.transform import Rotation
 
     from sg_prt_addon.harmonics import basis, projection, rotation
-    from sg_prt_addon.techniques import sh_glsl
+    from sg_prt_addon.techniques.sh import sh_glsl
 
     order, count = 8, SMALL_ROWS // 8
     d = fuzz.stress_vectors(count)
@@ -809,7 +809,7 @@ def test_sh_table_lookup_stress(glsl, fuzz):
     the horizon) and parameter (0, negative, beyond the axis, NaN-free huge values), both layouts: finite,
     and the mirror's lookup within 1e-5 of the table's scale on ordinary inputs."""
     from sg_prt_addon.harmonics import brdf_table
-    from sg_prt_addon.techniques import sh_glsl, sh_shading, spherical_harmonics
+    from sg_prt_addon.techniques.sh import sh_glsl, sh_shading, spherical_harmonics
 
     count = SMALL_ROWS // 4
     o = fuzz.stress_vectors(count)
@@ -855,7 +855,8 @@ def test_sh_fitted_product_stress(glsl, fuzz):
 
     from sg_prt_addon.blender.export import FittedLobes
     from sg_prt_addon.harmonics import fitted_table
-    from sg_prt_addon.techniques import fitted_texels, sh_glsl, sh_shading
+    from sg_prt_addon.techniques.sg import fitted_texels
+    from sg_prt_addon.techniques.sh import sh_glsl, sh_shading
 
     order, lobes, components, views, count = 5, 2, 5, 16, SMALL_ROWS // 8
     rng = fuzz.rng
@@ -951,7 +952,7 @@ def test_model_lobes_stress(glsl, model, lobes):
     and model_m_factor, per model, over the numpy suite's parameters (0 included) and directions."""
     import types
 
-    from sg_prt_addon.techniques import sg_parametric
+    from sg_prt_addon.techniques.sg import sg_parametric
 
     wo, wi, h, roughness, exponent, rng = _brdf_inputs()
     alpha_y = _f32(np.where(rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, np.exp(rng.uniform(np.log(1e-4), 0.0, SMALL_ROWS))))
@@ -999,7 +1000,7 @@ def test_table_lobes_stress(glsl, fuzz):
     import types
 
     from sg_prt_addon.reflectance import ndf_fit
-    from sg_prt_addon.techniques import sg_parametric
+    from sg_prt_addon.techniques.sg import sg_parametric
 
     roughness = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 10.0, SMALL_ROWS)))
     width_x = _f32(np.where(fuzz.rng.integers(0, 8, SMALL_ROWS) == 0, 0.0, fuzz.log_uniform(1e-6, 1e3, SMALL_ROWS)))

@@ -78,7 +78,7 @@ def test_objects_of_one_mesh_and_material_share_key_and_bindings(engine, monkeyp
     read the object's transform) and binds a run of objects with one variant and material once (unless the
     technique's bind reads the object's own): the image (passes and G-buffer, whose object ids are set per
     object) equals the one made with a key and a bind for each object."""
-    from sg_prt_addon.techniques import sg_parametric
+    from sg_prt_addon.techniques.sg import sg_parametric
 
     technique = sg_parametric.TECHNIQUE
     scene, objects, baked = _spheres("runs")

@@ -1,5 +1,5 @@
-"""The SH technique rendering a stored lobe fit (SH BRDF: Lobe Fit; techniques/spherical_harmonics.py,
-harmonics/fitted_table.py) on the GPU against its numpy mirror (techniques/sh_shading.py): a generated 8 x 8
+"""The SH technique rendering a stored lobe fit (SH BRDF: Lobe Fit; techniques/sh/spherical_harmonics.py,
+harmonics/fitted_table.py) on the GPU against its numpy mirror (techniques/sh/sh_shading.py): a generated 8 x 8
 SVBRDF table fitted by ``bpy.ops.sgprt.fit_lobes`` on an SH material (the fit becomes what it tabulates),
 its texels' tables read at the UV's nearest texel, each lobe's vector rotated and weighed by its colour and
 S(o) / (pi o.z); under an environment or a world colour, point, spot and sun lights, beside a parametric SH
@@ -19,13 +19,13 @@ def fitted_material(blender, tmp_path_factory):
     fx.fit_lobes(material, fx.svbrdf_table_file(tmp_path_factory.mktemp("sh_fitted")), lobe_count=2,
                  shadowing_components=5)
     assert lobe_fit.fit_status(material)[0] == "VALID" and not material.sgprt.lobe_fit.free_axes
-    assert (material.sgprt.technique, material.sgprt.sh_brdf) == ("SH", "LOBE_FIT")
+    assert (material.sgprt.technique, material.sgprt.sh.brdf) == ("SH", "LOBE_FIT")
     return material
 
 
 def _mirror_errors(result, transfer=False):
     """{(material, pass): max relative error} of the GPU's passes against sh_shading.shade_fragments."""
-    from sg_prt_addon.techniques import sh_shading, spherical_harmonics
+    from sg_prt_addon.techniques.sh import sh_shading, spherical_harmonics
 
     passes, state = result["passes"], result["state"]
     camera, uv = passes["camera"], passes["gbuffer_uv"]
@@ -54,8 +54,8 @@ def _mirror_errors(result, transfer=False):
 
 def _scene(name, fitted_material, world, order, window):
     scene = lit_scene(name, world)
-    fitted_material.sgprt.sh_order, fitted_material.sgprt.sh_window = order, window
-    glossy = fx.material(name + "_ggx", technique="SH", sh_order=order, sh_window=window, model="GGX",
+    fitted_material.sgprt.sh.order, fitted_material.sgprt.sh.window = order, window
+    glossy = fx.material(name + "_ggx", technique="SH", sh={"order": order, "window": window}, model="GGX",
                          roughness=0.4, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6))
     fx.uv_sphere(scene, name + "_a", (-1.1, 0.0, 1.0), radius=0.9).data.materials.append(fitted_material)
     fx.uv_sphere(scene, name + "_b", (1.1, 0.0, 1.0), radius=0.9).data.materials.append(glossy)
@@ -95,7 +95,7 @@ def test_transfer_shadows_match_the_mirror(fitted_material):
     scene.camera.rotation_euler = (1.05, 0.0, 0.0)
     fx.world_texture(scene, fx.studio_world_path("courtyard.exr"))
     fx.point_light(scene, "sh_fitted_transfer_light", (0.5, -0.5, 4.0), 800.0, radius=0.3)
-    fitted_material.sgprt.sh_order, fitted_material.sgprt.sh_window = 5, "NONE"
+    fitted_material.sgprt.sh.order, fitted_material.sgprt.sh.window = 5, "NONE"
     sphere = fx.uv_sphere(scene, "sh_fitted_transfer_sphere", (0.0, 0.0, 1.0), radius=0.8, segments=24, rings=12)
     sphere.data.materials.append(fitted_material)
     floor = fx.grid(scene, "sh_fitted_transfer_floor", (0.0, 0.0, 0.0), size=5.0, segments=24)

@@ -43,7 +43,7 @@ def _scores(scene, material, variants):
     for variant in variants:
         material.sgprt.technique = "SG_PARAMETRIC" if variant == "SG" else "SH"
         if variant != "SG":
-            material.sgprt.sh_order = variant
+            material.sgprt.sh.order = variant
         result = fx.render(scene)
         assert "error" not in result, result.get("error")
         images[variant] = result["passes"]["Combined"][::-1, :, :3]           # Blender rows start at the bottom

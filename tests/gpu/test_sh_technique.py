@@ -1,5 +1,5 @@
-"""The spherical-harmonics technique (techniques/spherical_harmonics.py, kautz2002) on the GPU against its
-numpy mirror (techniques/sh_shading.py), from the G-buffer: isotropic tables with a roughness texture, an
+"""The spherical-harmonics technique (techniques/sh/spherical_harmonics.py, kautz2002) on the GPU against its
+numpy mirror (techniques/sh/sh_shading.py), from the G-buffer: isotropic tables with a roughness texture, an
 anisotropic map, point, spot and sun lights, a world colour and an environment, orders and windows; and
 the material settings, saved and reopened."""
 import engine_fixtures as fx
@@ -24,7 +24,7 @@ ROUGHNESS[..., 0] = np.linspace(0.3, 1.6, 8)[None, :]
 
 
 def _mirror_errors(result):
-    from sg_prt_addon.techniques import sh_shading, spherical_harmonics
+    from sg_prt_addon.techniques.sh import sh_shading, spherical_harmonics
 
     passes, state = result["passes"], result["state"]
     camera, uv = passes["camera"], passes["gbuffer_uv"]
@@ -64,11 +64,11 @@ def lit_scene(name, world):
 
 def _scene(name, world, order, window):
     scene = lit_scene(name, world)
-    glossy = fx.material(name + "_ggx", technique="SH", sh_order=order, sh_window=window, model="GGX",
+    glossy = fx.material(name + "_ggx", technique="SH", sh={"order": order, "window": window}, model="GGX",
                          roughness=0.4, diffuse_color=(0.2, 0.25, 0.3), specular_color=(0.8, 0.7, 0.6),
                          fresnel="SCHLICK", multiscatter=True, layered_diffuse=True)
     glossy.sgprt.roughness_texture = fx.image(name + "_rough", ROUGHNESS)    # the layer's roughness follows it
-    brushed = fx.material(name + "_as", technique="SH", sh_order=order, sh_window=window, model="ASHIKHMIN_SHIRLEY",
+    brushed = fx.material(name + "_as", technique="SH", sh={"order": order, "window": window}, model="ASHIKHMIN_SHIRLEY",
                           nu=20.0, nv=200.0)
     fx.uv_sphere(scene, name + "_a", (-1.1, 0.0, 1.0), radius=0.9).data.materials.append(glossy)
     fx.uv_sphere(scene, name + "_b", (1.1, 0.0, 1.0), radius=0.9).data.materials.append(brushed)
@@ -93,13 +93,13 @@ def test_shader_matches_mirror(engine, world, order, window):
 def test_settings_survive_save_and_reopen(engine, tmp_path):
     import bpy
 
-    material = fx.material("sh_saved", technique="SH", model="GGX", sh_order=7, sh_window="LANCZOS")
+    material = fx.material("sh_saved", technique="SH", model="GGX", sh={"order": 7, "window": "LANCZOS"})
     material.use_fake_user = True
     path = tmp_path / "sh.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.open_mainfile(filepath=str(path))
     settings = bpy.data.materials["sh_saved"].sgprt
-    assert (settings.technique, settings.sh_order, settings.sh_window) == ("SH", 7, "LANCZOS")
+    assert (settings.technique, settings.sh.order, settings.sh.window) == ("SH", 7, "LANCZOS")
 
 
 @pytest.fixture
@@ -124,7 +124,7 @@ def transfer_scene(engine):
 
 
 def _transfer_mirror_errors(result):
-    from sg_prt_addon.techniques import sh_shading, spherical_harmonics
+    from sg_prt_addon.techniques.sh import sh_shading, spherical_harmonics
 
     passes, state = result["passes"], result["state"]
     camera, uv = passes["camera"], passes["gbuffer_uv"]
@@ -157,7 +157,7 @@ def test_transfer_shadows_match_the_mirror(transfer_scene, monkeypatch, bake_ord
     under the sphere darker than without the transfer."""
     import bpy
 
-    from sg_prt_addon.techniques import spherical_harmonics
+    from sg_prt_addon.techniques.sh import spherical_harmonics
 
     monkeypatch.setattr(spherical_harmonics, "VERTEX_TRANSFER", at_vertices)
     scene, sphere, floor = transfer_scene

@@ -120,13 +120,13 @@ def test_environment_shadows_under_a_uniform_sky(engine, bakes):
 def test_per_vertex_diffuse_visibility(engine, bakes, world):
     """The broad diffuse lobes (the environment's SG mixture, or the constant world's cosine lobe) take
     their visibility at the vertices (the renderer's per-vertex passes, interpolated): the Diffuse pass
-    against the same fractions computed at each pixel from its interpolated rows (techniques.sg_shading, the
+    against the same fractions computed at each pixel from its interpolated rows (techniques.sg.sg_shading, the
     same G-buffer pixels), relative RMSE over each object's pixels.  Measured (64 x 64, bake R = 16),
     courtyard: sphere 0.0018, floor 0.0005 (the courtyard score above: 0.0559, 0.0626 with eq. 30's
     reading at the vertices); colour: sphere 0.0017, floor 0.0004."""
     import dataclasses
 
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     scene, sphere, floor = _scene("shadow_per_vertex_" + world)
     if world == "courtyard":
@@ -196,7 +196,7 @@ def test_narrow_lights_share_their_visibility(engine, bakes):
     sphere's box): 2e-4.  A broad light (radius 1.5) keeps the decodes."""
     import bpy
 
-    from sg_prt_addon.techniques import sg_shading
+    from sg_prt_addon.techniques.sg import sg_shading
 
     scene, sphere, floor = _scene("shared_light")
     fx.world_colour(scene, (0.02, 0.02, 0.02))

@@ -78,7 +78,8 @@ def test_every_row_count_renders_the_same_at_every_texture_limit(engine, monkeyp
 
 def test_the_layout_fits_every_side(engine):
     """Any row count, the passes' texels and the vertices' sums fit a row of vertices_per_row(side) vertices."""
-    from sg_prt_addon.techniques import sg_lobes, shader_sources
+    from sg_prt_addon.techniques import shader_sources
+    from sg_prt_addon.techniques.sg import sg_lobes
 
     for side in (gpu_limits.SMALLEST_SIDE, 4096, 8192, 16384, gpu_limits.driver_texture_size()):
         per_row = per_vertex.vertices_per_row(side)

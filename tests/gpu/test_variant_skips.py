@@ -97,7 +97,7 @@ def variant_code(key):
 
 def test_preprocessor_keeps_the_full_variant_code():
     """The helper itself: the full variant keeps every term, the #if logic picks branches."""
-    from sg_prt_addon.techniques.sg_lobes import VariantKey
+    from sg_prt_addon.techniques.sg.sg_lobes import VariantKey
 
     assert active_source("#if defined(A) && B > 1\nyes\n#elif !defined(C)\nno\n#else\nelse\n#endif",
                          {"A": 1, "B": 2}) == "yes"

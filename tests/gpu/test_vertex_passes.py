@@ -1,4 +1,4 @@
-"""The per-vertex passes of the diffuse lobes' visibility (techniques/sg_lobes.py draw_diffuse_visibility): the
+"""The per-vertex passes of the diffuse lobes' visibility (techniques/sg/sg_lobes.py draw_diffuse_visibility): the
 SSDF's coverage at the quadrature points depends on the bake alone, so a redraw keeps it (the object target
 asked for with the same buffers is current) and a new bake draws it again; the lobes' fractions, which follow
 the world and the object's transform, are drawn every frame."""

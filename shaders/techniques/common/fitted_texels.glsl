@@ -1,6 +1,6 @@
 /* A stored lobe fit's texel and shadowing (blender.lobe_fit format 1, export.FittedLobes), what the techniques
  * rendering a fit share (SG_FITTED and a bi-scale material's fitted small scale through sg_shading.glsl, SH's
- * fitted tables through sh_shading.glsl); mirrored by techniques/fitted_texels.py.  fitted_layers: 0 base
+ * fitted tables through sh_shading.glsl); mirrored by techniques/sg/fitted_texels.py.  fitted_layers: 0 base
  * (kd RGB, eta), 1 + 2k lobe k (axis xyz local, sharpness), 2 + 2k lobe k amplitude RGB, 1 + 2K + j shadowing
  * PCA coefficients 4j..4j+3 (K = FITTED_LOBES: NDF_LOBES, or a bi-scale material's small-scale lobes); read
  * with texelFetch at the nearest texel of the UV (the paper's per-texel free-axis lobes).

@@ -1,7 +1,7 @@
 /* SSDF visibility of one SG lobe against the clamped cosine (wang2009 eq. 39-43 with eq. 30-31), and of a
  * light's cap, shared by the SG surface shader (techniques/sg/sg_shading.glsl), its per-vertex pass of the
  * broad diffuse lobes (techniques/sg/vertex_visibility.frag.glsl) and the factored technique
- * (techniques/factored); mirrored by techniques/sg_shading.py's lobe_visibility and light_cap_visibility.  Needs
+ * (techniques/factored); mirrored by techniques/sg/sg_shading.py's lobe_visibility and light_cap_visibility.  Needs
  * sg.glsl, hemisphere.glsl, clamped_cosine.glsl, ssdf.glsl and the `visibility_basis` sampler. */
 
 /* The pixel's (or vertex's) SSDF coefficient rows and the bake's local frame of its SSDF normal

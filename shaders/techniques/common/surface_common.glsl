@@ -1,5 +1,5 @@
-/* What every surface technique shares (techniques/sg_lobes.py and techniques/factored.py include it after
- * shaders/lib): the shading frame, the normal map and tangent rotation (mirrored by techniques.sg_shading's
+/* What every surface technique shares (techniques/sg/sg_lobes.py and techniques/homomorphic/factored.py include it after
+ * shaders/lib): the shading frame, the normal map and tangent rotation (mirrored by techniques.sg.sg_shading's
  * shading_frame, apply_normal_map, rotate_tangent) and, with HAS_LIGHTS, the scene's lights as SGs
  * (lights.glsl; mirrored by sg_shading.point_light_sgs) and, with HAS_ENVIRONMENT and HAS_SPECULAR, the
  * prefiltered environment's radiance for a lobe (env_prefilter.glsl and the environment_texture and
@@ -13,7 +13,7 @@ void shading_frame(vec3 normal, vec3 tangent, out vec3 n, out vec3 t, out vec3 b
   vec3 unit_tangent = safe_normalize(tangent, vec3(0.0));
   t = unit_tangent - n * dot(n, unit_tangent);
   /* within 0.06 degrees of the normal (or zero) what is left is rounding: take the fallback
-   * (1e-6 = techniques.sg_shading.SHADING_FRAME_MIN_SINE squared) */
+   * (1e-6 = techniques.sg.sg_shading.SHADING_FRAME_MIN_SINE squared) */
   if (dot(t, t) < 1.0e-6) {
     t = cross(n, abs(n.x) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0));
   }

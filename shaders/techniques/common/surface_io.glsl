@@ -13,7 +13,7 @@ vec3 surface_facing_normal()
 
 /* A material texture at the surface's texture coordinates, bilinear and repeating as Blender's Image Texture
  * (the gpu module binds samplers clamped to the edge, so the four texels are fetched here; numpy mirror:
- * techniques.sg_shading.sample_material_texture). */
+ * techniques.sg.sg_shading.sample_material_texture). */
 vec4 material_texture(sampler2D image)
 {
   ivec2 size = textureSize(image, 0);

@@ -2,7 +2,7 @@
  * the scene's lights (eq. 20: f(o, i) times each light's clamped-cosine integral, the light taken at its
  * SG's axis) and the environment (beyond the paper: diffuse from its SG mixture, glossy as the factored
  * BRDF's directional albedo times the prefiltered radiance around the mirror direction).  Mirrored by
- * techniques/factored_shading.py.  Needs sg.glsl, hemisphere.glsl, clamped_cosine.glsl, surface_common.glsl,
+ * techniques/homomorphic/factored_shading.py.  Needs sg.glsl, hemisphere.glsl, clamped_cosine.glsl, surface_common.glsl,
  * (HAS_LIGHTS) lights.glsl, (HAS_ENVIRONMENT) env_prefilter.glsl, (HAS_VISIBILITY: every lobe shadowed by
  * its SSDF visibility) ssdf.glsl and common/lobe_visibility.glsl, and the samplers factor_p, factor_q,
  * (FACTOR_R) factor_r and factored_albedo; factor_scale: rgb = alpha A (eq. 20, eq. 6), w = the sharpness

@@ -9,7 +9,7 @@
  * variant's term is exactly zero).  DIFFUSE_VISIBILITY_ROWS (with HAS_VISIBILITY and HAS_DIFFUSE): the
  * broad diffuse lobes' visible fractions come interpolated from the vertices (diffuse_fractions, filled
  * by surface.frag.glsl from the pass of vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with
- * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; techniques.sg_shading.shares_light_visibility): every light is narrow on
+ * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; techniques.sg.sg_shading.shares_light_visibility): every light is narrow on
  * the object, and its products with the slice lobes take its own visibility instead of a decode each.
  * BISCALE (biscale.glsl before this file): the lobes are a bi-scale material's effective lobes (NDF_LOBES of
  * them, iwasaki2012 eq. 15) with their tables' factors and the small-scale M, and the diffuse term is scaled by
@@ -146,7 +146,7 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
 }
 
 #if defined(HAS_LIGHTS) && !defined(MODEL_FITTED) && !defined(BISCALE)
-/* What the slice lobes miss of the model's own BRDF at a light's centre (techniques.sg_shading.light_tail) */
+/* What the slice lobes miss of the model's own BRDF at a light's centre (techniques.sg.sg_shading.light_tail) */
 #define LIGHT_TAIL
 
 /* rho_s(o, i) = M_o(i) D(h) of the model itself (brdf.glsl), local frame */
@@ -189,12 +189,12 @@ float model_specular(vec3 wo, vec3 wi, vec4 p, vec4 q)
 #endif
 
 #if defined(HAS_VISIBILITY) && defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
-/* A partly occluded slice lobe reads the environment where its visible part lies (techniques.sg_shading.
+/* A partly occluded slice lobe reads the environment where its visible part lies (techniques.sg.sg_shading.
  * visible_part_axes): its visible and occluded parts see different light, which the product of the visible
  * fraction and the radiance at the lobe's axis ignores. */
 #define VISIBLE_PART_LOOKUP
 
-/* Phi^-1(p), the standard normal's quantile, for p in (0, 1) (techniques.sg_shading.probit: Abramowitz and
+/* Phi^-1(p), the standard normal's quantile, for p in (0, 1) (techniques.sg.sg_shading.probit: Abramowitz and
  * Stegun 26.2.23, absolute error below 4.5e-4) */
 float probit(float p)
 {
@@ -203,7 +203,7 @@ float probit(float p)
   return p < 0.5 ? -x : x;
 }
 
-/* The part a straight boundary keeps, the fraction v, of a unit Gaussian (techniques.sg_shading.
+/* The part a straight boundary keeps, the fraction v, of a unit Gaussian (techniques.sg.sg_shading.
  * _truncated_moments): its mean beyond the axis m = phi(z) / v, z = Phi^-1(v), and its variance across the
  * boundary, 1 - z m - m^2. */
 vec2 truncated_moments(float v)
@@ -215,13 +215,13 @@ vec2 truncated_moments(float v)
 }
 
 /* Angle, in lobe widths 1/sqrt(lambda), from the axis of a lobe cut by a straight boundary that keeps the
- * fraction v of it to the mean of the kept part (techniques.sg_shading.visible_part_offset). */
+ * fraction v of it to the mean of the kept part (techniques.sg.sg_shading.visible_part_offset). */
 float visible_part_offset(float v)
 {
   return truncated_moments(v).x;
 }
 
-/* Factor on a lobe's sharpness that gives it the width of its visible part (techniques.sg_shading.
+/* Factor on a lobe's sharpness that gives it the width of its visible part (techniques.sg.sg_shading.
  * visible_part_narrowing): the kept part's variance across the boundary (at least VISIBLE_PART_MIN_VARIANCE) and
  * 1 along it, averaged (the lookup is isotropic). */
 float visible_part_narrowing(float v)
@@ -229,7 +229,7 @@ float visible_part_narrowing(float v)
   return 2.0 / (1.0 + clamp(truncated_moments(v).y, VISIBLE_PART_MIN_VARIANCE, 1.0));
 }
 
-/* lobe_visibility, and the side of the lobe its visible part lies on (techniques.sg_shading.
+/* lobe_visibility, and the side of the lobe its visible part lies on (techniques.sg.sg_shading.
  * lobe_visibility_side): the direction in which the SSDF's leading VISIBLE_SIDE_LAYERS rows (the occluders'
  * broad shape, not the nearest edge's detail) grow at the product lobe's axis, by forward differences
  * VISIBLE_SIDE_STEP radians across it (two more decodes of those rows), as a world direction perpendicular to
@@ -261,7 +261,7 @@ float lobe_visibility_side(vec3 axis, float sharpness, vec3 n, out vec3 side)
 #if defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
 /* Where and how sharp to read the environment for a lobe: its product with the clamped cosine's SG for lobes
  * broader than COSINE_LOOKUP_FULL (or always), handing over to the lobe itself at COSINE_LOOKUP_NONE
- * (techniques.sg_shading.cosine_weighted_lookup): a broad lobe crosses the cosine from its peak to the horizon. */
+ * (techniques.sg.sg_shading.cosine_weighted_lookup): a broad lobe crosses the cosine from its peak to the horizon. */
 void cosine_weighted_lookup(inout vec3 axis, inout float sharpness, vec3 n, bool always)
 {
   vec3 product_axis;
@@ -276,7 +276,7 @@ void cosine_weighted_lookup(inout vec3 axis, inout float sharpness, vec3 n, bool
 #endif
 
 /* The warped lobes of one NDF lobe lie close together: they share the visibility of the centre one
- * (techniques.sg_shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3; split2 has
+ * (techniques.sg.sg_shading.visibility_node_indices), a third of the slice terms' SSDF decodes for split3; split2 has
  * no centre node and takes node 0, the one towards the viewer (a valid half vector whenever the lobe's
  * centre is; the other can fall below the view's horizon at grazing views). */
 #define VISIBILITY_NODE ((WARP_NODES - 1) / 2)
@@ -372,7 +372,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
 #ifdef ENVIRONMENT_TAIL
   /* GGX's exact albedo (reflectance.ggx_albedo): the lobes keep at most it (at grazing views they overshoot it
-   * several times over), and the environment tail returns what they miss of it (techniques.sg_shading.model_albedo) */
+   * several times over), and the environment tail returns what they miss of it (techniques.sg.sg_shading.model_albedo) */
 #ifdef MODEL_GGX_ANISO
   float albedo_roughness = sqrt(sqrt(max(p.w, 1.0e-6) * max(q.x, 1.0e-6)));   /* Cycles' equivalent roughness */
 #else
@@ -469,7 +469,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
 #ifdef LIGHT_TAIL
     /* the model's BRDF minus the slice lobes at the light's centre, times what the light delivers there,
-     * weighted by how narrow the light is against the BRDF's local scale s^2 (techniques.sg_shading.light_tail) */
+     * weighted by how narrow the light is against the BRDF's local scale s^2 (techniques.sg.sg_shading.light_tail) */
     float slice_value = 0.0;
     float scale2 = 1.0e30;
     for (int j = 0; j < SLICE_LOBES; j++) {
@@ -536,7 +536,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
 #ifdef ENVIRONMENT_TAIL
   /* GGX's energy beyond its slice lobes: its exact albedo minus theirs, as a broad lobe on the broader NDF
-   * lobe's centre node (techniques.sg_shading.environment_tail), with its own visibility (broader than the
+   * lobe's centre node (techniques.sg.sg_shading.environment_tail), with its own visibility (broader than the
    * node's, it sees past more of an occluder), read where its own visible part lies: turned by its offset
    * towards the node's visible side */
   float tail_sharpness = slice_sharpness[VISIBILITY_NODE] * TAIL_SHARPNESS_RATIO;

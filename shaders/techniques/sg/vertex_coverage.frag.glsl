@@ -2,7 +2,7 @@
  * diffuse lobes (vertex_visibility.frag.glsl) to weigh: one texel = four points' visible shares (their
  * cells' coverage) of one vertex, laid out like the coefficient texture: vertex v's texel t (points
  * 4t .. 4t + 3) at ((v % per_row) * COVERAGE_TEXELS + t, v / per_row).  Mirrored by
- * techniques.sg_shading.vertex_coverage.  A vertex's points are decoded once here, not once a texel of
+ * techniques.sg.sg_shading.vertex_coverage.  A vertex's points are decoded once here, not once a texel of
  * lobes there. */
 void main()
 {

@@ -1,5 +1,5 @@
 /* The broad diffuse lobes' visibility at the mesh vertices, for the surface shader to interpolate
- * (DIFFUSE_VISIBILITY_ROWS; mirrored by techniques.sg_shading.vertex_diffuse_visibility).  One texel = four lobes
+ * (DIFFUSE_VISIBILITY_ROWS; mirrored by techniques.sg.sg_shading.vertex_diffuse_visibility).  One texel = four lobes
  * of one vertex, laid out like the coefficient texture: vertex v's row r at texel
  * ((v % per_row) * DIFFUSE_VISIBILITY_ROWS + r, v / per_row), per_row = coefficient texels a row /
  * SSDF_MAX_LAYERS.  The lobes: the environment's SG mixture (HAS_ENVIRONMENT), else the constant world's

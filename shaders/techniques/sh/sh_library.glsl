@@ -1,6 +1,6 @@
 /* Real spherical harmonics of order SH_ORDER (SH_COUNT = SH_ORDER^2 coefficients, (l, m) at l^2 + l + m,
  * Condon-Shortley phase: sg_prt_addon/harmonics, whose numpy this mirrors).  Needs the generated constants
- * (techniques/sh_glsl.py): SH_NORMALIZATION (K_lm, times sqrt(2) for m > 0, at l (l + 1) / 2 + m) and
+ * (techniques/sh/sh_glsl.py): SH_NORMALIZATION (K_lm, times sqrt(2) for m > 0, at l (l + 1) / 2 + m) and
  * sh_rotate_x90 / sh_rotate_x90_inverse. */
 
 /* Y_i(d) of a unit direction: P_l^m / sin^m by the recurrences in l, times Re / Im of (x + i y)^m. */

@@ -6,9 +6,9 @@
  * lights and area lights' patches, by sphere_light_cap) and SGs (suns), zonal about their direction: Phi g_l Y_lm(axis).  Diffuse:
  * the clamped cosine's bands A_l (Funk-Hecke), the lights' by the addition theorem; a light wholly below
  * the horizon adds nothing (its expansion would add only ringing).  Every band of the lighting is scaled by
- * the window's SH_WINDOW[l].  Mirrored by techniques/sh_shading.py.
+ * the window's SH_WINDOW[l].  Mirrored by techniques/sh/sh_shading.py.
  *
- * HAS_TRANSFER (a transfer bake, techniques/spherical_harmonics.py): the environment through the vertex's
+ * HAS_TRANSFER (a transfer bake, techniques/sh/spherical_harmonics.py): the environment through the vertex's
  * transfer, T L and t . L weighed from sh_transfer_radiance (row k: term k of the transfer times the
  * windowed lighting; columns 0 .. SH_COUNT - 1: T_k L, SH_COUNT: t_k . L) by transfer_rows; each light's
  * diffuse term t . L_light with t rebuilt from transfer_basis, its glossy term times the same visible

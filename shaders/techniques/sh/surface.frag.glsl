@@ -1,7 +1,7 @@
 /* Material colours and the table's parameter (property x texture), normal map and tangent frame
  * (common/surface_io.glsl), then shade_sh (sh_shading.glsl).  Writes the passes as the other techniques'
  * surfaces do.  SH_PARAMETER: the MaterialData field of the table's parameter axis
- * (techniques/spherical_harmonics.py).  SH_FITTED: kd from the lobe fit's texel, the colours in its lobes. */
+ * (techniques/sh/spherical_harmonics.py).  SH_FITTED: kd from the lobe fit's texel, the colours in its lobes. */
 void main()
 {
   vec3 normal = surface_facing_normal();

@@ -1,6 +1,6 @@
 """mccool2001's homomorphic factorization as a technique: the material's BRDF as p(o) q(h) p(i) r(o.h) texture
 lookups per light (measured/homomorphic.py fits them; shaders/techniques/factored/ renders them;
-techniques/factored_shading.py is the mirror).
+techniques/homomorphic/factored_shading.py is the mirror).
 
 The specular BRDF of the material's model is factorized once per set of model parameters (about 2 s,
 cached for the process): model parameters are uniform over the material (their textures do not apply;
@@ -17,11 +17,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..measured import homomorphic
-from ..reflectance import brdf, models
-from ..spherical import lattice
-from . import factored_shading, sg_lobes, shader_sources, surface_layering
-from .base import Technique
+from ...measured import homomorphic
+from ...reflectance import brdf, models
+from ...spherical import lattice
+from .. import shader_sources, surface_layering
+from ..base import Technique
+from ..sg import sg_lobes
+from . import factored_shading
 
 NAME = "FACTORED"
 GLSL_DIR = "factored"
@@ -153,6 +155,8 @@ class Factored(Technique):
     description = ("The material's BRDF factorized into p(o) q(h) p(i) r(o.h) texture lookups per light "
                    "(McCool et al. 2001), shadowed by the visibility bake")
     number = 2
+    blender_side = ".blender"
+    renders_stored = "factorization"
     paper = "mccool2001"
 
     mirror = staticmethod(factored_shading.shade_fragments)

@@ -48,10 +48,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..lighting import env_prefilter, equirect, lights
-from ..reflectance import brdf, ggx_albedo, layering, models
-from ..spherical import clamped_cosine, sg, texture_fetch, warp
-from . import biscale_shading, surface_layering
+from ...lighting import env_prefilter, equirect, lights
+from ...reflectance import brdf, ggx_albedo, layering, models
+from ...spherical import clamped_cosine, sg, texture_fetch, warp
+from .. import surface_layering
+from . import biscale_shading
 from .fitted_texels import FITTED_MODEL, fitted_m_factor, fitted_texel_values
 
 FLOAT = np.float32
@@ -93,7 +94,7 @@ VISIBLE_PART_MIN_VARIANCE = 0.05
 def _clamped_cosine_integral(axis, sharpness, amplitude, normal):
     """I(G, n) of a lobe whose sharpness varies per pixel (lights, slices, their products): from the
     table, as the shader reads it (clamped_cosine_table)."""
-    from ..spherical import clamped_cosine_table
+    from ...spherical import clamped_cosine_table
     return clamped_cosine_table.sg_clamped_cosine_integral_tabulated(axis, sharpness, amplitude, normal).astype(FLOAT)
 
 
@@ -118,7 +119,7 @@ class Visibility:
 
 def ssdf_decode_packed(rows, basis_texture, local_direction):
     """ssdf.glsl's ssdf_decode in numpy: rows (N, 4L), local directions (N, K, 3) -> (N, K) float32."""
-    from ..visibility import decode
+    from ...visibility import decode
 
     layers, resolution = basis_texture.shape[0], basis_texture.shape[1]
     texcoord, below = decode.texcoord_of(local_direction, resolution)        # (N, K, 2), (N, K)
@@ -133,7 +134,7 @@ def ssdf_decode_packed(rows, basis_texture, local_direction):
 def _ssdf_at(axis, visibility):
     """(local (N, K, 3), theta_d (N, K)): world directions (N, K, 3) in the SSDF's frame of each pixel's normal
     and the SSDF there (lobe_visibility.glsl's `axis * visibility_frame` and ssdf_decode)."""
-    from ..visibility import hemisphere_map
+    from ...visibility import hemisphere_map
 
     frame = hemisphere_map.local_frame(np.asarray(visibility.normal, np.float64))      # (N, 3, 3)
     local = np.einsum("nij,nkj->nki", frame, np.asarray(axis, np.float64))
@@ -155,7 +156,7 @@ def _visibility_product(axis, sharpness, n, visibility):
 def _product_visible_fraction(theta_d, local, product_sharpness):
     """eq. 30-31's fh(theta_d) / fh(theta_h) of the product lobes, clamped to [0, 1] (lobe_visibility.glsl's
     product_visible_fraction)."""
-    from ..spherical import hemisphere
+    from ...spherical import hemisphere
 
     visible = hemisphere.fh_normalized(theta_d, product_sharpness)
     unshadowed = hemisphere.fh_normalized_from_sine(sg.normalize(local.astype(FLOAT))[..., 2], product_sharpness)
@@ -175,7 +176,7 @@ def lobe_visibility_side(axis, sharpness, n, visibility):
     at the product lobe's axis, by forward differences VISIBLE_SIDE_STEP radians across it, as a unit world
     direction perpendicular to the lobe's axis (zero where the lobe is unoccluded or the SSDF flat;
     sg_shading.glsl's lobe_visibility_side)."""
-    from ..visibility import hemisphere_map
+    from ...visibility import hemisphere_map
 
     axis = np.asarray(axis, FLOAT)
     local, theta_d, product_sharpness = _visibility_product(axis, sharpness, n, visibility)
@@ -201,7 +202,7 @@ def lobe_visibility_side(axis, sharpness, n, visibility):
 def light_cap_visibility(axis, sharpness, visibility):
     """Visible fraction (N, K) of lights' caps: axis (N, K, 3), sharpness (N, K) of their SGs, whose caps are
     lights.cap_radius wide (lobe_visibility.glsl's light_cap_visibility with sg_shading.glsl's light_cap_radius)."""
-    from ..spherical import hemisphere
+    from ...spherical import hemisphere
 
     local, theta_d = _ssdf_at(axis, visibility)
     radius = lights.cap_radius(sharpness)
@@ -213,7 +214,7 @@ def light_cap_visibility(axis, sharpness, visibility):
 def vertex_coverage(vertices):
     """The SSDF's coverage (V, P) at the quadrature points of visibility.broad_lobes at mesh vertices
     (shaders/techniques/sg/vertex_coverage.frag.glsl); vertices: a Visibility of their coefficient rows."""
-    from ..visibility import broad_lobes
+    from ...visibility import broad_lobes
 
     rows = np.asarray(vertices.rows, FLOAT)
     points = np.broadcast_to(broad_lobes.quadrature_points().astype(FLOAT), (len(rows), broad_lobes.QUADRATURE_POINTS, 3))
@@ -227,7 +228,7 @@ def vertex_diffuse_visibility(environment, vertices):
     (E = 1), by the quadrature of visibility.broad_lobes over the SSDF's coverage, handing over to eq. 30's
     reading (lobe_visibility) for the sharper lobes.  vertices: a Visibility of the vertices (their
     coefficient rows and world SSDF normals), whose normal also stands in for the shading normal."""
-    from ..visibility import broad_lobes, hemisphere_map
+    from ...visibility import broad_lobes, hemisphere_map
 
     coverage = vertex_coverage(vertices)
     if not environment.has_texture:           # the cosine lobe about the SSDF's normal

@@ -4,8 +4,8 @@ the two fixed x rotations of the zyz method unrolled over
 their non-zero entries (harmonics.rotation.x90_blocks), so the shader does exactly the numpy's sums."""
 import math
 
-from ..harmonics import basis, fitted_table, projection, rotation
-from ..reflectance import brdf
+from ...harmonics import basis, fitted_table, projection, rotation
+from ...reflectance import brdf
 
 
 def _floats(values):

@@ -8,10 +8,10 @@ recomputation; the tile's BVNDF (lobes and tables) changes only with the geometr
 """
 import numpy as np
 
-from ..biscale import bvndf as bvndf_tables
-from ..biscale import effective_brdf
-from ..reflectance import brdf, models
-from ..spherical import sg, warp
+from ...biscale import bvndf as bvndf_tables
+from ...biscale import effective_brdf
+from ...reflectance import brdf, models
+from ...spherical import sg, warp
 from .fitted_texels import FITTED_MODEL, fitted_m_factor
 
 FLOAT = np.float32

@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 
-from ..harmonics import basis, brdf_table, fitted_table, projection, rotation
-from ..measured.svbrdf_table import interpolate_shadowing
-from ..reflectance.brdf import COSINE_EPSILON
-from ..spherical import sg, texture_fetch
-from . import fitted_texels, sg_shading
+from ...harmonics import basis, brdf_table, fitted_table, projection, rotation
+from ...measured.svbrdf_table import interpolate_shadowing
+from ...reflectance.brdf import COSINE_EPSILON
+from ...spherical import sg, texture_fetch
+from ..sg import fitted_texels, sg_shading
 
 FLOAT = np.float32
 

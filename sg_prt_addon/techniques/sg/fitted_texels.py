@@ -5,10 +5,10 @@ bi-scale material whose small-scale BRDF is the fit (biscale_shading) and the SH
 (spherical_harmonics, sh_shading)."""
 import numpy as np
 
-from ..measured.microfacet_fit import decompress_shadowing
-from ..measured.svbrdf_table import interpolate_shadowing
-from ..reflectance import brdf
-from ..spherical import sg
+from ...measured.microfacet_fit import decompress_shadowing
+from ...measured.svbrdf_table import interpolate_shadowing
+from ...reflectance import brdf
+from ...spherical import sg
 
 FLOAT = np.float32
 FITTED_MODEL = "FITTED"        # the variant's model with a stored fit (MODEL_FITTED in the GLSL)

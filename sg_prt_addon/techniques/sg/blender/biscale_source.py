@@ -11,8 +11,8 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..biscale import bvndf, microgeometry
-from .images import image_has_pixels, image_pixels
+from ....biscale import bvndf, microgeometry
+from ....blender.images import image_has_pixels, image_pixels
 
 CACHE_SIZE = 8
 _cache = OrderedDict()          # content key -> (BVNDF, its tile's triangles), least recently used first

@@ -2,9 +2,10 @@
 texture per pixel), GGX's two-lobe table and albedo tail, the anisotropic models' lobe tables."""
 import numpy as np
 
-from ..reflectance import ggx_albedo, models, ndf_fit
-from ..spherical import warp
-from . import sg_shading, surface_layering
+from ...reflectance import ggx_albedo, models, ndf_fit
+from ...spherical import warp
+from .. import surface_layering
+from . import sg_shading
 from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_PARAMETRIC"

@@ -1,10 +1,10 @@
 """Numpy mirror of the factored-BRDF technique's fragment shader (shaders/techniques/factored/): the same
-steps, per pixel, in float32 where the shader is.  tables: techniques.factored.FactoredTables."""
+steps, per pixel, in float32 where the shader is.  tables: techniques.homomorphic.factored.FactoredTables."""
 import numpy as np
 
-from ..measured import homomorphic
-from ..spherical import clamped_cosine, texture_fetch
-from . import sg_shading
+from ...measured import homomorphic
+from ...spherical import clamped_cosine, texture_fetch
+from ..sg import sg_shading
 
 FLOAT = np.float32
 

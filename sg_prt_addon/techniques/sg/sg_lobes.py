@@ -1,6 +1,6 @@
 """What wang2009's two techniques share: SG shading of lights and a prefiltered environment, the view warp
 of the NDF lobes, and SSDF visibility from a per-vertex bake (shaders/techniques/sg/, mirrored by
-techniques.sg_shading).  sg_parametric gives the lobes of an analytic BRDF model, sg_fitted those of a stored
+techniques.sg.sg_shading).  sg_parametric gives the lobes of an analytic BRDF model, sg_fitted those of a stored
 lobe fit; both subclass SGLobes and fill in the model's part through its hooks.
 
 A variant is keyed by what changes the code (not the values): the model, its NDF lobe count, whether
@@ -20,13 +20,14 @@ lobe_visibility, sg_shading) + the per-vertex rows' copy
 """
 from dataclasses import dataclass
 
-from ..reflectance import brdf
-from ..spherical import clamped_cosine_table, warp
-from ..visibility import broad_lobes
-from . import sg_shading, shader_sources, surface_layering
-from .base import Technique
+from ...reflectance import brdf
+from ...spherical import clamped_cosine_table, warp
+from ...visibility import broad_lobes
+from .. import shader_sources, surface_layering
+from ..base import Technique
+from ..shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
+from . import sg_shading
 from .fitted_texels import FITTED_MODEL
-from .shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
 
 GLSL_DIR = "sg"
 # Library files in dependency order (shaders/lib), then the technique's own (shaders/techniques/sg)
@@ -58,7 +59,7 @@ class VariantKey:
     has_specular: bool = True       # False: zero specular colour, no texture: no BRDF slice code
     # vec4 of broad diffuse lobe visibility a vertex, from the per-vertex pass (0: none, or decoded per pixel)
     diffuse_visibility_rows: int = 0
-    # light x slice products take the light's visibility (techniques.sg_shading.shares_light_visibility; with a bake,
+    # light x slice products take the light's visibility (techniques.sg.sg_shading.shares_light_visibility; with a bake,
     # lights and a specular term)
     shared_light_visibility: bool = False
     shadow_maps: bool = False       # with lights: the scene's lights have shadow maps (lighting.shadow_maps)
@@ -183,6 +184,7 @@ class SGLobes(Technique):
 
     paper = "wang2009"
     mirror = staticmethod(sg_shading.shade_fragments)
+    blender_side = ".blender"
 
     # ------------------------------------------------------------- model hooks
 

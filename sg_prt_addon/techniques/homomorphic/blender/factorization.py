@@ -2,7 +2,7 @@
 p(o) q(h) p(i) r(o.h) maps (measured/homomorphic.py, mccool2001) and stored in the active material for the
 factored technique.  The factors are one BRDF for the whole surface: a table's spatial variation is Fit Lobes'.
 
-Storage, per material (format 1): ``material.sgprt.factorization`` (properties.SGPRT_PG_factorization):
+Storage, per material (format 1): ``material.sgprt.factorization`` (SGPRT_PG_factorization below):
 ``format_version``, ``source_file``, ``source_path``, ``source_texel`` (-1: a MERL file), ``form``,
 ``resolution``, ``alpha_scale`` (alpha A, RGB), ``lobe_sharpness`` (the glossy environment lookup's), ``samples`` (valid BRDF samples fitted), ``masked`` (the
 NaN, Inf and negative channel samples left out), ``error`` (relative RMS against the source, cosine weighted),
@@ -17,14 +17,15 @@ import time
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, IntProperty, StringProperty
+from bpy.props import CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, StringProperty
 
-from .. import techniques
-from ..measured import homomorphic
-from ..techniques import factored
-from . import lobe_fit
-from .background_job import BackgroundJob, MaterialFileJobOperator, active_material
-from .panels import MaterialPanel
+from .... import techniques
+from ....blender import lobe_fit
+from ....blender.background_job import BackgroundJob, MaterialFileJobOperator, active_material
+from ....blender.panels import MaterialPanel
+from ....blender.properties import SGPRT_PG_lobe_fit_image
+from ....measured import homomorphic
+from .. import factored
 
 FORMAT_VERSION = 1
 IMAGE_PREFIX = "SGPRT factors"
@@ -35,6 +36,30 @@ SAMPLES = 256          # views x lights of the fit
 
 # Tests (and scripts) may set this to a callable(fraction, message) -> bool: True cancels the job.
 progress_hook = None
+
+
+class SGPRT_PG_factorization(bpy.types.PropertyGroup):
+    """A measured BRDF factorized by sgprt.factor_brdf (layout: factorization.py)."""
+    format_version: IntProperty(name="Format Version", default=0, description="0: no factors stored")
+    source_file: StringProperty(name="Source File", description="File name the factors were made from")
+    source_path: StringProperty(name="Source Path", description="Full path the factors were made from")
+    source_texel: IntProperty(name="Source Texel", default=-1, min=-1,
+                              description="The SVBRDF table texel factorized (row-major); -1: a MERL file")
+    form: StringProperty(name="Form", description="measured.homomorphic.FORMS key")
+    resolution: IntProperty(name="Resolution", default=0, min=0)
+    alpha_scale: FloatVectorProperty(name="Scale", size=3, default=(1.0, 1.0, 1.0),
+                                     description="alpha A of the factored BRDF (RGB)")
+    lobe_sharpness: FloatProperty(name="Lobe Sharpness", default=1.0, description="Of the glossy environment lookup")
+    samples: IntProperty(name="Samples", default=0, min=0)
+    masked: IntProperty(name="Masked Samples", default=0, min=0, description="NaN, Inf and negative samples left out")
+    error: FloatProperty(name="Error", default=0.0, description="Relative RMS against the source, cosine weighted")
+    date: StringProperty(name="Date", description="When the factors were stored (ISO 8601 UTC)")
+    seconds: FloatProperty(name="Seconds", default=0.0)
+    images: CollectionProperty(type=SGPRT_PG_lobe_fit_image, name="Images")
+    previous_technique: StringProperty(name="Technique Before",
+                                       description="The material's technique before the factors set theirs: "
+                                                   "Clear BRDF Factors gives it back")
+
 
 
 class FactorError(ValueError):
@@ -284,12 +309,3 @@ class SGPRT_PT_material_factorization(MaterialPanel, bpy.types.Panel):
 
 classes = (SGPRT_OT_factor_brdf, SGPRT_OT_clear_factorization, SGPRT_PT_material_factorization)
 
-
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)

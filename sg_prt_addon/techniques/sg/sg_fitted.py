@@ -3,7 +3,7 @@ lobes, kd and eta, and the PCA-compressed shadowing, fetched at the UV's nearest
 from .sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_FITTED"
-MODEL = "FITTED"        # the variant's model: MODEL_FITTED in the GLSL, techniques.sg_shading.FITTED_MODEL in the mirror
+MODEL = "FITTED"        # the variant's model: MODEL_FITTED in the GLSL, techniques.sg.sg_shading.FITTED_MODEL in the mirror
 
 
 class SGFitted(SGLobes):
@@ -12,6 +12,7 @@ class SGFitted(SGLobes):
     description = ("SG lobes fitted per texel to a measured BRDF or SVBRDF table (Fit Lobes); "
                    "all-frequency light and SSDF shadows (Wang et al. 2009)")
     number = 1
+    renders_stored = "lobe_fit"
 
     def variant_key(self, params, inputs):
         """The stored fit's lobes, shadowing and base; of the material's textures only a normal map applies."""

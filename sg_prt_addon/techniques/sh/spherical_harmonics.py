@@ -1,6 +1,6 @@
 """kautz2002 as a technique: any BRDF under low-frequency light, the BRDF times the cosine projected into SH
 per local view (harmonics/brdf_table.py), the lighting as SH, shading as their dot product (eq. 1), the
-rotation between frames per pixel on the GPU (shaders/techniques/sh/; techniques/sh_shading.py is the
+rotation between frames per pixel on the GPU (shaders/techniques/sh/; techniques/sh/sh_shading.py is the
 mirror).
 
 What it reads: the material's model and parameters; an isotropic model's table has its spatially varying
@@ -32,11 +32,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..harmonics import brdf_table, fitted_table, projection
-from ..reflectance import models
-from ..visibility import per_vertex, transfer
-from . import fitted_texels, sh_glsl, sh_shading, shader_sources, surface_layering
-from .base import Technique
+from ...harmonics import brdf_table, fitted_table, projection
+from ...reflectance import models
+from ...visibility import per_vertex, transfer
+from .. import shader_sources, surface_layering
+from ..base import Technique
+from ..sg import fitted_texels
+from . import sh_glsl, sh_shading
 
 NAME = "SH"
 GLSL_DIR = "sh"
@@ -214,6 +216,7 @@ class SphericalHarmonics(Technique):
     description = ("The BRDF times the cosine as SH coefficients per view direction, the lighting as SH, "
                    "shading as their dot product (Kautz et al. 2002): any BRDF under low-frequency light")
     number = 3
+    blender_side = ".blender"
     paper = "kautz2002"
     shadow_kind = TRANSFER_KIND
 
