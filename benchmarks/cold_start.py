@@ -123,7 +123,7 @@ def section(results, size, repeats, command):
             value = r[step] if kind is None else r[kind][step]
             cells.append(f"{value:.3f} | {value / r['eevee']['warm']:.3f}")
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
-    goal = (f"Issue 20's goal, a cold job's render within {COLD_GOAL:g}x of a warm render(): " + "; ".join(
+    goal = (f"The goal, a cold job's render within {COLD_GOAL:g}x of a warm render(): " + "; ".join(
         f"{r['scene']} {r['cached']['first'] / r['warm']:.2f}x with the disk cache "
         f"({'met' if r['cached']['first'] <= COLD_GOAL * r['warm'] else 'not met'}), "
         f"{r['empty']['first'] / r['warm']:.2f}x without" for r in results) + ".")

@@ -156,7 +156,7 @@ def section(results, size, command, eevee_samples):
         f"load average {r['load_start']:.1f} -> {r['load_end']:.1f}, depth pre-pass speed-up "
         f"{r['frame_no_prepass'] / r['frame']:.2f}x" for r in results) + "."
     base = f"eevee_{eevee_samples[0]}"
-    target = "Issue 6's target, render() at most 0.1 of EEVEE's 1-sample render: " + "; ".join(
+    target = "The target, render() at most 0.1 of EEVEE's 1-sample render: " + "; ".join(
         f"{r['scene']} {r['render'] / r[base]:.3f} ({'met' if r['render'] <= 0.1 * r[base] else 'not met'})"
         for r in results) + "."
     lines += ["", textwrap.fill(notes, 100), "", textwrap.fill(target, 100), ""]

@@ -5,11 +5,12 @@ with that tree first on sys.path: the scene built by that tree's examples/build_
 operator at its defaults, Render Samples 1 (the setting's first default; a tree without it draws one frame anyway),
 and its engine_vs_eevee.steady_frame (draw + read back, the median of --redraws redraws of one render).  The
 ratio is this tree's frame over the commit's of the same round, median and range: what every change between the
-two costs the frame together, where the frame-cost sections of docs/PERFORMANCE.md measure each against its parent.
+two costs the frame together, where docs/PERFORMANCE.md "What each accuracy feature costs the frame" measures
+each against its parent.
 
     .venv/bin/python -m benchmarks.frame_against_commit [--commit d145f8e] [--size 512] [--rounds 3] [--scenes NAME ...]
 
-The default commit is where issue 12 (the truth suite and the SG technique's fixes) began.
+The default commit is the tree before the truth suite and the SG technique's accuracy work.
 """
 import argparse
 import json
