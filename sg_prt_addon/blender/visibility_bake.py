@@ -20,7 +20,7 @@ mesh of the evaluated faces, with the modifier stack's fingerprint
 render whose modifiers changed since, or the viewport where it evaluates them
 otherwise, draws the object unshadowed and says why).
 
-The engine exports one vertex per face corner (blender/export.py).  To upload
+The engine exports one vertex per face corner (blender/export/meshes.py).  To upload
 per-corner data it maps corner -> vertex with the loop's ``vertex_index``::
 
     stored = visibility_for_object(object_eval)        # or load_visibility_bake(mesh, evaluated_mesh)

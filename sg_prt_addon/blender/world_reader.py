@@ -1,7 +1,7 @@
 """A world's shader nodes read as the engine's environment: from the active World Output, a Background (or
 Emission) shader's Color, an Environment Texture (equirectangular) with a Mapping node's rotation and scale
 in front of it, an RGB or the socket's colour, and its Strength.  What cannot be read is named in one warning
-(blender/export.py export_world) with what was used instead: another shader (a Sky Texture, a Mix of
+(blender/export/world.py export_world) with what was used instead: another shader (a Sky Texture, a Mix of
 backgrounds) renders the world colour."""
 from dataclasses import dataclass, field
 

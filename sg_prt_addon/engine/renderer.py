@@ -11,7 +11,7 @@ import collections
 import numpy as np
 
 from .. import techniques
-from ..blender.export import COLOUR_SLOTS, slot_pixels, texture_sources
+from ..blender.export import COLOUR_SLOTS, texture_sources
 from ..lighting import shadow_maps
 from ..spherical import clamped_cosine
 from ..techniques import shader_sources, surface_layering
@@ -405,8 +405,6 @@ class Renderer:
     def upload(self, state, dirty, camera, shadow_camera=None):
         """Upload what `dirty` names of `state`, and the scene block of `camera`; the shadow maps planned for
         shadow_camera's view when given (a jittered frame keeps its centred frame's plan, and so the atlas)."""
-        import bpy
-
         for key in dirty.meshes:
             if key in state.meshes:
                 self.mesh_buffers[key] = MeshBuffers(state.meshes[key], state.per_vertex.get(key))
@@ -430,9 +428,9 @@ class Renderer:
             self.material_tables.pop(params.name or name, None)
             for slot, value in params.textures.items():
                 key = _texture_key(value, slot, params)
-                if key not in self.textures and all(name in bpy.data.images for name in texture_sources(value)):
-                    self.textures[key] = self._image_texture(slot_pixels(value, slot, decode=key[1]),
-                                                             " x ".join(texture_sources(value)))
+                pixels = state.texture_pixels(value, slot, key[1]) if key not in self.textures else None
+                if pixels is not None:
+                    self.textures[key] = self._image_texture(pixels, " x ".join(texture_sources(value)))
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)

@@ -460,6 +460,12 @@ class SceneState:
         dirty, self.dirty = self.dirty, Dirty()
         return dirty
 
+    @staticmethod
+    def texture_pixels(value, slot, decode):
+        """What the shader samples for a material's texture (MaterialParams.textures[slot]): (H, W, 4) float32,
+        read from Blender's images when the renderer first uploads it; None while an image it reads is gone."""
+        return export.slot_pixels(value, slot, decode) if export.images_present(value) else None
+
     # ----------------------------------------------------------------- shader-side data
 
     def light_data(self):

@@ -22,7 +22,7 @@ N (N + 1) / 2 coefficients with m >= 0 are stored (the paper's Fig. 4 with the t
 A free-axes fit is anisotropic per texel: a parabolic view map per texel (the paper's anisotropic layout) at
 even 16 x 16 views (the paper used 128 x 128), order 5 and 4 lobes is 115 KB a texel, 470 MB for 64 x 64
 texels, and its lobes, off the normal, would each need nodes about their own axis (no rule shared by the
-texels), so the SH technique refuses it (blender/export.py renders it with the fitted SG lobes instead).
+texels), so the SH technique refuses it (techniques/sh/blender renders it with the fitted SG lobes instead).
 
 Layout and size: coefficients (T texels, K lobes, V views, M = N (N + 1) / 2) float32, V = 64 theta_v nodes at
 (j + 1/2) / V pi / 2; the GPU's copy (texture_layers) pads M to whole vec4s: T K V 4 ceil(M / 4) floats, e.g.

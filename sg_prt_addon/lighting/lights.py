@@ -157,7 +157,7 @@ AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
 # light's size away (docs/ACCURACY.md, "area_lights")
 AREA_PATCHES_PER_SIDE = 4
 # Cycles turns a spread of 0 into a delta beam; below this a beam from each patch centre is all a patch can
-# give (blender/export.py warns where the shaft's edge is then approximate)
+# give (blender/export/lights.py warns where the shaft's edge is then approximate)
 MIN_SPREAD = 1e-3
 
 

@@ -183,7 +183,7 @@ def test_panel_and_copy_from_node_tree(empty_file):
 def test_metallic_map_and_texture_factors_compute_textures(empty_file):
     """A metallic map and a Mix Shader's texture factor: the slots get textures computed from the images
     (export.slot_pixels), equal to the formulas on the decoded pixels."""
-    from sg_prt_addon.blender import export
+    from sg_prt_addon.blender import export, images
     from sg_prt_addon.reflectance.texture_expression import Expression
 
     rng = np.random.default_rng(2)
@@ -199,8 +199,8 @@ def test_metallic_map_and_texture_factors_compute_textures(empty_file):
     assert warnings == []
     assert isinstance(params.textures["diffuse_color"], Expression)
     assert params.diffuse_color == (1.0, 1.0, 1.0) and params.specular_color == (1.0, 1.0, 1.0)
-    base = export.srgb_to_linear(export.image_pixels(bpy.data.images["pbr_base"])[..., :3])    # as stored: bytes
-    metal = export.image_pixels(bpy.data.images["pbr_metal"])[..., :3]
+    base = export.srgb_to_linear(images.image_pixels(bpy.data.images["pbr_base"])[..., :3])    # as stored: bytes
+    metal = images.image_pixels(bpy.data.images["pbr_metal"])[..., :3]
     np.testing.assert_allclose(export.slot_pixels(params.textures["diffuse_color"], "diffuse_color")[..., :3],
                                base * (1 - metal), atol=1e-6)
     np.testing.assert_allclose(export.slot_pixels(params.textures["specular_color"], "specular_color")[..., :3],

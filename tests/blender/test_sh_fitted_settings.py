@@ -1,6 +1,6 @@
 """A spherical-harmonics material with a stored lobe fit (SH BRDF: Lobe Fit): Fit Lobes on an SH material makes
 the fit what it tabulates, the choice survives save and reopen, the panels say what renders, and a fit the
-technique cannot tabulate is refused with its reason (blender/export.py)."""
+technique cannot tabulate is refused with its reason (techniques/sh/blender)."""
 import numpy as np
 import pytest
 import recording_layout

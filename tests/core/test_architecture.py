@@ -186,3 +186,10 @@ def test_nothing_shipped_imports_validation(graph):
     bad = [f"{name} imports {target}" for name, imports in graph.items() for target, _ in imports
            if target.split(".")[0] in ("validation", "tests", "benchmarks", "examples", "tools")]
     assert not bad, "\n".join(bad)
+
+
+def test_the_renderer_reads_arrays_not_blender_data(graph):
+    """Data flows one way: the scene state hands the GPU upload arrays (its texture_pixels included); the
+    renderer never reads Blender's data itself."""
+    bad = [target for target, _ in graph[f"{PACKAGE}.engine.renderer"] if target.split(".")[0] in ("bpy", "mathutils")]
+    assert not bad, bad

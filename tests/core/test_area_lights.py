@@ -78,7 +78,7 @@ def test_patch_grid_converges():
 @pytest.mark.parametrize("spread_degrees, bound", [
     (90.0, 0.02),         # measured 0.014
     (60.0, 0.035),        # 0.025
-    (30.0, 0.12),         # 0.089: narrower, each patch's beam shows (blender/export.py warns below 30 degrees)
+    (30.0, 0.12),         # 0.089: narrower, each patch's beam shows (blender/export/lights.py warns below 30 degrees)
 ])
 def test_spread_patches_against_quadrature(spread_degrees, bound):
     """A narrowed spread: the patches take the attenuation at their centres, a light's size away."""

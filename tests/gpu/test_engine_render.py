@@ -213,12 +213,12 @@ def test_second_view_layer_renders_its_own_objects(engine, tmp_path):
 def test_srgb_byte_textures_are_linearised_for_colours_only(engine, tmp_path):
     import bpy
 
-    from sg_prt_addon.blender import export
+    from sg_prt_addon.blender import export, images
 
     image = bpy.data.images.new("srgb_bytes", 4, 2, alpha=True)       # byte buffer, sRGB
     values = np.linspace(0.0, 1.0, 32, dtype=np.float32)
     image.pixels.foreach_set(values)
-    stored = export.image_pixels(image)
+    stored = images.image_pixels(image)
     colour = export.texture_pixels(image, "diffuse_color")
     data = export.texture_pixels(image, "roughness")
     np.testing.assert_array_equal(data, stored)

@@ -157,8 +157,8 @@ def test_engine_and_blender_glue_name_no_technique():
             source = handle.read()
         found = sorted(word for word, pattern in patterns.items() if re.search(pattern, source))
         assert not found, f"engine/{file_name} names {found}"
-    paths = sorted(glob.glob(os.path.join(BLENDER_DIR, "*.py")))
+    paths = sorted(glob.glob(os.path.join(BLENDER_DIR, "**", "*.py"), recursive=True))
     assert len(paths) > 15
     for path in paths:
         found = sorted(word for word, pattern in patterns.items() if re.search(pattern, _code_of(path)))
-        assert not found, f"blender/{os.path.basename(path)} names {found}"
+        assert not found, f"blender/{os.path.relpath(path, BLENDER_DIR)} names {found}"
