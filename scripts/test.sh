@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Set up and run the whole test suite: every tier on pip bpy 5.0 (the last for Python 3.11) and on the newest,
-# 5.3 (Python 3.13, through pyenv), then the Blender and GPU tiers on 5.2 LTS and on the oldest, 4.2 LTS, and
-# the real-Blender tier (tests/ui: Debian's Blender 4.3 in a chroot, scripts/real_blender.sh; needs root).  The
-# scores against the Monte Carlo reference (marker "reference", about 3 min a tier) and the GPU run's smoke run
-# (marker "one_tier", 15-40 s) run on 5.0 alone: the same GLSL, maths and script on every Blender, and the suite
-# stays within 30 minutes on 2 cores.
+# 5.3 (Python 3.13, numpy 2, through pyenv), then the Blender and GPU tiers on 5.2 LTS and on the oldest, 4.2 LTS,
+# and the real-Blender tier (tests/ui: Debian's Blender 4.3 in a chroot, scripts/real_blender.sh; needs root).
+# What does not depend on the Blender version runs on one tier: the scores against the Monte Carlo reference
+# (marker "reference") and the GPU run's smoke run ("one_tier") on 5.0; the maths checks over fine grids
+# ("slow_maths") on 5.0, the rest of tests/core on both Pythons.  The files made by others (tests/real_files)
+# go through the newest Blender's importers; the scores against Cycles ("cycles") run on 5.0 and the newest.
+# README.md gives each tier's time; the whole stays within 20 minutes on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup_venv.sh .venv requirements.txt
@@ -20,21 +22,26 @@ version() { "$1/bin/python" -c 'import bpy; print(bpy.app.version_string)'; }
 # idle between their parallel parts.  "$@" comes after, so -n 0 runs serially.  The real-Blender tier stays
 # serial: its tests share one Xvfb display and one chroot.
 workers=$(( $(nproc) < 4 ? $(nproc) : 4 ))
+# Each tier's wall time after it, for README.md's table
+timed() { local start=$SECONDS; "$@"; echo "   tier time: $((SECONDS - start)) s"; }
 
 echo "== lint (ruff, pyproject.toml)"
 .venv/bin/ruff check .
 
-echo "== all tiers, bpy $(version .venv)"
-.venv/bin/python -m pytest tests --ignore=tests/ui -q -p no:cacheprovider -n "$workers" "$@"
+echo "== core, blender and gpu tiers, bpy $(version .venv)"
+timed .venv/bin/python -m pytest tests/core tests/blender tests/gpu -q -p no:cacheprovider -n "$workers" "$@"
 
-echo "== all tiers less the Monte Carlo scores and the one-tier checks, bpy $(version .venv-bpy53)"
-.venv-bpy53/bin/python -m pytest tests --ignore=tests/ui -q -p no:cacheprovider -n "$workers" -m "not reference and not one_tier" "$@"
+echo "== all tiers less the one-tier checks (real files included), bpy $(version .venv-bpy53)"
+timed .venv-bpy53/bin/python -m pytest tests --ignore=tests/ui -q -p no:cacheprovider -n "$workers" \
+    -m "not reference and not one_tier and not slow_maths" "$@"
 
-echo "== blender and gpu tiers, bpy $(version .venv-bpy52)"
-.venv-bpy52/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -n "$workers" -m "not reference and not one_tier" "$@"
+echo "== blender and gpu tiers less the Cycles scores, bpy $(version .venv-bpy52)"
+timed .venv-bpy52/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -n "$workers" \
+    -m "not reference and not one_tier and not cycles" "$@"
 
-echo "== blender and gpu tiers, bpy $(version .venv-bpy42)"
-.venv-bpy42/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -n "$workers" -m "not reference and not one_tier" "$@"
+echo "== blender and gpu tiers less the Cycles scores, bpy $(version .venv-bpy42)"
+timed .venv-bpy42/bin/python -m pytest tests/blender tests/gpu -q -p no:cacheprovider -n "$workers" \
+    -m "not reference and not one_tier and not cycles" "$@"
 
 echo "== real-Blender tier (Debian's Blender in a chroot, the extension installed from its zip)"
-.venv/bin/python -m pytest tests/ui -q -p no:cacheprovider "$@"
+timed .venv/bin/python -m pytest tests/ui -q -p no:cacheprovider "$@"

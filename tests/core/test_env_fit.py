@@ -3,6 +3,7 @@ against exact quadrature of synthetic maps (SG lobes, a sharp sun disc, a sky gr
 import time
 
 import numpy as np
+import pytest
 
 from sg_prt_addon.lighting import env_fit, equirect
 from sg_prt_addon.spherical import sg
@@ -43,6 +44,7 @@ def test_fits_an_sg_environment_nearly_exactly():
     assert report.irradiance_max_error < 0.003
 
 
+@pytest.mark.slow_maths
 def test_sun_and_sky_irradiance_error_is_small_and_fast():
     image = _sun_and_sky()
     start = time.perf_counter()

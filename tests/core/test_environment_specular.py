@@ -5,6 +5,8 @@ import pytest
 
 from validation import environment_specular as es
 
+pytestmark = pytest.mark.slow_maths
+
 
 @pytest.fixture(scope="module")
 def sky():

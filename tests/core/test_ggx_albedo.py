@@ -26,6 +26,7 @@ def test_albedo_matches_a_solid_angle_quadrature(cos_o, roughness):
     assert abs(ggx_albedo.directional_albedo(cos_o, roughness) - _solid_angle_albedo(cos_o, roughness)) < 2e-3
 
 
+@pytest.mark.slow_maths
 def test_table_is_bounded_and_close_to_a_finer_quadrature():
     table = ggx_albedo.albedo_table()
     assert table.shape == (ggx_albedo.TABLE_SIZE, ggx_albedo.TABLE_SIZE) and np.all(np.isfinite(table))

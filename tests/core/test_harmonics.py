@@ -130,6 +130,7 @@ def test_cap_projection_against_quadrature_of_the_cap():
         np.testing.assert_allclose(coefficients, expected, atol=1e-12)
 
 
+@pytest.mark.slow_maths
 def test_clamped_cosine_and_irradiance_by_funk_hecke():
     """Irradiance of a band-limited radiance by the closed-form A_l equals the integral over the
     hemisphere, by a rule exact for it, to float precision."""

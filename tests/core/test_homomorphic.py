@@ -70,6 +70,7 @@ def test_octahedral_map_covers_the_square_with_the_horizon_on_its_border():
     assert np.max(np.linalg.norm(disk - 0.5, axis=-1)) <= 0.5 + 1e-12
 
 
+@pytest.mark.slow_maths
 def test_map_choice_parabolic_at_the_techniques_resolution():
     """Measured (docs/ACCURACY.md, homomorphic): the octahedral map uses the whole square and wins on
     coarse maps (GGX 0.3 at 16^2: 0.39 against 0.52); at the technique's 64^2 the parabolic map wins (0.047
@@ -84,6 +85,7 @@ def test_map_choice_parabolic_at_the_techniques_resolution():
     assert error["parabolic", 64] < 0.7 * error["octahedral", 64]
 
 
+@pytest.mark.slow_maths
 def test_column_scaling_converges_within_the_iteration_budget():
     """Without Jacobi column scaling 400 LSMR iterations left a 64^2 fit of Blinn-Phong 50 at 0.312
     (2000 iterations: 0.244); with it 400 reach what 2000 do (0.239 both)."""
@@ -114,6 +116,7 @@ def test_factored_error_bounds(label, function, form, bound):
     assert error < bound
 
 
+@pytest.mark.slow_maths
 def test_fresnel_factor_halves_the_error_of_fresnel_brdfs():
     """Cook-Torrance's Fresnel depends on o.h, which p(o) q(h) p(i) cannot hold: the 1D factor r(o.h)
     (mccool2001 section 5's suggestion) takes it.  Measured 0.84 -> 0.41; the generated measured BRDF
@@ -136,6 +139,7 @@ def test_parabolic_map_covers_the_hemisphere():
     np.testing.assert_allclose(hf.parabolic_coordinates(np.array([1.0, 0.0, -0.5])), [1.0, 0.5])
 
 
+@pytest.mark.slow_maths
 def test_lobes_beat_factors_on_a_microfacet_measurement(tmp_path):
     """On a MERL file of the generated material (microfacet GGX + Fresnel, Oren-Nayar, weak retro-reflection)
     the Fit Lobes operator's 2-lobe fit is closer to the truth than the factors (measured 0.105 against 0.66):

@@ -19,6 +19,7 @@ def _lobe_cosine(cos_o, roughness):
     return values, np.sum(wo * h, axis=-1)
 
 
+@pytest.mark.slow_maths
 def test_table_against_a_finer_quadrature():
     """E and E_w at every texel against 4x the nodes (E_avg is checked through the furnace below)."""
     table = layering.layering_table()

@@ -59,6 +59,7 @@ def _max_error_against_exact(model, caps, lobe_sharpness):
     return worst
 
 
+@pytest.mark.slow_maths
 def test_sphere_light_against_exact_cap_quadrature():
     small_caps = [0.01, 0.05, 0.1]
     # broad (diffuse, clamped-cosine-like) lobes: the energy model is near exact, the paper's is off by ~r^2/d^2

@@ -2,11 +2,14 @@
 and its parameters among the material's fields; the anisotropic ones are the ones with lobe tables."""
 from pathlib import Path
 
+import pytest
+
 from sg_prt_addon.reflectance import brdf, models
 
 SHADERS = Path(__file__).resolve().parents[2] / "shaders"
 
 
+@pytest.mark.slow_maths
 def test_every_model_has_an_exact_form_and_glsl_lobes():
     shading = (SHADERS / "techniques" / "sg" / "sg_shading.glsl").read_text()
     for model in models.MODELS:
@@ -26,6 +29,7 @@ def test_the_model_enum_keeps_its_order():
                             "GGX_ANISO")
 
 
+@pytest.mark.slow_maths
 def test_anisotropic_ggx_lobes_against_its_ndf():
     """Anisotropic GGX's lobes, fitted together to its two isotropic lobes stretched (ndf_fit.ggx_anisotropy_table),
     relative L2 of the NDF at 4 and 8 lobes: measured 0.447 / 0.201, 0.243 / 0.153, 0.036 / 0.036 (the isotropic

@@ -149,6 +149,7 @@ def test_ggx_anisotropic_lobes_broad_and_near_isotropy(alphas, lobe_count, bound
     assert ndf_fit.ndf_l2_error(model, lobes, 16, 128) < bound
 
 
+@pytest.mark.slow_maths
 def test_ggx_anisotropy_table_interpolates_smoothly():
     """Between any two neighbouring rows the interpolated lobes are nearly as close to GGX as the rows
     themselves: the relative L2 of D at the midpoint ratio at most 1.12x the worse of the two rows' (alpha_x

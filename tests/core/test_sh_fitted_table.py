@@ -28,6 +28,7 @@ def _texels(fit):
                       int(np.argsort(sharpness.max(1))[len(sharpness) // 2])])
 
 
+@pytest.mark.slow_maths
 def test_entries_against_a_dense_lattice_per_order(fit):
     """Orders 3-6 at view nodes from the normal to 87 degrees: measured max 1.15e-3 of the texel's largest
     coefficient at every order (a coefficient's quadrature is the same at any order: the kinks of the

@@ -8,6 +8,8 @@ import engine_fixtures as fx
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.cycles
+
 
 def test_area_light_export(blender):
     """Shape, the spanning edges with the object's turn and scale, the normal (-Z), the spread, and the power as

@@ -4,6 +4,8 @@ averaged normal (before bakes were made per corner where a vertex has several no
 0.37 relative RMSE, bias -18%, and the flat cylinder 0.35, -15% (128 px)."""
 import pytest
 
+pytestmark = pytest.mark.cycles
+
 
 @pytest.fixture(scope="module")
 def flat_shading(blender):

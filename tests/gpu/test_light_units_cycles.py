@@ -4,6 +4,8 @@ import engine_fixtures as fx
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.cycles
+
 
 @pytest.fixture(scope="module")
 def engine(blender):

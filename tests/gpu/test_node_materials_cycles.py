@@ -3,6 +3,8 @@ at 64 x 64 with 2 x 32 spp: relative RMSE and mean bias over the sphere, with bo
 at this size (in comments: RMSE / bias / the truth's noise floor; docs/ACCURACY.md has the 128 px run)."""
 import pytest
 
+pytestmark = pytest.mark.cycles
+
 
 @pytest.fixture(scope="module")
 def node_materials(blender):

@@ -4,6 +4,8 @@ Edges Only).  Bounds on the mean bias and HDR-FLIP, and on the RMSE where the tr
 leaves room for it (the diffuse scene), from the figures measured at this size (in comments)."""
 import pytest
 
+pytestmark = pytest.mark.cycles
+
 pytest.importorskip("flip_evaluator", reason="HDR-FLIP needs the flip-evaluator package (requirements.txt)")
 
 

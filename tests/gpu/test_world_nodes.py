@@ -7,6 +7,8 @@ import engine_fixtures as fx
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.cycles
+
 bpy = pytest.importorskip("bpy")
 
 
