@@ -64,7 +64,7 @@ def engine_figures(size, redraws):
     from benchmarks.engine_vs_eevee import render_seconds, steady_frame
     from examples import build_scenes
     from sg_prt_addon.engine import render_engine
-    from validation import biscale_reference
+    from validation import biscale_reference, viewport_timing
 
     build_scenes.SCENES["hammered_metal"](size)
     material = bpy.data.materials["Hammered Gold"]
@@ -88,8 +88,8 @@ def engine_figures(size, redraws):
         def touch(edited_state):
             edited_state.dirty.materials.add(material.name)
 
-        _, painted, _, _ = render_engine.time_viewport_redraws(state, camera, width, height, redraws, edit=paint)
-        _, touched, _, _ = render_engine.time_viewport_redraws(state, camera, width, height, redraws, edit=touch)
+        _, painted, _, _ = viewport_timing.time_viewport_redraws(state, camera, width, height, redraws, edit=paint)
+        _, touched, _, _ = viewport_timing.time_viewport_redraws(state, camera, width, height, redraws, edit=touch)
         return statistics.median(exports), statistics.median(painted), statistics.median(touched)
 
     render_engine.debug["after_frame"] = measure

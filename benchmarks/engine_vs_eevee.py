@@ -6,7 +6,7 @@ Per scene (examples/build_scenes.py at --size, visibility baked by the operator 
 - steady frame: draw + read back (render_engine.debug["timed_redraws"]), with and without the
   depth pre-pass;
 - viewport: a new viewport's first draw, a redraw with nothing changed (the image is shown again)
-  and one after an edit (render_engine.time_viewport_redraws: view_draw's work, minus the window);
+  and one after an edit (viewport_timing.time_viewport_redraws: view_draw's work, minus the window);
 - EEVEE with node materials matched to the SG-PRT settings (benchmarks.matched_materials) at 1
   and 16 samples, after a first render that compiles its shaders.
 Ratios are against EEVEE's 1-sample render measured in the same run.  Errors against the
@@ -69,17 +69,18 @@ def steady_frame(redraws, depth_prepass=True):
 def viewport_redraws(redraws):
     """(first draw, median redraw with nothing changed, median redraw after a material edit) seconds."""
     from sg_prt_addon.engine import render_engine
+    from validation import viewport_timing
 
     def measure(depsgraph, state, renderer, camera):
         width, height = renderer.size
-        first, unchanged, draws, _ = render_engine.time_viewport_redraws(state, camera, width, height, redraws)
+        first, unchanged, draws, _ = viewport_timing.time_viewport_redraws(state, camera, width, height, redraws)
         assert draws == 1, "a redraw with nothing changed drew the scene again"
         name = next(iter(state.materials))
 
         def edit(edited_state):
             edited_state.dirty.materials.add(name)      # what view_update records after a material edit
 
-        _, edited, _, _ = render_engine.time_viewport_redraws(state, camera, width, height, redraws, edit=edit)
+        _, edited, _, _ = viewport_timing.time_viewport_redraws(state, camera, width, height, redraws, edit=edit)
         return first, statistics.median(unchanged), statistics.median(edited)
 
     render_engine.debug["after_frame"] = measure

@@ -6,6 +6,7 @@ normals up to 70 degrees off its direction."""
 import numpy as np
 
 from sg_prt_addon.lighting import lights
+from validation import exact_references
 
 CENTRE = np.zeros(3)
 EDGE_U, EDGE_V = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
@@ -47,7 +48,7 @@ def measure():
         patches = lights.area_light_patches(CENTRE, EDGE_U, EDGE_V, DOWN, "SQUARE", np.array([np.pi]), 4,
                                             spread=np.radians(spread))
         value = lights.patches_irradiance(position, normal, patches)[:, 0]
-        reference = lights.area_irradiance_quadrature(position, normal, CENTRE, EDGE_U, EDGE_V, DOWN,
+        reference = exact_references.area_irradiance_quadrature(position, normal, CENTRE, EDGE_U, EDGE_V, DOWN,
                                                       np.radians(spread))
         l2, largest = _errors(value, reference)
         rows.append(dict(name=f"area light, 4 x 4 patches, spread {spread:g} degrees, 1 light size away",

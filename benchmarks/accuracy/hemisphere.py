@@ -3,6 +3,7 @@ import numpy as np
 from scipy import special
 
 from sg_prt_addon.spherical import hemisphere, sg
+from validation import paper_forms
 
 
 def _grid(lam_low, lam_high, n_lam=40, n_theta=100):
@@ -29,7 +30,7 @@ def measure():
     theta, lam = _grid(0.1, 1e5)
     exact = hemisphere.fh_normalized_exact(theta, lam)
     fast = np.abs(hemisphere.fh_normalized(theta, lam) - exact)
-    paper = np.abs(hemisphere.fh_normalized_paper(theta, lam) - exact)
+    paper = np.abs(paper_forms.fh_normalized_paper(theta, lam) - exact)
     rows.append(_row("fh_normalized (erf form, float64)", fast, "quadrature (Bessel rings, rel 1e-11)",
                      "abs error of fh/fh(pi/2)", paper.max(),
                      "lambda in [0.1, 1e5], theta_d in [-pi/2, pi/2] (saturates beyond); paper column: printed sigmoid"))

@@ -2,7 +2,7 @@
 SG-prefiltered environment (eq. 34-35) and the SG-mixture diffuse fit (eq. 39).
 
 References: exact quadrature of a uniform spherical cap times SG lobes
-(lighting.lights.cap_sg_inner_product_reference); closed-form SG inner products for an
+(lighting.exact_references.cap_sg_inner_product_reference); closed-form SG inner products for an
 SG-mixture environment; brute-force summation over every texel of Blender's
 bundled HDRIs; quadrature of the clamped cosine for irradiance.
 """
@@ -13,6 +13,7 @@ import numpy as np
 
 from sg_prt_addon.lighting import env_fit, env_prefilter, equirect, light_clusters, lights
 from sg_prt_addon.spherical import sg
+from validation import exact_references
 
 WORLD_DIR = Path(__file__).resolve().parents[2] / ".venv/lib/python3.11/site-packages/bpy/5.0/datafiles/studiolights/world"
 WORLDS = ["courtyard", "forest", "city", "interior", "night", "studio", "sunrise", "sunset"]
@@ -38,7 +39,7 @@ def _light_errors(model, caps, lobe_sharpness):
         axis, sharpness, amplitude = lights.sphere_light_sg(np.zeros(3), [0, 0, 1.0], radius, np.pi * radius ** 2, model)
         for lam in lobe_sharpness:
             offsets = np.linspace(0, min(cap + 4 / np.sqrt(lam) + 0.2, np.pi), 40)
-            exact = lights.cap_sg_inner_product_reference(cap, lam, offsets, nodes=600)
+            exact = exact_references.cap_sg_inner_product_reference(cap, lam, offsets, nodes=600)
             lobe_axis = np.stack([np.sin(offsets), 0 * offsets, np.cos(offsets)], -1)
             approx = sg.inner_product(axis, sharpness, amplitude, lobe_axis, lam, 1.0)
             errors.append(float(np.max(np.abs(approx - exact)) / exact.max()))
@@ -102,7 +103,7 @@ def _prefilter_rows():
         seconds, cpu_seconds = time.perf_counter() - start, time.process_time() - cpu_start
         for low, high in BANDS + [(2048.0, 1e5)]:
             lam = np.exp(rng.uniform(np.log(low), np.log(high), 150))
-            reference = env_prefilter.brute_force_convolution(image, axes[:150], lam)
+            reference = exact_references.brute_force_convolution(image, axes[:150], lam)
             got = env_prefilter.lookup(pre, axes[:150], lam)
             relative = np.max(np.abs(got - reference), axis=1) / np.maximum(np.max(reference, axis=1), 1e-6)
             to_mean = np.max(np.abs(got - reference), axis=1) / image.mean()

@@ -408,23 +408,3 @@ def lookup_integral(prefiltered, axis, sharpness, amplitude=1.0):
     return values * scale * amplitude
 
 
-def brute_force_convolution(equirect_image, axis, sharpness):
-    """Reference Gamma_L(p, lambda) / integral G by direct summation over every texel of the map.
-
-    Uses the analytic kernel integral (not the discrete one) as the normaliser.
-    (N, 3) axes, (N,) sharpness -> (N, C); for tests and benchmarks.
-    """
-    image = np.asarray(equirect_image, dtype=np.float64)
-    height, width, channels = image.shape
-    src = equirect.texel_directions(height, width).reshape(-1, 3)
-    omega = np.broadcast_to(equirect.texel_solid_angles(height, width), (height, width)).reshape(-1)
-    radiance = image.reshape(-1, channels) * omega[:, None]
-    axis = sg.normalize(np.asarray(axis, dtype=np.float64)).reshape(-1, 3)
-    sharpness = np.broadcast_to(np.asarray(sharpness, dtype=np.float64), axis.shape[:1])
-    out = np.empty((axis.shape[0], channels))
-    for start in range(0, axis.shape[0], 64):
-        p = axis[start:start + 64]
-        lam = sharpness[start:start + 64, None]
-        d2 = np.maximum(2.0 - 2.0 * (p @ src.T), 0.0)
-        out[start:start + 64] = np.exp(-0.5 * lam * d2) @ radiance
-    return out / sg.sphere_integral(sharpness)[:, None]

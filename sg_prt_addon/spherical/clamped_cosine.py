@@ -106,17 +106,6 @@ def _cosine(axis, normal):
     return np.clip(np.sum(sg.normalize(axis) * sg.normalize(normal), axis=-1), -1.0, 1.0)
 
 
-def sg_clamped_cosine_integral_paper(axis, sharpness, amplitude, normal):
-    """wang2009 eq. 39-40: integral of G(i; p, lambda, mu) C*(i; n), i.e. the SG inner
-    product (eq. 5) of the light lobe with the eq. 40 lobe (visibility left out)."""
-    normal = np.asarray(normal)
-    dtype = _float_dtype(axis, sharpness, amplitude, normal)
-    lobe_sharpness = np.asarray(CLAMPED_COSINE_SHARPNESS, dtype)
-    lobe_amplitude = np.asarray(CLAMPED_COSINE_AMPLITUDE, dtype)
-    return sg.inner_product(sg.normalize(axis), np.asarray(sharpness, dtype), np.asarray(amplitude, dtype),
-                            sg.normalize(normal), lobe_sharpness, lobe_amplitude)
-
-
 def _pole_integrals(sharpness):
     """(I_up, I_low) / (2 pi / lambda): the normal on the lobe axis, and opposite to it."""
     lam = sharpness

@@ -60,9 +60,6 @@ FH_K2_C4 = 4.419
 # Sharpness beyond which the fast form is a step to rounding; clamp to keep lambda^2 finite in float32.
 _MAX_SHARPNESS = 1e8
 
-# wang2009 appendix eq. 47-48 as printed in our copy (measured only, not used).
-PAPER_SIGMOID_SCALE = 1.05
-PAPER_K_COEFFICIENTS = (0.204, -0.892, 2.995, 0.067)  # k = 0.204 l^3 - 0.892 l^2 + 2.995 l + 0.067
 
 HALF_PI = 0.5 * np.pi
 
@@ -84,7 +81,7 @@ def erf_approx(y):
     return (np.sign(y) * np.sqrt(-np.expm1(-exponent))).astype(dtype, copy=False)
 
 
-def _clamp_theta(theta_d):
+def clamp_theta(theta_d):
     theta_d = np.asarray(theta_d)
     return np.clip(theta_d, -HALF_PI, HALF_PI).astype(sg._float_dtype(theta_d), copy=False)
 
@@ -116,30 +113,13 @@ def fh_normalized_from_sine(sine_theta_d, sharpness):
 
 def fh_normalized(theta_d, sharpness):
     """Fast fh_hat(theta_d, lambda) = fh / fh(pi/2) (wang2009 eq. 46), theta_d clamped to +-pi/2."""
-    return fh_normalized_from_sine(np.sin(_clamp_theta(theta_d)), sharpness)
+    return fh_normalized_from_sine(np.sin(clamp_theta(theta_d)), sharpness)
 
 
 def fh(theta_d, sharpness):
     """Fast fh(theta_d, lambda) = fh_hat * (2 pi / lambda)(1 - e^-lambda)."""
     normalized = fh_normalized(theta_d, sharpness)
     return normalized * sg.axis_hemisphere_integral(np.asarray(sharpness, normalized.dtype)).astype(normalized.dtype)
-
-
-def fh_normalized_paper(theta_d, sharpness):
-    """wang2009 appendix (eq. 47-48) as printed in our copy, read as
-    a / (1 + exp(-k theta_d)) + (1 - a) / 2 with a = 1.05 and k cubic in lambda,
-    clamped to [0, 1].  Kept only to measure it: it is off by 0.2-0.5 for lambda <= 100.
-    """
-    theta = _clamp_theta(theta_d)
-    lam = np.asarray(sharpness, theta.dtype)
-    c3, c2, c1, c0 = PAPER_K_COEFFICIENTS
-    k = ((c3 * lam + c2) * lam + c1) * lam + c0
-    z = -k * theta
-    # Logistic in overflow-free form.
-    e = np.exp(-np.abs(z))
-    logistic = np.where(z <= 0, 1 / (1 + e), e / (1 + e))
-    a = PAPER_SIGMOID_SCALE
-    return np.clip(a * logistic + (1 - a) / 2, 0, 1).astype(theta.dtype, copy=False)
 
 
 def _hemisphere_quadrature(sine_theta_d, sharpness, cosine_weighted):
@@ -190,7 +170,7 @@ def fh_exact(theta_d, sharpness):
 
     Works for lambda in [0, 1e6]; about 1 ms per value.
     """
-    return _quadrature_array(np.sin(_clamp_theta(np.asarray(theta_d, np.float64))), sharpness, False)
+    return _quadrature_array(np.sin(clamp_theta(np.asarray(theta_d, np.float64))), sharpness, False)
 
 
 def fh_normalized_exact(theta_d, sharpness):

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from sg_prt_addon.lighting import lights
+from validation import exact_references
 
 CENTRE = np.zeros(3)
 EDGE_U, EDGE_V = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
@@ -32,7 +33,7 @@ def _patch_irradiance(position, normal, patches):
 
 
 def _quadrature_irradiance(position, normal, spread=np.pi):
-    return lights.area_irradiance_quadrature(position, normal, CENTRE, EDGE_U, EDGE_V, DOWN, spread)
+    return exact_references.area_irradiance_quadrature(position, normal, CENTRE, EDGE_U, EDGE_V, DOWN, spread)
 
 
 def _relative_l2(value, reference):

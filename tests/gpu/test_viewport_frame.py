@@ -6,6 +6,8 @@ import engine_fixtures as fx
 import numpy as np
 import pytest
 
+from validation import viewport_timing
+
 
 @pytest.fixture(scope="module")
 def viewport_scene(blender):
@@ -34,12 +36,11 @@ def _render_with(scene, after_frame):
 
 
 def test_unchanged_redraws_reuse_the_image(viewport_scene):
-    from sg_prt_addon.engine import render_engine
 
     scene, _ = viewport_scene
 
     def redraw(depsgraph, state, renderer, camera):
-        return render_engine.time_viewport_redraws(state, camera, *renderer.size, count=4)
+        return viewport_timing.time_viewport_redraws(state, camera, *renderer.size, count=4)
 
     result = _render_with(scene, redraw)
     first, redraws, draws, image = result["after_frame"]
@@ -58,7 +59,7 @@ def test_edits_and_view_changes_redraw(viewport_scene):
 
     def check(depsgraph, state, renderer, camera):
         width, height = renderer.size
-        edited = render_engine.time_viewport_redraws(state, camera, width, height, count=3, edit=edit_material)
+        edited = viewport_timing.time_viewport_redraws(state, camera, width, height, count=3, edit=edit_material)
         frame = render_engine.ViewportFrame()
         drew = [frame.update(state, camera, width, height)]
         view = camera.view.copy()
