@@ -132,11 +132,17 @@ def test_registry_refuses_clashes(registered):
         techniques.unregister(techniques.DEFAULT)
 
 
+# Tokens of text, not code: strings, comments, and the literal parts of f-strings (tokens of their own from
+# Python 3.12)
+TEXT_TOKENS = {tokenize.STRING, tokenize.COMMENT} | {getattr(tokenize, name) for name in ("FSTRING_MIDDLE",)
+                                                     if hasattr(tokenize, name)}
+
+
 def _code_of(path):
     """A module's code without its strings and comments (labels and tooltips may speak of a technique)."""
     with open(path, encoding="utf-8") as handle:
         tokens = tokenize.generate_tokens(handle.readline)
-        return " ".join(token.string for token in tokens if token.type not in (tokenize.STRING, tokenize.COMMENT))
+        return " ".join(token.string for token in tokens if token.type not in TEXT_TOKENS)
 
 
 def test_engine_and_blender_glue_name_no_technique():
