@@ -31,7 +31,7 @@ def test_defaults_are_a_plausible_glossy_material(empty_file):
     assert settings.normal_map is None
 
 
-def test_every_model_lists_only_existing_parameters():
+def test_every_model_lists_only_existing_parameters(addon):
     names = set(properties.SGPRT_PG_material.__annotations__)
     from sg_prt_addon.reflectance import models
 
