@@ -601,8 +601,8 @@ def test_numpy_suite_inputs_through_per_pixel_kernels(glsl):
 
 RESOURCE_KERNELS = {
     "../common/lobe_visibility.glsl": ["set_visibility_frame", "lobe_visibility", "light_cap_visibility"],
-    "sg_shading.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_m_factor", "probit", "visible_part_offset",
-                        "visible_part_narrowing", "lobe_visibility_side"],
+    "sg_models.glsl": ["model_ndf_lobe", "model_m_factor", "fitted_m_factor"],
+    "sg_shading.glsl": ["probit", "visible_part_offset", "visible_part_narrowing", "lobe_visibility_side"],
     "../common/fitted_texels.glsl": ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
                                      "fitted_shadowing_at", "fitted_shadowing_of"],
     "anisotropic_lobes.glsl": ["anisotropic_lobes"],
@@ -948,7 +948,7 @@ MODEL_VARIANTS = [("GGX", 1), ("GGX", 2), ("COOK_TORRANCE", 1), ("BLINN_PHONG", 
 
 @pytest.mark.parametrize("model,lobes", MODEL_VARIANTS, ids=[f"{m}-{k}" for m, k in MODEL_VARIANTS])
 def test_model_lobes_stress(glsl, model, lobes):
-    """sg_shading.glsl's model_ndf_lobe (through ggx_two_lobes / anisotropic_lobes and their tables)
+    """sg_models.glsl's model_ndf_lobe (through ggx_two_lobes / anisotropic_lobes and their tables)
     and model_m_factor, per model, over the numpy suite's parameters (0 included) and directions."""
     import types
 
@@ -962,7 +962,7 @@ def test_model_lobes_stress(glsl, model, lobes):
     # p = (roughness, ior, exponent, alpha_x), q = (alpha_y, nu, nv, rf0)
     inputs = {"p": np.c_[roughness, ior, exponent, roughness], "q": np.c_[alpha_y, exponent, nv, rf0],
               "wo": wo, "wi": wi}
-    shading = _resource("sg_shading.glsl")
+    shading = _resource("sg_models.glsl")
     defines = f"#define MODEL_{model} 1\n#define NDF_LOBES {lobes}\n"
     pieces = [defines]
     textures = {}
@@ -1029,7 +1029,7 @@ def test_table_lobes_stress(glsl, fuzz):
 
 
 def test_fitted_pieces_stress(glsl, fuzz):
-    """common/fitted_texels.glsl and sg_shading.glsl's fitted_m_factor with a random 2-lobe, 5-component fit (shadowing nodes
+    """common/fitted_texels.glsl and sg_models.glsl's fitted_m_factor with a random 2-lobe, 5-component fit (shadowing nodes
     stopping short of the horizon, so the appended S(pi/2) = 0 node is used): any UV (outside [0, 1]
     too), the numpy suite's directions, eta 0..4."""
     wo, wi, _, _, _, rng = _brdf_inputs()
@@ -1044,7 +1044,7 @@ def test_fitted_pieces_stress(glsl, fuzz):
     eta = _f32(rng.uniform(0.0, 4.0, SMALL_ROWS))
     source = (f"#define NDF_LOBES {lobes}\n#define FITTED_LOBES {lobes}\n#define FITTED_COMPONENTS {components}\n"
               f"#define FITTED_SHADOWING_LAYERS {shadowing_layers}\n" + _resource("fitted_texels.glsl", "common")
-              + _glsl_function(_resource("sg_shading.glsl"), "fitted_m_factor"))
+              + _glsl_function(_resource("sg_models.glsl"), "fitted_m_factor"))
     body = """
     fitted_select_texel(t.xy);
     vec4 lobe = fitted_layer(1);

@@ -126,8 +126,8 @@ def paired_amplitudes(tables, lobe_of_row, wi, wo):
 
 
 def slice_lobes(tables, model, params, view_local, warp_mode=None, mask=None):
-    """The BRDF slice of a bi-scale material (sg_shading.glsl's slice loop under BISCALE): axis (N, K', 3)
-    local, sharpness (N, K'), amplitude (N, K'); mask (N,) the mask's value per pixel with two tiles."""
+    """The BRDF slice of a bi-scale material (biscale.glsl, the lobe source of sg_shading.glsl's slice_lobes): axis
+    (N, K', 3) local, sharpness (N, K'), amplitude (N, K'); mask (N,) the mask's value per pixel with two tiles."""
     mode = warp_mode or warp.DEFAULT_MODE
     small_sharpness, small_amplitude = small_lobes(model, params)
     axis, sharpness, amplitude = effective_lobes(tables, small_sharpness, small_amplitude)

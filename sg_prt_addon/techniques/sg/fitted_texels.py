@@ -1,4 +1,4 @@
-"""Numpy mirror of shaders/techniques/common/fitted_texels.glsl and sg_shading.glsl's fitted_m_factor: a stored
+"""Numpy mirror of shaders/techniques/common/fitted_texels.glsl and sg_models.glsl's fitted_m_factor: a stored
 lobe fit (blender.lobe_fit, export.FittedLobes) read at each pixel's texel, its shadowing S and its
 M_o(i) = F_eta(i.h) S(o) S(i) / (pi (i.n)(o.n)).  Shared by the fitted-lobes technique's slice (sg_shading), a
 bi-scale material whose small-scale BRDF is the fit (biscale_shading) and the SH technique's tables of the fit

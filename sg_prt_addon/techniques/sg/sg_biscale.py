@@ -71,9 +71,13 @@ class SGBiScale(SGLobes):
         """GGX's two small-scale lobes come from its table, read with the specular term only."""
         return key.model == "GGX" and key.has_specular
 
+    def lobe_source(self, key):
+        """biscale.glsl: the effective lobes, their M and the tile's diffuse factor."""
+        return ("sg", "biscale.glsl")
+
     def technique_files(self, key):
-        """biscale.glsl (after GGX's two-lobe table reader) before the SG shading it plugs into."""
-        own = ([("sg", "ggx_two_lobes.glsl")] if self._reads_ggx_table(key) else []) + [("sg", "biscale.glsl")]
+        """GGX's two-lobe table reader (the small-scale lobes) besides what the SG shading takes."""
+        own = [("sg", "ggx_two_lobes.glsl")] if self._reads_ggx_table(key) else []
         return own + [entry for entry in super().technique_files(key) if entry not in own]
 
     def model_samplers(self, key):

@@ -35,7 +35,9 @@ LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_c
                  "shadow_maps.glsl", "brdf.glsl", "warp.glsl", "env_prefilter.glsl")
 # (directory under shaders/techniques, file) in order: lobe_visibility is shared with other techniques
 TECHNIQUE_FILES = (("sg", "anisotropic_lobes.glsl"), ("sg", "ggx_two_lobes.glsl"), ("common", "lobe_visibility.glsl"),
-                   ("common", "fitted_texels.glsl"), ("sg", "sg_shading.glsl"))
+                   ("common", "fitted_texels.glsl"), ("sg", "sg_models.glsl"))
+# After those, the technique's lobe source (SGLobes.lobe_source), then the stages that shade with it
+SHADING_FILE = ("sg", "sg_shading.glsl")
 # The per-vertex precomputation this technique reads (visibility.per_vertex kinds)
 VISIBILITY_KIND = "ssdf"
 # texels a vertex of the SSDF's coverage at the quadrature points (vertex_coverage.frag.glsl), four points each
@@ -255,13 +257,19 @@ class SGLobes(Technique):
         files = [name for name in LIBRARY_FILES if name not in skip]
         return files + (["hemisphere_map.glsl", "ssdf.glsl"] if key.visibility_layers else [])
 
+    def lobe_source(self, key):
+        """(folder, file) of the GLSL that gives sg_shading.glsl's stages the technique's lobes (the interface:
+        shaders/techniques/sg/lobes_model.glsl): a stored fit's, else the model's own."""
+        return ("sg", "lobes_fitted.glsl") if key.model == FITTED_MODEL else ("sg", "lobes_model.glsl")
+
     def technique_files(self, key):
-        wanted = set(self.model_files(key) if key.has_specular else ()) | {"sg_shading.glsl"}
+        wanted = set(self.model_files(key) if key.has_specular else ()) | {"sg_models.glsl"}
         if key.visibility_layers:
             wanted.add("lobe_visibility.glsl")
         if key.model == FITTED_MODEL:
             wanted.add("fitted_texels.glsl")
-        return [(folder, name) for folder, name in TECHNIQUE_FILES if name in wanted]
+        files = [(folder, name) for folder, name in TECHNIQUE_FILES if name in wanted]
+        return files + [self.lobe_source(key), SHADING_FILE]
 
     def fragment_source(self, key):
         parts = [_constants_source()]

@@ -1,19 +1,19 @@
 /* Bi-scale materials (iwasaki2012 eq. 15): the effective BRDF's lobes and factors, mirrored by
- * sg_prt_addon/techniques/biscale_shading.py.  Needs sg.glsl, hemisphere_map.glsl, surface_io.glsl (the mask's
+ * sg_prt_addon/techniques/sg/biscale_shading.py.  Needs sg.glsl, hemisphere_map.glsl, surface_io.glsl (the mask's
  * material_texture); with HAS_SPECULAR, brdf.glsl, (MODEL_GGX) ggx_two_lobes.glsl and the ggx_table sampler, and
- * sg_shading.glsl after this file (its model_ndf_lobe and model_m_factor); and:
+ * sg_models.glsl before this file (its model_ndf_lobe and model_m_factor); and:
  *   biscale_lobes  (sampler2D, J x 1): texel j = (axis xyz in the local frame, sharpness) of BVNDF lobe j;
  *   biscale_tables (sampler2DArray, R^2 x R^2 RGBA32F, linear filtering): the node pair (i, o) of the lattice
  *     (biscale/bvndf.py, R = BISCALE_RESOLUTION) at texel (o_a R + i_a, o_b R + i_b); layer t, channel c:
  *     mu_j(i, o) per unit cos(theta_i) of lobe j = 4 t + c; layer BISCALE_LOBE_LAYERS: (D(i, o), A(o)) of the
  *     first tile and of the second: the diffuse factor and its cosine-weighted mean over i.
- * MODEL_FITTED: the small-scale BRDF is the stored lobe fit at the pixel's texel (sg_shading.glsl's fitted_*
+ * MODEL_FITTED: the small-scale BRDF is the stored lobe fit at the pixel's texel (sg_models.glsl's fitted_*
  *     functions: its lobes about the facet normal, their RGB amplitudes, its M with S(o) in each facet's frame).
  * HAS_TEXTURE_BISCALE_MASK: two tiles (biscale.bvndf.MaskedTiles), lobes [0, BISCALE_FIRST_LOBES) the first's,
  *     chosen per pixel by the mask texture's red channel m: the first's amplitudes and diffuse weighted 1 - m,
  *     the second's m.
  * The sampler interpolates i inside an o node's block; o's four nodes are blended here (biscale_set_view:
- * once a pixel, the view is fixed). */
+ * once a pixel, the view is fixed).  It is the bi-scale technique's lobe source (at the end of this file). */
 
 const float BISCALE_R = float(BISCALE_RESOLUTION);
 vec2 biscale_view_corner[4];
@@ -87,13 +87,7 @@ float biscale_albedo()
 }
 
 #ifdef HAS_SPECULAR
-/* The small-scale model's lobes and M, or the stored fit's: sg_shading.glsl's, defined after this file. */
-void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude);
-float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q);
 #ifdef MODEL_FITTED
-vec4 fitted_layer(int layer);
-float fitted_shadowing_of(vec3 w);
-float fitted_m_factor(vec3 wo, vec3 wi, float eta, float shadowing_o);
 vec3 biscale_small_colour[BISCALE_SMALL_LOBES];     /* the fit's RGB lobe amplitudes */
 #endif
 
@@ -174,5 +168,43 @@ float biscale_m_factor(int k, vec3 axis, float ndf_sharpness, vec3 wo, vec3 wi, 
 #else
   return biscale_lobe_amplitude * model_m_factor(to_facet * wo, to_facet * wi, p, q);
 #endif
+}
+#endif
+
+/* The lobe source of the bi-scale technique (the interface: lobes_model.glsl): the effective lobes, their M with
+ * the BVNDF's amplitude, and the tile's diffuse factor D(i, o) at a world direction (its mean A(o) for a constant
+ * world). */
+#define DIFFUSE_FACTOR(world_direction) biscale_diffuse((world_direction) * frame)
+#define DIFFUSE_ALBEDO biscale_albedo()
+
+void lobes_begin(inout vec4 p, vec4 q, vec3 view_local)
+{
+  biscale_set_view(view_local);
+#ifdef HAS_SPECULAR
+#ifdef MODEL_FITTED
+  p.z = fitted_shadowing_of(view_local);       /* S(o), for model_m_factor */
+#endif
+  biscale_set_small_lobes(p, q);
+#endif
+}
+
+#ifdef HAS_SPECULAR
+float biscale_ndf_sharpness;       /* eta_j of the lobe lobes_ndf gave last, for the product axis of its M */
+
+void lobes_ndf(int k, vec4 p, vec4 q, vec3 view_local, out vec3 axis, out float sharpness, out float amplitude,
+               out vec3 colour)
+{
+  biscale_lobe(k, axis, sharpness, amplitude, biscale_ndf_sharpness);
+  biscale_set_lobe_amplitude(k, axis, safe_normalize(view_local));
+#ifdef MODEL_FITTED
+  colour = biscale_small_colour[k % BISCALE_SMALL_LOBES];
+#else
+  colour = vec3(1.0);
+#endif
+}
+
+float lobes_m_factor(int k, vec3 ndf_axis, vec3 view_local, vec3 wi, vec4 p, vec4 q)
+{
+  return biscale_m_factor(k, ndf_axis, biscale_ndf_sharpness, view_local, wi, p, q);
 }
 #endif

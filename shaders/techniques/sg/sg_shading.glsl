@@ -1,5 +1,8 @@
-/* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43);
- * mirrored line by line by sg_prt_addon/techniques/sg_shading.py.  Needs sg.glsl, hemisphere.glsl,
+/* Per-pixel SG shading (wang2009 eq. 36-43; HAS_VISIBILITY: with SSDF shadows, eq. 39-43) in named stages:
+ * slice_lobes (the BRDF slice), shade_lights, environment_specular, environment_irradiance, summed by
+ * shade_surface, averaged over the pixel by shade_footprint.  The lobes come from the technique's lobe source,
+ * included before this file (lobes_model.glsl: the interface; lobes_fitted.glsl; biscale.glsl), the models from
+ * sg_models.glsl.  Mirrored by sg_prt_addon/techniques/sg/sg_shading.py.  Needs sg.glsl, hemisphere.glsl,
  * clamped_cosine.glsl, (lights or specular) clamped_cosine_table.glsl and the `clamped_cosine_table`
  * sampler (the clamped cosine of the lobes whose sharpness varies per pixel), (HAS_LIGHTS) lights.glsl,
  * (HAS_SPECULAR) brdf.glsl + warp.glsl,
@@ -11,7 +14,7 @@
  * by surface.frag.glsl from the pass of vertex_visibility.frag.glsl).  SHARED_LIGHT_VISIBILITY (with
  * HAS_VISIBILITY, HAS_LIGHTS and HAS_SPECULAR; techniques.sg.sg_shading.shares_light_visibility): every light is narrow on
  * the object, and its products with the slice lobes take its own visibility instead of a decode each.
- * BISCALE (biscale.glsl before this file): the lobes are a bi-scale material's effective lobes (NDF_LOBES of
+ * BISCALE (biscale.glsl the lobe source): the lobes are a bi-scale material's effective lobes (NDF_LOBES of
  * them, iwasaki2012 eq. 15) with their tables' factors and the small-scale M, and the diffuse term is scaled by
  * the tile's D(i, o); no light or environment tail (those are GGX's own). */
 
@@ -33,160 +36,8 @@ vec4 diffuse_fractions[DIFFUSE_VISIBILITY_ROWS];
 #define DIFFUSE_VISIBILITY(e, axis, sharpness) LOBE_VISIBILITY(axis, sharpness)
 #endif
 
-#ifdef HAS_SPECULAR
-/* NDF lobe k of the model (brdf.glsl's <model>_ndf_lobe, or the anisotropy table), local
- * frame.  p = (roughness, ior, exponent, alpha_x), q = (alpha_y, nu, nv, rf0). */
-void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, out float amplitude)
-{
-  axis = vec3(0.0, 0.0, 1.0);
-  vec2 lobe = vec2(0.0, 0.0);
-#if defined(MODEL_GGX) && NDF_LOBES == 1
-  lobe = ggx_ndf_lobe(p.x);
-#elif defined(MODEL_GGX)
-  ggx_two_lobes(ggx_table, p.x, k, lobe.x, lobe.y);
-#elif defined(MODEL_COOK_TORRANCE)
-  lobe = cook_torrance_ndf_lobe(p.x);
-#elif defined(MODEL_BLINN_PHONG)
-  lobe = blinn_phong_ndf_lobe(p.z);
-#elif defined(MODEL_WARD_ISO)
-  lobe = ward_isotropic_ndf_lobe(p.w);
-#endif
-  sharpness = lobe.x;
-  amplitude = lobe.y;
-#if defined(MODEL_WARD_ANISO) || defined(MODEL_GGX_ANISO)
-  float ax = max(p.w, 1.0e-6);
-  float ay = max(q.x, 1.0e-6);
-#if defined(MODEL_GGX_ANISO) && NDF_LOBES > 1
-  /* ndf_fit.ggx_anisotropic_lobes: all lobes fitted together to GGX's two sphere-fitted lobes stretched */
-  ggx_anisotropic_lobes(anisotropy_table, ax, ay, k, axis, sharpness, amplitude);
-#else
-  anisotropic_lobes(anisotropy_table, ax, ay, 1.0 / (SG_PI * ax * ay), k, axis, sharpness, amplitude);
-#endif
-#if defined(MODEL_GGX_ANISO) && NDF_LOBES == 1
-  /* one lobe: the table's Gaussian scaled by GGX's one-lobe mapping at the geometric-mean alpha */
-  vec2 ggx_scale = isotropic_mapping_ggx(sqrt(ax * ay));
-  sharpness *= 0.5 * ggx_scale.x;
-  amplitude *= ggx_scale.y;
-#endif
-#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
-  float nu = max(q.y, 0.0);
-  float nv = max(q.z, 0.0);
-  anisotropic_lobes(anisotropy_table, sqrt(2.0 / max(nu, 1.0e-6)), sqrt(2.0 / max(nv, 1.0e-6)),
-                    sqrt((nu + 1.0) * (nv + 1.0)) / (2.0 * SG_PI), k, axis, sharpness, amplitude);
-#endif
-}
-
-#ifdef MODEL_FITTED
-/* The stored lobe fit's texel and shadowing: common/fitted_texels.glsl. */
-
-/* M_o(i) = F_eta(|i.h|) S(o) S(i) / (pi (i.n)(o.n)), S(o) given (once a pixel). */
-float fitted_m_factor(vec3 wo, vec3 wi, float eta, float shadowing_o)
-{
-  wo = safe_normalize(wo);
-  wi = safe_normalize(wi);
-  if (!(wo.z > 0.0 && wi.z > 0.0)) {
-    return 0.0;
-  }
-  vec3 h = safe_normalize(wo + wi);
-  return fresnel_dielectric(dot(wi, h), eta) * shadowing_o * fitted_shadowing_of(wi)
-         / (SG_PI * max(wi.z, BRDF_COSINE_EPSILON) * max(wo.z, BRDF_COSINE_EPSILON));   /* grazing: no 0/0 */
-}
-#endif
-
-/* The NDF's angular widths along the tangent and the bitangent (radians, about the slopes' spread: GGX's and
- * Beckmann's alpha, Blinn-Phong's and Ashikhmin-Shirley's sqrt(2 / (n + 2)) and sqrt(2 / (n + 1)), a fitted
- * lobe's sqrt(2 / lambda), the sharpest); the small-scale BRDF's for a bi-scale material. */
-vec2 model_lobe_widths(vec4 p, vec4 q)
-{
-#if defined(MODEL_FITTED)
-  float sharpest = 0.0;
-  for (int k = 0; k < FITTED_LOBES; k++) {
-    sharpest = max(sharpest, fitted_layer(1 + 2 * k).w);
-  }
-  return vec2(sqrt(2.0 / max(sharpest, 1.0e-6)));
-#elif defined(MODEL_GGX)
-  return vec2(ggx_alpha(p.x));
-#elif defined(MODEL_COOK_TORRANCE)
-  return vec2(p.x);
-#elif defined(MODEL_BLINN_PHONG)
-  return vec2(sqrt(2.0 / (max(p.z, 0.0) + 2.0)));
-#elif defined(MODEL_WARD_ISO)
-  return vec2(p.w);
-#elif defined(MODEL_WARD_ANISO) || defined(MODEL_GGX_ANISO)
-  return vec2(p.w, q.x);
-#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
-  return sqrt(2.0 / (max(q.yz, vec2(0.0)) + 1.0));
-#else
-  return vec2(1.0);
-#endif
-}
-
-/* M_o(i) of the model (brdf.glsl's <model>_m_factor). */
-float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
-{
-#if defined(MODEL_GGX)
-  return ggx_m_factor(wo, wi, p.x);
-#elif defined(MODEL_COOK_TORRANCE)
-  return cook_torrance_m_factor(wo, wi, p.x, p.y);
-#elif defined(MODEL_BLINN_PHONG)
-  return blinn_phong_m_factor(wo, wi, p.z);
-#elif defined(MODEL_WARD_ISO)
-  return ward_isotropic_m_factor(wo, wi);
-#elif defined(MODEL_WARD_ANISO)
-  return ward_anisotropic_m_factor(wo, wi);
-#elif defined(MODEL_GGX_ANISO)
-  return ggx_anisotropic_m_factor(wo, wi, p.w, q.x);
-#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
-  return ashikhmin_shirley_m_factor(wo, wi, q.y, q.z, q.w);
-#elif defined(MODEL_FITTED)
-  return fitted_m_factor(wo, wi, p.y, p.z);     /* p.y eta, p.z S(o) (shade_surface) */
-#else
-  return 0.0;
-#endif
-}
-
-#if defined(HAS_LIGHTS) && !defined(MODEL_FITTED) && !defined(BISCALE)
-/* What the slice lobes miss of the model's own BRDF at a light's centre (techniques.sg.sg_shading.light_tail) */
-#define LIGHT_TAIL
-
-/* rho_s(o, i) = M_o(i) D(h) of the model itself (brdf.glsl), local frame */
-float model_specular(vec3 wo, vec3 wi, vec4 p, vec4 q)
-{
-  vec3 h = safe_normalize(safe_normalize(wo) + safe_normalize(wi));
-  float ndf = 0.0;
-#if defined(MODEL_GGX)
-  ndf = ggx_ndf(h, p.x);
-#elif defined(MODEL_COOK_TORRANCE)
-  ndf = cook_torrance_ndf(h, p.x);
-#elif defined(MODEL_BLINN_PHONG)
-  ndf = blinn_phong_ndf(h, p.z);
-#elif defined(MODEL_WARD_ISO)
-  ndf = ward_isotropic_ndf(h, p.w);
-#elif defined(MODEL_WARD_ANISO)
-  ndf = ward_anisotropic_ndf(h, p.w, q.x);
-#elif defined(MODEL_GGX_ANISO)
-  ndf = ggx_anisotropic_ndf(h, p.w, q.x);
-#elif defined(MODEL_ASHIKHMIN_SHIRLEY)
-  ndf = ashikhmin_shirley_ndf(h, q.y, q.z);
-#endif
-  return model_m_factor(wo, wi, p, q) * ndf;
-}
-#endif
-#endif
-
-
-
-
 #define SLICE_LOBES (WARP_NODES * NDF_LOBES)
 
-#ifdef BISCALE
-/* the bi-scale diffuse factor D(i, o) at a world direction, and its mean A(o) for a constant world */
-#define BISCALE_DIFFUSE(world_direction) biscale_diffuse((world_direction) * frame)
-#define BISCALE_ALBEDO biscale_albedo()
-#else
-#define BISCALE_DIFFUSE(world_direction) 1.0
-#define BISCALE_ALBEDO 1.0
-#endif
 
 #if defined(HAS_VISIBILITY) && defined(HAS_ENVIRONMENT) && defined(HAS_SPECULAR)
 /* A partly occluded slice lobe reads the environment where its visible part lies (techniques.sg.sg_shading.
@@ -281,62 +132,25 @@ void cosine_weighted_lookup(inout vec3 axis, inout float sharpness, vec3 n, bool
  * centre is; the other can fall below the view's horizon at grazing views). */
 #define VISIBILITY_NODE ((WARP_NODES - 1) / 2)
 
-/* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer.  Without HAS_DIFFUSE
- * the irradiance stays 0, without HAS_SPECULAR the radiance (the variant's colour is zero); without
- * with_environment_diffuse the environment's irradiance is left out (shade_footprint's specular samples). */
-void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
-                   vec3 diffuse_color, vec3 specular_color, bool with_environment_diffuse,
-                   out vec3 diffuse, out vec3 specular)
-{
-  vec3 n, t, b;
-  shading_frame(normal, tangent, n, t, b);
-  vec3 irradiance = vec3(0.0);
-  vec3 radiance = vec3(0.0);
-
-#if defined(HAS_SPECULAR) || defined(BISCALE)
-  vec3 view = scene.camera.w > 0.5 ? safe_normalize(scene.camera.xyz - position)
-                                   : -safe_normalize(scene.camera.xyz);
-  mat3 frame = mat3(t, b, n);                    /* local -> world */
-  vec3 view_local = view * frame;                /* transpose(frame) * view */
-#endif
-#ifdef BISCALE
-  biscale_set_view(view_local);
-#endif
 #ifdef HAS_SPECULAR
+/* The BRDF slice of the pixel, in world space: the lobe source's NDF lobes warped to the view (WARP_NODES per NDF
+ * lobe) times M_o at their centres, their RGB amplitudes (a fit's; else 1), I(S_j, n) of each unshadowed and their
+ * sum (with ENVIRONMENT_TAIL, kept within the model's exact albedo, model_albedo).  Set by slice_lobes, read by the
+ * stages after it. */
+vec3 slice_axis[SLICE_LOBES];
+float slice_sharpness[SLICE_LOBES];
+float slice_amplitude[SLICE_LOBES];
+vec3 slice_colour[SLICE_LOBES];
+float slice_cosines[SLICE_LOBES];
+float slice_albedo;
+float model_albedo;
 
-  /* BRDF slice: NDF lobes warped to the view (WARP_NODES per NDF lobe) times M_o at their centres, in world space */
-  vec3 slice_axis[SLICE_LOBES];
-  float slice_sharpness[SLICE_LOBES];
-  float slice_amplitude[SLICE_LOBES];
-  vec3 slice_colour[SLICE_LOBES];              /* RGB lobe amplitude of the fit, else 1 */
-#ifdef MODEL_FITTED
-  p.z = fitted_shadowing_of(view_local);       /* S(o), for model_m_factor */
-#endif
-#ifdef BISCALE
-  biscale_set_small_lobes(p, q);
-#endif
+void slice_lobes(vec4 p, vec4 q, vec3 view_local, mat3 frame, vec3 n)
+{
   for (int k = 0; k < NDF_LOBES; k++) {
-    vec3 ndf_axis;
+    vec3 ndf_axis, colour;
     float ndf_sharpness, ndf_amplitude;
-#ifdef BISCALE
-    float bvndf_sharpness;      /* eta_j, for the product axis of M */
-    biscale_lobe(k, ndf_axis, ndf_sharpness, ndf_amplitude, bvndf_sharpness);
-    biscale_set_lobe_amplitude(k, ndf_axis, safe_normalize(view_local));
-#ifdef MODEL_FITTED
-    vec3 colour = biscale_small_colour[k % BISCALE_SMALL_LOBES];
-#else
-    vec3 colour = vec3(1.0);
-#endif
-#elif defined(MODEL_FITTED)
-    vec4 fitted_lobe = fitted_layer(1 + 2 * k);
-    ndf_axis = safe_normalize(fitted_lobe.xyz);
-    ndf_sharpness = fitted_lobe.w;
-    ndf_amplitude = 1.0;
-    vec3 colour = fitted_layer(2 + 2 * k).rgb;
-#else
-    model_ndf_lobe(p, q, k, ndf_axis, ndf_sharpness, ndf_amplitude);
-    vec3 colour = vec3(1.0);
-#endif
+    lobes_ndf(k, p, q, view_local, ndf_axis, ndf_sharpness, ndf_amplitude, colour);
     /* warp.DEFAULT_MODE: WARP_FUNCTION with WARP_NODES lobes per NDF lobe (defines from the variant) */
     vec3 warped_axis[WARP_NODES];
     float warped_sharpness[WARP_NODES], warped_amplitude[WARP_NODES];
@@ -349,27 +163,21 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
     for (int node = 0; node < WARP_NODES; node++) {
       int j = WARP_NODES * k + node;
-#ifdef BISCALE
       slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
-                                                biscale_m_factor(k, ndf_axis, bvndf_sharpness, view_local,
-                                                                 warped_axis[node], p, q));
-#else
-      slice_amplitude[j] = brdf_slice_amplitude(warped_amplitude[node],
-                                                model_m_factor(view_local, warped_axis[node], p, q));
-#endif
+                                                lobes_m_factor(k, ndf_axis, view_local, warped_axis[node], p, q));
       slice_axis[j] = frame * warped_axis[node];
       slice_colour[j] = colour;
       slice_sharpness[j] = warped_sharpness[node];
     }
   }
   /* I(S_j, n) of the slice lobes, unshadowed: their albedo, and the environment's weights below */
-  float slice_cosines[SLICE_LOBES];
-  float slice_albedo = 0.0;
+  slice_albedo = 0.0;
   for (int j = 0; j < SLICE_LOBES; j++) {
     slice_cosines[j] = sg_clamped_cosine_integral_tabulated(clamped_cosine_table, slice_axis[j], slice_sharpness[j],
                                                             slice_amplitude[j], n);
     slice_albedo += slice_cosines[j];
   }
+  model_albedo = 0.0;
 #ifdef ENVIRONMENT_TAIL
   /* GGX's exact albedo (reflectance.ggx_albedo): the lobes keep at most it (at grazing views they overshoot it
    * several times over), and the environment tail returns what they miss of it (techniques.sg.sg_shading.model_albedo) */
@@ -380,7 +188,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
 #endif
   vec2 albedo_coords = (clamp(vec2(view_local.z, albedo_roughness), 0.0, 1.0) * float(GGX_ALBEDO_SIZE - 1) + 0.5) /
                        float(GGX_ALBEDO_SIZE);
-  float model_albedo = texture(ggx_albedo_table, albedo_coords).r;
+  model_albedo = texture(ggx_albedo_table, albedo_coords).r;
   float energy_scale = min(1.0, model_albedo / max(slice_albedo, 1.0e-30));
   for (int j = 0; j < SLICE_LOBES; j++) {
     slice_amplitude[j] *= energy_scale;
@@ -388,9 +196,15 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   }
   slice_albedo *= energy_scale;
 #endif
+}
 #endif
 
 #ifdef HAS_LIGHTS
+/* The lights (eq. 42-43): the irradiance they give (HAS_DIFFUSE) and the radiance their products with the slice
+ * lobes reflect (HAS_SPECULAR), each light shadowed by its map or the bake. */
+void shade_lights(vec3 position, vec3 n, vec3 view_local, mat3 frame, vec4 p, vec4 q,
+                  inout vec3 irradiance, inout vec3 radiance)
+{
   for (int l = 0; l < scene.counts.x + scene.counts.y; l++) {
     vec3 light_axis;
     float light_sharpness;
@@ -420,7 +234,7 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     float light_visibility = LIGHT_VISIBILITY(light_axis, light_sharpness);
 #endif
 #ifdef HAS_DIFFUSE
-    irradiance += light_amplitude * (light_cosine * light_visibility * BISCALE_DIFFUSE(light_axis));   /* eq. 42 */
+    irradiance += light_amplitude * (light_cosine * light_visibility * DIFFUSE_FACTOR(light_axis));   /* eq. 42 */
 #endif
 #ifdef HAS_SPECULAR
     vec3 weight = vec3(0.0);
@@ -484,9 +298,15 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
     radiance += light_amplitude * weight;
 #endif
   }
+}
 #endif
 
 #ifdef HAS_SPECULAR
+/* The environment's light the slice lobes reflect (eq. 41), each NDF lobe shadowed at its centre node (read where
+ * its visible part lies, VISIBLE_PART_LOOKUP), and (ENVIRONMENT_TAIL) GGX's energy beyond the lobes. */
+vec3 environment_specular(vec3 n)
+{
+  vec3 radiance = vec3(0.0);
   vec3 tail_axis = slice_axis[VISIBILITY_NODE];
 #ifdef VISIBLE_PART_LOOKUP
   /* the first NDF lobe's visible side (GGX's broader), shared with the others (they see the same occluders) and
@@ -554,25 +374,64 @@ void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
   radiance += tail_albedo * scene.world_colour.rgb;
 #endif
 #endif
+  return radiance;
+}
 #endif
 
 #ifdef HAS_DIFFUSE
+/* The environment's irradiance (eq. 39): its SG lobes' clamped-cosine integrals, each shadowed; a constant world's
+ * cosine lobe alone. */
+vec3 environment_irradiance(vec3 n, mat3 frame)
+{
+  vec3 irradiance = vec3(0.0);
 #ifdef HAS_ENVIRONMENT
-  for (int e = 0; with_environment_diffuse && e < scene.counts.z; e++) {
+  for (int e = 0; e < scene.counts.z; e++) {
     irradiance += scene.env_amplitude[e].rgb *
                   (clamped_cosine_from_terms(dot(safe_normalize(scene.env_axis_sharpness[e].xyz), n),
                                              scene.env_axis_sharpness[e].w, scene.env_cosine_terms[2 * e],
                                              scene.env_cosine_terms[2 * e + 1]) *
                    DIFFUSE_VISIBILITY(e, scene.env_axis_sharpness[e].xyz, scene.env_axis_sharpness[e].w) *
-                   BISCALE_DIFFUSE(safe_normalize(scene.env_axis_sharpness[e].xyz)));   /* eq. 39 */
+                   DIFFUSE_FACTOR(safe_normalize(scene.env_axis_sharpness[e].xyz)));   /* eq. 39 */
   }
 #else
   /* a constant world: the cosine lobe alone (a zero-sharpness G) */
-  irradiance += float(with_environment_diffuse) * SG_PI * scene.world_colour.rgb * DIFFUSE_VISIBILITY(0, n, 0.0) *
-                BISCALE_ALBEDO;
+  irradiance += SG_PI * scene.world_colour.rgb * DIFFUSE_VISIBILITY(0, n, 0.0) * DIFFUSE_ALBEDO;
 #endif
+  return irradiance;
+}
 #endif
 
+/* Diffuse (kd/pi times irradiance) and specular radiance towards the viewer, in stages: the lobe source's setup,
+ * the BRDF slice, the lights, the environment.  Without HAS_DIFFUSE the irradiance stays 0, without HAS_SPECULAR
+ * the radiance (the variant's colour is zero); without with_environment_diffuse the environment's irradiance is
+ * left out (shade_footprint's specular samples). */
+void shade_surface(vec3 position, vec3 normal, vec3 tangent, vec4 p, vec4 q,
+                   vec3 diffuse_color, vec3 specular_color, bool with_environment_diffuse,
+                   out vec3 diffuse, out vec3 specular)
+{
+  vec3 n, t, b;
+  shading_frame(normal, tangent, n, t, b);
+  vec3 irradiance = vec3(0.0);
+  vec3 radiance = vec3(0.0);
+  vec3 view = scene.camera.w > 0.5 ? safe_normalize(scene.camera.xyz - position)
+                                   : -safe_normalize(scene.camera.xyz);
+  mat3 frame = mat3(t, b, n);                    /* local -> world */
+  vec3 view_local = view * frame;                /* transpose(frame) * view */
+  lobes_begin(p, q, view_local);
+#ifdef HAS_SPECULAR
+  slice_lobes(p, q, view_local, frame, n);
+#endif
+#ifdef HAS_LIGHTS
+  shade_lights(position, n, view_local, frame, p, q, irradiance, radiance);
+#endif
+#ifdef HAS_SPECULAR
+  radiance += environment_specular(n);
+#endif
+#ifdef HAS_DIFFUSE
+  if (with_environment_diffuse) {
+    irradiance += environment_irradiance(n, frame);
+  }
+#endif
   diffuse = diffuse_color * (1.0 / SG_PI) * irradiance;
   specular = specular_color * radiance;
 }
