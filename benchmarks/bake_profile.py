@@ -122,7 +122,7 @@ def main(argv=None):
     print(text)
     if "--update-doc" in arguments:
         from benchmarks import markdown_sections
-        markdown_sections.update_file(markdown_sections.PERFORMANCE_DOC, SECTION_TITLE, text)
+        markdown_sections.update_file(markdown_sections.BAKE_DOC, SECTION_TITLE, text)
     return figures
 
 

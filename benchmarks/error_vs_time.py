@@ -1,8 +1,8 @@
 """Error vs time of the SG-PRT engine beside its baselines, on the two example scenes.
 
     .venv/bin/python -m benchmarks.error_vs_time [--size 512] [--noise 0.015] [--quick]
-    .venv/bin/python -m benchmarks.error_vs_time --markdown     # the PERFORMANCE.md section from the JSON
-    .venv/bin/python -m benchmarks.error_vs_time --update-doc   # ... written into docs/PERFORMANCE.md
+    .venv/bin/python -m benchmarks.error_vs_time --markdown     # the ERROR_VS_TIME.md section from the JSON
+    .venv/bin/python -m benchmarks.error_vs_time --update-doc   # ... written into docs/ERROR_VS_TIME.md
 
 For each scene of examples/build_scenes.py (suzanne_courtyard, brushed_metal), in one process
 on one machine:
@@ -57,7 +57,7 @@ if str(ROOT) not in sys.path:
 
 JSON_PATH = ROOT / "docs" / "error_vs_time.json"
 PLOT_PATH = ROOT / "docs" / "images" / "error_vs_time.png"
-DOC_PATH = ROOT / "docs" / "PERFORMANCE.md"
+DOC_PATH = ROOT / "docs" / "ERROR_VS_TIME.md"
 SECTION_TITLE = "## Error vs time"
 SCENES = ("suzanne_courtyard", "brushed_metal", "hammered_metal")
 
@@ -202,7 +202,7 @@ def target_lines(checks):
 
 
 def markdown_section(data, image="images/error_vs_time.png"):
-    """The "Error vs time" section of docs/PERFORMANCE.md, from the JSON this module writes."""
+    """The "Error vs time" section of docs/ERROR_VS_TIME.md, from the JSON this module writes."""
     machine = data["machine"]
     per_scene = "; ".join(f"{name}: {info['triangles']} triangles, reference {info['reference_spp']} spp "
                           f"({info['reference_noise']:.1%} mean relative noise, noise floor "
@@ -709,8 +709,8 @@ def main(argv=None):
     parser.add_argument("--scenes", nargs="*", default=list(SCENES), choices=SCENES)
     parser.add_argument("--json", default=None, help=f"output JSON (default {JSON_PATH.relative_to(ROOT)})")
     parser.add_argument("--plot", default=None, help=f"output PNG (default {PLOT_PATH.relative_to(ROOT)})")
-    parser.add_argument("--markdown", action="store_true", help="print the PERFORMANCE.md section from the JSON")
-    parser.add_argument("--update-doc", action="store_true", help="write that section into docs/PERFORMANCE.md")
+    parser.add_argument("--markdown", action="store_true", help="print the ERROR_VS_TIME.md section from the JSON")
+    parser.add_argument("--update-doc", action="store_true", help="write that section into docs/ERROR_VS_TIME.md")
     args = parser.parse_args(argv)
     json_path = Path(args.json) if args.json else (ROOT / "out" / "error_vs_time_quick.json" if args.quick
                                                    else JSON_PATH)

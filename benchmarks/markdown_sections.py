@@ -3,6 +3,7 @@ from pathlib import Path
 
 PERFORMANCE_DOC = Path(__file__).resolve().parents[1] / "docs" / "PERFORMANCE.md"
 ACCURACY_DOC = Path(__file__).resolve().parents[1] / "docs" / "ACCURACY.md"
+BAKE_DOC = Path(__file__).resolve().parents[1] / "docs" / "BAKE_PERFORMANCE.md"
 
 
 def replace_section(text, title, section):

@@ -1,5 +1,5 @@
 """The pure parts of benchmarks/error_vs_time.py (no bpy): noise-corrected error, Pareto front,
-rows, target check, the markdown table and the PERFORMANCE.md section replacement."""
+rows, target check, the markdown table and the ERROR_VS_TIME.md section replacement."""
 import math
 
 import pytest
