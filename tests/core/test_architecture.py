@@ -76,36 +76,11 @@ def _package(module):
 
 
 def test_no_import_cycles(graph):
-    """Tarjan over the module graph; importing a submodule runs its packages' __init__, which is not an
-    edge of its own (an __init__ importing its submodules is no cycle)."""
-    edges = {name: sorted({target for target, _ in imports if target in graph and target != name
-                           and not name.startswith(target + ".")}) for name, imports in graph.items()}
-    index, low, stack, on_stack, cycles = {}, {}, [], set(), []
-
-    def connect(node):
-        index[node] = low[node] = len(index)
-        stack.append(node)
-        on_stack.add(node)
-        for target in edges[node]:
-            if target not in index:
-                connect(target)
-                low[node] = min(low[node], low[target])
-            elif target in on_stack:
-                low[node] = min(low[node], index[target])
-        if low[node] == index[node]:
-            component = []
-            while True:
-                member = stack.pop()
-                on_stack.discard(member)
-                component.append(member)
-                if member == node:
-                    break
-            if len(component) > 1:
-                cycles.append(sorted(component))
-
-    for node in edges:
-        if node not in index:
-            connect(node)
+    """Importing a submodule runs its packages' __init__, which is not an edge of its own (an __init__
+    importing its submodules is no cycle)."""
+    edges = {name: {target for target, _ in imports if target in graph and target != name
+                    and not name.startswith(target + ".")} for name, imports in graph.items()}
+    cycles = _cycles(edges)
     assert not cycles, f"import cycles: {cycles}"
 
 
