@@ -10,6 +10,7 @@ import numpy as np
 from sg_prt_addon.biscale import effective_brdf
 from sg_prt_addon.blender import export
 from sg_prt_addon.reflectance import brdf, models
+from sg_prt_addon.techniques.biscale import biscale_shading
 from sg_prt_addon.techniques.sg import sg_shading
 from validation import biscale_reference, reference
 from validation.camera import Camera
@@ -61,9 +62,9 @@ def reference_material(params, texture_pixels, biscale_geometry=None):
         small = small_scale_brdf(params)
         first = biscale_reference.TracedEffectiveBRDF(biscale_geometry(params.name, False), small)
         material = reference.Material((0.0, 0.0, 0.0), (1.0, 1.0, 1.0), first)
-        if sg_shading.BISCALE_MASK in params.textures:       # two tiles, chosen by the mask
+        if biscale_shading.MASK_SLOT in params.textures:       # two tiles, chosen by the mask
             second = biscale_reference.TracedEffectiveBRDF(biscale_geometry(params.name, True), small, seed=12)
-            mask = texture_pixels(params.textures[sg_shading.BISCALE_MASK], sg_shading.BISCALE_MASK)
+            mask = texture_pixels(params.textures[biscale_shading.MASK_SLOT], biscale_shading.MASK_SLOT)
 
             def lookup(uv):
                 uv = sg_shading.material_uv(params, uv)
@@ -170,7 +171,7 @@ def reference_inputs(depsgraph, width, height):
         return export.slot_pixels(value, slot, decode)
 
     def biscale_geometry(material_name, second):
-        from sg_prt_addon.techniques.sg.blender import biscale_source
+        from sg_prt_addon.techniques.biscale.blender import biscale_source
 
         return biscale_source.geometry(bpy.data.materials[material_name], second)
 

@@ -1,14 +1,15 @@
-"""Rendering methods, one module each, and the registry the engine and the material panel read.
+"""Rendering methods, one package each, and the registry the engine and the material panel read.
 
 A technique (base.Technique) plugs in by registering: ``register(MyTechnique())``.  The draw loop,
 the shader cache and the scene state look techniques up here by the material's choice
 (MaterialParams.technique); none is named in them.  Built in: wang2009's SG lobes, parametric
 (sg_parametric) and from a stored lobe fit (sg_fitted); mccool2001's factored BRDF (factored); kautz2002's
-spherical harmonics (spherical_harmonics); iwasaki2012's bi-scale materials on the SG lobes (sg_biscale).
+spherical harmonics (spherical_harmonics); iwasaki2012's bi-scale materials on the SG lobes (biscale: sg_biscale).
 """
 from .base import DrawContext, ObjectInputs, Technique
+from .biscale import sg_biscale
 from .homomorphic import factored
-from .sg import sg_biscale, sg_fitted, sg_parametric
+from .sg import sg_fitted, sg_parametric
 from .sh import spherical_harmonics
 
 DEFAULT = sg_parametric.NAME

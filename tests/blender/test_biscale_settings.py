@@ -1,5 +1,5 @@
 """A bi-scale material's settings in Blender (material.sgprt.biscale): its panel, what export makes of them,
-and the clear word when they cannot be rendered (techniques/sg/blender/biscale_source.py)."""
+and the clear word when they cannot be rendered (techniques/biscale/blender/biscale_source.py)."""
 import numpy as np
 import pytest
 import recording_layout
@@ -31,24 +31,24 @@ def _drawn(panel, material):
 
 def test_panel_shows_the_tile_of_the_chosen_source(empty_file):
     from sg_prt_addon.blender import panels
-    from sg_prt_addon.techniques.sg import blender as sg_side
+    from sg_prt_addon.techniques.biscale import blender as biscale_side
 
     material = _biscale("panel_biscale", model="GGX")
     material.sgprt.biscale.height_image = _height_image("panel_height", np.zeros((8, 8)))
-    calls = _drawn(sg_side.SGPRT_PT_material_biscale, material)
+    calls = _drawn(biscale_side.SGPRT_PT_material_biscale, material)
     assert ("template_ID", "height_image") in calls and ("prop", "height_scale") in calls
     assert ("prop", "tile_object") not in calls
     export_with_warnings(material)
     assert any(kind == "label" and "lobes from 128 triangles" in text for kind, text in
-               _drawn(sg_side.SGPRT_PT_material_biscale, material))
+               _drawn(biscale_side.SGPRT_PT_material_biscale, material))
     material.sgprt.biscale.source = "OBJECT"
-    calls = _drawn(sg_side.SGPRT_PT_material_biscale, material)
+    calls = _drawn(biscale_side.SGPRT_PT_material_biscale, material)
     assert ("prop", "tile_object") in calls and ("template_ID", "height_image") not in calls
     # shown only while the material renders bi-scale
     context = type("Context", (), {"engine": panels.ENGINE_ID, "material": material})()
-    assert sg_side.SGPRT_PT_material_biscale.poll(context)
+    assert biscale_side.SGPRT_PT_material_biscale.poll(context)
     material.sgprt.technique = "SG_PARAMETRIC"
-    assert not sg_side.SGPRT_PT_material_biscale.poll(context)
+    assert not biscale_side.SGPRT_PT_material_biscale.poll(context)
 
 
 def test_export_gives_the_tables_and_what_it_reads(empty_file):
@@ -66,7 +66,7 @@ def test_export_gives_the_tables_and_what_it_reads(empty_file):
 
 def test_a_mask_and_a_second_height_field_make_two_tiles(empty_file):
     from sg_prt_addon.biscale import bvndf
-    from sg_prt_addon.techniques.sg import blender as sg_side
+    from sg_prt_addon.techniques.biscale import blender as biscale_side
 
     material = _biscale("masked_biscale", model="GGX")
     settings = material.sgprt.biscale
@@ -75,7 +75,7 @@ def test_a_mask_and_a_second_height_field_make_two_tiles(empty_file):
     params, warnings = export_with_warnings(material)
     assert any("no second height image: the mask is not applied" in warning for warning in warnings)
     assert isinstance(params.biscale, bvndf.BVNDF) and "biscale_mask" not in params.textures
-    assert ("template_ID", "second_height_image") in _drawn(sg_side.SGPRT_PT_material_biscale, material)
+    assert ("template_ID", "second_height_image") in _drawn(biscale_side.SGPRT_PT_material_biscale, material)
     settings.second_height_image = _height_image("masked_second", np.zeros((8, 8)))
     params, warnings = export_with_warnings(material)
     assert isinstance(params.biscale, bvndf.MaskedTiles) and params.biscale.lobe_count == 4 + 4

@@ -212,9 +212,9 @@ def test_small_scale_models_are_the_engines_own():
 
 def test_masked_tiles_blend_the_two_tiles_by_the_mask():
     """Two tiles chosen by a mask (iwasaki2012 fig. 1c): at 0 the first tile's slice and diffuse, at 1 the
-    second's, in between the blend of the two (techniques.sg.biscale_shading, the GLSL's mirror)."""
+    second's, in between the blend of the two (techniques.biscale.biscale_shading, the GLSL's mirror)."""
     from sg_prt_addon.spherical import clamped_cosine
-    from sg_prt_addon.techniques.sg import biscale_shading
+    from sg_prt_addon.techniques.biscale import biscale_shading
 
     first = bvndf.compute(microgeometry.from_height_field(reference.egg_crate(16)), lobes=4, samples=1024)
     second = bvndf.compute(microgeometry.from_height_field(reference.grooves(16)), lobes=3, samples=1024)

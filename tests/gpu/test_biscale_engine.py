@@ -1,5 +1,5 @@
 """The bi-scale technique (SG_BISCALE, iwasaki2012) in the engine: its GLSL against its numpy mirror
-(techniques.sg.biscale_shading through sg_shading.shade_fragments) on the G-buffer's pixels, under a point light
+(techniques.biscale.biscale_shading.shade_fragments: its lobe source in sg_shading's stages) on the G-buffer's pixels, under a point light
 with an environment map and under a constant world; a material whose tile is unusable renders as a single
 scale with a warning that says why."""
 import engine_fixtures as fx

@@ -20,8 +20,8 @@ def engine(blender):
 def _mirror(result, textures_by_material=None, use_visibility=True, use_shadow_maps=True):
     """Numpy shading of every covered pixel; returns (expected, actual) diffuse/specular and mask.  With shadow
     maps, their lookups (lighting.shadow_maps.light_visibility) read the frame's atlas."""
+    from sg_prt_addon import techniques
     from sg_prt_addon.lighting import shadow_maps
-    from sg_prt_addon.techniques.sg import sg_shading
 
     passes, state = result["passes"], result["state"]
     camera = passes["camera"]
@@ -44,8 +44,9 @@ def _mirror(result, textures_by_material=None, use_visibility=True, use_shadow_m
                 light_shadow = shadow_maps.light_visibility(passes["shadow_atlas"], passes["shadow_plan"], light_data,
                                                             passes["gbuffer_position"][mask][:, :3],
                                                             passes["gbuffer_normal"][mask][:, :3])
-            diffuse, specular = sg_shading.shade_fragments(
-                state.materials[name], (textures_by_material or {}).get(name, {}),
+            params = state.materials[name]
+            diffuse, specular = techniques.for_material(params).mirror(
+                params, (textures_by_material or {}).get(name, {}),
                 passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
                 passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
                 light_data, state.environment,

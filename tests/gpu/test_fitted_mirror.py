@@ -27,7 +27,7 @@ def fitted_material(blender, tmp_path_factory):
 
 
 def _mirror(result):
-    from sg_prt_addon.techniques.sg import sg_shading
+    from sg_prt_addon import techniques
 
     passes, state = result["passes"], result["state"]
     camera = passes["camera"]
@@ -38,8 +38,9 @@ def _mirror(result):
     view_origin = camera.position if camera.is_perspective else camera.forward
     for material_id in np.unique(uv[covered][:, 2]).astype(int):
         mask = covered & (np.abs(uv[..., 2] - material_id) < 0.25)
-        diffuse, specular = sg_shading.shade_fragments(
-            state.materials[material_of_id[material_id]], {}, passes["gbuffer_position"][mask][:, :3],
+        params = state.materials[material_of_id[material_id]]
+        diffuse, specular = techniques.for_material(params).mirror(
+            params, {}, passes["gbuffer_position"][mask][:, :3],
             passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin,
             camera.is_perspective, state.light_data(), state.environment)
         expected["Diffuse"][mask] = diffuse

@@ -157,7 +157,7 @@ def test_engine_and_blender_glue_name_no_technique():
                                                          "ssdf_coefficients", "fitted_texels", "fitted_m_factor",
                                                          "anisotropy_table", "ggx_", "spherical_harmonics",
                                                          "sh_shading", "factored")})
-    patterns.update({f"techniques.{package}": rf"techniques\.{package}\b" for package in ("sg", "sh", "homomorphic")})
+    patterns.update({f"techniques.{package}": rf"techniques\.{package}\b" for package in ("sg", "sh", "homomorphic", "biscale")})
     for file_name in ("renderer.py", "shader_cache.py", "scene_state.py"):
         with open(os.path.join(ENGINE_DIR, file_name), encoding="utf-8") as handle:
             source = handle.read()

@@ -52,7 +52,6 @@ from ...lighting import env_prefilter, equirect, lights
 from ...reflectance import brdf, ggx_albedo, layering, models
 from ...spherical import clamped_cosine, sg, texture_fetch, warp
 from .. import surface_layering
-from . import biscale_shading
 from .fitted_texels import FITTED_MODEL, fitted_m_factor, fitted_texel_values
 
 FLOAT = np.float32
@@ -552,15 +551,14 @@ class _Pixels:
     slice_colour: np.ndarray
     slice_cosine: np.ndarray    # I(S_j, n), unshadowed
     albedo: object              # the model's directional albedo where it is tabulated, else None
-    biscale: object = None      # a bi-scale material's biscale.bvndf.BVNDF or MaskedTiles (biscale_shading), else None
-    biscale_mask: object = None  # (N,) the mask between its two tiles, else None
+    lobes: object = None        # the lobe source (ModelLobes, or a technique's own)
 
     def diffuse_factor(self, world_axis):
-        """The bi-scale diffuse factor D(i, o) at world directions (N, P, 3) (1 without bi-scale)."""
-        if self.biscale is None:
+        """The lobe source's diffuse factor at world directions (N, P, 3) (1: none)."""
+        if not self.lobes.scales_diffuse:
             return FLOAT(1)
         local = np.einsum("nji,npj->npi", self.frame, np.asarray(world_axis, FLOAT))
-        return biscale_shading.diffuse_factor(self.biscale, local, self.view_local, self.biscale_mask)
+        return self.lobes.diffuse_factor(local, self.view_local)
 
     def visible(self, axis, sharpness):
         if self.visibility is None:
@@ -588,38 +586,65 @@ class _Pixels:
         return np.repeat(group_values, self.nodes, axis=-1)
 
 
+class ModelLobes:
+    """The lobe source of the parametric and fitted SG techniques (lobes_model.glsl, lobes_fitted.glsl): the
+    model's own NDF lobes, or a stored fit's, warped to the view.  A technique with lobes of its own gives shade()
+    an object with the same methods (biscale_shading.BiScaleLobes)."""
+    scales_diffuse = False      # diffuse_factor() is 1 everywhere
+    glossy_layer = True         # the material's glossy layer (Fresnel, layered diffuse) applies
+
+    def slice(self, model, params, lobe_count, view_local, warp_mode):
+        """(axis (N, J, 3) local, sharpness (N, J), amplitude (N, J)) of the view's BRDF slice."""
+        return specular_slice(model, params, lobe_count, view_local, warp_mode)
+
+    def colours(self, model, params, slice_count, warp_mode):
+        """(N, J, 3) RGB amplitudes of the slice lobes, or None (1)."""
+        return slice_colours(model, params, slice_count)
+
+    def albedo(self, model, params, view_local):
+        """The model's directional albedo the slice is kept within and its tail returns (None: no tail)."""
+        return model_albedo(model, params, view_local)
+
+    def light_tail(self, model):
+        return model != FITTED_MODEL
+
+    def diffuse_factor(self, local, view_local):
+        return FLOAT(1)
+
+    def world_albedo(self, view_local):
+        """What scales a constant world's irradiance: 1."""
+        return FLOAT(1)
+
+
+MODEL_LOBES = ModelLobes()
+
+
 def _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
-            warp_mode, biscale=None, biscale_mask=None):
+            warp_mode, lobes=MODEL_LOBES):
     position = np.asarray(position, FLOAT)
     n, t, b = shading_frame(normal, tangent)
     view = view_directions(position, view_origin, is_perspective)
     frame = np.stack([t, b, n], axis=-1)                          # local -> world: columns t, b, n
     view_local = np.einsum("nji,nj->ni", frame, view).astype(FLOAT)
 
-    if biscale is not None:
-        slice_axis, slice_sharpness, slice_amplitude = biscale_shading.slice_lobes(biscale, model, params, view_local,
-                                                                                    warp_mode, biscale_mask)
-    else:
-        slice_axis, slice_sharpness, slice_amplitude = specular_slice(model, params, lobe_count, view_local,
-                                                                      warp_mode)
+    slice_axis, slice_sharpness, slice_amplitude = lobes.slice(model, params, lobe_count, view_local, warp_mode)
     slice_axis = np.einsum("nij,nkj->nki", frame, slice_axis).astype(FLOAT)    # to world
     slice_sharpness = slice_sharpness.astype(FLOAT)
     slice_amplitude = slice_amplitude.astype(FLOAT)
-    slice_colour = slice_colours(model, params, slice_sharpness.shape[1]) if biscale is None else \
-        biscale_shading.slice_colours(biscale, model, params, warp.nodes_per_lobe(warp_mode or warp.DEFAULT_MODE))
+    slice_colour = lobes.colours(model, params, slice_sharpness.shape[1], warp_mode)
     if slice_colour is None:
         slice_colour = np.ones(slice_sharpness.shape + (3,), FLOAT)
 
     # I(S_j, n) unshadowed: the lobes' albedo, capped at the model's own where it is known (GGX: the lobes
     # overshoot it several times over at grazing views), and the environment's weights below
     slice_cosine = _clamped_cosine_integral(slice_axis, slice_sharpness, slice_amplitude, n[:, None, :])  # (N, J)
-    albedo = model_albedo(model, params, view_local) if biscale is None else None
+    albedo = lobes.albedo(model, params, view_local)
     if albedo is not None:
         scale = np.minimum(FLOAT(1), albedo / np.maximum(np.sum(slice_cosine, axis=1), FLOAT(1e-30)))[:, None]
         slice_amplitude = (slice_amplitude * scale).astype(FLOAT)
         slice_cosine = (slice_cosine * scale).astype(FLOAT)
     return _Pixels(position, n, frame, view, view_local, model, params, visibility, warp_mode, slice_axis,
-                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo, biscale, biscale_mask)
+                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo, lobes)
 
 
 def _light_sets(position, light_data):
@@ -666,7 +691,7 @@ def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, sp
                                                                        sharpness_m[:, :, centre])), weight)
         weight = np.where(mapped[..., None], weight * light_visible[..., None], weight)
     weight = np.sum(weight[..., None] * px.slice_colour[:, None], axis=2)                          # (N, P, 3)
-    if px.model != FITTED_MODEL and px.biscale is None:
+    if px.lobes.light_tail(px.model):
         tail = light_tail(px.model, px.params, px.view_local, px.frame, light_axis, light_sharpness, light_cosine,
                           px.slice_axis, px.slice_sharpness, px.slice_amplitude)
         weight = np.maximum(weight + (tail * light_visible)[..., None], FLOAT(0))
@@ -724,9 +749,8 @@ def _add_environment(px, environment, irradiance, specular):
             specular += tail[0][:, None] * environment_radiance(environment, tail_axis, tail_sharpness)
         return
     colour = np.asarray(environment.colour, FLOAT)
-    # a bi-scale material's diffuse sees the constant world through its mean factor A(o)
-    lit = colour if px.biscale is None else \
-        colour * biscale_shading.albedo(px.biscale, px.view_local, px.biscale_mask)[:, None]
+    # a lobe source that scales the diffuse (a bi-scale tile) has the constant world seen through its mean factor
+    lit = colour if not px.lobes.scales_diffuse else colour * px.lobes.world_albedo(px.view_local)[:, None]
     if visibility is None:
         irradiance += np.pi * lit
     elif visibility.diffuse is not None:
@@ -739,8 +763,7 @@ def _add_environment(px, environment, irradiance, specular):
 
 
 def shade(position, normal, tangent, view_origin, is_perspective, model, params, diffuse_color, specular_color,
-          light_data, environment, lobe_count=1, visibility=None, warp_mode=None, biscale=None, biscale_mask=None,
-          light_shadow=None):
+          light_data, environment, lobe_count=1, visibility=None, warp_mode=None, lobes=MODEL_LOBES, light_shadow=None):
     """Diffuse and specular radiance (N, 3) each, float32, for pixels with world ``position`` (N, 3),
     ``normal`` (N, 3) (final: normal map applied), ``tangent`` (N, 3) (final direction, rotation
     applied), per-pixel model ``params`` (dict of (N,) arrays) and colours (N, 3).
@@ -748,13 +771,13 @@ def shade(position, normal, tangent, view_origin, is_perspective, model, params,
     view_origin: camera position (perspective) or the camera's forward direction (orthographic).
     visibility: a Visibility (the SSDF shadows of the HAS_VISIBILITY variant) or None (unshadowed).
     warp_mode: spherical.warp's mode of the view slice (the material's view warp; None: the default).
-    biscale: a bi-scale material's biscale.bvndf.BVNDF or MaskedTiles (model: its small-scale model), or None;
-    biscale_mask: (N,) the mask between MaskedTiles' two tiles.
+    lobes: the lobe source (MODEL_LOBES: the model's or the fit's; a bi-scale material's BiScaleLobes, whose
+    model is its small-scale model).
     light_shadow: (N, lights, 2) the lights' shadow maps at the pixels (lighting.shadow_maps.light_visibility:
     point lights then suns, NaN without a map), or None (no maps).
     """
     px = _pixels(position, normal, tangent, view_origin, is_perspective, model, params, lobe_count, visibility,
-                 warp_mode, biscale, biscale_mask)
+                 warp_mode, lobes)
     irradiance = np.zeros(px.position.shape, FLOAT)
     specular = np.zeros(px.position.shape, FLOAT)
     first = 0
@@ -836,11 +859,8 @@ def surface_layers(material, roughness_texture, uv, diffuse_color, specular_colo
     return diffuse_color * diffuse_factor[:, None], specular
 
 
-BISCALE_MASK = "biscale_mask"      # the texture slot of a bi-scale material's mask between its two tiles
-
-
 def shade_fragments(material, textures, position, normal, tangent, uv, view_origin,
-                    is_perspective, light_data, environment, visibility=None, light_shadow=None):
+                    is_perspective, light_data, environment, visibility=None, light_shadow=None, lobes=MODEL_LOBES):
     """Mirror of surface.frag.glsl's main(): per-fragment inputs as the G-buffer holds them.
 
     material: an object with export.MaterialParams' fields; textures: slot name -> (H, W, 4)
@@ -848,20 +868,18 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     world normal (already flipped for back faces); tangent (N, 4): the tangent input (the UV
     map's world tangent and sign, or the object axis in world space); uv (N, 2).
     visibility: per-fragment Visibility (HAS_VISIBILITY variant) or None; light_shadow: the lights' shadow maps at
-    the fragments (shade's), or None.
+    the fragments (shade's), or None; lobes: the lobe source (shade's).
     Returns (diffuse, specular), each (N, 3) float32.
     """
     count = len(position)
     fitted = getattr(material, "fitted", None)
-    biscale = getattr(material, "biscale", None)
-    biscale_mask = sample_material_texture(textures[BISCALE_MASK], uv)[:, 0] if BISCALE_MASK in textures else None
     if fitted is not None:         # the stored lobe fit (MODEL_FITTED): only a normal map (and a bi-scale mask) apply
         model_params, diffuse_color = fitted_texel_values(fitted, uv)
         shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
         return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
                      model_params, diffuse_color, np.ones((count, 3), FLOAT), light_data, environment,
-                     visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale,
-                     biscale_mask=biscale_mask, light_shadow=light_shadow)
+                     visibility=visibility, warp_mode=getattr(material, "warp_mode", None), lobes=lobes,
+                     light_shadow=light_shadow)
     diffuse_color, specular_color = surface_colours(material, textures, uv, count)
     params = {}
     for name in SCALAR_SLOTS:
@@ -870,7 +888,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
             value = value * sample_material_texture(textures[name], uv)[:, 0]
         params[name] = value
     shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
-    if biscale is None:         # a bi-scale material's variant has no glossy layer (sg_biscale)
+    if lobes.glossy_layer:      # a bi-scale material's variant has none (sg_biscale)
         roughness_texture = textures["roughness"] if surface_layering.textured_roughness(material.model, textures) \
             else None
         diffuse_color, specular_color = surface_layers(material, roughness_texture, uv, diffuse_color, specular_color,
@@ -880,7 +898,7 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
                  diffuse_color, specular_color, light_data, environment,
                  lobe_count=material.lobe_count if model in models.ANISOTROPIC else 1,
-                 visibility=visibility, warp_mode=getattr(material, "warp_mode", None), biscale=biscale,
-                 biscale_mask=biscale_mask, light_shadow=light_shadow)
+                 visibility=visibility, warp_mode=getattr(material, "warp_mode", None), lobes=lobes,
+                 light_shadow=light_shadow)
 
 

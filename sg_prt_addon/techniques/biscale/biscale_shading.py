@@ -1,4 +1,4 @@
-"""Numpy mirror of shaders/techniques/sg/biscale.glsl: a bi-scale material's effective lobes (iwasaki2012
+"""Numpy mirror of shaders/techniques/biscale/biscale.glsl: a bi-scale material's effective lobes (iwasaki2012
 eq. 15) as the SG technique's BRDF slice, and its diffuse factor; and the GPU layout of a biscale.bvndf.BVNDF
 (or of two tiles a mask chooses between, bvndf.MaskedTiles).
 
@@ -12,7 +12,10 @@ from ...biscale import bvndf as bvndf_tables
 from ...biscale import effective_brdf
 from ...reflectance import brdf, models
 from ...spherical import sg, warp
-from .fitted_texels import FITTED_MODEL, fitted_m_factor
+from ..sg import sg_shading
+from ..sg.fitted_texels import FITTED_MODEL, fitted_m_factor
+
+MASK_SLOT = "biscale_mask"      # the texture slot of a bi-scale material's mask between its two tiles
 
 FLOAT = np.float32
 # Small-scale models: the isotropic ones (iwasaki2012 sec. 7: as its previous method, isotropic small-scale BRDFs)
@@ -153,6 +156,46 @@ def albedo(tables, view_local, mask=None):
     up = np.array([0.0, 0.0, 1.0])
     values = bvndf_tables.interpolate(texture, up, np.asarray(view_local, np.float64), tables.resolution)  # (T, N)
     return np.sum(values.T * tile_weights(tables, mask, len(view_local)), axis=1).astype(FLOAT)
+
+
+class BiScaleLobes:
+    """The bi-scale technique's lobe source for sg_shading.shade (biscale.glsl's): the effective lobes of the
+    tables (a BVNDF or MaskedTiles) under the small-scale model, their colours, and the tile's diffuse factor;
+    mask (N,): the mask's value per pixel with two tiles, else None."""
+    scales_diffuse = True
+    glossy_layer = False        # the variant has no glossy layer: the small-scale BRDF is the look
+
+    def __init__(self, tables, mask=None):
+        self.tables = tables
+        self.mask = mask
+
+    def slice(self, model, params, lobe_count, view_local, warp_mode):
+        return slice_lobes(self.tables, model, params, view_local, warp_mode, self.mask)
+
+    def colours(self, model, params, slice_count, warp_mode):
+        return slice_colours(self.tables, model, params, warp.nodes_per_lobe(warp_mode or warp.DEFAULT_MODE))
+
+    def albedo(self, model, params, view_local):
+        return None             # no environment tail (GGX's own)
+
+    def light_tail(self, model):
+        return False
+
+    def diffuse_factor(self, local, view_local):
+        return diffuse_factor(self.tables, local, view_local, self.mask)
+
+    def world_albedo(self, view_local):
+        return albedo(self.tables, view_local, self.mask)
+
+
+def shade_fragments(material, textures, position, normal, tangent, uv, view_origin, is_perspective, light_data,
+                    environment, visibility=None, light_shadow=None):
+    """The bi-scale technique's mirror: sg_shading.shade_fragments with the material's tiles (material.biscale) as
+    the lobe source, the mask's red channel sampled at uv where it has one."""
+    mask = (sg_shading.sample_material_texture(textures[MASK_SLOT], uv)[:, 0] if MASK_SLOT in textures else None)
+    return sg_shading.shade_fragments(material, textures, position, normal, tangent, uv, view_origin, is_perspective,
+                                      light_data, environment, visibility=visibility, light_shadow=light_shadow,
+                                      lobes=BiScaleLobes(material.biscale, mask))
 
 
 # ---------------------------------------------------------------- GPU layout

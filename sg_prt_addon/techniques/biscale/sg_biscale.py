@@ -1,16 +1,17 @@
 """iwasaki2012's bi-scale materials rendered by wang2009's SG shading: the effective BRDF of a small-scale tile
 (its BVNDF's lobes and tables, biscale.bvndf, from export.MaterialParams.biscale) with the material's own
 isotropic model as the small-scale BRDF, or its stored lobe fit (MaterialParams.fitted: a measured small-scale
-BRDF, iwasaki2012 fig. 8) (shaders/techniques/sg/biscale.glsl; mirror biscale_shading.py)."""
-from . import biscale_shading, sg_fitted, sg_parametric, sg_shading
-from .sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
-from .sg_parametric import material_terms
+BRDF, iwasaki2012 fig. 8) (shaders/techniques/biscale/biscale.glsl; mirror biscale_shading.py)."""
+from ..sg import sg_fitted, sg_parametric
+from ..sg.sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
+from ..sg.sg_parametric import material_terms
+from . import biscale_shading
 
 NAME = "SG_BISCALE"
 # the small-scale parameters a texture may scale per pixel, and the colours and normal map
 TEXTURES = ("diffuse_color", "specular_color", "roughness", "ior", "exponent", "alpha_x", "normal_map",
-            sg_shading.BISCALE_MASK)
-FITTED_TEXTURES = ("normal_map", sg_shading.BISCALE_MASK)      # a fit holds its own colours and lobes
+            biscale_shading.MASK_SLOT)
+FITTED_TEXTURES = ("normal_map", biscale_shading.MASK_SLOT)      # a fit holds its own colours and lobes
 
 
 def texture_slots(params):
@@ -24,6 +25,7 @@ class SGBiScale(SGLobes):
                    "SG lobes: all-frequency light and SSDF shadows (Iwasaki et al. 2012, Wang et al. 2009)")
     number = 4
     paper = "iwasaki2012"
+    mirror = staticmethod(biscale_shading.shade_fragments)
 
     def variant_key(self, params, inputs):
         tables = getattr(params, "biscale", None)
@@ -73,7 +75,7 @@ class SGBiScale(SGLobes):
 
     def lobe_source(self, key):
         """biscale.glsl: the effective lobes, their M and the tile's diffuse factor."""
-        return ("sg", "biscale.glsl")
+        return ("biscale", "biscale.glsl")
 
     def technique_files(self, key):
         """GGX's two-lobe table reader (the small-scale lobes) besides what the SG shading takes."""

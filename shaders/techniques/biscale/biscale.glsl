@@ -1,5 +1,5 @@
 /* Bi-scale materials (iwasaki2012 eq. 15): the effective BRDF's lobes and factors, mirrored by
- * sg_prt_addon/techniques/sg/biscale_shading.py.  Needs sg.glsl, hemisphere_map.glsl, surface_io.glsl (the mask's
+ * sg_prt_addon/techniques/biscale/biscale_shading.py.  Needs sg.glsl, hemisphere_map.glsl, surface_io.glsl (the mask's
  * material_texture); with HAS_SPECULAR, brdf.glsl, (MODEL_GGX) ggx_two_lobes.glsl and the ggx_table sampler, and
  * sg_models.glsl before this file (its model_ndf_lobe and model_m_factor); and:
  *   biscale_lobes  (sampler2D, J x 1): texel j = (axis xyz in the local frame, sharpness) of BVNDF lobe j;
