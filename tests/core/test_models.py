@@ -11,7 +11,7 @@ SHADERS = Path(__file__).resolve().parents[2] / "shaders"
 
 @pytest.mark.slow_maths
 def test_every_model_has_an_exact_form_and_glsl_lobes():
-    shading = (SHADERS / "techniques" / "sg" / "sg_shading.glsl").read_text()
+    shading = (SHADERS / "techniques" / "sg" / "sg_models.glsl").read_text()
     for model in models.MODELS:
         exact = brdf.model_from_name(model.name)
         assert exact is not None and f"defined(MODEL_{model.name})" in shading, model.name
