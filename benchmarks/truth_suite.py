@@ -51,9 +51,7 @@ filters; FLIP's exposure range comes from the truth image, the same for every me
 The errors are raw: the truth's noise floor is reported beside them, not taken out.
 
 Lights: Blender's units as lighting.lights states them (the same for every renderer); point and spot
-lights have Blender's "soft falloff" turned off, so Cycles renders the uniform sphere SG-PRT models
-(with it, a sphere light differs from a sphere closer than a few radii: diffuse_sphere_light's
-light is 4 radii away).
+lights keep Blender's Soft Falloff (on), which SG-PRT models as Cycles does (lighting.lights.light_cap_extent).
 
 Writes docs/truth_suite.json (every row; ``--quick`` runs write out/truth_suite_quick.json unless
 ``--json`` says otherwise) and, per scene, out/truth/<scene>.png: Cycles truth | SG-PRT | EEVEE 16
@@ -347,8 +345,7 @@ def markdown_section(data, before=None):
         "Truth: Cycles on the CPU, direct light only (max bounces 0, 1-pixel box filter, no denoising), node "
         "materials matched to the SG-PRT settings (benchmarks/matched_materials.py, which lists what differs; "
         "the anisotropic ones through the Glossy BSDF's own Anisotropy mapping, not the Principled BSDF's), "
-        "point and spot lights without Blender's soft falloff (a uniform sphere, "
-        "as SG-PRT models it), the mean of two renders of seeds 1 and 2. Noise floor: the relative RMSE between "
+        "point and spot lights with Blender's Soft Falloff as it defaults (on), the mean of two renders of seeds 1 and 2. Noise floor: the relative RMSE between "
         "the two seed "
         "images / 2 (their difference has sqrt(2) x one image's noise, their mean 1/sqrt(2) of it): what a "
         "perfect image would score; errors are raw, not corrected for it. Scores over the surface pixels "
@@ -604,18 +601,14 @@ def _white_world(scene):
 
 
 def _light(scene, kind, location, energy, radius=0.0, target=(0.0, 0.0, 0.8)):
-    """A light aimed at ``target``.  Point and spot lights turn Blender's soft falloff off: with it a
-    sphere light is not a uniform sphere closer than a few radii, and SG-PRT (lighting.lights) models the
-    sphere."""
+    """A light aimed at ``target``, Blender's other settings at their defaults (Soft Falloff on)."""
     import bpy
     from mathutils import Vector
 
     light = bpy.data.objects.new(f"{kind.title()} Light", bpy.data.lights.new(f"{kind.title()} Light", kind))
     light.data.energy = energy
     if kind in ("POINT", "SPOT"):
-        light.data.shadow_soft_size = radius
-        if hasattr(light.data, "use_soft_falloff"):
-            light.data.use_soft_falloff = False
+        light.data.shadow_soft_size = radius       # Soft Falloff left at Blender's default (on)
     light.location = location
     light.rotation_euler = (Vector(target) - Vector(location)).to_track_quat("-Z", "Y").to_euler()
     scene.collection.objects.link(light)

@@ -14,7 +14,8 @@ Estimators, per pixel sample (one camera ray):
     multiple importance sampling, power heuristic, of ``environment_samples``
     (default 16, stratified 4x4) environment samples (validation.env_sampling) and as
     many BRDF samples (cosine lobe or the specular model, picked by weight);
-  - point lights (sphere of radius r, r = 0 a true point, optional spot cone)
+  - point lights (sphere of radius r, or with Soft Falloff a disk of radius r facing the point; r = 0 a true
+    point; optional spot cone)
     and directional lights (cone of angular radius a, a = 0 a delta): one light
     sample, uniform over the solid angle the light subtends; lights of finite
     size seen by points with a specular model add one BRDF sample, power
@@ -74,6 +75,7 @@ class PointLight:
     spot_direction: Any = None                # (3,) world axis of a spot cone; None: no cone
     spot_size: float = np.pi                  # full cone angle (Blender spot_size)
     spot_blend: float = 0.0                   # Blender spot_blend: smoothstep over this fraction of 1 - cos(size/2)
+    soft_falloff: bool = False                # Blender's Soft Falloff: a disk of the radius facing the point, not a sphere
 
     def spot_falloff(self, to_light):
         """Intensity factor (N,) for unit directions (N, 3) from shading points to the light centre:
@@ -517,7 +519,13 @@ class _Renderer:
             axis = _normalize(to_centre, np.array([0.0, 0.0, 1.0]))
             intensity = np.asarray(light.intensity, float)[None, :] * light.spot_falloff(axis)[:, None]
             radius = float(light.radius)
-            if radius > 0:
+            if radius > 0 and light.soft_falloff:
+                # Cycles' Soft Falloff: a disk of radius r at the centre, facing the point, radiance I / (pi r^2)
+                # along every ray that hits it (its normal is the ray's): a cone of tan a = r / d
+                sin_max = radius / np.sqrt(distance ** 2 + radius ** 2)
+                radiance = intensity / (np.pi * radius ** 2)
+                cone = (axis, _one_minus_cos_from_sin(sin_max), radiance, distance, None)
+            elif radius > 0:
                 # A uniform sphere of this intensity has radiance I / (pi r^2); points inside it get nothing.
                 outside = distance > radius
                 sin_max = np.where(outside, radius / np.maximum(distance, 1e-300), 1.0)
@@ -558,7 +566,7 @@ class _Renderer:
         value = self._brdf_cosine(points, wi_local) * radiance * solid_angle[:, None]
         if use_mis:
             value *= _power_weight(light_pdf, self._brdf_pdf(points, wi_local))[:, None]
-        max_distance = None if distance is None else _sphere_entry(distance, radius, np.sum(wi * axis, axis=-1))
+        max_distance = _light_entry(distance, radius, np.sum(wi * axis, axis=-1))
         total = value * self._visible(points, wi, max_distance, np.any(value > 0, axis=-1))[:, None]
         if not use_mis:
             return total
@@ -569,7 +577,7 @@ class _Renderer:
         inside = (cos_to_axis >= 1.0 - one_minus_cos) & (brdf_pdf > 0)
         weight = np.where(inside, _power_weight(brdf_pdf, light_pdf) / np.where(brdf_pdf > 0, brdf_pdf, 1.0), 0.0)
         value = self._brdf_cosine(points, wi_local) * radiance * weight[:, None]
-        max_distance = None if distance is None else _sphere_entry(distance, radius, cos_to_axis)
+        max_distance = _light_entry(distance, radius, cos_to_axis)
         return total + value * self._visible(points, wi, max_distance, np.any(value > 0, axis=-1))[:, None]
 
     def _area_light_contribution(self, points, light, uniforms, rng):
@@ -652,6 +660,16 @@ def _stratified_uniforms(rng, count, per_point, dimensions):
     else:
         uniforms[:, 0] = (stratum + uniforms[:, 0]) / per_point
     return uniforms
+
+
+def _light_entry(distance, radius, cos_to_centre):
+    """Distance along rays to where they reach a light: None for a distant light (distance None), the plane of a
+    disk facing the point at the centre's distance (radius None: Soft Falloff's), else the sphere's surface."""
+    if distance is None:
+        return None
+    if radius is None:
+        return distance / np.maximum(cos_to_centre, 1e-12)
+    return _sphere_entry(distance, radius, cos_to_centre)
 
 
 def _sphere_entry(distance, radius, cos_to_centre):

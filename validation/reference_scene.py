@@ -98,7 +98,8 @@ def reference_lights(light_exports):
             spot = dict(spot_direction=np.asarray(light.direction), spot_size=light.spot_size,
                         spot_blend=light.spot_blend) if light.is_spot else {}
             lights.append(reference.PointLight(np.asarray(light.position), np.asarray(light.colour_intensity),
-                                               radius=light.radius, **spot))
+                                               radius=light.radius,
+                                               soft_falloff=getattr(light, "soft_falloff", False), **spot))
     return lights
 
 

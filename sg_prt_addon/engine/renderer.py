@@ -106,7 +106,8 @@ def scene_block(camera, light_data, environment, shadow_plan=None):
         vec4_array(MAX_LAYERS, scale_offset),
         vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.point_position, light_data.point_radius[:, None]], 1)
                    if points else []),
-        vec4_array(MAX_POINT_LIGHTS, np.pad(light_data.point_intensity, ((0, 0), (0, 1))) if points else []),
+        vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.point_intensity, light_data.soft_falloff[:, None]], 1)
+                   if points else []),
         vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.spot_direction,
                                                      light_data.spot_size[:, None]], 1) if points else []),
         vec4_array(MAX_POINT_LIGHTS, np.concatenate([light_data.spot_blend[:, None], light_data.point_emitter], 1)

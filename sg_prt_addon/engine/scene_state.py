@@ -597,23 +597,24 @@ def fit_light_budget(light_exports, max_points, max_suns, area_patches=core_ligh
             continue
         group = export.LightExport(f"{len(members)} lights about '{members[0].name}'", "POINT",
                                    tuple(clusters.position[k]), (0.0, 0.0, -1.0), tuple(clusters.intensity[k]),
-                                   radius=float(clusters.radius[k]))
+                                   radius=float(clusters.radius[k]),
+                                   soft_falloff=all(light.soft_falloff for light in members))
         drawn.append(group)
         merged.append((group, [light.name for light in members]))
     return LightBudget(drawn + suns, patches, merged, dropped)
 
 
 def _point_rows(light, area_patches):
-    """(position, radius, intensity, direction, spot size, spot blend, emitter) rows of one point-like light:
-    one for a point or spot, a patch each for an area light."""
+    """(position, radius, intensity, direction, spot size, spot blend, emitter, soft falloff) rows of one
+    point-like light: one for a point or spot, a patch each for an area light (a sphere of its patch's size)."""
     if light.kind != "AREA":
         return [(light.position, light.radius, light.colour_intensity, light.direction,
                  light.spot_size if light.is_spot else -1.0, light.spot_blend if light.is_spot else 0.0,
-                 (0.0, 0.0, 0.0))]
+                 (0.0, 0.0, 0.0), light.soft_falloff)]
     patches = core_lights.area_light_patches(light.position, light.edge_u, light.edge_v, light.direction,
                                              light.shape, light.colour_intensity, area_patches, light.spread)
     emitter = (1.0, patches.tan_half_spread, patches.spread_normalization)
-    return [(position, radius, intensity, patches.normal, -1.0, 0.0, emitter)
+    return [(position, radius, intensity, patches.normal, -1.0, 0.0, emitter, False)
             for position, radius, intensity in zip(patches.position, patches.radius, patches.intensity)]
 
 
@@ -630,8 +631,10 @@ def budget_light_data(budget):
     data = LightData()
     f = np.float32
     if rows:
+        columns = list(zip(*rows))
         (data.point_position, data.point_radius, data.point_intensity, data.spot_direction, data.spot_size,
-         data.spot_blend, data.point_emitter) = (np.array(column, f) for column in zip(*rows))
+         data.spot_blend, data.point_emitter) = (np.array(column, f) for column in columns[:7])
+        data.point_soft_falloff = np.array(columns[7], bool)
     if suns:
         axis, sharpness, amplitude = core_lights.directional_light_sg(
             -np.array([light.direction for light in suns], np.float64),

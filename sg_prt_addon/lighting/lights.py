@@ -77,7 +77,18 @@ def _cap_sharpness_and_integral(sin2, energy_scale, model, paper_amplitude):
     return sharpness, amplitude
 
 
-def sphere_light_sg(shading_position, light_position, radius, intensity, model="energy"):
+def light_cap_extent(distance2, radius2, soft_falloff=False):
+    """max(d^2, r^2) of a sphere light (points inside it see a hemisphere), or d^2 + r^2 with Blender's Soft
+    Falloff (on by default for point and spot lights): Cycles then draws the light as a disk of its radius
+    facing the shading point, seen within tan a = r / d, so sin^2 a = r^2 / (d^2 + r^2) and, the radiance being
+    the sphere's, the intensity falls as I / (d^2 + r^2) near the light.  Floored at 1e-12 max(r^2, 1)."""
+    distance2 = np.asarray(distance2, np.float64)
+    radius2 = np.asarray(radius2, np.float64)
+    extent2 = np.where(soft_falloff, distance2 + radius2, np.maximum(distance2, radius2))
+    return np.maximum(extent2, 1e-12 * np.maximum(radius2, 1.0))
+
+
+def sphere_light_sg(shading_position, light_position, radius, intensity, model="energy", soft_falloff=False):
     """SG radiance field of a spherical light seen from shading points (wang2009 eq. 32).
 
     shading_position (..., 3), light_position (..., 3), radius (...) >= 0 and
@@ -85,7 +96,8 @@ def sphere_light_sg(shading_position, light_position, radius, intensity, model="
     Returns (axis (..., 3), sharpness (...), amplitude (...) or (..., C)).
 
     Points inside the light (d < r) see a hemisphere of it (the cap is clamped
-    at 90 degrees).  Distances are floored at 1e-6 of the light scale so a
+    at 90 degrees).  soft_falloff (...): Blender's Soft Falloff, the light a disk facing the point
+    (light_cap_extent).  Distances are floored at 1e-6 of the light scale so a
     zero distance gives a finite, very bright lobe and never NaN/Inf.
     """
     x = np.asarray(shading_position)
@@ -93,12 +105,11 @@ def sphere_light_sg(shading_position, light_position, radius, intensity, model="
     to_light = (np.asarray(light_position, dtype=np.float64) - np.asarray(x, dtype=np.float64))
     distance2 = np.sum(to_light * to_light, axis=-1)
     radius2 = np.square(np.asarray(radius, dtype=np.float64))
-    floor2 = 1e-12 * np.maximum(radius2, 1.0)
-    effective2 = np.maximum(np.maximum(distance2, radius2), floor2)
+    effective2 = light_cap_extent(distance2, radius2, soft_falloff)
     sin2 = radius2 / effective2
     cos_half = np.sqrt(np.maximum(1.0 - sin2, 0.0))
     intensity64 = np.asarray(intensity, dtype=np.float64)
-    # cap radiance integral L_e * Omega = I/(pi r^2) * 2 pi sin^2/(1+cos) = 2 I / (max(d, r)^2 (1+cos))
+    # cap radiance integral L_e * Omega = I/(pi r^2) * 2 pi sin^2/(1+cos) = 2 I / (extent^2 (1+cos))
     energy = 2.0 / (effective2 * (1.0 + cos_half))
     axis = sg.normalize(to_light)
     sharpness, amplitude = _cap_sharpness_and_integral(sin2, energy, model, 1.0 / effective2)

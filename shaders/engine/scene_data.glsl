@@ -16,7 +16,8 @@ struct SceneData {
   vec4 prefilter_scale_offset[SGPRT_MAX_LAYERS];
   /* xyz position, w radius */
   vec4 point_position_radius[SGPRT_MAX_POINT_LIGHTS];
-  /* rgb radiant intensity (W/sr) */
+  /* rgb radiant intensity (W/sr); a: 1 for Blender's Soft Falloff (the light a disk facing the point: lights.glsl
+   * light_cap), 0 a sphere */
   vec4 point_intensity[SGPRT_MAX_POINT_LIGHTS];
   /* xyz spot axis, w spot size (full cone angle; negative: a point light) */
   vec4 spot_direction_size[SGPRT_MAX_POINT_LIGHTS];

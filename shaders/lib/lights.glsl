@@ -2,6 +2,8 @@
  * GLSL mirror of sg_prt_addon/lighting/lights.py.  Depends on sg.glsl.
  *
  *   blender_point_light_intensity <- lights.blender_point_light_intensity
+ *   light_cap                     <- lights.light_cap_extent (sphere, or Soft Falloff's disk)
+ *   soft_light_sg                 <- lights.sphere_light_sg(model="energy", soft_falloff)
  *   sphere_light_sg               <- lights.sphere_light_sg(model="energy")
  *   sphere_light_sg_paper         <- lights.sphere_light_sg(model="paper")
  *   point_light_sg                <- lights.point_light_sg (energy model)
@@ -40,17 +42,38 @@ float light_cap_radius(float sharpness)
   return precise_asin(sqrt(clamp(LIGHT_LN10 / max(sharpness, 1.0e-30), 0.0, 1.0)));
 }
 
-/* Geometry shared by both sphere-light models: returns sin^2 of the cap and
- * writes effective2 = max(d^2, r^2, 1e-12 max(r^2, 1)) and the axis. */
-float sphere_light_cap(vec3 shading_position, vec3 light_position, float radius,
-                       out float effective2, out vec3 axis)
+/* The cap a point-like light of radius r covers: returns sin^2 of it and writes effective2 (lights.light_cap_extent:
+ * max(d^2, r^2) for a sphere, d^2 + r^2 for Soft Falloff's disk facing the point; floored at 1e-12 max(r^2, 1))
+ * and the axis. */
+float light_cap(vec3 shading_position, vec3 light_position, float radius, bool soft_falloff,
+                out float effective2, out vec3 axis)
 {
   vec3 to_light = light_position - shading_position;
   float distance2 = dot(to_light, to_light);
   float radius2 = radius * radius;
-  effective2 = max(max(distance2, radius2), 1.0e-12 * max(radius2, 1.0));
+  effective2 = max(soft_falloff ? distance2 + radius2 : max(distance2, radius2), 1.0e-12 * max(radius2, 1.0));
   axis = safe_normalize(to_light);
   return radius2 / effective2;
+}
+
+/* Geometry shared by both sphere-light models: light_cap of a sphere. */
+float sphere_light_cap(vec3 shading_position, vec3 light_position, float radius,
+                       out float effective2, out vec3 axis)
+{
+  return light_cap(shading_position, light_position, radius, false, effective2, axis);
+}
+
+/* A light of radius r and intensity I [W/sr] (use blender_point_light_intensity), energy model: sphere integral =
+ * cap radiance integral 2 I / (effective2 (1 + cos)); a sphere, or with soft_falloff Blender's disk. */
+void soft_light_sg(vec3 shading_position, vec3 light_position, float radius, bool soft_falloff, float intensity,
+                   out vec3 axis, out float sharpness, out float amplitude)
+{
+  float effective2;
+  float sin2 = light_cap(shading_position, light_position, radius, soft_falloff, effective2, axis);
+  float cos_half = sqrt(max(1.0 - sin2, 0.0));
+  float energy = 2.0 / (effective2 * (1.0 + cos_half));
+  light_cap_energy_lobe(sin2, energy, sharpness, amplitude);
+  amplitude = clamp(amplitude * intensity, -LIGHT_MAX_AMPLITUDE, LIGHT_MAX_AMPLITUDE);
 }
 
 /* Sphere light of radius r and intensity I [W/sr] (use blender_point_light_intensity),
@@ -58,12 +81,7 @@ float sphere_light_cap(vec3 shading_position, vec3 light_position, float radius,
 void sphere_light_sg(vec3 shading_position, vec3 light_position, float radius, float intensity,
                      out vec3 axis, out float sharpness, out float amplitude)
 {
-  float effective2;
-  float sin2 = sphere_light_cap(shading_position, light_position, radius, effective2, axis);
-  float cos_half = sqrt(max(1.0 - sin2, 0.0));
-  float energy = 2.0 / (effective2 * (1.0 + cos_half));
-  light_cap_energy_lobe(sin2, energy, sharpness, amplitude);
-  amplitude = clamp(amplitude * intensity, -LIGHT_MAX_AMPLITUDE, LIGHT_MAX_AMPLITUDE);
+  soft_light_sg(shading_position, light_position, radius, false, intensity, axis, sharpness, amplitude);
 }
 
 /* eq. 32 as printed: sharpness ln(10) d^2 / r^2, amplitude I / d^2 (comparison only). */

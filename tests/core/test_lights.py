@@ -37,6 +37,22 @@ def test_energy_model_carries_the_cap_radiance_integral(distance, radius, intens
     np.testing.assert_allclose(axis, [0, 0, 1], atol=1e-12)
 
 
+@settings(max_examples=25, deadline=None)
+@given(distance=st.floats(0.01, 100.0), radius=st.floats(1e-3, 5.0), intensity=st.floats(1e-3, 1e3))
+def test_soft_falloff_is_a_disk_facing_the_point(distance, radius, intensity):
+    """Blender's Soft Falloff (Cycles: a disk of the radius at the light, facing the shading point, radiance
+    I / (pi r^2)): a cone of tan a = r / d, its radiance integral I / (pi r^2) 2 pi (1 - cos a), whatever d
+    against r (no inside: the disk is never entered)."""
+    _, sharpness, amplitude = lights.sphere_light_sg(np.zeros(3), [0.0, 0.0, distance], radius, intensity,
+                                                     soft_falloff=True)
+    half_angle = np.arctan2(radius, distance)
+    one_minus_cos = np.sin(half_angle) ** 2 / (1 + np.cos(half_angle))        # 1 - cos a without cancellation
+    expected = intensity / (np.pi * radius ** 2) * 2 * np.pi * one_minus_cos
+    assert float(sg.sphere_integral(sharpness, amplitude)) == pytest.approx(expected, rel=1e-9)
+    expected_sharpness = min(np.log(10) / np.sin(half_angle) ** 2, lights.MAX_SHARPNESS)
+    assert float(sharpness) == pytest.approx(expected_sharpness, rel=1e-9)
+
+
 def test_radius_zero_is_an_inverse_square_point_light():
     for distance in (0.5, 2.0, 10.0):
         _, sharpness, amplitude = lights.point_light_sg(np.zeros(3), [distance, 0, 0], intensity=5.0)

@@ -56,6 +56,9 @@ def test_sphere_light(glsl, fuzz, record_error):
            lights.sphere_light_sg(position, light, radius, intensity, model="paper"))
     got = _run(glsl, "point_light_sg(x.xyz, l.xyz, m.x, l.w, axis, sharpness, amplitude)", inputs)
     _check(record_error, "point_light_sg", got, lights.point_light_sg(position, light, intensity, radius))
+    got = _run(glsl, "soft_light_sg(x.xyz, l.xyz, l.w, true, m.x, axis, sharpness, amplitude)", inputs)
+    _check(record_error, "soft_light_sg (Soft Falloff)", got,         # measured 6.0e-6: d^2 + r^2 rounded in float32
+           lights.sphere_light_sg(position, light, radius, intensity, soft_falloff=True), bound=1e-5)
 
 
 def test_spot_light(glsl, fuzz, record_error):

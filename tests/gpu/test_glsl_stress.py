@@ -149,6 +149,7 @@ def test_lights_stress(glsl, fuzz):
     calls = {
         "sphere_light_sg": "sphere_light_sg(x.xyz, l.xyz, l.w, s.w, axis, sharpness, amplitude)",
         "sphere_light_sg_paper": "sphere_light_sg_paper(x.xyz, l.xyz, l.w, s.w, axis, sharpness, amplitude)",
+        "soft_light_sg": "soft_light_sg(x.xyz, l.xyz, l.w, x.w > 1.0, s.w, axis, sharpness, amplitude)",
         "spot_light_sg": "spot_light_sg(x.xyz, l.xyz, s.xyz, x.w, fract(x.w), s.w, l.w, axis, sharpness, amplitude)",
         "directional_light_sg": "directional_light_sg(s.xyz, x.w, s.w, axis, sharpness, amplitude)",
     }
@@ -453,6 +454,9 @@ def test_lights_helpers_stress(glsl):
     body = """
     float effective2; vec3 cap_axis;
     float cap = sphere_light_cap(x.xyz, l.xyz, l.w, effective2, cap_axis);
+    float soft_effective2; vec3 soft_axis;
+    cap += light_cap(x.xyz, l.xyz, l.w, true, soft_effective2, soft_axis);
+    effective2 += soft_effective2;
     float cap_sharpness, cap_amplitude;
     light_cap_energy_lobe(x.w, blender_point_light_intensity(i.x * 12.566370614359172), cap_sharpness, cap_amplitude);
     vec3 axis; float sharpness, amplitude;
@@ -1131,7 +1135,8 @@ COVERED = {
                        "cook_torrance_beckmann_ndf_lobe", "blinn_phong_ndf_lobe", "ward_isotropic_ndf_lobe",
                        "ggx_ndf_lobe", "ggx_anisotropic_ndf", "ggx_anisotropic_smith_lambda",
                        "ggx_anisotropic_m_factor"],
-    test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "spot_light_sg", "directional_light_sg"],
+    test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "soft_light_sg", "spot_light_sg",
+                         "directional_light_sg"],
     test_light_emission_stress: ["light_emission_factor"],
     test_shadow_maps_stress: ["shadow_point_visibility", "shadow_sun_visibility", "shadow_tile_visibility",
                               "shadow_fetch", "shadow_linear", "shadow_window", "shadow_penumbra"],
@@ -1150,7 +1155,7 @@ COVERED = {
                                "isotropic_mapping_blinn_phong", "isotropic_mapping_ward_iso", "isotropic_mapping_ggx",
                                "beckmann_ndf", "ward_isotropic_m_factor", "ggx_alpha", "ggx_smith_lambda"],
     test_warp_helpers_stress: ["warp_at", "warp_split_frame", "warp_split_node"],
-    test_lights_helpers_stress: ["blender_point_light_intensity", "light_cap_energy_lobe", "sphere_light_cap",
+    test_lights_helpers_stress: ["blender_point_light_intensity", "light_cap_energy_lobe", "sphere_light_cap", "light_cap",
                                  "point_light_sg", "light_cap_radius"],
     test_env_prefilter_helpers_stress: ["env_sign_not_zero", "oct_encode", "env_prefilter_blend_parameter"],
     test_ssdf_stress: ["hemisphere_map_disc_to_square", "hemisphere_map_to_square", "ssdf_horizon_lookup", "ssdf_local_frame",

@@ -25,6 +25,7 @@ class LightExport:
     edge_u: tuple = (0.0, 0.0, 0.0)  # AREA: world vectors spanning the light (size along local x and y)
     edge_v: tuple = (0.0, 0.0, 0.0)
     spread: float = np.pi          # AREA: full spread angle
+    soft_falloff: bool = False     # POINT: Blender's Soft Falloff (a disk facing the point: lights.light_cap_extent)
 
 
 # --------------------------------------------------------------------------- lights
@@ -90,7 +91,8 @@ def export_light(object_eval, matrix_world=None):
         unnormalized = 4 * np.pi * radius * radius if radius > 0 else 4.0
         intensity = _clamped_intensity(power * float(core_lights.blender_point_light_intensity(1.0))
                                        * (1.0 if normalized else unnormalized), object_eval.name)
-        export = LightExport(object_eval.name, "POINT", position, direction, tuple(intensity), radius=radius)
+        export = LightExport(object_eval.name, "POINT", position, direction, tuple(intensity), radius=radius,
+                             soft_falloff=bool(getattr(light, "use_soft_falloff", False)))
         if light.type == "SPOT":
             export.is_spot = True
             export.spot_size = finite_setting(light.spot_size, np.pi, what + " spot size")

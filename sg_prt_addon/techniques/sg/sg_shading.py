@@ -379,7 +379,8 @@ def point_light_sgs(position, light_data):
     (lights.sphere_light_sg / spot_light_sg with unit intensity, times the colour intensity)."""
     position = np.asarray(position, FLOAT)[:, None, :]
     axis, sharpness, amplitude = lights.sphere_light_sg(
-        position, light_data.point_position[None], light_data.point_radius[None], FLOAT(1))
+        position, light_data.point_position[None], light_data.point_radius[None], FLOAT(1),
+        soft_falloff=light_data.soft_falloff[None])
     amplitude = (amplitude * point_light_emission(axis, light_data))[..., None] * light_data.point_intensity[None]
     return axis.astype(FLOAT), sharpness.astype(FLOAT), amplitude.astype(FLOAT)
 
@@ -414,7 +415,7 @@ def shares_light_visibility(light_data, bounds):
     distance2 = np.sum((position - nearest) ** 2, axis=-1)
     radius2 = np.asarray(light_data.point_radius, np.float64) ** 2
     # lights.sphere_light_sg's cap, and the suns' cap sharpness ln(10) / sin^2
-    sin2 = radius2 / np.maximum(np.maximum(distance2, radius2), 1e-12 * np.maximum(radius2, 1.0))
+    sin2 = radius2 / lights.light_cap_extent(distance2, radius2, light_data.soft_falloff)
     suns_narrow = np.asarray(light_data.sun_sharpness, np.float64) >= np.log(10.0) / limit
     return bool(np.all(sin2 <= limit) and np.all(suns_narrow))
 

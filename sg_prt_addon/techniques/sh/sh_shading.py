@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from ...harmonics import basis, brdf_table, fitted_table, projection, rotation
+from ...lighting import lights
 from ...measured.svbrdf_table import interpolate_shadowing
 from ...reflectance.brdf import COSINE_EPSILON
 from ...spherical import sg, texture_fetch
@@ -56,7 +57,7 @@ def _cap_flux_and_factors(position, light_data, order):
     to_light = light_data.point_position[None] - position[:, None]
     distance2 = np.sum(to_light * to_light, axis=-1)
     radius2 = light_data.point_radius[None] ** 2
-    effective2 = np.maximum(np.maximum(distance2, radius2), FLOAT(1e-12) * np.maximum(radius2, FLOAT(1)))
+    effective2 = lights.light_cap_extent(distance2, radius2, light_data.soft_falloff[None]).astype(FLOAT)
     axis = sg.normalize(to_light)
     sin2 = radius2 / effective2
     cos_half = np.sqrt(np.maximum(1 - sin2, 0)).astype(FLOAT)

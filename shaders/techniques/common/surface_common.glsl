@@ -52,8 +52,8 @@ void scene_light_sg(int l, vec3 position, out vec3 axis, out float sharpness, ou
 {
   if (l < scene.counts.x) {
     float scalar_amplitude;
-    sphere_light_sg(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w, 1.0,
-                    axis, sharpness, scalar_amplitude);
+    soft_light_sg(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w,
+                  scene.point_intensity[l].a > 0.5, 1.0, axis, sharpness, scalar_amplitude);
     amplitude = scalar_amplitude * scene_light_emission(l, axis) * scene.point_intensity[l].rgb;
   }
   else {

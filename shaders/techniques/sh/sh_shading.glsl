@@ -200,11 +200,11 @@ void shade_sh(vec3 position, vec3 normal, vec3 tangent, vec3 diffuse_color, vec3
     float sin2;                                  /* of the light's angular radius */
     if (l < scene.counts.x) {
       float effective2;
-      sin2 = sphere_light_cap(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w,
-                              effective2, axis);
+      sin2 = light_cap(position, scene.point_position_radius[l].xyz, scene.point_position_radius[l].w,
+                       scene.point_intensity[l].a > 0.5, effective2, axis);
       float cos_half = sqrt(max(1.0 - sin2, 0.0));
       sh_cap_factors(sin2 / (1.0 + cos_half), g);
-      /* radiance I / (pi r^2) over the cap's solid angle 2 pi (1 - cos): 2 I / (d^2 (1 + cos)) */
+      /* radiance I / (pi r^2) over the cap's solid angle 2 pi (1 - cos): 2 I / (effective2 (1 + cos)) */
       flux = scene.point_intensity[l].rgb * (2.0 / (effective2 * (1.0 + cos_half))) * scene_light_emission(l, axis);
     }
     else {
