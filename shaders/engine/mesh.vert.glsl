@@ -11,7 +11,11 @@ void main()
   mat3 linear = mat3(model_matrix);
   mat3 normal_matrix = transpose(inverse(linear));
   world_position = world.xyz;
-  world_normal = normal_matrix * normal;
+  /* unit at the vertices: the normal matrix scales normals by the inverse of the object's scale, and what reads
+   * the interpolated normal's length (the view's cosine of the glossy layer) must not see that */
+  vec3 scaled_normal = normal_matrix * normal;
+  float normal_length2 = dot(scaled_normal, scaled_normal);
+  world_normal = normal_length2 > 0.0 ? scaled_normal * inversesqrt(normal_length2) : scaled_normal;
   /* a mirroring transform flips n x t: keep the bitangent on the UV side */
   float handedness = determinant(linear) < 0.0 ? -1.0 : 1.0;
   world_tangent = vec4(linear * tangent.xyz, tangent.w * handedness);
