@@ -70,6 +70,12 @@ def gold():
     return _principled("gold", Base_Color=GOLD, Metallic=1.0, Roughness=0.3)[0]
 
 
+def black_metal():
+    """Metallic 1 of a black base colour: Cycles' metallic Fresnel (F82 tint, white by default: Schlick's) still
+    reflects at grazing views."""
+    return _principled("black_metal", Base_Color=(0.0, 0.0, 0.0, 1.0), Metallic=1.0, Roughness=0.3)[0]
+
+
 def textured():
     """A checker Base Color, a striped roughness map (Non-Color) and a bumpy normal map."""
     import numpy as np
@@ -179,7 +185,7 @@ def glossy_anisotropic(anisotropy):
 
 
 SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),
-          "principled_gold_r030": gold, "principled_textured": textured, "principled_pbr_metallic_map": pbr_metallic_map,
+          "principled_gold_r030": gold, "principled_black_metal": black_metal, "principled_textured": textured, "principled_pbr_metallic_map": pbr_metallic_map,
           "principled_tiled": tiled, "mix_diffuse_glossy": mix_diffuse_glossy,
           "principled_anisotropic": anisotropic, "glossy_anisotropic": glossy_anisotropic(0.6),
           "glossy_anisotropic_negative": glossy_anisotropic(-0.6)}

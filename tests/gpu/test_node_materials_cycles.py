@@ -17,6 +17,8 @@ def node_materials(blender):
     ("principled_r050", 0.14, 0.03),          # 0.091 / -0.003 / 0.081
     ("principled_r080", 0.13, 0.03),          # 0.081 / -0.002 / 0.076
     ("principled_gold_r030", 0.27, 0.04),     # 0.214 / +0.007 / 0.136
+    ("principled_black_metal", 1.2, 0.2),     # 0.871 / +0.057 / 0.451: the grazing rim alone, dim and noisy at
+                                              # 32 spp (before the rim: 4.45 / -1.000, nothing drawn)
     ("principled_textured", 0.30, 0.15),      # 0.214 / +0.084 / 0.106; Blender 4.2's Cycles: 0.259 / +0.125 (the
                                               # normal map: light below the mesh's horizon reaches bumps facing
                                               # it; Cycles cuts it)

@@ -37,7 +37,7 @@ class SGBiScale(SGLobes):
                              f"({', '.join(biscale_shading.SMALL_SCALE_MODELS)}), not {params.model}")
         if fitted is None:
             model, components = params.model, 0
-            has_diffuse, has_specular = material_terms(params)
+            has_diffuse, has_specular = material_terms(params, glossy_layer=False)
         else:           # the fit's colours are in its layers (sg_fitted's key: both terms)
             model, components = sg_fitted.MODEL, int(fitted.components)
             has_diffuse, has_specular = True, True

@@ -13,15 +13,18 @@ NAME = "SG_PARAMETRIC"
 SPECULAR_ONLY_TEXTURES = ("specular_color", "roughness", "ior", "exponent", "alpha_x", "alpha_y", "nu", "nv")
 
 
-def material_terms(material_params):
+def material_terms(material_params, glossy_layer=True):
     """(has_diffuse, has_specular) of an export.MaterialParams: False when that colour is zero and no
     texture scales it, so the term (colour x irradiance / pi, colour x radiance) is exactly zero and the
-    variant leaves its code out."""
+    variant leaves its code out.  With the glossy layer's Schlick Fresnel (glossy_layer: the technique applies
+    it) a zero specular colour is the F0 of a rim that still reflects at grazing views (Cycles' metals of a black
+    base colour), so the specular term stays."""
     def present(colour, slot):      # NaN counts as present: the full variant shows it
         return slot in material_params.textures or any(not float(c) == 0.0 for c in tuple(colour)[:3])
 
+    fresnel = glossy_layer and getattr(material_params, "fresnel", "NONE") == "SCHLICK"
     return (present(material_params.diffuse_color, "diffuse_color"),
-            present(material_params.specular_color, "specular_color"))
+            present(material_params.specular_color, "specular_color") or fresnel)
 
 
 def uses_ggx_table(key):
