@@ -18,8 +18,9 @@ A side is a module of the technique's package (``techniques/<package>/blender``)
 - ``settings_given(material)``: the material holds data of the side's (stored factors): its SG-PRT settings were
   given (properties.settings_given);
 - ``lobe_fit_use(material, name)``: a line for the Lobe Fit panel saying how the technique uses the material's
-  stored lobe fit ("" to say nothing), or None when it renders the model instead; ``take_lobe_fit(material, name)``: after a fit is stored, make the technique read it (False:
-  it cannot, the technique that renders fits is picked).
+  stored lobe fit ("" to say nothing), or None when it renders the model instead;
+- ``take_lobe_fit(material, name)``: after a fit is stored, make the technique read it (False: it cannot, and
+  the technique that renders fits is picked).
 """
 import importlib
 import sys
