@@ -443,6 +443,8 @@ def _closure_values(reader, closure):
             reader.note(node, "Oren-Nayar roughness: rendered as Lambert")
         values["diffuse_color"] = reader.value(node.inputs["Color"], True)
     elif kind == "glossy":
+        if node.distribution == "BECKMANN":
+            reader.note(node, "Beckmann distribution: rendered as Ward, about 20-30% darker than Cycles")
         anisotropy = _constant_input(reader, node, "Anisotropy")
         plain_ggx = node.distribution in ("GGX", "MULTI_GGX") and anisotropy == 0.0
         values.update(principled.glossy(reader.value(node.inputs["Color"], True),
