@@ -134,8 +134,7 @@ def test_registry_refuses_clashes(registered):
 
 # Tokens of text, not code: strings, comments, and the literal parts of f-strings (tokens of their own from
 # Python 3.12)
-TEXT_TOKENS = {tokenize.STRING, tokenize.COMMENT} | {getattr(tokenize, name) for name in ("FSTRING_MIDDLE",)
-                                                     if hasattr(tokenize, name)}
+TEXT_TOKENS = {tokenize.STRING, tokenize.COMMENT, getattr(tokenize, "FSTRING_MIDDLE", tokenize.STRING)}
 
 
 def _code_of(path):
