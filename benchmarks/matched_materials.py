@@ -281,8 +281,8 @@ def configure_eevee(scene, samples):
     Ray tracing (screen-space reflections and global illumination) and fast GI (horizon scan,
     which also darkens like AO) are off, so surfaces see the world probe and the lights only,
     with EEVEE's shadow maps (the world's sun extraction stays at Blender's default: the HDRI's
-    brightest part casts shadows, the rest of the world is unshadowed).  No clamping; the pixel
-    filter is 1 px wide (Blackman-Harris; Cycles and the reference use a 1-pixel box)."""
+    brightest part casts shadows, the rest of the world is unshadowed).  No clamping; the film's
+    Filter Size as the scene has it (Blender's default 1.5 px, which Cycles and SG-PRT read too)."""
     scene.render.engine = eevee_engine_id()
     eevee = scene.eevee
     eevee.taa_render_samples = int(samples)
@@ -292,8 +292,7 @@ def configure_eevee(scene, samples):
         if hasattr(eevee, name):
             setattr(eevee, name, value)
             made[name] = value
-    scene.render.filter_size = 1.0
-    made["filter_size"] = 1.0
+    made["filter_size"] = float(scene.render.filter_size)
     if scene.world is not None:
         for name in ("sun_threshold", "use_sun_shadow"):
             if hasattr(scene.world, name):
@@ -302,8 +301,8 @@ def configure_eevee(scene, samples):
 
 
 def configure_cycles(scene, samples, seed=3):
-    """Cycles on the CPU with direct light only (max_bounces 0), a 1-pixel box filter, no
-    adaptive sampling or denoising (as benchmarks.reference_speed.compare_with_cycles)."""
+    """Cycles on the CPU with direct light only (max_bounces 0), no adaptive sampling or denoising, the
+    pixel filter as the scene has it (Blender's default: Blackman-Harris 1.5 px, which SG-PRT reads too)."""
     scene.render.engine = "CYCLES"
     cycles = scene.cycles
     cycles.device = "CPU"
@@ -312,6 +311,6 @@ def configure_cycles(scene, samples, seed=3):
     cycles.use_adaptive_sampling = False
     cycles.use_denoising = False
     cycles.max_bounces = 0
-    cycles.pixel_filter_type, cycles.filter_width = "BOX", 1.0
-    return {"device": "CPU", "samples": int(samples), "max_bounces": 0, "pixel_filter_type": "BOX",
-            "filter_width": 1.0, "use_adaptive_sampling": False, "use_denoising": False}
+    return {"device": "CPU", "samples": int(samples), "max_bounces": 0,
+            "pixel_filter_type": cycles.pixel_filter_type, "filter_width": float(cycles.filter_width),
+            "use_adaptive_sampling": False, "use_denoising": False}

@@ -47,6 +47,8 @@ def render(scene, anti_aliasing, samples=1, redraws=0):
     scene.sgprt.specular_anti_aliasing = anti_aliasing
     scene.sgprt.render_samples = samples
     scene.sgprt.sample_edges_only = False       # the reference: every pixel's jittered frames
+    # the 1-pixel box: the footprint's square is the pixel, the jittered frames its exact box filter
+    scene.sgprt.pixel_filter_type, scene.render.filter_size = "BOX", 1.0
     render_engine.debug["timed_redraws"] = redraws
     render_engine.last_render.clear()
     try:

@@ -97,6 +97,18 @@ class SGPRT_PT_sampling(RenderPanel, bpy.types.Panel):
         layout.prop(settings, "area_light_patches")
 
 
+class SGPRT_PT_film(RenderPanel, bpy.types.Panel):
+    bl_label = "Film"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        column = layout.column()
+        column.prop(context.scene.sgprt, "pixel_filter_type")
+        column.prop(context.scene.render, "filter_size")
+        layout.prop(context.scene.render, "film_transparent")
+
+
 class SGPRT_PT_shadows(RenderPanel, bpy.types.Panel):
     bl_label = "Light Shadows"
 
@@ -110,7 +122,7 @@ class SGPRT_PT_shadows(RenderPanel, bpy.types.Panel):
         row.prop(settings, "shadow_map_size")
 
 
-classes = (SGPRT_PT_material, SGPRT_PT_material_geometry, SGPRT_PT_sampling, SGPRT_PT_shadows)
+classes = (SGPRT_PT_material, SGPRT_PT_material_geometry, SGPRT_PT_sampling, SGPRT_PT_film, SGPRT_PT_shadows)
 
 # Built-in panels that work unchanged with this engine.
 COMPATIBLE_BUILTIN_PANELS = (

@@ -211,9 +211,18 @@ class SGPRT_PG_scene(bpy.types.PropertyGroup):
     """Render settings of the SG-PRT engine: `scene.sgprt`."""
     render_samples: IntProperty(name="Render Samples", default=DEFAULT_RENDER_SAMPLES, min=1, max=64,
                                 soft_max=16,
-                                description="Samples a pixel of final renders, averaged: anti-aliasing with a "
-                                            "1-pixel box filter, as Cycles' Box filter (16 = a 4x4 grid). "
-                                            "The viewport draws one")
+                                description="Samples a pixel of final renders, reconstructed with the Pixel "
+                                            "Filter (16 = a 4x4 grid). The viewport draws one")
+    pixel_filter_type: EnumProperty(
+        name="Pixel Filter", default="BLACKMAN_HARRIS",
+        items=[("BOX", "Box", "Every sample within half the Filter Size of the pixel's centre weighs the same", 0),
+               ("GAUSSIAN", "Gaussian", "Samples weighted by a Gaussian of standard deviation a quarter of the "
+                                        "Filter Size", 1),
+               ("BLACKMAN_HARRIS", "Blackman-Harris", "Samples weighted by a Blackman-Harris window reaching "
+                                                      "the Filter Size from the pixel's centre (Cycles' default)",
+                2)],
+        description="The filter final renders reconstruct pixels with, as Cycles' of the same name, over the "
+                    "Film's Filter Size (engine/pixel_filter.py)")
     sample_edges_only: BoolProperty(name="Edges Only", default=True,
                                     description="Take the Render Samples only at the pixels where a first frame, "
                                                 "shaded at the pixels' centres, differs from a neighbour by more "

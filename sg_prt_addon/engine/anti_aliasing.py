@@ -1,6 +1,6 @@
-"""Sub-pixel offsets of the frames a final render averages (Render Samples), and the projection moved by
-one: anti-aliasing with a 1-pixel box filter; and the footprint each frame's shading averages its
-specular over (Specular Anti-Aliasing).  Pixels: x to the right, y DOWN, as validation/camera.py.
+"""Sub-pixel offsets of the frames a final render averages (Render Samples): strata of the pixel, which the
+pixel filter (engine/pixel_filter.py) spreads by its own distribution; the projection moved by one; and the
+footprint each frame's shading averages its specular over (Specular Anti-Aliasing).  Pixels: x to the right, y DOWN, as validation/camera.py.
 
 Edges Only (engine/multi_sample.py draws it): which pixels of a frame shaded at the pixels' centres are
 edges (edge_pixels, the mirror of engine/edge_pixels.frag.glsl), the grid of samples an edge pixel takes,
@@ -37,12 +37,16 @@ def jittered_projection(projection, offset, width, height):
     return shift @ np.asarray(projection, np.float64).reshape(4, 4)
 
 
-def specular_footprint(samples, enabled=True):
+def specular_footprint(samples, enabled=True, filter_side=1.0):
     """The side, in pixels, of the square each pixel of one frame shades its specular over (the scene
-    block's shading_footprint, sg_shading.glsl shade_footprint): the whole pixel for one frame, a cell
-    of the 1 / sqrt(samples) grid for each of ``samples`` jittered frames, 0 (the centre alone) when
+    block's shading_footprint, sg_shading.glsl shade_footprint): for one frame, the square of the pixel
+    filter's variance (``filter_side``: pixel_filter.PixelFilter.footprint_side, 1 for a 1-pixel box); a cell
+    of the 1 / sqrt(samples) grid for each of ``samples`` jittered frames; 0 (the centre alone) when
     Specular Anti-Aliasing is off."""
-    return 1.0 / float(np.sqrt(max(int(samples), 1))) if enabled else 0.0
+    if not enabled:
+        return 0.0
+    samples = max(int(samples), 1)
+    return float(filter_side) if samples == 1 else 1.0 / float(np.sqrt(samples))
 
 
 # Render Samples' Edges Only: a pixel pair differs when a channel differs by more than the threshold times the

@@ -1,10 +1,12 @@
 """Render Samples on the GPU: the frames' passes summed in float targets and read back once.
 
-Every pixel sampled: jittered frames (anti_aliasing.pixel_jitter), each added whole.  Edges Only: a frame
-shaded at the pixels' centres, the mask of its edges (engine/edge_pixels.frag.glsl; mirror
-anti_aliasing.edge_pixels), and each tile of the image that holds an edge drawn grid_side times larger with only
-the edge pixels shaded (the others fail a near-plane depth) and box-filtered into the sums: one pass of the
-objects' vertices a tile instead of one a sample.  Runs where the `gpu` module works.
+Every pixel sampled: jittered frames (their offsets drawn from the pixel filter: engine/pixel_filter.py), each
+added whole.  Edges Only: a frame shaded at the pixels' centres, the mask of its edges
+(engine/edge_pixels.frag.glsl; mirror anti_aliasing.edge_pixels), and each tile of the image that holds an edge
+drawn grid_side times larger, with an apron of the pixels the filter reaches around it, shading only the edge
+pixels and their neighbours within that reach (the others fail a near-plane depth), then each edge pixel the
+filter-weighted sum of the samples around it (engine/add_edge_tile.frag.glsl): one pass of the objects' vertices
+a tile instead of one a sample.  Runs where the `gpu` module works.
 """
 import numpy as np
 
@@ -15,10 +17,10 @@ PASSES = shader_sources.output_names(False)     # ("combined", "diffuse", "specu
 MAX_TILE_PIXELS = 2048      # side of a supersampled tile's targets (3 RGBA32F + depth: 208 MB at 2048)
 
 
-def tile_side(grid_side, width, height, max_side=MAX_TILE_PIXELS):
-    """Image pixels a side of Edges Only's tiles: their supersampled targets at most MAX_TILE_PIXELS and
-    max_side (the GPU's) a side, and no larger than the image needs."""
-    return max(1, min(min(MAX_TILE_PIXELS, max_side) // grid_side, max(width, height)))
+def tile_side(grid_side, width, height, max_side=MAX_TILE_PIXELS, reach=0):
+    """Image pixels a side of Edges Only's tiles: their supersampled targets, the apron of ``reach`` pixels each
+    side included, at most MAX_TILE_PIXELS and max_side (the GPU's) a side, and no larger than the image needs."""
+    return max(1, min(min(MAX_TILE_PIXELS, max_side) // grid_side - 2 * reach, max(width, height)))
 
 
 def _frame_samplers():
@@ -43,25 +45,37 @@ def pixel_mask_calls():
     """Near-plane depth over a supersampled tile's pixels that the mask leaves out (engine/pixel_mask.frag.glsl)."""
     calls = shader_sources.full_screen_calls("sgprt_pixel_mask_interface", {"FULL_SCREEN_DEPTH": "-1.0"})
     calls += [("push_constant", ("IVEC2", "mask_origin")), ("push_constant", ("INT", "mask_scale")),
+              ("push_constant", ("INT", "mask_reach")),
               ("sampler", (0, "FLOAT_2D", "pixel_mask")), ("fragment_out", (0, "VEC4", "out_unused")),
               ("fragment_source", (shader_sources.engine_source("pixel_mask.frag.glsl"),))]
     return calls
 
 
 def add_frame_calls():
-    """A frame's passes, box-filtered and weighted, into the sums (engine/add_frame.frag.glsl)."""
+    """A jittered frame's passes, weighted by the pixel filter, into the sums (engine/add_frame.frag.glsl)."""
     calls = shader_sources.full_screen_calls("sgprt_add_frame_interface", {})
-    calls += [("push_constant", ("IVEC2", "tile_origin")), ("push_constant", ("INT", "grid_side")),
-              ("push_constant", ("FLOAT", "frame_weight"))]
-    calls += _frame_samplers() + _pass_outputs()
+    calls += _frame_samplers() + [("sampler", (len(PASSES), "FLOAT_2D", "frame_weights"))] + _pass_outputs()
     calls.append(("fragment_source", (shader_sources.engine_source("add_frame.frag.glsl"),)))
+    return calls
+
+
+def add_edge_tile_calls():
+    """An edge tile's samples, weighted by the pixel filter, into the sums at the mask's pixels
+    (engine/add_edge_tile.frag.glsl)."""
+    calls = shader_sources.full_screen_calls("sgprt_add_edge_tile_interface", {})
+    calls += [("push_constant", ("IVEC2", "tile_origin")), ("push_constant", ("INT", "grid_side"))]
+    calls += _frame_samplers()
+    calls += [("sampler", (len(PASSES), "FLOAT_2D", "pixel_mask")),
+              ("sampler", (len(PASSES) + 1, "FLOAT_2D", "filter_weights"))]
+    calls += _pass_outputs()
+    calls.append(("fragment_source", (shader_sources.engine_source("add_edge_tile.frag.glsl"),)))
     return calls
 
 
 class FrameSums:
     """The sums of a final render's frames (one RGBA32F target a pass), the mask of Edges Only's pixels and
-    its supersampled tile.  start() then add() after each jittered frame; or start_at_edges() then
-    draw_edge_tile() for each tile of anti_aliasing.edge_tiles; then read()."""
+    its supersampled tile.  start() then add() after each jittered frame; or start_at_edges() and
+    set_filter_weights() then draw_edge_tile() for each tile of anti_aliasing.edge_tiles; then read()."""
 
     def __init__(self):
         self.size = None
@@ -74,6 +88,8 @@ class FrameSums:
         self.tile_targets = []          # the supersampled tile's GPUTextures, in PASSES' order
         self.tile_depth = None
         self.tile_framebuffer = None
+        self.filter_weights = None      # GPUTexture R32F (n, 1): the pixel filter's weights along an axis
+        self.filter_weights_values = None
 
     def _ensure(self, width, height):
         import gpu
@@ -123,17 +139,26 @@ class FrameSums:
             renderer.full_screen_batch(shader, "edge_pixels").draw(shader)
         self.masked = True
 
-    def add(self, renderer, weight):
-        """Add the renderer's whole frame, times weight, into the sums."""
-        self._add(renderer, renderer.targets, (0, 0), 1, weight, None)
-
-    def draw_edge_tile(self, renderer, state, tile_camera, origin, tile, grid_side, background_alpha):
-        """The tile x tile image pixels from `origin` (x right, y up) drawn grid_side times larger by
-        tile_camera (anti_aliasing.tile_projection), shading only the pixels of the edge mask, each image pixel's
-        grid_side x grid_side samples then averaged into the sums (which hold 0 there: start_at_edges)."""
+    def set_filter_weights(self, weights):
+        """The pixel filter's weights along an axis for draw_edge_tile (pixel_filter.grid_weights)."""
         import gpu
 
-        self._ensure_tile(tile * grid_side)
+        values = [float(value) for value in weights]
+        if self.filter_weights_values == values:
+            return
+        self.filter_weights = gpu.types.GPUTexture((len(values), 1), format="R32F",
+                                                   data=gpu.types.Buffer("FLOAT", len(values), values))
+        self.filter_weights_values = values
+
+    def draw_edge_tile(self, renderer, state, tile_camera, origin, tile, grid_side, reach, background_alpha):
+        """The tile x tile image pixels from `origin` (x right, y up) and an apron of `reach` pixels around them
+        drawn grid_side times larger by tile_camera (anti_aliasing.tile_projection of the tile and its apron),
+        shading only the pixels of the edge mask and those within `reach` of one; then each edge pixel of the
+        tile the sum of its and its neighbours' samples weighted by set_filter_weights' weights, into the sums
+        (which hold 0 there: start_at_edges)."""
+        import gpu
+
+        self._ensure_tile((tile + 2 * reach) * grid_side)
         shader = shader_cache.get_fixed_shader(("pixel_mask",), pixel_mask_calls, "pixel mask")
 
         def mask_pixels():
@@ -142,8 +167,9 @@ class FrameSums:
             gpu.state.depth_mask_set(True)
             gpu.state.color_mask_set(False, False, False, False)
             shader.bind()
-            shader.uniform_int("mask_origin", tuple(int(v) for v in origin))
+            shader.uniform_int("mask_origin", (int(origin[0]) - reach, int(origin[1]) - reach))
             shader.uniform_int("mask_scale", int(grid_side))
+            shader.uniform_int("mask_reach", int(reach))
             shader.uniform_sampler("pixel_mask", self.mask)
             renderer.full_screen_batch(shader, "pixel_mask").draw(shader)
             gpu.state.color_mask_set(True, True, True, True)
@@ -151,27 +177,42 @@ class FrameSums:
 
         renderer.draw(state, tile_camera, background_alpha=background_alpha, framebuffer=self.tile_framebuffer,
                       before_shading=mask_pixels)
-        self._add(renderer, self.tile_targets, origin, grid_side, 1.0 / grid_side ** 2, tile)
-
-    def _add(self, renderer, targets, origin, grid_side, weight, tile):
-        import gpu
-
-        shader = shader_cache.get_fixed_shader(("add_frame",), add_frame_calls, "add frame")
+        shader = shader_cache.get_fixed_shader(("add_edge_tile",), add_edge_tile_calls, "add edge tile")
         with self.sums_framebuffer.bind():
-            if tile is not None:
-                gpu.state.viewport_set(int(origin[0]), int(origin[1]), int(tile), int(tile))
+            gpu.state.viewport_set(int(origin[0]), int(origin[1]), int(tile), int(tile))
             gpu.state.depth_test_set("NONE")
             gpu.state.blend_set("ADDITIVE_PREMULT")
             shader.bind()
             shader.uniform_int("tile_origin", tuple(int(v) for v in origin))
             shader.uniform_int("grid_side", int(grid_side))
-            shader.uniform_float("frame_weight", float(weight))
-            for name, texture in zip(PASSES, targets):
+            for name, texture in zip(PASSES, self.tile_targets):
                 shader.uniform_sampler("frame_" + name, texture)
+            shader.uniform_sampler("pixel_mask", self.mask)
+            shader.uniform_sampler("filter_weights", self.filter_weights)
+            renderer.full_screen_batch(shader, "add_edge_tile").draw(shader)
+            gpu.state.blend_set("NONE")
+            gpu.state.viewport_set(0, 0, *self.size)
+
+    def add(self, renderer, weights):
+        """Add the renderer's whole frame into the sums, weighted by the pixel filter: ``weights`` (2, 2 reach + 1),
+        one frame's pixel_filter.frame_weights."""
+        import gpu
+
+        weights = np.asarray(weights, np.float32)
+        values = [float(value) for value in weights.ravel()]
+        frame_weights = gpu.types.GPUTexture((weights.shape[1], 2), format="R32F",
+                                             data=gpu.types.Buffer("FLOAT", len(values), values))
+
+        shader = shader_cache.get_fixed_shader(("add_frame",), add_frame_calls, "add frame")
+        with self.sums_framebuffer.bind():
+            gpu.state.depth_test_set("NONE")
+            gpu.state.blend_set("ADDITIVE_PREMULT")
+            shader.bind()
+            for name, texture in zip(PASSES, renderer.targets):
+                shader.uniform_sampler("frame_" + name, texture)
+            shader.uniform_sampler("frame_weights", frame_weights)
             renderer.full_screen_batch(shader, "add_frame").draw(shader)
             gpu.state.blend_set("NONE")
-            if tile is not None:
-                gpu.state.viewport_set(0, 0, *self.size)
 
     def read(self):
         """name -> (H, W, 4) float32 of each pass's sum, row 0 at the bottom."""

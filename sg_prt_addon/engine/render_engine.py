@@ -8,7 +8,7 @@ import numpy as np
 
 from ..blender import export, properties
 from ..techniques.shader_sources import GBUFFER_OUTPUTS, MAX_POINT_LIGHTS, MAX_SUNS
-from . import anti_aliasing, gpu_limits, multi_sample, scene_state
+from . import anti_aliasing, gpu_limits, multi_sample, pixel_filter, scene_state
 from . import renderer as renderer_module
 from .shader_cache import ShaderCompileError
 
@@ -91,7 +91,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
             return
         if timings.get("cancelled"):
             self.report({"WARNING"}, "SG-PRT: render cancelled; the image holds the samples taken until then")
-        for warning in dict.fromkeys(state.warnings + state.unshadowed_warnings()):
+        for warning in dict.fromkeys(state.warnings + state.unshadowed_warnings() + pixel_filter_warnings(scene)):
             self.report({"WARNING"}, f"SG-PRT: {warning}")
         for line in state.light_budget_warnings(MAX_POINT_LIGHTS, MAX_SUNS):
             self.report({"WARNING"}, f"SG-PRT: {line}")
@@ -143,7 +143,8 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
         region_3d = context.region_data
         camera = export.camera_from_view(region_3d.view_matrix, region_3d.window_matrix,
                                          region_3d.is_perspective)
-        camera.shading_footprint = anti_aliasing.specular_footprint(1, specular_anti_aliasing(depsgraph.scene))
+        camera.shading_footprint = anti_aliasing.specular_footprint(
+            1, specular_anti_aliasing(depsgraph.scene), scene_pixel_filter(depsgraph.scene).footprint_side())
         try:
             self.viewport_frame.update(self.viewport_state, camera, width, height,
                                        0.0 if depsgraph.scene.render.film_transparent else 1.0)
@@ -167,7 +168,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
 
 class ViewportFrame:
     """view_draw's work, which needs no window: the scene is drawn again only when something changed
-    (the scene's dirty set, the view, the region's size or the film); otherwise the last image is
+    (the scene's dirty set, the view, the region's size, the film or the pixel filter's footprint); otherwise the last image is
     shown again, a texture blit (Blender redraws the viewport for overlays, cursor moves, UI...)."""
 
     def __init__(self):
@@ -177,7 +178,7 @@ class ViewportFrame:
 
     def update(self, state, camera, width, height, background_alpha=1.0):
         """Draw if needed; returns whether it drew."""
-        signature = (width, height, float(background_alpha), bool(camera.is_perspective),
+        signature = (width, height, float(background_alpha), bool(camera.is_perspective), camera.shading_footprint,
                      np.asarray(camera.view, np.float64).tobytes(), np.asarray(camera.projection, np.float64).tobytes())
         if signature == self.signature and not state.dirty.any():
             return False
@@ -245,6 +246,22 @@ def specular_anti_aliasing(scene):
     return bool(getattr(getattr(scene, "sgprt", None), "specular_anti_aliasing", True))
 
 
+def scene_pixel_filter(scene):
+    """The pixel filter of the scene's Film: its type (scene.sgprt.pixel_filter_type, Blackman-Harris where the
+    add-on's settings are absent) at Blender's Filter Size (scene.render.filter_size)."""
+    kind = getattr(getattr(scene, "sgprt", None), "pixel_filter_type", pixel_filter.DEFAULT_KIND)
+    return pixel_filter.PixelFilter(kind, float(scene.render.filter_size))
+
+
+def pixel_filter_warnings(scene):
+    """What the render cannot honour of the scene's pixel filter."""
+    chosen = scene_pixel_filter(scene)
+    if not chosen.truncated:
+        return []
+    return [f"the {chosen.kind.replace('_', '-').title()} filter of Filter Size {chosen.width:g} px reaches "
+            f"{chosen.full_radius:g} px from a pixel; SG-PRT cuts it at {pixel_filter.MAX_RADIUS:g} px"]
+
+
 def edge_sampling(scene):
     """(Edges Only, its threshold, the difference floor) of the scene's Render Samples: the floor, in the
     scene's linear units, is EDGE_FLOOR of the display's white, which the view's exposure moves."""
@@ -256,54 +273,65 @@ def edge_sampling(scene):
 
 
 def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, timings, cancelled, progress):
-    """The passes of Render Samples > 1, summed on the GPU (engine/multi_sample.py).  Every pixel: the mean of
-    `samples` frames, each with the projection moved by anti_aliasing.pixel_jitter's sub-pixel offset.  Edges
-    Only: a frame at the pixels' centres (its specular over the whole pixel); where it shows an edge
-    (passes["edge_pixels"]; timings["edge_pixels"]: their fraction), the mean of a grid_side x grid_side grid of
-    samples, drawn tile by tile (timings["edge_tiles"]).  cancelled() is asked between frames or tiles: when it
-    says so (Esc), the mean of the frames so far, or the tiles not drawn keep the centred frame
-    (timings["cancelled"]); progress(fraction) is told after each."""
+    """The passes of Render Samples > 1, summed on the GPU (engine/multi_sample.py), reconstructed with the
+    scene's pixel filter.  Every pixel: `samples` frames, each with the projection moved by a sub-pixel offset
+    (anti_aliasing.pixel_jitter's strata), each pixel the filter-weighted sum of the frames' pixels it reaches.
+    Edges Only: a frame at the pixels' centres (its specular over the filter's footprint); where it shows an
+    edge (passes["edge_pixels"]; timings["edge_pixels"]: their fraction), the filter-weighted sum of a grid_side
+    x grid_side grid of samples a pixel over the pixel and the neighbours the filter reaches, drawn tile by tile
+    (timings["edge_tiles"]).  cancelled() is asked between frames or tiles: when it says so (Esc), the frames so
+    far, their weights made whole, or the tiles not drawn keep the centred frame (timings["cancelled"]);
+    progress(fraction) is told after each."""
     width, height = renderer.size
     sums = renderer.frame_sums
     edges_only, threshold, floor = edge_sampling(scene)
+    chosen_filter = scene_pixel_filter(scene)
     if not edges_only:
         sums.start(width, height)
-        offsets = anti_aliasing.pixel_jitter(samples)
+        offsets = chosen_filter.jitter_offsets(anti_aliasing.pixel_jitter(samples))
+        weights = chosen_filter.frame_weights(offsets)
         for done, offset in enumerate(offsets):
             if done and cancelled():
                 timings["cancelled"] = True
                 summed = sums.read()
-                return {name: summed[name.lower()] * np.float32(len(offsets) / done)
-                        for name in renderer_module.PASS_NAMES}
+                # the frames so far, their weights made whole
+                taken = float(np.sum(weights[:done, 0].sum(axis=1) * weights[:done, 1].sum(axis=1)))
+                return {name: summed[name.lower()] * np.float32(1.0 / taken) for name in renderer_module.PASS_NAMES}
             # the view-projection is in the scene block: upload it moved (the shadow maps keep the centred plan)
             frame_camera = dataclasses.replace(
                 camera, projection=anti_aliasing.jittered_projection(camera.projection, offset, width, height))
             renderer.upload(state, state.consume_dirty(), frame_camera, shadow_camera=camera)
             renderer.draw(state, frame_camera, background_alpha=background_alpha)
-            sums.add(renderer, 1.0 / len(offsets))
+            sums.add(renderer, weights[done])
             progress((done + 1) / len(offsets))
         summed = sums.read()
         return {name: summed[name.lower()] for name in renderer_module.PASS_NAMES}
-    # a sample's specular footprint: the whole pixel at the centre, a grid cell (one pixel of a tile) in the grid
-    whole_pixel = anti_aliasing.specular_footprint(1, camera.shading_footprint > 0.0)
-    centred = dataclasses.replace(camera, shading_footprint=whole_pixel)
+    # a sample's specular footprint: the filter's at the centre, a grid cell (one pixel of a tile) in the grid
+    specular_aa = camera.shading_footprint > 0.0
+    centred = dataclasses.replace(camera, shading_footprint=anti_aliasing.specular_footprint(
+        1, specular_aa, chosen_filter.footprint_side()))
     renderer.upload(state, state.consume_dirty(), centred)
     renderer.draw(state, centred, background_alpha=background_alpha)
     sums.start_at_edges(renderer, threshold, floor)
     edges = sums.read_mask()
     side = anti_aliasing.grid_side(samples)
-    tile = multi_sample.tile_side(side, width, height, gpu_limits.max_texture_size())
+    reach = chosen_filter.reach
+    sums.set_filter_weights(chosen_filter.grid_weights(side))
+    tile = multi_sample.tile_side(side, width, height, gpu_limits.max_texture_size(), reach)
     tiles = anti_aliasing.edge_tiles(edges, tile)
+    cell = anti_aliasing.specular_footprint(1, specular_aa)
     drawn = 0
     for origin in tiles:
         if cancelled():
             timings["cancelled"] = True
             break
+        apron_origin = (origin[0] - reach, origin[1] - reach)
         tile_camera = dataclasses.replace(
-            camera, projection=anti_aliasing.tile_projection(camera.projection, origin, tile, width, height),
-            shading_footprint=whole_pixel, footprint_grid_limit=anti_aliasing.footprint_grid_limit(side))
+            camera, projection=anti_aliasing.tile_projection(camera.projection, apron_origin, tile + 2 * reach,
+                                                             width, height),
+            shading_footprint=cell, footprint_grid_limit=anti_aliasing.footprint_grid_limit(side))
         renderer.upload(state, state.consume_dirty(), tile_camera, shadow_camera=camera)
-        sums.draw_edge_tile(renderer, state, tile_camera, origin, tile, side, background_alpha)
+        sums.draw_edge_tile(renderer, state, tile_camera, origin, tile, side, reach, background_alpha)
         drawn += 1
         progress(drawn / len(tiles))
     timings["edge_pixels"] = float(edges.mean())
@@ -339,7 +367,8 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     camera = export.export_camera(camera_object, depsgraph, width, height,
                                   scene.render.pixel_aspect_x, scene.render.pixel_aspect_y)
     # the G-buffer the mirrors read is shaded at the pixels' centres
-    camera.shading_footprint = anti_aliasing.specular_footprint(samples, specular_anti_aliasing(scene) and not gbuffer)
+    camera.shading_footprint = anti_aliasing.specular_footprint(
+        samples, specular_anti_aliasing(scene) and not gbuffer, scene_pixel_filter(scene).footprint_side())
     timings["export"] = time.perf_counter() - start
     renderer = renderer or renderer_module.Renderer(gbuffer=gbuffer)
     start = time.perf_counter()

@@ -1,5 +1,5 @@
 """The pure parts of benchmarks/truth_suite.py (no bpy): rows, the truth's noise floor, equal-time
-samples, the box filter, the issue's goals, the markdown section, tone mapping and HDR-FLIP."""
+samples, the issue's goals, the markdown section, tone mapping and HDR-FLIP."""
 import subprocess
 import sys
 from pathlib import Path
@@ -66,15 +66,6 @@ def test_equal_time_samples_fits_a_fixed_cost_and_a_cost_per_sample():
     # 1-sample render fixed: 0.1 s a sample, 0.9 s fixed
     assert ts.equal_time_samples(2.0, 1.0, 1.0, 10) == 11
     assert ts.equal_time_samples(0.5, 0.1, 0.1, 1) == 5
-
-
-def test_box_downsample_averages_blocks():
-    image = np.arange(4 * 6 * 3, dtype=float).reshape(4, 6, 3)
-    small = ts.box_downsample(image, 2)
-    assert small.shape == (2, 3, 3)
-    np.testing.assert_allclose(small[0, 0], image[:2, :2].mean(axis=(0, 1)))
-    np.testing.assert_allclose(small[1, 2], image[2:, 4:].mean(axis=(0, 1)))
-    np.testing.assert_allclose(ts.box_downsample(image, 1), image)
 
 
 def test_rmse_goals():

@@ -1,6 +1,6 @@
-"""Render Samples (scene.sgprt.render_samples): final renders average frames moved by sub-pixel offsets
-(engine.anti_aliasing.pixel_jitter).  Four samples sample the same points as a render twice as large, so their
-average must equal that render box-filtered down (Cycles' 1-pixel box filter); the render panel shows it.
+"""Render Samples (scene.sgprt.render_samples) with the 1-pixel Box filter: final renders average frames moved by
+sub-pixel offsets (engine.anti_aliasing.pixel_jitter).  Four samples sample the same points as a render twice as
+large, so their average must equal that render box-filtered down; the render panel shows it.
 Specular Anti-Aliasing (scene.sgprt.specular_anti_aliasing, sg_shading.glsl shade_footprint): one frame
 shading each pixel over its footprint comes close to the box-filtered frames the jitter averages.  Edges Only
 (scene.sgprt.sample_edges_only, engine/multi_sample.py): the samples at the edges of a frame shaded at the
@@ -29,11 +29,16 @@ def test_pixel_jitter_patterns():
     # each jittered frame's shading covers its cell of the pixel: the whole pixel for one frame, none when off
     assert [anti_aliasing.specular_footprint(n) for n in (1, 4, 16)] == [1.0, 0.5, 0.25]
     assert anti_aliasing.specular_footprint(16, enabled=False) == 0.0
+    assert anti_aliasing.specular_footprint(1, filter_side=1.44) == 1.44     # one frame: the filter's square
 
 
-def _scene(name, size, samples, specular_anti_aliasing=False, roughness=0.25, edges_only=False):
+def _scene(name, size, samples, specular_anti_aliasing=False, roughness=0.25, edges_only=False,
+           pixel_filter=("BOX", 1.0)):
+    """A GGX sphere under a small point light; the 1-pixel Box filter unless told (the sampling's equalities
+    below hold for it; tests/gpu/test_pixel_filter_render.py measures the others)."""
     scene = fx.new_scene(name, size, size)
     scene.sgprt.render_samples = samples
+    scene.sgprt.pixel_filter_type, scene.render.filter_size = pixel_filter
     scene.sgprt.sample_edges_only = edges_only
     scene.sgprt.specular_anti_aliasing = specular_anti_aliasing
     fx.world_colour(scene, (0.05, 0.05, 0.05))
