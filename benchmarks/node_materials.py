@@ -184,11 +184,24 @@ def glossy_anisotropic(anisotropy):
     return build
 
 
+def glossy_beckmann(roughness):
+    """A Glossy BSDF of the Beckmann distribution, its colour white."""
+    def build():
+        material, tree, output = _nodes(f"glossy_beckmann_{roughness}")
+        glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+        glossy.distribution = "BECKMANN"
+        glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+        glossy.inputs["Roughness"].default_value = roughness
+        tree.links.new(glossy.outputs[0], output.inputs["Surface"])
+        return material
+    return build
+
+
 SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),
           "principled_gold_r030": gold, "principled_black_metal": black_metal, "principled_textured": textured, "principled_pbr_metallic_map": pbr_metallic_map,
           "principled_tiled": tiled, "mix_diffuse_glossy": mix_diffuse_glossy,
           "principled_anisotropic": anisotropic, "glossy_anisotropic": glossy_anisotropic(0.6),
-          "glossy_anisotropic_negative": glossy_anisotropic(-0.6)}
+          "glossy_anisotropic_negative": glossy_anisotropic(-0.6), "glossy_beckmann_r030": glossy_beckmann(0.3)}
 
 
 def build(name, size):

@@ -443,9 +443,9 @@ def _closure_values(reader, closure):
             reader.note(node, "Oren-Nayar roughness: rendered as Lambert")
         values["diffuse_color"] = reader.value(node.inputs["Color"], True)
     elif kind == "glossy":
-        if node.distribution == "BECKMANN":
-            reader.note(node, "Beckmann distribution: rendered as Ward, about 20-30% darker than Cycles")
         anisotropy = _constant_input(reader, node, "Anisotropy")
+        if node.distribution == "BECKMANN" and anisotropy != 0.0:
+            reader.note(node, "anisotropic Beckmann: rendered as anisotropic Ward (its NDF, Ward's shadowing)")
         plain_ggx = node.distribution in ("GGX", "MULTI_GGX") and anisotropy == 0.0
         values.update(principled.glossy(reader.value(node.inputs["Color"], True),
                                         _width(reader, node, plain_ggx), node.distribution, anisotropy,

@@ -30,6 +30,7 @@ PARAMETER_AXES = {
     "COOK_TORRANCE": ("roughness", "linear", 0.02, 1.0),
     "BLINN_PHONG": ("exponent", "log", 1.0, 10000.0),
     "WARD_ISO": ("alpha_x", "linear", 0.02, 1.0),
+    "BECKMANN": ("roughness", "linear", 0.02, 1.0),
 }
 DEFAULT_ORDER = 5
 DEFAULT_VIEWS = 64              # theta_v nodes (isotropic) or parabolic side (anisotropic: DEFAULT_MAP)

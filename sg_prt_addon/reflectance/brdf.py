@@ -23,7 +23,7 @@ denominators are clamped at COSINE_EPSILON (about 89.99999 degrees) so the
 exact formulas stay finite at grazing angles.
 
 Isotropic models map their parameter to one SG lobe analytically (like eq. 12).
-The mappings of CookTorranceBeckmann, BlinnPhong, WardIsotropic and GGX are
+The mappings of CookTorranceBeckmann, Beckmann, BlinnPhong, WardIsotropic and GGX are
 L2-optimal fits (derived by ndf_fit.derive_isotropic_mapping and frozen in ndf_fit as
 polynomials in the lobe width); CookTorrance keeps the paper's eq. 12.
 """
@@ -563,6 +563,53 @@ class GGX(_Microfacet):
 
 
 @dataclass(frozen=True, eq=False)
+class Beckmann(_Microfacet):
+    """Beckmann with Blender's Glossy BSDF conventions: alpha = roughness^2, the normalized Beckmann D,
+    height-correlated Smith G = 1/(1 + Lambda(i) + Lambda(o)) with Lambda by Walter et al. 2007's rational
+    approximation (as Cycles), no Fresnel: M_o(i) = G / (4 (n.i)(n.o)).  One SG lobe by the frozen L2 mapping.
+    """
+
+    def ndf_widths(self):
+        return [self.roughness ** 2]
+    roughness: object = 0.3
+
+    def _alpha(self, dtype):
+        return np.maximum(np.square(_param(self.roughness, dtype)), np.asarray(1e-6, dtype))
+
+    def ndf(self, h):
+        h = np.asarray(h)
+        alpha = self._alpha(h.dtype)
+        return _beckmann_ndf(h, alpha, alpha)
+
+    @staticmethod
+    def smith_lambda(w, alpha):
+        """Walter et al. 2007: a = 1 / (alpha tan theta); (1 - 1.259 a + 0.396 a^2) / (3.535 a + 2.181 a^2)
+        below a = 1.6, else 0: the exact (erf(a) - 1)/2 + exp(-a^2) / (2 a sqrt(pi)) to within 0.4% of 1 + Lambda."""
+        z = np.maximum(w[..., 2], COSINE_EPSILON)
+        tangent = np.sqrt(w[..., 0] ** 2 + w[..., 1] ** 2) / z
+        a = 1 / np.maximum(alpha * tangent, np.asarray(1e-30, tangent.dtype))
+        return np.where(a < 1.6, (1 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a), 0)
+
+    def _m_factor(self, wo, wi, h):
+        alpha = self._alpha(wo.dtype)
+        no, ni, visible = _cosines(wo, wi)
+        shadowing = 1 / (1 + self.smith_lambda(wo, alpha) + self.smith_lambda(wi, alpha))
+        return np.where(visible, shadowing / (4 * ni * no), 0)
+
+    def ndf_lobes(self):
+        alpha = self._alpha(_dtype(self.roughness))
+        scaled_sharpness, relative_amplitude = ndf_fit.isotropic_mapping("BECKMANN", alpha)
+        return _frame_lobes(alpha, scaled_sharpness / (alpha * alpha), relative_amplitude / (np.pi * alpha * alpha))
+
+    def half_vector_pdf(self, h):
+        return self.ndf(h) * np.maximum(h[..., 2], 0)
+
+    def sample_half_vector(self, u1, u2):
+        alpha = self._alpha(u1.dtype)
+        return _beckmann_sample(u1, u2, alpha, alpha)
+
+
+@dataclass(frozen=True, eq=False)
 class GGXAnisotropic(_Microfacet):
     """Anisotropic GGX as Blender's Principled and Glossy BSDFs with Anisotropic > 0 (alpha_x along the
     tangent, alpha_y along the bitangent; reflectance.principled.anisotropic_alphas):
@@ -651,6 +698,7 @@ _MODELS = {
     "WARD_ANISO": (WardAnisotropic, {"alpha_x": "alpha_x", "alpha_y": "alpha_y"}),
     "ASHIKHMIN_SHIRLEY": (AshikhminShirley, {"nu": "nu", "nv": "nv", "rf0": "rf0"}),
     "GGX": (GGX, {"roughness": "roughness"}),
+    "BECKMANN": (Beckmann, {"roughness": "roughness"}),
     "GGX_ANISO": (GGXAnisotropic, {"alpha_x": "alpha_x", "alpha_y": "alpha_y"}),
     "LAMBERT": (Lambert, {"kd": "kd"}),
 }

@@ -59,6 +59,7 @@ def equivalent_roughness(model, params):
         "COOK_TORRANCE": lambda: float(params["roughness"]),
         "BLINN_PHONG": lambda: from_exponent(params["exponent"]),
         "WARD_ISO": lambda: float(params["alpha_x"]),
+        "BECKMANN": lambda: float(params["roughness"]) ** 2,
         "WARD_ANISO": lambda: np.sqrt(float(params["alpha_x"]) * float(params["alpha_y"])),
         "GGX_ANISO": lambda: np.sqrt(float(params["alpha_x"]) * float(params["alpha_y"])),
         "ASHIKHMIN_SHIRLEY": lambda: np.sqrt(from_exponent(params["nu"]) * from_exponent(params["nv"])),

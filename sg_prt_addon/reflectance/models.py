@@ -39,6 +39,8 @@ MODELS = (
     Model("GGX_ANISO", "GGX Anisotropic", "Anisotropic GGX as Blender's Principled BSDF with Anisotropic > 0 "
                                           "(alpha x along the tangent, alpha y across it), fitted with several SG "
                                           "lobes", ("alpha_x", "alpha_y"), anisotropic=True, default_lobes=6),
+    Model("BECKMANN", "Beckmann", "Microfacet Beckmann matching Blender's Glossy BSDF of that distribution "
+                                  "(alpha = roughness^2, height-correlated Smith shadowing, no Fresnel)", ("roughness",)),
 )
 BY_NAME = {model.name: model for model in MODELS}
 NAMES = tuple(BY_NAME)

@@ -16,8 +16,8 @@ import numpy as np
 
 from .texture_expression import Expression
 
-# Glossy BSDF distributions -> (model, multiscatter); Beckmann's NDF is Ward's but for a cosine
-GLOSSY_DISTRIBUTIONS = {"GGX": ("GGX", False), "MULTI_GGX": ("GGX", True), "BECKMANN": ("WARD_ISO", False),
+# Glossy BSDF distributions -> (model, multiscatter)
+GLOSSY_DISTRIBUTIONS = {"GGX": ("GGX", False), "MULTI_GGX": ("GGX", True), "BECKMANN": ("BECKMANN", False),
                         "ASHIKHMIN_SHIRLEY": ("ASHIKHMIN_SHIRLEY", False), "SHARP": ("GGX", False)}
 MIN_ROUGHNESS = 0.001       # material.sgprt.roughness's lower end: a mirror renders as the sharpest lobe
 
@@ -95,11 +95,11 @@ def _roughness_fields(roughness, distribution_model, anisotropic_alphas_of=None)
         if distribution_model == "ASHIKHMIN_SHIRLEY":
             return {"model": "ASHIKHMIN_SHIRLEY", "nu": _ashikhmin_shirley_exponent(alpha_x),
                     "nv": _ashikhmin_shirley_exponent(alpha_y)}
-        if distribution_model == "WARD_ISO":
+        if distribution_model == "BECKMANN":      # Ward's NDF is Beckmann's but for a cosine
             return {"model": "WARD_ANISO", "alpha_x": alpha_x, "alpha_y": alpha_y}
         return {"model": "GGX_ANISO", "alpha_x": alpha_x, "alpha_y": alpha_y}
-    if distribution_model == "WARD_ISO":
-        return {"model": "WARD_ISO", "alpha_x": float(np.clip(roughness ** 2, MIN_ROUGHNESS, 1.0))}
+    if distribution_model == "BECKMANN":
+        return {"model": "BECKMANN", "roughness": max(roughness, MIN_ROUGHNESS)}
     if distribution_model == "ASHIKHMIN_SHIRLEY":
         exponent = _ashikhmin_shirley_exponent(roughness ** 2)
         return {"model": "ASHIKHMIN_SHIRLEY", "nu": exponent, "nv": exponent}

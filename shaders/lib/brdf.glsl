@@ -26,6 +26,9 @@
  *   ggx_*                     <- GGX (Blender conventions: alpha = roughness^2,
  *                                height-correlated Smith, no Fresnel); ggx_alpha <- GGX._alpha,
  *                                ggx_smith_lambda <- GGX.smith_lambda
+ *   beckmann_*                <- Beckmann (Blender's Glossy BSDF: alpha = roughness^2, height-correlated
+ *                                Smith with Walter's rational Lambda, no Fresnel; ndf_lobe, smith_lambda,
+ *                                m_factor; its NDF is beckmann_ndf)
  *   lambert_m_factor          <- Lambert.m_factor
  * beckmann_ndf, ward_anisotropic_ndf and ggx_ndf normalise h first (brdf.py takes
  * h as given): a tiny non-unit h would overflow float32 there.
@@ -338,6 +341,40 @@ float ggx_m_factor(vec3 wo, vec3 wi, float roughness)
   float alpha = ggx_alpha(roughness);
   float shadowing = 1.0 / (1.0 + ggx_smith_lambda(wo, alpha) + ggx_smith_lambda(wi, alpha));
   return shadowing / (4.0 * max(wi.z, BRDF_COSINE_EPSILON) * max(wo.z, BRDF_COSINE_EPSILON));
+}
+
+/* ---- Beckmann with Blender's conventions (Beckmann) ---- */
+
+float beckmann_alpha(float roughness)
+{
+  return max(roughness * roughness, 1.0e-6);
+}
+
+/* Walter et al. 2007's rational Lambda, a = 1 / (alpha tan theta), as Cycles */
+float beckmann_smith_lambda(vec3 w, float alpha)
+{
+  float z = max(w.z, BRDF_COSINE_EPSILON);
+  float a = z / max(alpha * length(w.xy), 1.0e-30);
+  return a < 1.6 ? (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a) : 0.0;
+}
+
+float beckmann_m_factor(vec3 wo, vec3 wi, float roughness)
+{
+  wo = safe_normalize(wo);
+  wi = safe_normalize(wi);
+  if (!(wo.z > 0.0 && wi.z > 0.0)) {
+    return 0.0;
+  }
+  float alpha = beckmann_alpha(roughness);
+  float shadowing = 1.0 / (1.0 + beckmann_smith_lambda(wo, alpha) + beckmann_smith_lambda(wi, alpha));
+  return shadowing / (4.0 * max(wi.z, BRDF_COSINE_EPSILON) * max(wo.z, BRDF_COSINE_EPSILON));
+}
+
+vec2 beckmann_ndf_lobe(float roughness)
+{
+  float alpha = beckmann_alpha(roughness);
+  vec2 mapping = isotropic_mapping_beckmann(alpha);
+  return vec2(mapping.x / (alpha * alpha), mapping.y / (SG_PI * alpha * alpha));
 }
 
 /* ---- anisotropic GGX (GGXAnisotropic): alpha_x along the tangent, alpha_y along the bitangent ---- */

@@ -271,17 +271,20 @@ def test_node_tree_chosen_over_tuned_settings_reads_nothing_from_them(empty_file
     assert (params.tangent_source, params.tangent_rotation, params.normal_strength) == ("UV_MAP", 0.0, 1.0)
 
 
-def test_a_beckmann_glossy_says_it_is_rendered_as_ward(empty_file):
-    """The Glossy BSDF's Beckmann has no model of its own yet: it renders as Ward, darker than Cycles'
-    (the truth suite measured 19-31%), and the material's warning says so; GGX says nothing."""
-    for distribution in ("BECKMANN", "GGX"):
-        material, tree, output = _material(f"glossy_{distribution.lower()}")
+def test_a_beckmann_glossy_reads_as_beckmann(empty_file):
+    """The Glossy BSDF's Beckmann reads as the Beckmann model at the node's roughness, without a word; an
+    anisotropic one as anisotropic Ward, which its warning says."""
+    for distribution, anisotropy, model in (("BECKMANN", 0.0, "BECKMANN"), ("GGX", 0.0, "GGX"),
+                                            ("BECKMANN", 0.5, "WARD_ANISO")):
+        material, tree, output = _material(f"glossy_{distribution.lower()}_{anisotropy}")
         glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
         glossy.distribution = distribution
+        glossy.inputs["Roughness"].default_value = 0.4
+        glossy.inputs["Anisotropy"].default_value = anisotropy
         tree.links.new(glossy.outputs[0], output.inputs["Surface"])
         params, warnings = _read(material)
-        said = [w for w in warnings if "Beckmann distribution: rendered as Ward" in w]
-        if distribution == "BECKMANN":
-            assert params.model == "WARD_ISO" and len(said) == 1, warnings
-        else:
-            assert params.model == "GGX" and not said, warnings
+        said = [w for w in warnings if "Beckmann" in w]
+        assert params.model == model, warnings
+        assert len(said) == (1 if model == "WARD_ANISO" else 0), warnings
+        if model == "BECKMANN":
+            assert params.roughness == pytest.approx(0.4)

@@ -121,7 +121,9 @@ def test_principled_mapping():
 def test_glossy_mapping():
     assert principled.glossy((0.5, 0.5, 0.5), 0.3, "MULTI_GGX")["multiscatter"]
     assert principled.glossy((0.5, 0.5, 0.5), 0.3, "GGX")["fresnel"] == "NONE"
-    assert principled.glossy((1, 1, 1), 0.5, "BECKMANN")["model"] == "WARD_ISO"
+    beckmann = principled.glossy((1, 1, 1), 0.5, "BECKMANN")
+    assert beckmann["model"] == "BECKMANN" and beckmann["roughness"] == 0.5
+    assert principled.glossy((1, 1, 1), 0.5, "BECKMANN", anisotropy=0.5)["model"] == "WARD_ANISO"
     assert principled.glossy((1, 1, 1), 0.5, "SHARP")["roughness"] == principled.MIN_ROUGHNESS
     shirley = principled.glossy((1, 1, 1), 0.5, "ASHIKHMIN_SHIRLEY")
     assert shirley["nu"] == shirley["nv"] == pytest.approx(2 / 0.0625 - 2)

@@ -26,7 +26,7 @@ def test_every_model_has_an_exact_form_and_glsl_lobes():
 def test_the_model_enum_keeps_its_order():
     """A .blend stores material.sgprt.model by position: new models are appended, never inserted."""
     assert models.NAMES == ("GGX", "COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY",
-                            "GGX_ANISO")
+                            "GGX_ANISO", "BECKMANN")
 
 
 @pytest.mark.slow_maths

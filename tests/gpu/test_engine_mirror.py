@@ -103,6 +103,21 @@ def test_isotropic_models_lights_and_world_colour(engine):
     _check(result)
 
 
+def test_beckmann(engine):
+    """The Glossy BSDF's Beckmann (alpha = roughness^2, Walter's Smith Lambda) on a sphere over the floor, a point
+    light and a sun."""
+    scene = fx.new_scene("mirror_beckmann", 128, 128)
+    fx.world_colour(scene, (0.05, 0.07, 0.1))
+    sphere = fx.uv_sphere(scene, "sphere_beckmann", (0.0, 0.0, 1.0), radius=0.8)
+    sphere.data.materials.append(fx.material("mat_beckmann", model="BECKMANN", roughness=0.4,
+                                             diffuse_color=(0.3, 0.3, 0.3), specular_color=(0.7, 0.7, 0.7)))
+    fx.plane(scene, "floor", (0.0, 0.0, 0.2))
+    fx.point_light(scene, "point", (2.0, -3.0, 3.0), 800.0, radius=0.1)
+    sun = fx.point_light(scene, "sun", (0.0, 0.0, 5.0), 2.0, kind="SUN")
+    sun.rotation_euler = (0.5, 0.3, 0.0)
+    _check(fx.render(scene, gbuffer=True))
+
+
 def test_anisotropic_models_textures_and_normal_map(engine):
     """Ward anisotropic and Ashikhmin-Shirley with textured parameters, a normal map and both tangent sources."""
     rng = np.random.default_rng(3)

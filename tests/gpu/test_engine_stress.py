@@ -114,7 +114,8 @@ EXTREMES = {
 
 
 @pytest.mark.parametrize("world", ["colour", "hdri"])
-@pytest.mark.parametrize("model", ["GGX", "COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY"])
+@pytest.mark.parametrize("model", ["GGX", "COOK_TORRANCE", "BLINN_PHONG", "WARD_ISO", "WARD_ANISO", "ASHIKHMIN_SHIRLEY",
+                                   "BECKMANN"])
 def test_extreme_materials(engine, model, world):
     """Each model at roughness 1e-4 and 1, exponents 1e-4 and 1e8, zero diffuse / specular / both,
     lit by a point, a spot, a sun and the world (a colour, or an HDRI with a 500x sun texel)."""

@@ -947,7 +947,7 @@ def test_shading_frame_stress(glsl, fuzz):
 
 
 MODEL_VARIANTS = [("GGX", 1), ("GGX", 2), ("COOK_TORRANCE", 1), ("BLINN_PHONG", 1), ("WARD_ISO", 1),
-                  ("WARD_ANISO", 3), ("ASHIKHMIN_SHIRLEY", 3), ("GGX_ANISO", 1), ("GGX_ANISO", 4)]
+                  ("WARD_ANISO", 3), ("ASHIKHMIN_SHIRLEY", 3), ("GGX_ANISO", 1), ("GGX_ANISO", 4), ("BECKMANN", 1)]
 
 
 @pytest.mark.parametrize("model,lobes", MODEL_VARIANTS, ids=[f"{m}-{k}" for m, k in MODEL_VARIANTS])

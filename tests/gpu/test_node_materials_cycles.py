@@ -32,6 +32,7 @@ def node_materials(blender):
     # through the Principled BSDF's mapping (and a negative one as none) they were 1.51 / +0.047 and 1.26 / +0.088
     ("glossy_anisotropic", 0.40, 0.06),
     ("glossy_anisotropic_negative", 0.43, 0.17),
+    ("glossy_beckmann_r030", 0.18, 0.04),     # 0.122 / -0.005 / 0.133 (read as isotropic Ward: 0.538 / -0.188)
 ])
 def test_node_material_against_cycles(node_materials, name, rmse_bound, bias_bound):
     row = node_materials.score(name, 64, 32)

@@ -20,6 +20,8 @@ void model_ndf_lobe(vec4 p, vec4 q, int k, out vec3 axis, out float sharpness, o
   lobe = blinn_phong_ndf_lobe(p.z);
 #elif defined(MODEL_WARD_ISO)
   lobe = ward_isotropic_ndf_lobe(p.w);
+#elif defined(MODEL_BECKMANN)
+  lobe = beckmann_ndf_lobe(p.x);
 #endif
   sharpness = lobe.x;
   amplitude = lobe.y;
@@ -82,6 +84,8 @@ vec2 model_lobe_widths(vec4 p, vec4 q)
   return vec2(sqrt(2.0 / (max(p.z, 0.0) + 2.0)));
 #elif defined(MODEL_WARD_ISO)
   return vec2(p.w);
+#elif defined(MODEL_BECKMANN)
+  return vec2(beckmann_alpha(p.x));
 #elif defined(MODEL_WARD_ANISO) || defined(MODEL_GGX_ANISO)
   return vec2(p.w, q.x);
 #elif defined(MODEL_ASHIKHMIN_SHIRLEY)
@@ -102,6 +106,8 @@ float model_m_factor(vec3 wo, vec3 wi, vec4 p, vec4 q)
   return blinn_phong_m_factor(wo, wi, p.z);
 #elif defined(MODEL_WARD_ISO)
   return ward_isotropic_m_factor(wo, wi);
+#elif defined(MODEL_BECKMANN)
+  return beckmann_m_factor(wo, wi, p.x);
 #elif defined(MODEL_WARD_ANISO)
   return ward_anisotropic_m_factor(wo, wi);
 #elif defined(MODEL_GGX_ANISO)
@@ -132,6 +138,8 @@ float model_specular(vec3 wo, vec3 wi, vec4 p, vec4 q)
   ndf = blinn_phong_ndf(h, p.z);
 #elif defined(MODEL_WARD_ISO)
   ndf = ward_isotropic_ndf(h, p.w);
+#elif defined(MODEL_BECKMANN)
+  ndf = beckmann_ndf(h, beckmann_alpha(p.x), beckmann_alpha(p.x));
 #elif defined(MODEL_WARD_ANISO)
   ndf = ward_anisotropic_ndf(h, p.w, q.x);
 #elif defined(MODEL_GGX_ANISO)
