@@ -588,7 +588,8 @@ class Beckmann(_Microfacet):
         z = np.maximum(w[..., 2], COSINE_EPSILON)
         tangent = np.sqrt(w[..., 0] ** 2 + w[..., 1] ** 2) / z
         a = 1 / np.maximum(alpha * tangent, np.asarray(1e-30, tangent.dtype))
-        return np.where(a < 1.6, (1 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a), 0)
+        # not below 0: the form dips 2e-5 under near a = 1.6
+        return np.where(a < 1.6, np.maximum((1 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a), 0), 0)
 
     def _m_factor(self, wo, wi, h):
         alpha = self._alpha(wo.dtype)

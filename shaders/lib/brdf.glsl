@@ -350,12 +350,13 @@ float beckmann_alpha(float roughness)
   return max(roughness * roughness, 1.0e-6);
 }
 
-/* Walter et al. 2007's rational Lambda, a = 1 / (alpha tan theta), as Cycles */
+/* Walter et al. 2007's rational Lambda, a = 1 / (alpha tan theta), as Cycles; not below 0 (it dips 2e-5 under
+ * near a = 1.6) */
 float beckmann_smith_lambda(vec3 w, float alpha)
 {
   float z = max(w.z, BRDF_COSINE_EPSILON);
   float a = z / max(alpha * length(w.xy), 1.0e-30);
-  return a < 1.6 ? (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a) : 0.0;
+  return a < 1.6 ? max((1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a), 0.0) : 0.0;
 }
 
 float beckmann_m_factor(vec3 wo, vec3 wi, float roughness)

@@ -121,7 +121,7 @@ def test_brdf_stress(glsl, fuzz):
     result = vec4(cook_torrance_m_factor(wo.xyz, wi.xyz, r, wi.w) + cook_torrance_beckmann_m_factor(wo.xyz, wi.xyz, r, wi.w),
                   blinn_phong_m_factor(wo.xyz, wi.xyz, n) + ward_anisotropic_m_factor(wo.xyz, wi.xyz),
                   ashikhmin_shirley_m_factor(wo.xyz, wi.xyz, n, 1.0, e.x) + ggx_m_factor(wo.xyz, wi.xyz, r)
-                  + ggx_anisotropic_m_factor(wo.xyz, wi.xyz, r, 1.0 - r),
+                  + ggx_anisotropic_m_factor(wo.xyz, wi.xyz, r, 1.0 - r) + beckmann_m_factor(wo.xyz, wi.xyz, r),
                   lambert_m_factor(wo.xyz, wi.xyz, e.x));
     """
     out = glsl(["sg.glsl", "brdf.glsl"], m_factors, inputs, 4)
@@ -130,7 +130,7 @@ def test_brdf_stress(glsl, fuzz):
     lobes = """
     float r = wo.w, n = h.w;
     result = vec4(cook_torrance_ndf_lobe(r) + cook_torrance_beckmann_ndf_lobe(r),
-                  blinn_phong_ndf_lobe(n) + ward_isotropic_ndf_lobe(r) + ggx_ndf_lobe(r));
+                  blinn_phong_ndf_lobe(n) + ward_isotropic_ndf_lobe(r) + ggx_ndf_lobe(r) + beckmann_ndf_lobe(r));
     """
     out = glsl(["sg.glsl", "brdf.glsl"], lobes, inputs, 4)
     _assert_finite(out, "brdf ndf lobes")
@@ -417,7 +417,9 @@ def test_brdf_helpers_stress(glsl):
                   shadowing_cook_torrance(safe_normalize(wo.xyz), safe_normalize(wi.xyz), half_vector)
                   + ward_isotropic_m_factor(wo.xyz, wi.xyz),
                   beckmann_ndf(h.xyz, max(wo.w, 1.0e-6), max(a.x, 1.0e-6))
-                  + ggx_smith_lambda(safe_normalize(wo.xyz), alpha) + ggx_smith_lambda(wi.xyz, alpha),
+                  + ggx_smith_lambda(safe_normalize(wo.xyz), alpha) + ggx_smith_lambda(wi.xyz, alpha)
+                  + beckmann_smith_lambda(safe_normalize(wo.xyz), beckmann_alpha(wo.w))
+                  + beckmann_smith_lambda(wi.xyz, beckmann_alpha(wo.w)),
                   mappings.x + mappings.y);
     """
     out = glsl(["sg.glsl", "brdf.glsl"], body, inputs, 4)
@@ -1134,7 +1136,7 @@ COVERED = {
                        "ggx_m_factor", "lambert_m_factor", "cook_torrance_ndf_lobe",
                        "cook_torrance_beckmann_ndf_lobe", "blinn_phong_ndf_lobe", "ward_isotropic_ndf_lobe",
                        "ggx_ndf_lobe", "ggx_anisotropic_ndf", "ggx_anisotropic_smith_lambda",
-                       "ggx_anisotropic_m_factor"],
+                       "ggx_anisotropic_m_factor", "beckmann_m_factor", "beckmann_ndf_lobe"],
     test_lights_stress: ["sphere_light_sg", "sphere_light_sg_paper", "soft_light_sg", "spot_light_sg",
                          "directional_light_sg"],
     test_light_emission_stress: ["light_emission_factor"],
@@ -1153,7 +1155,8 @@ COVERED = {
     test_brdf_helpers_stress: ["brdf_half_vector", "reflect_about", "brdf_theta", "brdf_log_cosine",
                                "shadowing_cook_torrance", "isotropic_polynomial", "isotropic_mapping_beckmann",
                                "isotropic_mapping_blinn_phong", "isotropic_mapping_ward_iso", "isotropic_mapping_ggx",
-                               "beckmann_ndf", "ward_isotropic_m_factor", "ggx_alpha", "ggx_smith_lambda"],
+                               "beckmann_ndf", "ward_isotropic_m_factor", "ggx_alpha", "ggx_smith_lambda",
+                               "beckmann_alpha", "beckmann_smith_lambda"],
     test_warp_helpers_stress: ["warp_at", "warp_split_frame", "warp_split_node"],
     test_lights_helpers_stress: ["blender_point_light_intensity", "light_cap_energy_lobe", "sphere_light_cap", "light_cap",
                                  "point_light_sg", "light_cap_radius"],
