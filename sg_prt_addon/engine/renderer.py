@@ -13,7 +13,7 @@ import numpy as np
 from .. import techniques
 from ..blender.export import COLOUR_SLOTS, texture_sources
 from ..lighting import shadow_maps
-from ..spherical import clamped_cosine
+from ..spherical import clamped_cosine, texture_mips
 from ..techniques import shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility import per_vertex as per_vertex_layout  # the layout of every per-vertex texture
@@ -60,9 +60,9 @@ def _texture_2d_array(layers):
 
 
 def _texture_key(value, slot, params):
-    """(image name or Expression, decoded from sRGB): a colour slot, or a data slot a node tree reads decoded
-    (as Blender does; an Expression decodes each of its images so)."""
-    return value, slot in COLOUR_SLOTS or slot in params.decoded_slots
+    """(image name or Expression, decoded from sRGB: a colour slot, or a data slot a node tree reads decoded (as
+    Blender does; an Expression decodes each of its images so), a normal map: its normals made unit)."""
+    return value, slot in COLOUR_SLOTS or slot in params.decoded_slots, slot == "normal_map"
 
 
 def _uniform_buffer(data):
@@ -431,7 +431,7 @@ class Renderer:
                 key = _texture_key(value, slot, params)
                 pixels = state.texture_pixels(value, slot, key[1]) if key not in self.textures else None
                 if pixels is not None:
-                    self.textures[key] = self._image_texture(pixels, " x ".join(texture_sources(value)))
+                    self.textures[key] = self._image_texture(pixels, " x ".join(texture_sources(value)), key[2])
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)
@@ -450,14 +450,19 @@ class Renderer:
         else:
             self.scene_buffer.update(gpu_buffer(block))
 
-    def _image_texture(self, pixels, name):
-        """The GPU texture of an image's pixels, made smaller where it passes the GPU's side (said once)."""
+    def _image_texture(self, pixels, name, normal_map=False):
+        """The GPU texture of an image's mip levels (spherical/texture_mips.py's atlas, half as wide again as the
+        image; a normal map's normals made unit first), the image made smaller where that atlas would pass the
+        GPU's side (said once)."""
+        if normal_map:
+            pixels = texture_mips.unit_normals(pixels)
         side = gpu_limits.max_texture_size()
-        fitted, factor = within_side(pixels, side)
+        fitted, factor = within_side(pixels, side * 2 // 3)
         if factor > 1:
             self.texture_warnings[name] = (f"image '{name}' is {pixels.shape[1]} x {pixels.shape[0]}, over this "
-                                           f"GPU's limit of {side} texels a side: rendered at 1/{factor} of its size")
-        return _texture_2d(fitted)
+                                           f"GPU's limit of {side} texels a side (with its mip levels): rendered "
+                                           f"at 1/{factor} of its size")
+        return _texture_2d(texture_mips.atlas(fitted))
 
     def upload_warnings(self, state):
         """The render report's lines for objects whose per-vertex data the upload refused (MeshBuffers.refused):

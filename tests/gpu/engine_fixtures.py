@@ -337,6 +337,13 @@ def bake_objects(scene, receivers, resolution=16, terms=None, error_target=0.02,
     return bakes
 
 
+def mirror_uv(gbuffer_uv):
+    """The mirrors' texture coordinates of G-buffer uv rows (N, 4): (u, v, the textures' footprint), its w less 1
+    (common/surface_io.glsl surface_write)."""
+    gbuffer_uv = np.asarray(gbuffer_uv)
+    return np.column_stack([gbuffer_uv[:, :2], gbuffer_uv[:, 3] - 1.0])
+
+
 def clear_bakes():
     from sg_prt_addon.engine import scene_state
     scene_state.visibility_provider = None

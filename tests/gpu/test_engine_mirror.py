@@ -48,7 +48,7 @@ def _mirror(result, textures_by_material=None, use_visibility=True, use_shadow_m
             diffuse, specular = techniques.for_material(params).mirror(
                 params, (textures_by_material or {}).get(name, {}),
                 passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
-                passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective,
+                passes["gbuffer_tangent"][mask], fx.mirror_uv(uv[mask]), view_origin, camera.is_perspective,
                 light_data, state.environment,
                 visibility=fx.pixel_visibility(result, mask) if use_visibility else None, light_shadow=light_shadow)
             expected["Diffuse"][mask] = diffuse

@@ -30,7 +30,7 @@ def _mirror_errors(result, shadowed=False):
         view_origin = camera.position if camera.is_perspective else camera.forward
         diffuse, specular = factored_shading.shade_fragments(
             params, {}, factored.tables_for(params), passes["gbuffer_position"][mask][:, :3],
-            passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin,
+            passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], fx.mirror_uv(uv[mask]), view_origin,
             camera.is_perspective, state.light_data(), state.environment,
             visibility=fx.pixel_visibility(result, mask) if shadowed else None)
         for name, expected in (("Diffuse", diffuse), ("Specular", specular)):

@@ -41,7 +41,7 @@ def _mirror(result):
         params = state.materials[material_of_id[material_id]]
         diffuse, specular = techniques.for_material(params).mirror(
             params, {}, passes["gbuffer_position"][mask][:, :3],
-            passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin,
+            passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask], fx.mirror_uv(uv[mask]), view_origin,
             camera.is_perspective, state.light_data(), state.environment)
         expected["Diffuse"][mask] = diffuse
         expected["Specular"][mask] = specular

@@ -43,7 +43,7 @@ def _mirror_errors(result, transfer=False):
         diffuse, specular = sh_shading.shade_fragments(
             params, {}, spherical_harmonics.table_for(params, order), environment,
             passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
-            passes["gbuffer_tangent"][mask], uv[mask][:, :2], camera.position if camera.is_perspective
+            passes["gbuffer_tangent"][mask], fx.mirror_uv(uv[mask]), camera.position if camera.is_perspective
             else camera.forward, camera.is_perspective, state.light_data(), transfer=inputs)
         for name, expected in (("Diffuse", diffuse), ("Specular", specular)):
             actual = passes[name][mask][:, :3]

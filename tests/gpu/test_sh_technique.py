@@ -40,7 +40,7 @@ def _mirror_errors(result):
         diffuse, specular = sh_shading.shade_fragments(
             params, textures, spherical_harmonics.table_for(params), environment,
             passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
-            passes["gbuffer_tangent"][mask], uv[mask][:, :2], view_origin, camera.is_perspective, state.light_data())
+            passes["gbuffer_tangent"][mask], fx.mirror_uv(uv[mask]), view_origin, camera.is_perspective, state.light_data())
         for name, expected in (("Diffuse", diffuse), ("Specular", specular)):
             actual = passes[name][mask][:, :3]
             assert np.all(np.isfinite(actual)) and expected.max() > 0
@@ -140,7 +140,7 @@ def _transfer_mirror_errors(result):
         diffuse, specular = sh_shading.shade_fragments(
             params, {}, spherical_harmonics.table_for(params, order), environment,
             passes["gbuffer_position"][mask][:, :3], passes["gbuffer_normal"][mask][:, :3],
-            passes["gbuffer_tangent"][mask], uv[mask][:, :2], camera.position, camera.is_perspective,
+            passes["gbuffer_tangent"][mask], fx.mirror_uv(uv[mask]), camera.position, camera.is_perspective,
             state.light_data(), transfer=inputs)
         for name, expected in (("Diffuse", diffuse), ("Specular", specular)):
             actual = passes[name][mask][:, :3]

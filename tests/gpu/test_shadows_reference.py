@@ -151,7 +151,7 @@ def test_per_vertex_diffuse_visibility(engine, bakes, world):
             return sg_shading.shade_fragments(
                 state.materials[name], {}, passes["gbuffer_position"][mask][:, :3],
                 passes["gbuffer_normal"][mask][:, :3], passes["gbuffer_tangent"][mask],
-                passes["gbuffer_uv"][mask][:, :2], camera.position, camera.is_perspective,
+                fx.mirror_uv(passes["gbuffer_uv"][mask]), camera.position, camera.is_perspective,
                 state.light_data(), state.environment, visibility=visibility)[0]
 
         interpolated = diffuse(per_vertex)

@@ -132,9 +132,10 @@ def test_an_image_past_the_limit_is_rendered_smaller_and_named(engine, monkeypat
     smallest = _render(scene, monkeypatch, gpu_limits.SMALLEST_SIDE)
     assert not any("texture_limit_wide" in line for line in at_driver["state"].warnings)
     named = [line for line in smallest["state"].warnings if "texture_limit_wide" in line]
+    # the atlas of its mip levels is half as wide again: the image must fit in 2/3 of the side
     assert named == [f"image 'texture_limit_wide' is {wide.shape[1]} x 4, over this GPU's limit of "
-                     f"{gpu_limits.SMALLEST_SIDE} texels a side: rendered at 1/3 of its size"]
-    # a smooth ramp box-averaged by 3: the same floor within the ramp's step over 3 texels
+                     f"{gpu_limits.SMALLEST_SIDE} texels a side (with its mip levels): rendered at 1/4 of its size"]
+    # a smooth ramp box-averaged by 4: the same floor within the ramp's step over 4 texels
     np.testing.assert_allclose(smallest["passes"]["Combined"], at_driver["passes"]["Combined"], atol=2e-3)
 
 

@@ -134,6 +134,7 @@ def slice_lobes(tables, model, params, view_local, warp_mode=None, mask=None):
     mode = warp_mode or warp.DEFAULT_MODE
     small_sharpness, small_amplitude = small_lobes(model, params)
     axis, sharpness, amplitude = effective_lobes(tables, small_sharpness, small_amplitude)
+    sharpness, amplitude = sg_shading.spread_lobes(sharpness, amplitude, params.get("normal_spread"))
     m_factor = m_factor_rows(tables, model, params, small_sharpness, warp.nodes_per_lobe(mode), mask)
     return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, m_factor, mode=mode)
 

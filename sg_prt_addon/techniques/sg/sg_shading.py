@@ -50,7 +50,7 @@ import numpy as np
 
 from ...lighting import env_prefilter, equirect, lights
 from ...reflectance import brdf, ggx_albedo, layering, models
-from ...spherical import clamped_cosine, sg, texture_fetch, warp
+from ...spherical import clamped_cosine, sg, texture_fetch, texture_mips, warp
 from .. import surface_layering
 from .fitted_texels import FITTED_MODEL, fitted_m_factor, fitted_texel_values
 
@@ -471,8 +471,10 @@ def ndf_lobes(model, params, lobe_count=1):
 def fitted_slice(params, view_local, warp_mode=None):
     """Slice lobes of the stored fit: its NDF lobes (amplitude 1) warped to the view, times its M_o(i); the RGB
     lobe amplitudes come separately."""
-    axis, sharpness = params["axis"], params["sharpness"]
-    return warp.brdf_slice_lobes(axis, sharpness, np.ones_like(sharpness), view_local,
+    axis = params["axis"]
+    sharpness, amplitude = spread_lobes(params["sharpness"], np.ones_like(params["sharpness"]),
+                                        params.get("normal_spread"))
+    return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local,
                                  lambda wo, wi: fitted_m_factor(params, wo, wi), mode=warp_mode or warp.DEFAULT_MODE)
 
 
@@ -491,6 +493,7 @@ def specular_slice(model, params, lobe_count, view_local, warp_mode=None):
     if model == FITTED_MODEL:
         return fitted_slice(params, view_local, warp_mode)
     axis, sharpness, amplitude = ndf_lobes(model, params, lobe_count)
+    sharpness, amplitude = spread_lobes(sharpness, amplitude, params.get("normal_spread"))
     # brdf_slice_lobes calls m_factor with the lobe index leading, so per-pixel parameters broadcast
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT) for k, v in params.items()})
     return warp.brdf_slice_lobes(axis, sharpness, amplitude, view_local, instance.m_factor,
@@ -506,7 +509,7 @@ def visibility_node_indices(slice_count, mode=None):
 
 
 def light_tail(model, params, view_local, frame, light_axis, light_sharpness, light_cosine,
-               slice_axis, slice_sharpness, slice_amplitude):
+               slice_axis, slice_sharpness, slice_amplitude, spread_peak=None):
     """What the slice lobes miss of the model's own BRDF at each light's centre, (N, P): the long tail of
     GGX (an SG falls off as exp(-lambda theta^2 / 2), GGX as theta^-4) and the lobes' error at the
     peak.  The residual rho_s(o, i_c) - sum_j S_j(i_c) times the light's clamped-cosine integral (what
@@ -520,7 +523,9 @@ def light_tail(model, params, view_local, frame, light_axis, light_sharpness, li
     distance to it: the tail varies on the scale of its distance from the peak), 1 / lambda_L the
     light's: a point light keeps all of it (w -> 1); a broad light on the peak of a sharp lobe, where the
     SG products integrate the lobes exactly and the peak residual would be multiplied by the light's whole
-    solid angle, none of it.  Light (N, P, 3) / (N, P), slices world (N, J, 3) / (N, J)."""
+    solid angle, none of it.  Light (N, P, 3) / (N, P), slices world (N, J, 3) / (N, J).  spread_peak (N,):
+    what a normal map's spread leaves of the model's peak (normal_spread_peak): the slice lobes are then the
+    spread BRDF's and the model's own is not, so the tail fades by it."""
     light_axis = np.asarray(light_axis, FLOAT)
     cosine = np.einsum("npc,njc->npj", light_axis, slice_axis)                             # (N, P, J)
     slice_value = np.sum(slice_amplitude[:, None] * np.exp(slice_sharpness[:, None] * (cosine - FLOAT(1))), axis=-1)
@@ -530,6 +535,8 @@ def light_tail(model, params, view_local, frame, light_axis, light_sharpness, li
     instance = brdf.model_from_name(model, **{k: np.asarray(v, FLOAT)[:, None] for k, v in params.items()})
     exact = instance.specular(np.broadcast_to(view_local[:, None, :], light_local.shape), light_local)
     narrow = scale2 * light_sharpness / (FLOAT(1) + scale2 * light_sharpness)
+    if spread_peak is not None:
+        narrow = narrow * spread_peak[:, None]
     return (narrow * light_cosine * (exact - slice_value)).astype(FLOAT)
 
 
@@ -553,6 +560,7 @@ class _Pixels:
     slice_cosine: np.ndarray    # I(S_j, n), unshadowed
     albedo: object              # the model's directional albedo where it is tabulated, else None
     lobes: object = None        # the lobe source (ModelLobes, or a technique's own)
+    spread_peak: object = None  # (N,) normal_spread_peak where a normal map spreads the lobes and a light tail reads it
 
     def diffuse_factor(self, world_axis):
         """The lobe source's diffuse factor at world directions (N, P, 3) (1: none)."""
@@ -644,8 +652,11 @@ def _pixels(position, normal, tangent, view_origin, is_perspective, model, param
         scale = np.minimum(FLOAT(1), albedo / np.maximum(np.sum(slice_cosine, axis=1), FLOAT(1e-30)))[:, None]
         slice_amplitude = (slice_amplitude * scale).astype(FLOAT)
         slice_cosine = (slice_cosine * scale).astype(FLOAT)
+    spread_peak = None
+    if "normal_spread" in params and lobes.light_tail(model):
+        spread_peak = normal_spread_peak(ndf_lobes(model, params, lobe_count)[1], params["normal_spread"])
     return _Pixels(position, n, frame, view, view_local, model, params, visibility, warp_mode, slice_axis,
-                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo, lobes)
+                   slice_sharpness, slice_amplitude, slice_colour, slice_cosine, albedo, lobes, spread_peak)
 
 
 def _light_sets(position, light_data):
@@ -694,7 +705,7 @@ def _add_lights(px, light_axis, light_sharpness, light_amplitude, irradiance, sp
     weight = np.sum(weight[..., None] * px.slice_colour[:, None], axis=2)                          # (N, P, 3)
     if px.lobes.light_tail(px.model):
         tail = light_tail(px.model, px.params, px.view_local, px.frame, light_axis, light_sharpness, light_cosine,
-                          px.slice_axis, px.slice_sharpness, px.slice_amplitude)
+                          px.slice_axis, px.slice_sharpness, px.slice_amplitude, px.spread_peak)
         weight = np.maximum(weight + (tail * light_visible)[..., None], FLOAT(0))
     specular += np.sum(light_amplitude * weight, axis=1)
 
@@ -799,8 +810,12 @@ def sample_texture(image, uv):
 
 def sample_material_texture(image, uv):
     """A material texture (H, W, C) at the surface's texture coordinates, as common/surface_io.glsl's
-    material_texture reads it (bilinear, repeating as Blender's Image Texture does): float32 (N, C)."""
-    return texture_fetch.bilinear(image, np.asarray(uv, FLOAT), wrap=True).astype(FLOAT)
+    material_texture reads it (repeating as Blender's Image Texture does): float32 (N, C).  uv (N, 2), or (N, 3)
+    with the G-buffer's footprint (its uv.w - 1) third: trilinear in the image's mip levels at it
+    (spherical.texture_mips.sample); without it, bilinear in the image."""
+    uv = np.asarray(uv, FLOAT)
+    footprint = uv[:, 2] if uv.shape[-1] > 2 else None
+    return texture_mips.sample(image, uv[:, :2], footprint).astype(FLOAT)
 
 
 def material_uv(material, uv):
@@ -836,9 +851,52 @@ def surface_geometry(material, textures, normal, tangent, uv):
     shading_normal = np.asarray(normal, FLOAT)
     tangent = np.asarray(tangent, FLOAT)
     if "normal_map" in textures:
-        shading_normal = apply_normal_map(shading_normal, tangent, sample_material_texture(textures["normal_map"], uv)[:, :3],
-                                          FLOAT(material.normal_strength))
+        mapped, _ = normal_map_sample(textures["normal_map"], uv)
+        shading_normal = apply_normal_map(shading_normal, tangent, mapped, FLOAT(material.normal_strength))
     return shading_normal, rotate_tangent(shading_normal, tangent[:, :3], material.tangent_rotation)
+
+
+def normal_map_sample(image, uv):
+    """(RGB (N, 3), mip level (N,)) of a normal map at uv (N, 2), or (N, 3) with the footprint (level 0
+    without): its normals made unit before the levels are made, as the renderer uploads it."""
+    uv = np.asarray(uv, FLOAT)
+    image = texture_mips.unit_normals(image)
+    if uv.shape[-1] > 2:
+        level = texture_mips.level_of(uv[:, 2], image.shape[1], image.shape[0],
+                                      texture_mips.level_count(image.shape[1], image.shape[0]))
+    else:
+        level = np.zeros(len(uv), FLOAT)
+    return sample_material_texture(image, uv)[:, :3], level
+
+
+def normal_spread(mean, level, strength):
+    """common/surface_common.glsl's normal_spread: 1 / kappa of the normals averaged into ``mean`` (N, 3)."""
+    r = np.minimum(np.linalg.norm(np.asarray(mean, FLOAT), axis=-1), FLOAT(1.0))
+    return (np.minimum(level, FLOAT(1.0)) * FLOAT(strength) ** 2 * (1 - r * r)
+            / np.maximum(3 * r - r * r * r, FLOAT(1e-6))).astype(FLOAT)
+
+
+def normal_map_spread(material, textures, uv):
+    """The normal map's spread (N,) at uv (0 without one), as surface_io.glsl's normal_map_spread."""
+    if "normal_map" not in textures:
+        return None
+    mapped, level = normal_map_sample(textures["normal_map"], uv)
+    return normal_spread(2 * mapped - 1, level, material.normal_strength)
+
+
+def normal_spread_peak(ndf_sharpness, spread):
+    """(N,) what the normals' spread leaves of the model's peak: its sharpest NDF lobe's narrowing,
+    1 / (1 + max_k lambda_k spread) (sg_shading.glsl's normal_spread_peak, by which the light tail fades)."""
+    sharpest = np.max(np.asarray(ndf_sharpness, FLOAT).reshape(len(spread), -1), axis=1)
+    return (FLOAT(1) / (FLOAT(1) + sharpest * np.asarray(spread, FLOAT))).astype(FLOAT)
+
+
+def spread_lobes(sharpness, amplitude, spread):
+    """surface_common.glsl's spread_lobe of NDF lobes (N, K) by the normals' spread (N,)."""
+    if spread is None:
+        return sharpness, amplitude
+    narrowing = FLOAT(1) / (FLOAT(1) + np.asarray(sharpness, FLOAT) * np.asarray(spread, FLOAT)[:, None])
+    return sharpness * narrowing, amplitude * narrowing
 
 
 def surface_layers(material, roughness_texture, uv, diffuse_color, specular_color, shading_normal, position,
@@ -877,6 +935,8 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
     if fitted is not None:         # the stored lobe fit (MODEL_FITTED): only a normal map (and a bi-scale mask) apply
         model_params, diffuse_color = fitted_texel_values(fitted, uv)
         shading_normal, shading_tangent = surface_geometry(material, textures, normal, tangent, uv)
+        if "normal_map" in textures:
+            model_params["normal_spread"] = normal_map_spread(material, textures, uv)
         return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, FITTED_MODEL,
                      model_params, diffuse_color, np.ones((count, 3), FLOAT), light_data, environment,
                      visibility=visibility, warp_mode=getattr(material, "warp_mode", None), lobes=lobes,
@@ -896,6 +956,8 @@ def shade_fragments(material, textures, position, normal, tangent, uv, view_orig
                                                        shading_normal, position, view_origin, is_perspective)
     model = material.model
     model_params = {key: params[key] for key in models.BY_NAME[model].parameters}
+    if "normal_map" in textures:
+        model_params["normal_spread"] = normal_map_spread(material, textures, uv)
     return shade(position, shading_normal, shading_tangent, view_origin, is_perspective, model, model_params,
                  diffuse_color, specular_color, light_data, environment,
                  lobe_count=material.lobe_count if model in models.ANISOTROPIC else 1,

@@ -31,6 +31,25 @@ vec3 apply_normal_map(vec3 normal, vec4 tangent, vec3 sample_value, float streng
   return safe_normalize(n + (mapped - n) * strength);
 }
 
+/* The spread 1 / kappa of the normals a minified normal map averaged into `mean` (decoded, unit texels: its
+ * length r < 1): the von Mises-Fisher concentration of mean length r, kappa ~ (3 r - r^3) / (1 - r^2) (Banerjee
+ * et al. 2005), the map's strength squared scaling the variance; faded in over the first mip level, so a
+ * magnified map's bilinear blend of texels adds none (mirror: techniques.sg.sg_shading.normal_spread). */
+float normal_spread(vec3 mean, float level, float strength)
+{
+  float r = min(length(mean), 1.0);
+  return min(level, 1.0) * strength * strength * (1.0 - r * r) / max(3.0 * r - r * r * r, 1.0e-6);
+}
+
+/* An NDF lobe convolved with the normals' spread (an SG of sharpness 1 / spread): sharpness
+ * lambda / (1 + lambda spread), its integral kept (mirror: techniques.sg.sg_shading.spread_lobes). */
+void spread_lobe(inout float sharpness, inout float amplitude, float spread)
+{
+  float narrowing = 1.0 / (1.0 + sharpness * spread);
+  sharpness *= narrowing;
+  amplitude *= narrowing;
+}
+
 vec3 rotate_tangent(vec3 normal, vec3 tangent, float rotation)
 {
   vec3 n, t, b;

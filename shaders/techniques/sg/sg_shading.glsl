@@ -144,13 +144,19 @@ vec3 slice_colour[SLICE_LOBES];
 float slice_cosines[SLICE_LOBES];
 float slice_albedo;
 float model_albedo;
+/* What a normal map's spread leaves of the model's peak: its sharpest NDF lobe's narrowing, by which the light
+ * tail fades (techniques.sg.sg_shading.normal_spread_peak). */
+float normal_spread_peak;
 
 void slice_lobes(vec4 p, vec4 q, vec3 view_local, mat3 frame, vec3 n)
 {
+  normal_spread_peak = 1.0;
   for (int k = 0; k < NDF_LOBES; k++) {
     vec3 ndf_axis, colour;
     float ndf_sharpness, ndf_amplitude;
     lobes_ndf(k, p, q, view_local, ndf_axis, ndf_sharpness, ndf_amplitude, colour);
+    normal_spread_peak = min(normal_spread_peak, 1.0 / (1.0 + ndf_sharpness * normal_map_spread));
+    spread_lobe(ndf_sharpness, ndf_amplitude, normal_map_spread);
     /* warp.DEFAULT_MODE: WARP_FUNCTION with WARP_NODES lobes per NDF lobe (defines from the variant) */
     vec3 warped_axis[WARP_NODES];
     float warped_sharpness[WARP_NODES], warped_amplitude[WARP_NODES];
@@ -292,7 +298,9 @@ void shade_lights(vec3 position, vec3 n, vec3 view_local, mat3 frame, vec4 p, ve
       scale2 = min(scale2, 1.0 / max(slice_sharpness[j], 1.0e-6) + 2.0 * (1.0 - c));
     }
     float narrow = scale2 * light_sharpness / (1.0 + scale2 * light_sharpness);
-    float tail = narrow * light_cosine * (model_specular(view_local, light_axis * frame, p, q) - slice_value);
+    /* a normal map's spread: the slice lobes are the spread BRDF's, the model's own is not; the tail fades */
+    float tail = normal_spread_peak * narrow * light_cosine
+                 * (model_specular(view_local, light_axis * frame, p, q) - slice_value);
     weight = max(weight + tail * light_visibility, vec3(0.0));
 #endif
     radiance += light_amplitude * weight;
