@@ -44,6 +44,8 @@ Mapping per model (ours -> nodes) and the mismatches left:
 - GGX_ANISO (ours: Cycles' anisotropic GGX, alpha_x along the tangent) -> Glossy BSDF, GGX,
   the roughness and Anisotropy whose alphas the node makes are ours (glossy_node_anisotropy),
   colour ks, the tangent wired as for Ashikhmin-Shirley.  Exact up to Cycles' own Smith form, as GGX.
+- BECKMANN (the Glossy BSDF's) -> Glossy BSDF, Beckmann, same roughness, colour ks: exact up to Cycles'
+  Smith form.
 - Others (not in the example scenes): BLINN_PHONG -> Beckmann alpha = sqrt(2/(n + 2));
   WARD_ISO / WARD_ANISO -> Beckmann of the same alphas (anisotropic as above), colour ks.
 - Textures: diffuse and specular colour textures multiply the colours (sRGB images decoded
@@ -195,11 +197,11 @@ def match_material(material):
     specular = _textured_colour(builder, settings, "specular_color")
     model = settings.model
     description = model
-    if model == "GGX":
-        glossy.distribution = "GGX"
+    if model in ("GGX", "BECKMANN"):
+        glossy.distribution = model
         builder.link(_textured_scalar(builder, settings, "roughness"), glossy.inputs["Roughness"])
         builder.link(specular, glossy.inputs["Color"])
-        description = "Glossy GGX, same roughness, colour ks"
+        description = f"Glossy {'GGX' if model == 'GGX' else 'Beckmann'}, same roughness, colour ks"
     elif model == "COOK_TORRANCE":
         glossy.distribution = "BECKMANN"
         m = _textured_scalar(builder, settings, "roughness")

@@ -18,7 +18,7 @@ def test_importing_the_suite_does_not_import_bpy():
 
 
 def test_every_scene_records_its_kind_and_roughness():
-    assert len(ts.SCENES) == 15
+    assert len(ts.SCENES) == 17
     for name, scene in ts.SCENES.items():
         assert scene.kind in ("diffuse", "glossy"), name
         assert (scene.roughness is None) == (scene.kind == "diffuse"), name
@@ -145,6 +145,25 @@ def test_markdown_section_and_its_replacement_in_accuracy_md():
     assert twice.count(ts.SECTION_TITLE) == 1 and "(128x128;" in twice and "## warp\n\nrows\n" in twice
     middle = ts.replace_section(text.replace("## warp", ts.SECTION_TITLE + "\n\nold\n\n## warp"), section)
     assert "old" not in middle and middle.index(ts.SECTION_TITLE) < middle.index("## warp")
+
+
+def test_a_later_run_of_some_scenes_goes_into_the_earlier_json():
+    earlier = {**_data(), "goals": [{"scene": "a"}, {"scene": "b"}]}
+    later_rows = [ts.make_row("b", "SG-PRT", "again", 0.2, 0.01, 0.0, 0.02), ts.make_row("c", "SG-PRT", "new", 0.3)]
+    later = {**_data(), "command": "python -m benchmarks.truth_suite --scenes b,c", "runtime_seconds": 30.0,
+             "date": "2026-01-02 00:00 UTC", "scenes": {"b": {"kind": "glossy", "roughness": 0.3},
+                                                        "c": {"kind": "diffuse", "roughness": None}},
+             "rows": later_rows, "goals": [{"scene": "b", "new": True}, {"scene": "c"}]}
+    merged = ts.merged_run(earlier, later)
+    assert [row["scene"] for row in merged["rows"]].count("b") == 1 and merged["rows"][-2:] == later_rows
+    assert set(merged["scenes"]) == {"a", "b", "c"} and {"scene": "b", "new": True} in merged["goals"]
+    assert merged["command"] == earlier["command"] and len(merged["goals"]) == 3
+    assert merged["added_runs"] == [{"command": later["command"], "scenes": ["b", "c"], "date": later["date"],
+                                     "runtime_seconds": 30.0}]
+    section = ts.markdown_section(merged)
+    assert "; b, c: `.venv/bin/python -m benchmarks.truth_suite --scenes b,c` (0.5 min; 2026-01-02" in section
+    with pytest.raises(ValueError, match="cycles_samples"):
+        ts.merged_run(earlier, {**later, "cycles_samples": 64})
 
 
 def test_before_sentence_names_a_change_of_truth_samples():
