@@ -145,6 +145,7 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
                                          region_3d.is_perspective)
         camera.shading_footprint = anti_aliasing.specular_footprint(
             1, specular_anti_aliasing(depsgraph.scene), scene_pixel_filter(depsgraph.scene).footprint_side())
+        camera.texture_footprint = anti_aliasing.texture_footprint(1)
         try:
             self.viewport_frame.update(self.viewport_state, camera, width, height,
                                        0.0 if depsgraph.scene.render.film_transparent else 1.0)
@@ -179,6 +180,7 @@ class ViewportFrame:
     def update(self, state, camera, width, height, background_alpha=1.0):
         """Draw if needed; returns whether it drew."""
         signature = (width, height, float(background_alpha), bool(camera.is_perspective), camera.shading_footprint,
+                     camera.texture_footprint,
                      np.asarray(camera.view, np.float64).tobytes(), np.asarray(camera.projection, np.float64).tobytes())
         if signature == self.signature and not state.dirty.any():
             return False
@@ -308,8 +310,9 @@ def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, t
         return {name: summed[name.lower()] for name in renderer_module.PASS_NAMES}
     # a sample's specular footprint: the filter's at the centre, a grid cell (one pixel of a tile) in the grid
     specular_aa = camera.shading_footprint > 0.0
-    centred = dataclasses.replace(camera, shading_footprint=anti_aliasing.specular_footprint(
-        1, specular_aa, chosen_filter.footprint_side()))
+    centred = dataclasses.replace(
+        camera, shading_footprint=anti_aliasing.specular_footprint(1, specular_aa, chosen_filter.footprint_side()),
+        texture_footprint=anti_aliasing.texture_footprint(1))
     renderer.upload(state, state.consume_dirty(), centred)
     renderer.draw(state, centred, background_alpha=background_alpha)
     sums.start_at_edges(renderer, threshold, floor)
@@ -329,7 +332,8 @@ def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, t
         tile_camera = dataclasses.replace(
             camera, projection=anti_aliasing.tile_projection(camera.projection, apron_origin, tile + 2 * reach,
                                                              width, height),
-            shading_footprint=cell, footprint_grid_limit=anti_aliasing.footprint_grid_limit(side))
+            shading_footprint=cell, texture_footprint=1.0,
+            footprint_grid_limit=anti_aliasing.footprint_grid_limit(side))
         renderer.upload(state, state.consume_dirty(), tile_camera, shadow_camera=camera)
         sums.draw_edge_tile(renderer, state, tile_camera, origin, tile, side, reach, background_alpha)
         drawn += 1
@@ -369,6 +373,7 @@ def render_frame(depsgraph, width, height, gbuffer=False, state=None, renderer=N
     # the G-buffer the mirrors read is shaded at the pixels' centres
     camera.shading_footprint = anti_aliasing.specular_footprint(
         samples, specular_anti_aliasing(scene) and not gbuffer, scene_pixel_filter(scene).footprint_side())
+    camera.texture_footprint = anti_aliasing.texture_footprint(samples)
     timings["export"] = time.perf_counter() - start
     renderer = renderer or renderer_module.Renderer(gbuffer=gbuffer)
     start = time.perf_counter()

@@ -123,7 +123,7 @@ def scene_block(camera, light_data, environment, shadow_plan=None):
         vec4_array(2 * MAX_ENV_LOBES, clamped_cosine.sharpness_terms(environment.lobe_sharpness[:env_lobes], np.float32)
                    if env_lobes else []),
         np.asarray(_column_major(camera.projection @ camera.view), np.float32).reshape(4, 4),   # mat4 columns
-        np.array([[camera.shading_footprint, camera.footprint_grid_limit, 0.0, 0.0]], np.float32),
+        np.array([[camera.shading_footprint, camera.footprint_grid_limit, camera.texture_footprint, 0.0]], np.float32),
         shadow_pass.scene_rows(shadow_plan, light_data),
     ]
     return np.concatenate(parts, axis=0)

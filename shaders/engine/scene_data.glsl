@@ -36,7 +36,8 @@ struct SceneData {
   mat4 view_projection;
   /* x: the side, in pixels, of the square each pixel's shading averages its specular over (engine/
    * anti_aliasing.py specular_footprint): 1 one frame, 1/m each of m x m jittered frames, 0 the centre alone;
-   * y: the most samples a side of that square (anti_aliasing.footprint_grid_limit) */
+   * y: the most samples a side of that square (anti_aliasing.footprint_grid_limit); z: the side, in pixels, of
+   * the square each pixel's material textures are read over (anti_aliasing.texture_footprint) */
   vec4 shading_footprint;
   /* the lights' shadow maps (lighting/shadow_maps.py ShadowPlan): x tile side (texels, 0: none), y tiles a row,
    * z a face's share of its tile, w lights with a map */

@@ -30,6 +30,8 @@ def test_pixel_jitter_patterns():
     assert [anti_aliasing.specular_footprint(n) for n in (1, 4, 16)] == [1.0, 0.5, 0.25]
     assert anti_aliasing.specular_footprint(16, enabled=False) == 0.0
     assert anti_aliasing.specular_footprint(1, filter_side=1.44) == 1.44     # one frame: the filter's square
+    # textures: the pixel, or a jittered frame's cell of it (its mip level; not the filter's square)
+    assert [anti_aliasing.texture_footprint(n) for n in (1, 4, 16)] == [1.0, 0.5, 0.25]
 
 
 def _scene(name, size, samples, specular_anti_aliasing=False, roughness=0.25, edges_only=False,

@@ -11,11 +11,12 @@ vec3 surface_facing_normal()
   return front ? world_normal : -world_normal;
 }
 
-/* The texture coordinates' footprint in a pixel: the larger of their screen derivatives (numpy mirror: the
- * G-buffer's uv.w - 1). */
+/* The texture coordinates' footprint in a pixel: the larger of their screen derivatives, times the side of the
+ * square the pixel stands for (the scene block's shading_footprint.z: a cell of a jittered frame's grid; numpy
+ * mirror: the G-buffer's uv.w - 1). */
 float texture_footprint()
 {
-  return max(length(dFdx(texcoord)), length(dFdy(texcoord)));
+  return max(length(dFdx(texcoord)), length(dFdy(texcoord))) * scene.shading_footprint.z;
 }
 
 /* texture_footprint as the fragment's first material texture took it, outside any loop: a lobe source may read
