@@ -1,6 +1,6 @@
 """Batch render a .blend with the SG-PRT engine through the pip `bpy` module.
 
-    python -m sg_prt_addon.render scene.blend -o out.png [--width 512 --height 512]
+    python -m sg_prt_addon.render scene.blend -o out.png [--width 512 --height 512] [--frame 12]
 
 With a Blender binary and the extension installed, the same render is
 `blender -b scene.blend -E SG_PRT -f 1`.
@@ -45,8 +45,10 @@ def ensure_registered():
         sg_prt_addon.register()
 
 
-def render_to_file(scene, output, width=None, height=None):
+def render_to_file(scene, output, width=None, height=None, frame=None):
     import bpy
+    if frame is not None:
+        scene.frame_set(int(frame))
     scene.render.engine = ENGINE_ID
     if width:
         scene.render.resolution_x = width
@@ -84,12 +86,14 @@ def main(argv=None):
     parser.add_argument("-o", "--output", required=True, help="output image (.png or .exr)")
     parser.add_argument("--width", type=int, help="override the scene's resolution")
     parser.add_argument("--height", type=int, help="override the scene's resolution")
+    parser.add_argument("--frame", type=int, help="the frame to render (default: the scene's current frame)")
     arguments = parser.parse_args(argv)
 
     clock = StageClock()
     clock.run("register add-on", ensure_registered)
     scene = clock.run("open scene", open_blend, arguments.blend)
-    output = clock.run("render", render_to_file, scene, arguments.output, arguments.width, arguments.height)
+    output = clock.run("render", render_to_file, scene, arguments.output, arguments.width, arguments.height,
+                       arguments.frame)
     print(f"[sg-prt] wrote {output}", flush=True)
     return clock.durations
 

@@ -1,7 +1,7 @@
 """Render Samples on the GPU: the frames' passes summed in float targets and read back once.
 
-Every pixel sampled: jittered frames (their offsets drawn from the pixel filter: engine/pixel_filter.py), each
-added whole.  Edges Only: a frame shaded at the pixels' centres, the mask of its edges
+Every pixel sampled: jittered frames, each pixel adding the frame's pixels around it weighted by the pixel filter
+(engine/pixel_filter.py frame_weights).  Edges Only: a frame shaded at the pixels' centres, the mask of its edges
 (engine/edge_pixels.frag.glsl; mirror anti_aliasing.edge_pixels), and each tile of the image that holds an edge
 drawn grid_side times larger, with an apron of the pixels the filter reaches around it, shading only the edge
 pixels and their neighbours within that reach (the others fail a near-plane depth), then each edge pixel the

@@ -169,8 +169,9 @@ class SGPRT_RenderEngine(bpy.types.RenderEngine):
 
 class ViewportFrame:
     """view_draw's work, which needs no window: the scene is drawn again only when something changed
-    (the scene's dirty set, the view, the region's size, the film or the pixel filter's footprint); otherwise the last image is
-    shown again, a texture blit (Blender redraws the viewport for overlays, cursor moves, UI...)."""
+    (the scene's dirty set, the view, the region's size, the film or the footprints the pixel filter sets);
+    otherwise the last image is shown again, a texture blit (Blender redraws the viewport for overlays, cursor
+    moves, UI...)."""
 
     def __init__(self):
         self.renderer = renderer_module.Renderer()
