@@ -51,9 +51,15 @@ def pixel_mask_calls():
     return calls
 
 
+# Blender 5.3 binds a full-screen pass's fourth sampler to its first one as well unless the pass declares a
+# uniform block (measured: the first read the fourth's texture); the passes of four samplers or more declare the
+# scene block, and bind it.
+SCENE_BLOCK = ("uniform_buf", (0, "SceneData", "scene"))
+
+
 def add_frame_calls():
     """A jittered frame's passes, weighted by the pixel filter, into the sums (engine/add_frame.frag.glsl)."""
-    calls = shader_sources.full_screen_calls("sgprt_add_frame_interface", {})
+    calls = shader_sources.full_screen_calls("sgprt_add_frame_interface", {}) + [SCENE_BLOCK]
     calls += _frame_samplers() + [("sampler", (len(PASSES), "FLOAT_2D", "frame_weights"))] + _pass_outputs()
     calls.append(("fragment_source", (shader_sources.engine_source("add_frame.frag.glsl"),)))
     return calls
@@ -62,7 +68,7 @@ def add_frame_calls():
 def add_edge_tile_calls():
     """An edge tile's samples, weighted by the pixel filter, into the sums at the mask's pixels
     (engine/add_edge_tile.frag.glsl)."""
-    calls = shader_sources.full_screen_calls("sgprt_add_edge_tile_interface", {})
+    calls = shader_sources.full_screen_calls("sgprt_add_edge_tile_interface", {}) + [SCENE_BLOCK]
     calls += [("push_constant", ("IVEC2", "tile_origin")), ("push_constant", ("INT", "grid_side"))]
     calls += _frame_samplers()
     calls += [("sampler", (len(PASSES), "FLOAT_2D", "pixel_mask")),
@@ -70,6 +76,15 @@ def add_edge_tile_calls():
     calls += _pass_outputs()
     calls.append(("fragment_source", (shader_sources.engine_source("add_edge_tile.frag.glsl"),)))
     return calls
+
+
+def _weights_texture(rows):
+    """An R32F texture of (rows, columns) weights."""
+    import gpu
+
+    values = np.ascontiguousarray(rows, np.float32)
+    return gpu.types.GPUTexture((values.shape[1], values.shape[0]), format="R32F",
+                                data=gpu.types.Buffer("FLOAT", values.size, values.ravel().tolist()))
 
 
 class FrameSums:
@@ -146,8 +161,7 @@ class FrameSums:
         values = [float(value) for value in weights]
         if self.filter_weights_values == values:
             return
-        self.filter_weights = gpu.types.GPUTexture((len(values), 1), format="R32F",
-                                                   data=gpu.types.Buffer("FLOAT", len(values), values))
+        self.filter_weights = _weights_texture(np.asarray(values, np.float32)[None, :])
         self.filter_weights_values = values
 
     def draw_edge_tile(self, renderer, state, tile_camera, origin, tile, grid_side, reach, background_alpha):
@@ -189,6 +203,7 @@ class FrameSums:
                 shader.uniform_sampler("frame_" + name, texture)
             shader.uniform_sampler("pixel_mask", self.mask)
             shader.uniform_sampler("filter_weights", self.filter_weights)
+            shader.uniform_block("scene", renderer.scene_buffer)
             renderer.full_screen_batch(shader, "add_edge_tile").draw(shader)
             gpu.state.blend_set("NONE")
             gpu.state.viewport_set(0, 0, *self.size)
@@ -198,10 +213,7 @@ class FrameSums:
         one frame's pixel_filter.frame_weights."""
         import gpu
 
-        weights = np.asarray(weights, np.float32)
-        values = [float(value) for value in weights.ravel()]
-        frame_weights = gpu.types.GPUTexture((weights.shape[1], 2), format="R32F",
-                                             data=gpu.types.Buffer("FLOAT", len(values), values))
+        frame_weights = _weights_texture(np.asarray(weights, np.float32))
 
         shader = shader_cache.get_fixed_shader(("add_frame",), add_frame_calls, "add frame")
         with self.sums_framebuffer.bind():
@@ -211,6 +223,7 @@ class FrameSums:
             for name, texture in zip(PASSES, renderer.targets):
                 shader.uniform_sampler("frame_" + name, texture)
             shader.uniform_sampler("frame_weights", frame_weights)
+            shader.uniform_block("scene", renderer.scene_buffer)
             renderer.full_screen_batch(shader, "add_frame").draw(shader)
             gpu.state.blend_set("NONE")
 
