@@ -156,8 +156,6 @@ class FrameSums:
 
     def set_filter_weights(self, weights):
         """The pixel filter's weights along an axis for draw_edge_tile (pixel_filter.grid_weights)."""
-        import gpu
-
         values = [float(value) for value in weights]
         if self.filter_weights_values == values:
             return
@@ -213,8 +211,7 @@ class FrameSums:
         one frame's pixel_filter.frame_weights."""
         import gpu
 
-        frame_weights = _weights_texture(np.asarray(weights, np.float32))
-
+        frame_weights = _weights_texture(weights)
         shader = shader_cache.get_fixed_shader(("add_frame",), add_frame_calls, "add frame")
         with self.sums_framebuffer.bind():
             gpu.state.depth_test_set("NONE")
