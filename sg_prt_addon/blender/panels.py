@@ -20,18 +20,21 @@ class MaterialPanel:
 
 
 class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
-    bl_label = "SG-PRT Surface"
+    """The material's one Surface panel: its Source and Technique, then what SG-PRT renders of it, the node
+    tree's surface as Blender draws it (its own Surface panel is not shown) or SG-PRT's settings."""
+    bl_label = "Surface"
 
     def draw(self, context):
-        settings = context.material.sgprt
+        material = context.material
+        settings = material.sgprt
         layout = self.layout
         layout.use_property_split = True
         layout.prop(settings, "source")
         layout.prop(settings, "technique")
         if settings.source == "NODE_TREE":
-            layout.label(text="Shading nodes: Principled, Diffuse, Glossy, Emission, Mix, Add", icon="NODETREE")
+            _draw_node_surface(layout, material)
             layout.operator("sgprt.copy_from_node_tree")
-            technique_sides.draw(layout, context.material)
+            technique_sides.draw(layout, material)
             return
         layout.prop(settings, "model")
         textured = settings.show_textures
@@ -47,6 +50,17 @@ class SGPRT_PT_material(MaterialPanel, bpy.types.Panel):
         technique_sides.draw(layout, context.material)
         layout.prop(settings, "show_textures")
 
+
+
+def _draw_node_surface(layout, material):
+    """The material output's Surface input and the nodes behind it, as EEVEE's and Cycles' Surface panels draw
+    them; a material without nodes (Blender 4.x's Use Nodes off) offers Use Nodes."""
+    from bl_ui.properties_material import panel_node_draw
+
+    if material.node_tree is None or not getattr(material, "use_nodes", True):
+        layout.prop(material, "use_nodes", icon="NODETREE")
+        return
+    panel_node_draw(layout, material.node_tree, "OUTPUT_MATERIAL", "Surface")
 
 
 class SGPRT_PT_material_geometry(MaterialPanel, bpy.types.Panel):
@@ -129,7 +143,6 @@ COMPATIBLE_BUILTIN_PANELS = (
     "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_output", "RENDER_PT_color_management",
     "DATA_PT_context_light", "DATA_PT_light", "DATA_PT_lens", "DATA_PT_camera", "DATA_PT_camera_display",
     "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface", "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_context_material",
-    "EEVEE_MATERIAL_PT_surface",
 )
 
 

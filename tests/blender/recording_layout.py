@@ -22,6 +22,10 @@ class RecordingLayout:
         getattr(data, name)
         self.calls.append(("template_ID", name))
 
+    def template_node_view(self, tree, node, socket):
+        assert socket.node == node and node.id_data == tree      # the output's own socket, in the material's tree
+        self.calls.append(("template_node_view", socket.name))
+
     def row(self, **kwargs):
         return self
 

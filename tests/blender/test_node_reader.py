@@ -170,7 +170,10 @@ def test_panel_and_copy_from_node_tree(empty_file):
 
     calls = drawn()
     assert ("prop", "source") in calls and ("operator", "sgprt.copy_from_node_tree") in calls
-    assert ("prop", "model") not in calls
+    # one Surface panel: the node tree's surface drawn in it, and Blender's own not shown beside it
+    assert ("template_node_view", "Surface") in calls and ("prop", "model") not in calls
+    assert panels.SGPRT_PT_material.bl_label == "Surface"
+    assert panels.ENGINE_ID not in bpy.types.EEVEE_MATERIAL_PT_surface.COMPAT_ENGINES
     with bpy.context.temp_override(material=material):
         assert bpy.ops.sgprt.copy_from_node_tree() == {"FINISHED"}
     assert material.sgprt.source == "SETTINGS" and ("prop", "model") in drawn()

@@ -144,8 +144,17 @@ def lobe_fit():
 
 
 def material_panels():
-    area("PROPERTIES")[1].spaces[0].context = "MATERIAL"
-    next_step("material context")
+    window, properties, region = area("PROPERTIES")
+    properties.spaces[0].context = "MATERIAL"
+    material = bpy.data.objects["Suzanne"].active_material
+    # the material (the tab has not drawn yet, so the editor's context holds none this tick)
+    with bpy.context.temp_override(window=window, area=properties, region=region, material=material):
+        # the material tab's panels that poll true here: (class, label)
+        shown = sorted((cls.__name__, cls.bl_label) for cls in bpy.types.Panel.__subclasses__()
+                       if getattr(cls, "bl_space_type", "") == "PROPERTIES"
+                       and getattr(cls, "bl_context", "") == "material"
+                       and (not hasattr(cls, "poll") or cls.poll(bpy.context)))
+    next_step("material context", panels=shown)
 
 
 def invoke_fit():

@@ -71,8 +71,8 @@ def _region(image, place):
 def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     """In a window under Xvfb: the 3D view in Rendered shading shows the scene and follows a material edit,
     and with a render border shows it inside the border only; the render panels draw; Bake Visibility runs modal with progress and writes a bake; a second bake
-    cancelled with Esc writes nothing and keeps the first; the material panels draw and Fit Lobes fits a MERL
-    file."""
+    cancelled with Esc writes nothing and keeps the first; the material panels draw, one Surface panel among
+    them, and Fit Lobes fits a MERL file."""
     from validation import brdf_generators
 
     out = real_blender.work / "window"
@@ -119,6 +119,9 @@ def test_a_window_renders_edits_and_bakes_with_esc(real_blender, scene_file):
     assert steps["fit finished"]["record"] is not None and steps["fit finished"]["record"].startswith("1 lobes")
     material = _region(read_float_image(out / "material_panels.png"), places["properties"])
     assert np.abs(material - panels).mean() > 0.005                # the material's panels, not the render's
+    # one Surface panel, SG-PRT's, which draws the node tree's surface or its settings: not EEVEE's beside it
+    shown = dict(map(tuple, steps["material context"]["panels"]))
+    assert list(shown.values()).count("Surface") == 1 and shown.get("SGPRT_PT_material") == "Surface", shown
     progress = read_float_image(out / "bake_progress.png")[status_bar]
     assert np.abs(progress - read_float_image(out / "render_panels.png")[status_bar]).mean() > 0.002
     shots = ROOT / "out" / "ui"                                    # for the README's pictures (not committed)
