@@ -1,6 +1,7 @@
-"""Sub-pixel offsets of the frames a final render averages (Render Samples): strata of the pixel, which the
-pixel filter (engine/pixel_filter.py) spreads by its own distribution; the projection moved by one; and the
-footprint each frame's shading averages its specular over (Specular Anti-Aliasing).  Pixels: x to the right, y DOWN, as validation/camera.py.
+"""Sub-pixel offsets of the frames a final render averages (Render Samples): strata of the pixel, whose samples
+the pixel filter weighs (engine/pixel_filter.py frame_weights); the projection moved by one; and the footprint
+each frame's shading averages its specular and reads its textures over (Specular Anti-Aliasing, the textures' mip
+level).  Pixels: x to the right, y DOWN, as validation/camera.py.
 
 Edges Only (engine/multi_sample.py draws it): which pixels of a frame shaded at the pixels' centres are
 edges (edge_pixels, the mirror of engine/edge_pixels.frag.glsl), the grid of samples an edge pixel takes,

@@ -7,6 +7,7 @@ from the filter; here every sample weighs by the filter the pixels it falls near
 and its neighbours (nine times the samples a pixel for a 3-pixel filter): the jittered frames' (frame_weights)
 and Edges Only's supersampled tiles' (grid_weights).  Offsets in pixels from the pixel's centre."""
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -78,10 +79,7 @@ class PixelFilter:
 
     def variance(self):
         """The filter's variance along an axis, pixels squared."""
-        radius = max(self.radius, 1e-6)
-        x = np.linspace(-radius, radius, _QUADRATURE_POINTS)
-        density = self.weight(x)
-        return float(_trapezoids(x * x * density, x).sum() / _trapezoids(density, x).sum())
+        return _variance(self)
 
     def footprint_side(self):
         """The side of the square, in pixels, whose box has the filter's variance (side^2 / 12): what a frame
@@ -100,6 +98,15 @@ class PixelFilter:
             nearest = np.abs(positions)
             weights = (nearest <= nearest.min() + 1e-9).astype(np.float64)
         return weights / weights.sum()
+
+
+@lru_cache(maxsize=16)
+def _variance(pixel_filter):
+    """PixelFilter.variance by the trapezoid rule, once a filter: the viewport asks for it at every redraw."""
+    radius = max(pixel_filter.radius, 1e-6)
+    x = np.linspace(-radius, radius, _QUADRATURE_POINTS)
+    density = pixel_filter.weight(x)
+    return float(_trapezoids(x * x * density, x).sum() / _trapezoids(density, x).sum())
 
 
 def _trapezoids(values, x):

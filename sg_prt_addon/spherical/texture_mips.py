@@ -27,13 +27,12 @@ def levels(image):
 
 
 def level_rect(size, level):
-    """((x, y) origin, (w, h) size) of a level in the atlas of an image of size (W, H)."""
-    width, height = int(size[0]), int(size[1])
-    origin, current = (0, 0), (width, height)
-    for index in range(level):
-        origin = (width, 0 if index == 0 else origin[1] + current[1])
-        current = (max((current[0] + 1) // 2, 1), max((current[1] + 1) // 2, 1))
-    return origin, current
+    """((x, y) origin, (w, h) size) of a level in the atlas of an image of size (W, H): level 0 at the origin, the
+    others stacked in the column at its right."""
+    sizes = _sizes(*size)
+    if level == 0:
+        return (0, 0), sizes[0]
+    return (sizes[0][0], sum(h for _, h in sizes[1:level])), sizes[level]
 
 
 def atlas_size(width, height):
@@ -91,13 +90,13 @@ def level_of(footprint, width, height, count):
     return np.clip(level, np.float32(0.0), np.float32(count - 1))
 
 
-def sample(image, uv, footprint=None, pyramid=None):
+def sample(image, uv, footprint=None):
     """The image at texture coordinates uv (N, 2), repeating: bilinear in level 0 where footprint is None, else
-    trilinear at level_of(footprint) (the mirror of material_texture).  pyramid: levels(image), if made."""
+    trilinear at level_of(footprint) (the mirror of material_texture)."""
     uv = np.asarray(uv)
     if footprint is None:
         return texture_fetch.bilinear(np.asarray(image), uv, wrap=True)
-    pyramid = levels(image) if pyramid is None else pyramid
+    pyramid = levels(image)
     height, width = pyramid[0].shape[:2]
     level = level_of(footprint, width, height, len(pyramid))
     low = np.floor(level).astype(np.int64)
