@@ -12,11 +12,13 @@ COPIED_FIELDS = ("model", "diffuse_color", "specular_color", "roughness", "alpha
 
 def copy_reading(material):
     """Write the reading into material.sgprt; returns the reading's notes (with the slots whose texture the
-    nodes compute from several images, or an affine function of one: the settings hold one image a slot)."""
+    settings cannot hold: one the nodes compute from several images, or an affine function or channel of one
+    (the settings hold one image a slot), and the emission's (the settings have no emission texture))."""
     reading = node_reader.read_material(material)
-    computed = sorted(slot for slot, value in reading.textures.items() if not isinstance(value, str))
-    if computed:
-        reading.notes.append(f"computed textures not copied (the factor alone): {', '.join(computed)}")
+    held = properties.TEXTURED_PARAMETERS + ("normal_map",)
+    dropped = sorted(slot for slot, value in reading.textures.items() if not isinstance(value, str) or slot not in held)
+    if dropped:
+        reading.notes.append(f"textures not copied (the factor alone): {', '.join(dropped)}")
     settings = material.sgprt
     for name in COPIED_FIELDS:
         if name in reading.fields:

@@ -1,14 +1,15 @@
 """A material's shader nodes read as the engine's parameters (material.sgprt.source = Node Tree).
 
-From the active Material Output's Surface, the shader tree is walked into weighted closures: Principled,
-Diffuse and Glossy BSDFs, Emission, through Mix Shader (its factor a constant or a texture) and Add Shader.
-Their inputs are read as texture_expression.Expressions: unlinked sockets, RGB, Value, Image Texture (its
-Color, over the UV map), Math (add, subtract, multiply; divide by a constant), Invert and Mix / MixRGB
-(mix, multiply, add) of them, a Normal Map in tangent space.  reflectance/principled.py maps the BSDFs'
-values to the model, colours and layering; an expression that is a constant or a factor times one image
-takes the engine's factor x texture path, any other one (a metallic map, a texture factor) becomes a texture
-computed from its images (export.slot_pixels).  What cannot be read as Blender renders it takes the nearest
-reading (a socket's default value) and is named in one warning per material.
+From the Material Output EEVEE renders, the shader tree (node_graph: groups entered, reroutes and muted nodes
+passed) is walked into weighted closures: Principled, Diffuse and Glossy BSDFs, Emission, through Mix Shader
+(its factor a constant or a texture) and Add Shader.  Their inputs are read as texture_expression.Expressions:
+unlinked sockets, RGB, Value, Image Texture (its Color, over the UV map), Math (add, subtract, multiply; divide
+by a constant), Invert, Mix / MixRGB (mix, multiply, add), Separate and Combine Color (RGB) and XYZ of them, a
+Normal Map in tangent space.  reflectance/principled.py maps the BSDFs' values to the model, colours and
+layering; an expression that is a constant or a factor times one image takes the engine's factor x texture
+path, any other one (a metallic map, an image's channel, a texture factor) becomes a texture computed from its
+images (export.slot_pixels).  The emission is a colour slot like the others.  What cannot be read as Blender
+renders it takes the nearest reading (a socket's default value) and is named in one warning per material.
 """
 from dataclasses import dataclass, field
 
@@ -16,12 +17,14 @@ import numpy as np
 
 from ..reflectance import principled
 from ..reflectance.texture_expression import Expression
+from .node_graph import output_node
 
-PASS_THROUGH = ("REROUTE",)
 IDENTITY_UV_TRANSFORM = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
 # Blender's implicit colour -> float conversion (Rec. 709 luminance)
 LUMINANCE = (0.2126, 0.7152, 0.0722)
-COLOUR_SLOTS = ("diffuse_color", "specular_color")
+COLOUR_SLOTS = ("diffuse_color", "specular_color", "emission")
+SEPARATE_NODES = ("SEPARATE_COLOR", "SEPRGB", "SEPXYZ")
+COMBINE_NODES = ("COMBINE_COLOR", "COMBRGB", "COMBXYZ")
 
 
 @dataclass
@@ -43,19 +46,9 @@ class _Closure:
 
 
 def follow(socket):
-    """The output socket feeding an input (through reroutes), or None."""
-    if not socket.is_linked or not socket.links:
-        return None
-    link = socket.links[0]
-    if getattr(link, "is_muted", False) or not getattr(link, "is_valid", True):
-        return None
-    out = link.from_socket
-    while out.node.type in PASS_THROUGH:
-        inputs = out.node.inputs
-        if not inputs or not inputs[0].is_linked:
-            return None
-        out = inputs[0].links[0].from_socket
-    return out
+    """The output socket computing an input's value (node_graph: through groups, reroutes and muted nodes), or
+    None."""
+    return socket.links[0].from_socket if socket.is_linked and socket.links else None
 
 
 def _default(socket):
@@ -120,7 +113,10 @@ class SocketReader:
             return _constant(_default(out), colour)
         if node.type == "TEX_IMAGE":
             return self.image_value(node, out, socket, colour)
-        reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix}.get(node.type)
+        if node.type in SEPARATE_NODES:
+            return self.separate(node, out)
+        reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix,
+                  **dict.fromkeys(COMBINE_NODES, self.combine)}.get(node.type)
         if reader is not None:
             result = reader(node, colour)
             if result is not None:
@@ -152,6 +148,21 @@ class SocketReader:
             else:
                 result = Expression.constant(float(np.clip(value, 0.0, 1.0)))
         return result
+
+    def separate(self, node, out):
+        """One output of Separate Color (RGB), Separate RGB or Separate XYZ: that channel of its input."""
+        if getattr(node, "mode", "RGB") != "RGB":
+            self.note(node, f"{node.mode} mode: its channels are read as red, green and blue")
+        channel = [socket.identifier for socket in node.outputs].index(out.identifier)
+        return self.value(node.inputs[0], True).channel(min(channel, 2))
+
+    def combine(self, node, colour):
+        """Combine Color (RGB), Combine RGB or Combine XYZ: its three inputs as one colour's channels."""
+        if getattr(node, "mode", "RGB") != "RGB":
+            self.note(node, f"{node.mode} mode: its inputs are read as red, green and blue")
+            return None
+        return sum((self.value(node.inputs[k], False) * tuple(unit) for k, unit in enumerate(np.eye(3))),
+                   Expression.constant(0.0))
 
     def invert(self, node, colour):
         factor = self.value(node.inputs["Fac"], False)
@@ -269,13 +280,6 @@ class SocketReader:
         return []
 
 
-def output_node(tree, node_type="OUTPUT_MATERIAL"):
-    """A node tree's active output node (the one every engine renders; else its first of `node_type`), or
-    None."""
-    node = tree.get_output_node("ALL") if hasattr(tree, "get_output_node") else None
-    return node or next((n for n in tree.nodes if n.type == node_type), None)
-
-
 def read_material(material):
     """Reading of a bpy Material's node tree."""
     reader = SocketReader(material)
@@ -294,8 +298,7 @@ def _combine(reader, closures, reading):
     """The closures' weighted sum as one parameter set: diffuse colours add, the heaviest glossy lobe gives the
     model (others are named), emissions add."""
     fields = reading.fields
-    diffuse = Expression.constant(0.0)
-    emission = np.zeros(3)
+    diffuse = emission = Expression.constant(0.0)
     specular = None
     for closure in closures:
         values = _closure_values(reader, closure)
@@ -314,10 +317,9 @@ def _combine(reader, closures, reading):
             else:
                 reader.note(closure.node, "a second glossy lobe: not rendered")
         if "emission" in values:
-            if not isinstance(weight, (int, float)):
-                reader.note(closure.node, "emission under a texture factor: its mean is used")
-            emission += np.asarray(values["emission"]) * _mean_weight(reader, weight)
+            emission = emission + weight * Expression.of(values["emission"])
     _to_slot(reader, reading, "diffuse_color", diffuse)
+    _to_slot(reader, reading, "emission", emission)
     if specular is not None:
         _, closure, values = specular
         for name, value in values.items():
@@ -330,7 +332,6 @@ def _combine(reader, closures, reading):
     else:
         fields["specular_color"] = (0.0, 0.0, 0.0)
         fields["layered_f0"] = -1.0
-    fields["emission"] = tuple(float(c) for c in emission)
     _uv_transform(reader, fields)
     reading.decoded_slots = tuple(sorted(slot for slot, value in reading.textures.items()
                                          if isinstance(value, str) and slot not in COLOUR_SLOTS + ("normal_map",)
@@ -436,8 +437,7 @@ def _closure_values(reader, closure):
     node, kind = closure.node, closure.kind
     values = {}
     if kind == "emission":
-        colour = _constant_colour(reader, node, "Color", (1.0, 1.0, 1.0))
-        return {"emission": tuple(c * _constant_input(reader, node, "Strength") for c in colour)}
+        return {"emission": reader.value(node.inputs["Color"], True) * reader.value(node.inputs["Strength"], False)}
     if kind == "diffuse":
         if _constant_input(reader, node, "Roughness") > 0:
             reader.note(node, "Oren-Nayar roughness: rendered as Lambert")
@@ -460,14 +460,14 @@ def _principled_values(reader, node):
     inputs = node.inputs
     optional = {name: _constant_input(reader, node, name, default)
                 for name, default in (("Specular IOR Level", 0.5), ("Anisotropic", 0.0), ("Anisotropic Rotation", 0.0),
-                                      ("Transmission Weight", 0.0), ("Emission Strength", 0.0), ("Alpha", 1.0),
+                                      ("Transmission Weight", 0.0), ("Alpha", 1.0),
                                       ("Coat Weight", 0.0), ("Sheen Weight", 0.0), ("Subsurface Weight", 0.0))}
     values = principled.principled(
         reader.value(inputs["Base Color"], True), reader.value(inputs["Metallic"], False),
         _width(reader, node, optional["Anisotropic"] == 0.0), _constant_input(reader, node, "IOR", 1.5),
         optional["Specular IOR Level"], _constant_colour(reader, node, "Specular Tint", (1.0, 1.0, 1.0)),
         optional["Anisotropic"], optional["Anisotropic Rotation"], optional["Transmission Weight"],
-        _constant_colour(reader, node, "Emission Color", (1.0, 1.0, 1.0)), optional["Emission Strength"],
+        reader.value(inputs["Emission Color"], True), reader.value(inputs["Emission Strength"], False),
         multiscatter=node.distribution == "MULTI_GGX")
     for name, what in (("Transmission Weight", "transmission"), ("Coat Weight", "the coat"),
                        ("Sheen Weight", "sheen"), ("Subsurface Weight", "subsurface scattering")):

@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .node_reader import SocketReader, follow, output_node, scalar_of
+from .node_graph import output_node
+from .node_reader import SocketReader, follow, scalar_of
 
 
 @dataclass

@@ -110,8 +110,8 @@ def principled(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, ior=1.5,
                specular_tint=(1.0, 1.0, 1.0), anisotropic=0.0, anisotropic_rotation=0.0, transmission=0.0,
                emission_color=(1.0, 1.0, 1.0), emission_strength=0.0, multiscatter=True):
     """MaterialParams fields of a Principled BSDF with these input values (colours linear RGB).  Base Color,
-    Metallic and Roughness may be texture_expression.Expressions (textured): the colours then come out as
-    Expressions of the same formulas."""
+    Metallic, Roughness, Emission Color and Emission Strength may be texture_expression.Expressions (textured):
+    the colours then come out as Expressions of the same formulas."""
     base_color, metallic, roughness = (_plain(value) for value in (base_color, metallic, roughness))
     textured_metallic = isinstance(metallic, Expression)
     if isinstance(base_color, Expression):
@@ -131,7 +131,7 @@ def principled(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, ior=1.5,
            "layered_f0": float(f0 * float(np.max(tint))) if textured_metallic or metallic < 1.0 else -1.0,
            "ior": ior_of_f0(f0) if f0 > 0 else 1.0,
            "tangent_rotation": float(anisotropic_rotation) * 2.0 * np.pi,
-           "emission": tuple(float(c) * float(emission_strength) for c in _rgb(emission_color))}
+           "emission": _colour(_plain(Expression.of(_colour(emission_color)) * _plain(emission_strength)))}
     out.update(_roughness_fields(roughness, "GGX", lambda width: anisotropic_alphas(width, float(anisotropic))))
     return out
 

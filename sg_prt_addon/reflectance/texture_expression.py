@@ -6,17 +6,27 @@ own (`evaluate`, pure numpy: the images resampled to the largest one's size).
 
 Colours are RGB triples throughout: a scalar constant c is (c, c, c), and a scalar slot reads the red channel.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 
 @dataclass(frozen=True)
 class Factor:
-    """offset + scale x an image's RGB (linear, as Blender decodes it)."""
+    """offset + scale x an image's RGB (linear, as Blender decodes it), or x one of its channels on all three
+    (channel 0, 1, 2: a Separate Color's output)."""
     image: str
     scale: float = 1.0
     offset: float = 0.0
+    channel: int = None
+
+    def sort_key(self):
+        return (self.image, self.scale, self.offset, -1 if self.channel is None else self.channel)
+
+    def values(self, rgb):
+        """Its image's RGB (..., 3) as this factor reads it."""
+        rgb = np.asarray(rgb)
+        return rgb if self.channel is None else np.repeat(rgb[..., self.channel:self.channel + 1], 3, axis=-1)
 
 
 def _rgb(value):
@@ -64,15 +74,21 @@ class Expression:
 
     __rmul__ = __mul__
 
+    def channel(self, k):
+        """Its channel k (0, 1, 2) on all three: each coefficient's k-th part, each image read at channel k."""
+        terms = tuple(((c[k],) * 3, tuple(f if f.channel is not None else replace(f, channel=k) for f in factors))
+                      for c, factors in self.terms)
+        return Expression(terms).simplified()
+
     def simplified(self):
         """Like terms (the same factors) summed, zero terms dropped, a single factor with no offset folded into
         the coefficient."""
         merged = {}
         for coefficient, factors in self.terms:
-            key = tuple(sorted(factors, key=lambda f: (f.image, f.scale, f.offset)))
+            key = tuple(sorted(factors, key=Factor.sort_key))
             if len(key) == 1 and key[0].offset == 0.0 and key[0].scale != 1.0:
                 coefficient = tuple(c * key[0].scale for c in coefficient)
-                key = (Factor(key[0].image),)
+                key = (Factor(key[0].image, channel=key[0].channel),)
             previous = merged.get(key, (0.0, 0.0, 0.0))
             merged[key] = tuple(a + b for a, b in zip(previous, coefficient))
         terms = tuple((c, f) for f, c in merged.items() if any(v != 0.0 for v in c))
@@ -94,7 +110,7 @@ class Expression:
         if len(self.terms) != 1:
             return None
         coefficient, factors = self.terms[0]
-        if len(factors) == 1 and factors[0].scale == 1.0 and factors[0].offset == 0.0:
+        if len(factors) == 1 and factors[0] == Factor(factors[0].image):
             return coefficient, factors[0].image
         return None
 
@@ -104,7 +120,8 @@ class Expression:
         for coefficient, factors in self.terms:
             product = np.asarray(coefficient, np.float64)
             for factor in factors:
-                product = product * (factor.offset + factor.scale * np.asarray(means[factor.image], np.float64))
+                product = product * (factor.offset + factor.scale * factor.values(np.asarray(means[factor.image],
+                                                                                             np.float64)))
             total += product
         return tuple(float(v) for v in total)
 
@@ -128,6 +145,7 @@ class Expression:
         for coefficient, factors in self.terms:
             product = np.broadcast_to(np.asarray(coefficient, np.float32), (height, width, 3))
             for factor in factors:
-                product = product * (np.float32(factor.offset) + np.float32(factor.scale) * samples[factor.image])
+                product = product * (np.float32(factor.offset)
+                                     + np.float32(factor.scale) * factor.values(samples[factor.image]))
             out[..., :3] += product
         return out

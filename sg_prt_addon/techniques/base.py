@@ -20,6 +20,10 @@ import functools
 
 import numpy as np
 
+# The texture slot every technique applies the same way (shaders/techniques/common/surface_io.glsl
+# surface_write): the emitted radiance's colour
+EMISSION_TEXTURE = "emission"
+
 
 class ObjectInputs:
     """What a variant may depend on besides its material: the scene and the object drawn.

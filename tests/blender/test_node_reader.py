@@ -291,3 +291,31 @@ def test_a_beckmann_glossy_reads_as_beckmann(empty_file):
         assert len(said) == (1 if model == "WARD_ANISO" else 0), warnings
         if model == "BECKMANN":
             assert params.roughness == pytest.approx(0.4)
+
+
+def test_a_shader_inside_a_group_and_the_output_eevee_renders(empty_file):
+    """A Principled BSDF inside a node group reads as if it were in the material's tree (its notes name it by
+    its path), with the group node's own input values; of an output for Cycles and one for EEVEE, EEVEE's."""
+    material, tree, cycles_output = _material("grouped")
+    cycles_output.target = "CYCLES"
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    tree.links.new(diffuse.outputs[0], cycles_output.inputs["Surface"])
+    eevee_output = tree.nodes.new("ShaderNodeOutputMaterial")
+    eevee_output.target = "EEVEE"
+    group = bpy.data.node_groups.new("Shell", "ShaderNodeTree")
+    group.interface.new_socket("Roughness", in_out="INPUT", socket_type="NodeSocketFloat").default_value = 0.5
+    group.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    group_input, group_output = group.nodes.new("NodeGroupInput"), group.nodes.new("NodeGroupOutput")
+    principled = group.nodes.new("ShaderNodeBsdfPrincipled")
+    group.links.new(group_input.outputs["Roughness"], principled.inputs["Roughness"])
+    ramp = group.nodes.new("ShaderNodeValToRGB")
+    group.links.new(ramp.outputs["Color"], principled.inputs["Base Color"])
+    group.links.new(principled.outputs[0], group_output.inputs["Shader"])
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    node.name = "Outer"
+    node.inputs["Roughness"].default_value = 0.2
+    tree.links.new(node.outputs["Shader"], eevee_output.inputs["Surface"])
+    params, warnings = _read(material)
+    assert params.roughness == pytest.approx(0.2) and params.specular_color != (0.0, 0.0, 0.0)
+    assert len(warnings) == 1 and "'Outer/Color Ramp' (Color Ramp)" in warnings[0], warnings

@@ -1,6 +1,7 @@
 """reflectance.texture_expression: the arithmetic of textured node values and their evaluation, against the
 same formula applied to the pixels."""
 import numpy as np
+import pytest
 
 from sg_prt_addon.reflectance import principled
 from sg_prt_addon.reflectance.texture_expression import Expression
@@ -54,3 +55,23 @@ def test_material_textures_repeat_and_the_uv_transform():
     assert not np.allclose(sg_shading.sample_texture(image, [[0.0, 0.0]])[0], corner)     # clamped: texel (0, 0)
     material = SimpleNamespace(uv_transform=(2.0, 0.0, 0.5, 0.0, 3.0, -1.0))
     np.testing.assert_allclose(sg_shading.material_uv(material, uv[:1]), [[1.1, 0.8]], atol=1e-6)
+
+
+def test_channels_of_products_and_their_recombination():
+    """channel(k) of a sum of products is each product's channel k (Separate Color); the channels put back
+    with unit colours (Combine Color) give the expression back, swizzled where asked."""
+    base, metal = Expression.image("base"), Expression.image("metal")
+    expression = (0.2, 0.5, 1.0) * base * (1.0 - 0.5 * metal) + (0.1, 0.0, 0.3)
+    images = {"base": BASE, "metal": METAL}
+    value = expression.evaluate(images)[..., :3]
+    for k in range(3):
+        channel = expression.channel(k)
+        np.testing.assert_allclose(channel.evaluate(images)[..., :3], np.repeat(value[..., k:k + 1], 3, -1),
+                                   atol=1e-6)
+        assert channel.channel(0) == channel            # a channel's channel is itself
+        assert channel.as_factor_times_image() is None
+    swizzled = sum((expression.channel(source) * tuple(np.eye(3)[target]) for target, source in enumerate((2, 0, 1))),
+                   Expression.constant(0.0))
+    np.testing.assert_allclose(swizzled.evaluate(images)[..., :3], value[..., [2, 0, 1]], atol=1e-6)
+    means = {"base": (0.2, 0.4, 0.6), "metal": (0.5, 0.5, 0.5)}
+    assert expression.channel(1).mean_value(means) == pytest.approx((expression.mean_value(means)[1],) * 3)

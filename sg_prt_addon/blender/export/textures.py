@@ -6,7 +6,7 @@ import numpy as np
 from ..images import image_has_pixels, image_pixels
 from .messages import finite_texels, warn
 
-COLOUR_SLOTS = ("diffuse_color", "specular_color")
+COLOUR_SLOTS = ("diffuse_color", "specular_color", "emission")
 # What a texture whose image has no pixels (a missing or unreadable file) samples, and what the warning calls it:
 # Blender's magenta for colours (what its own engines show), a flat normal for the normal map, 1 for scalars.
 MISSING_TEXEL = {"colour": ((1.0, 0.0, 1.0, 1.0), "magenta"), "normal_map": ((0.5, 0.5, 1.0, 1.0), "a flat normal"),

@@ -2,6 +2,7 @@
 (its BVNDF's lobes and tables, biscale.bvndf, from export.MaterialParams.biscale) with the material's own
 isotropic model as the small-scale BRDF, or its stored lobe fit (MaterialParams.fitted: a measured small-scale
 BRDF, iwasaki2012 fig. 8) (shaders/techniques/biscale/biscale.glsl; mirror biscale_shading.py)."""
+from ..base import EMISSION_TEXTURE
 from ..sg import sg_fitted, sg_parametric
 from ..sg.sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
 from ..sg.sg_parametric import material_terms
@@ -10,8 +11,8 @@ from . import biscale_shading
 NAME = "SG_BISCALE"
 # the small-scale parameters a texture may scale per pixel, and the colours and normal map
 TEXTURES = ("diffuse_color", "specular_color", "roughness", "ior", "exponent", "alpha_x", "normal_map",
-            biscale_shading.MASK_SLOT)
-FITTED_TEXTURES = ("normal_map", biscale_shading.MASK_SLOT)      # a fit holds its own colours and lobes
+            EMISSION_TEXTURE, biscale_shading.MASK_SLOT)
+FITTED_TEXTURES = ("normal_map", EMISSION_TEXTURE, biscale_shading.MASK_SLOT)   # a fit holds its colours and lobes
 
 
 def texture_slots(params):

@@ -1,5 +1,6 @@
 """wang2009 with lobes fitted to measured data (blender.lobe_fit, export.FittedLobes): per texel SG
 lobes, kd and eta, and the PCA-compressed shadowing, fetched at the UV's nearest texel."""
+from ..base import EMISSION_TEXTURE
 from .sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_FITTED"
@@ -15,11 +16,12 @@ class SGFitted(SGLobes):
     renders_stored = "lobe_fit"
 
     def variant_key(self, params, inputs):
-        """The stored fit's lobes, shadowing and base; of the material's textures only a normal map applies."""
+        """The stored fit's lobes, shadowing and base; of the material's textures only a normal map and the
+        emission apply."""
         fitted = params.fitted
         if fitted is None:
             raise ValueError(f"material '{params.name}' has no usable lobe fit for {self.label}")
-        textures = ("normal_map",) if "normal_map" in params.textures else ()
+        textures = tuple(name for name in (EMISSION_TEXTURE, "normal_map") if name in params.textures)
         return VariantKey(self.name, MODEL, int(fitted.lobe_count), textures=textures,
                           shadowing_components=int(fitted.components), warp_mode=warp_mode_of(params),
                           **scene_fields(inputs))

@@ -107,14 +107,18 @@ void surface_geometry(vec3 normal, out vec4 tangent, out vec3 shading_normal, ou
   shading_tangent = rotate_tangent(shading_normal, tangent.xyz, material.tangent_axis_rotation.w);
 }
 
-/* Combined with the emission (summed on the CPU in the G-buffer variant, without it: framebuffers take 6
- * attachments), Diffuse, Specular,
- * and the GBUFFER variant's shading inputs for the numpy mirrors; w: the triangle (index into the mesh's
- * triangle list) and the object (draw order) + 1. */
+/* Combined (with the emission, its texture applied), Diffuse, Specular, and the GBUFFER variant's shading inputs
+ * for the numpy mirrors (framebuffers take 6 attachments: that variant has no Combined, the CPU sums Diffuse and
+ * Specular, without the emission); w: the triangle (index into the mesh's triangle list) and the object (draw
+ * order) + 1. */
 void surface_write(vec3 diffuse, vec3 specular, vec3 normal, vec4 tangent)
 {
 #ifndef GBUFFER
-  out_combined = vec4(diffuse + specular + material.emission.rgb, 1.0);
+  vec3 emission = material.emission.rgb;
+#  ifdef HAS_TEXTURE_EMISSION
+  emission *= material_texture(texture_emission).rgb;
+#  endif
+  out_combined = vec4(diffuse + specular + emission, 1.0);
 #endif
   out_diffuse = vec4(diffuse, 1.0);
   out_specular = vec4(specular, 1.0);

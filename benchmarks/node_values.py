@@ -1,0 +1,335 @@
+"""Node values against Cycles' own evaluation of them: each case routes a node's output into an Emission shader
+on a plane that fills an orthographic view (black world, no lights), so Cycles' image is the socket's value at
+every pixel and SG-PRT's is its reading of the same nodes (blender/node_reader.py).  Scores: relative RMSE and
+bias over the plane against the mean of two Cycles seeds, and the noise floor (benchmarks/cycles_truth.py).
+
+    .venv/bin/python -m benchmarks.node_values [--size 64] [--cycles-samples 16] [--update-doc]
+"""
+import argparse
+import json
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+JSON_PATH = ROOT / "docs" / "node_values.json"
+DOC_PATH = ROOT / "docs" / "ACCURACY.md"
+SECTION_TITLE = "## Node values against Cycles' evaluation"
+TEXTURE_SIDE = 16
+
+
+def _material(name):
+    import bpy
+
+    material = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        material.use_nodes = True
+    tree = material.node_tree
+    for node in list(tree.nodes):
+        tree.nodes.remove(node)
+    return material, tree, tree.nodes.new("ShaderNodeOutputMaterial")
+
+
+def _emitting(name, value_of):
+    """A material whose surface is an Emission of Strength 1 whose Color is value_of(tree) (an output socket)."""
+    material, tree, output = _material(name)
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = 1.0
+    tree.links.new(value_of(tree), emission.inputs["Color"])
+    tree.links.new(emission.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def colour_image(colorspace="sRGB"):
+    """A smooth 16 x 16 colour image (three slow waves, one a channel), magnified on the plane."""
+    import bpy
+    import numpy as np
+
+    name = f"waves_{colorspace}"
+    if name in bpy.data.images:
+        return bpy.data.images[name]
+    u, v = np.meshgrid((np.arange(TEXTURE_SIDE) + 0.5) / TEXTURE_SIDE, (np.arange(TEXTURE_SIDE) + 0.5) / TEXTURE_SIDE)
+    pixels = np.ones((TEXTURE_SIDE, TEXTURE_SIDE, 4))
+    pixels[..., 0] = 0.5 + 0.4 * np.sin(2 * np.pi * u)
+    pixels[..., 1] = 0.5 + 0.4 * np.cos(2 * np.pi * v)
+    pixels[..., 2] = 0.2 + 0.6 * u * v
+    image = bpy.data.images.new(name, TEXTURE_SIDE, TEXTURE_SIDE, alpha=True)
+    image.colorspace_settings.name = colorspace
+    image.pixels.foreach_set(np.ascontiguousarray(pixels, np.float32).ravel())
+    image.pack()
+    return image
+
+
+def _image_node(tree, colorspace="sRGB"):
+    node = tree.nodes.new("ShaderNodeTexImage")
+    node.image = colour_image(colorspace)
+    return node
+
+
+def _separate(tree, colour_socket):
+    node = tree.nodes.new("ShaderNodeSeparateColor")
+    tree.links.new(colour_socket, node.inputs[0])
+    return node
+
+
+def image(tree):
+    return _image_node(tree).outputs["Color"]
+
+
+def image_non_color(tree):
+    return _image_node(tree, "Non-Color").outputs["Color"]
+
+
+def separate_green(tree):
+    return _separate(tree, _image_node(tree).outputs["Color"]).outputs["Green"]
+
+
+def combine_swizzled(tree):
+    """Separate Color's channels put back as (blue, red, green) by Combine Color."""
+    separate = _separate(tree, _image_node(tree).outputs["Color"])
+    combine = tree.nodes.new("ShaderNodeCombineColor")
+    for target, source in (("Red", "Blue"), ("Green", "Red"), ("Blue", "Green")):
+        tree.links.new(separate.outputs[source], combine.inputs[target])
+    return combine.outputs["Color"]
+
+
+def separate_combine_xyz(tree):
+    """Separate XYZ of a Non-Color image, recombined as (z, x, 0.5) by Combine XYZ."""
+    separate = tree.nodes.new("ShaderNodeSeparateXYZ")
+    tree.links.new(_image_node(tree, "Non-Color").outputs["Color"], separate.inputs[0])
+    combine = tree.nodes.new("ShaderNodeCombineXYZ")
+    tree.links.new(separate.outputs["Z"], combine.inputs["X"])
+    tree.links.new(separate.outputs["X"], combine.inputs["Y"])
+    combine.inputs["Z"].default_value = 0.5
+    return combine.outputs["Vector"]
+
+
+def math_and_mix(tree):
+    """Mix (Multiply, factor 0.7) of the image and a colour, times twice the image's red channel (Math)."""
+    texture = _image_node(tree)
+    mix = tree.nodes.new("ShaderNodeMix")
+    mix.data_type = "RGBA"
+    mix.blend_type = "MULTIPLY"
+    mix.inputs["Factor"].default_value = 0.7
+    tree.links.new(texture.outputs["Color"], mix.inputs["A"])
+    mix.inputs["B"].default_value = (0.9, 0.4, 0.7, 1.0)
+    red = tree.nodes.new("ShaderNodeMath")
+    red.operation = "MULTIPLY"
+    tree.links.new(_separate(tree, texture.outputs["Color"]).outputs["Red"], red.inputs[0])
+    red.inputs[1].default_value = 2.0
+    scale = tree.nodes.new("ShaderNodeMix")
+    scale.data_type = "RGBA"
+    scale.blend_type = "MULTIPLY"
+    scale.inputs["Factor"].default_value = 1.0
+    tree.links.new(mix.outputs["Result"], scale.inputs["A"])
+    tree.links.new(red.outputs[0], scale.inputs["B"])
+    return scale.outputs["Result"]
+
+
+def muted_and_rerouted(tree):
+    """The image through two reroutes and a muted Invert (a muted node passes its input)."""
+    texture = _image_node(tree)
+    first, second = tree.nodes.new("NodeReroute"), tree.nodes.new("NodeReroute")
+    tree.links.new(texture.outputs["Color"], first.inputs[0])
+    tree.links.new(first.outputs[0], second.inputs[0])
+    invert = tree.nodes.new("ShaderNodeInvert")
+    invert.mute = True
+    tree.links.new(second.outputs[0], invert.inputs["Color"])
+    return invert.outputs["Color"]
+
+
+def _group(name, build_inside, inputs):
+    """A shader node group: its interface `inputs` ((name, socket type, default)) and a Color output, which
+    build_inside(tree, group_input) returns the socket of."""
+    import bpy
+
+    group = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    for socket_name, socket_type, default in inputs:
+        item = group.interface.new_socket(socket_name, in_out="INPUT", socket_type=socket_type)
+        item.default_value = default
+    group.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
+    group_input = group.nodes.new("NodeGroupInput")
+    group_output = group.nodes.new("NodeGroupOutput")
+    group.links.new(build_inside(group, group_input), group_output.inputs["Color"])
+    return group
+
+
+def nested_groups(tree):
+    """The image into a group that scales it by its Float input (unlinked: the group node's 0.8, not the
+    interface's 0.5) and passes it through an inner group adding a colour."""
+    def inner_build(group, group_input):
+        add = group.nodes.new("ShaderNodeMix")
+        add.data_type = "RGBA"
+        add.blend_type = "ADD"
+        add.inputs["Factor"].default_value = 1.0
+        group.links.new(group_input.outputs["Color"], add.inputs["A"])
+        add.inputs["B"].default_value = (0.1, 0.2, 0.05, 1.0)
+        return add.outputs["Result"]
+
+    inner = _group("add_tint", inner_build, [("Color", "NodeSocketColor", (0.5, 0.5, 0.5, 1.0))])
+
+    def outer_build(group, group_input):
+        scale = group.nodes.new("ShaderNodeMix")
+        scale.data_type = "RGBA"
+        scale.blend_type = "MULTIPLY"
+        scale.inputs["Factor"].default_value = 1.0
+        group.links.new(group_input.outputs["Color"], scale.inputs["A"])
+        group.links.new(group_input.outputs["Scale"], scale.inputs["B"])
+        inner_node = group.nodes.new("ShaderNodeGroup")
+        inner_node.node_tree = inner
+        group.links.new(scale.outputs["Result"], inner_node.inputs["Color"])
+        return inner_node.outputs["Color"]
+
+    outer = _group("scaled_tint", outer_build, [("Color", "NodeSocketColor", (0.5, 0.5, 0.5, 1.0)),
+                                               ("Scale", "NodeSocketFloat", 0.5)])
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = outer
+    node.inputs["Scale"].default_value = 0.8
+    tree.links.new(_image_node(tree).outputs["Color"], node.inputs["Color"])
+    return node.outputs["Color"]
+
+
+def principled_emission_texture(name):
+    """A black Principled BSDF (nothing to reflect here) whose Emission Color is the image, Strength 3."""
+    material, tree, output = _material(name)
+    node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    node.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    node.inputs["Emission Strength"].default_value = 3.0
+    tree.links.new(_image_node(tree).outputs["Color"], node.inputs["Emission Color"])
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def emission_strength_texture(name):
+    """An Emission of a constant colour whose Strength is four times the image's red channel."""
+    material, tree, output = _material(name)
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (1.0, 0.5, 0.2, 1.0)
+    strength = tree.nodes.new("ShaderNodeMath")
+    strength.operation = "MULTIPLY"
+    tree.links.new(_separate(tree, _image_node(tree).outputs["Color"]).outputs["Red"], strength.inputs[0])
+    strength.inputs[1].default_value = 4.0
+    tree.links.new(strength.outputs[0], emission.inputs["Strength"])
+    tree.links.new(emission.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def grouped_shader(name):
+    """A Principled BSDF inside a node group (as asset libraries and some glTF exporters make them): black base,
+    the image as its emission through the group's Color input."""
+    def build(group, group_input):
+        node = group.nodes.new("ShaderNodeBsdfPrincipled")
+        node.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        node.inputs["Emission Strength"].default_value = 1.0
+        group.links.new(group_input.outputs["Color"], node.inputs["Emission Color"])
+        return node.outputs[0]
+
+    import bpy
+
+    group = bpy.data.node_groups.new("emitting_principled", "ShaderNodeTree")
+    item = group.interface.new_socket("Color", in_out="INPUT", socket_type="NodeSocketColor")
+    item.default_value = (0.5, 0.5, 0.5, 1.0)
+    group.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    group_input, group_output = group.nodes.new("NodeGroupInput"), group.nodes.new("NodeGroupOutput")
+    group.links.new(build(group, group_input), group_output.inputs["Shader"])
+    material, tree, output = _material(name)
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    tree.links.new(_image_node(tree).outputs["Color"], node.inputs["Color"])
+    tree.links.new(node.outputs["Shader"], output.inputs["Surface"])
+    return material
+
+
+def mix_shader_textured_factor(name):
+    """Two Emissions (red; the image) mixed by the image's green channel."""
+    material, tree, output = _material(name)
+    red, textured = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeEmission")
+    red.inputs["Color"].default_value = (1.0, 0.1, 0.1, 1.0)
+    texture = _image_node(tree)
+    tree.links.new(texture.outputs["Color"], textured.inputs["Color"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(_separate(tree, texture.outputs["Color"]).outputs["Green"], mix.inputs["Fac"])
+    tree.links.new(red.outputs[0], mix.inputs[1])
+    tree.links.new(textured.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def _socket_case(value_of):
+    return lambda name: _emitting(name, value_of)
+
+
+CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non_color),
+         "separate_color": _socket_case(separate_green), "combine_color": _socket_case(combine_swizzled),
+         "separate_combine_xyz": _socket_case(separate_combine_xyz), "math_and_mix": _socket_case(math_and_mix),
+         "muted_and_rerouted": _socket_case(muted_and_rerouted), "nested_groups": _socket_case(nested_groups),
+         "principled_emission_texture": principled_emission_texture,
+         "emission_strength_texture": emission_strength_texture, "grouped_shader": grouped_shader,
+         "mix_shader_textured_factor": mix_shader_textured_factor}
+
+
+def build(name, size):
+    """The case's plane (2 m, its UVs over [0, 1]) under an orthographic camera that it fills."""
+    import bpy
+
+    from benchmarks import truth_suite
+    from examples import build_scenes
+
+    scene = truth_suite._start(size)
+    truth_suite._black_world(scene)
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    plane = bpy.context.active_object
+    plane.data.materials.append(CASES[name](name))
+    camera = build_scenes._add_camera(scene, location=(0.0, 0.0, 3.0), target=(0.0, 0.0, 0.0))
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 2.0
+    scene.render.film_transparent = True
+    return scene
+
+
+def score(name, size, samples, log=print):
+    from benchmarks import cycles_truth
+
+    row = {"case": name, "size": size, **cycles_truth.score(build(name, size), samples)}
+    log(f"{name:28s} rmse {row['relative_rmse']:.4f}  bias {row['relative_bias']:+.4f}  noise floor "
+        f"{row['noise_floor']:.4f}")
+    return row
+
+
+def markdown_section(data):
+    lines = [SECTION_TITLE, "", "Each node's output routed into an Emission on a plane filling an orthographic view "
+             f"(`benchmarks/node_values.py`), {data['size']} x {data['size']}, Cycles {data['cycles_samples']} spp x "
+             "2 seeds: Cycles' image is the socket's value.  SG-PRT reads the same nodes.  Relative RMSE and bias "
+             "over the plane.  The cases of an 8-bit sRGB image keep a bias of +0.5-0.8%: Cycles filters the "
+             "encoded texels and decodes the result, the GPU (SG-PRT, EEVEE) decodes the texels before it filters; "
+             "the same image as Non-Color has none.", "",
+             "| case | relative RMSE | bias | noise floor |", "|---|---|---|---|"]
+    for row in data["rows"]:
+        lines.append(f"| {row['case']} | {row['relative_rmse']:.4f} | {row['relative_bias']:+.4f} | "
+                     f"{row['noise_floor']:.4f} |")
+    lines += ["", f"Rerun: `.venv/bin/python -m benchmarks.node_values --size {data['size']} --cycles-samples "
+              f"{data['cycles_samples']}` ({data['seconds']:.0f} s), then `--update-doc`."]
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=int, default=64)
+    parser.add_argument("--cycles-samples", type=int, default=16)
+    parser.add_argument("--cases", default=",".join(CASES))
+    parser.add_argument("--update-doc", action="store_true", help="write the section from the JSON (no run)")
+    args = parser.parse_args(argv)
+    if args.update_doc:
+        from benchmarks import markdown_sections
+        markdown_sections.update_file(str(DOC_PATH), SECTION_TITLE, markdown_section(json.loads(JSON_PATH.read_text())))
+        print(f"updated {DOC_PATH}")
+        return
+    started = time.perf_counter()
+    rows = [score(name, args.size, args.cycles_samples) for name in args.cases.split(",")]
+    data = {"size": args.size, "cycles_samples": args.cycles_samples, "rows": rows,
+            "seconds": time.perf_counter() - started}
+    JSON_PATH.write_text(json.dumps(data, indent=1))
+    print(markdown_section(data))
+
+
+if __name__ == "__main__":
+    main()
