@@ -15,6 +15,7 @@ JSON_PATH = ROOT / "docs" / "node_values.json"
 DOC_PATH = ROOT / "docs" / "ACCURACY.md"
 SECTION_TITLE = "## Node values against Cycles' evaluation"
 TEXTURE_SIDE = 16
+COLOUR_ATTRIBUTE = "Col"
 
 
 def _material(name):
@@ -254,6 +255,44 @@ def mix_shader_textured_factor(name):
     return material
 
 
+def color_attribute(tree):
+    node = tree.nodes.new("ShaderNodeVertexColor")
+    node.layer_name = COLOUR_ATTRIBUTE
+    return node.outputs["Color"]
+
+
+def attribute_fac(tree):
+    """The Attribute node's Fac of the colour attribute (the mean of its channels)."""
+    node = tree.nodes.new("ShaderNodeAttribute")
+    node.attribute_name = COLOUR_ATTRIBUTE
+    return node.outputs["Fac"]
+
+
+def image_times_color_attribute(tree):
+    """The image times the colour attribute (Mix, Multiply), as glTF's importer joins COLOR_0 and a texture."""
+    mix = tree.nodes.new("ShaderNodeMix")
+    mix.data_type = "RGBA"
+    mix.blend_type = "MULTIPLY"
+    mix.inputs["Factor"].default_value = 1.0
+    tree.links.new(_image_node(tree).outputs["Color"], mix.inputs["A"])
+    tree.links.new(color_attribute(tree), mix.inputs["B"])
+    return mix.outputs["Result"]
+
+
+def add_colour_attribute(mesh, domain="POINT", data_type="FLOAT_COLOR"):
+    """A smooth colour attribute over the grid (a function of each point's position)."""
+    import numpy as np
+
+    attribute = mesh.color_attributes.new(COLOUR_ATTRIBUTE, data_type, domain)
+    positions = np.array([vertex.co[:2] for vertex in mesh.vertices])
+    if domain == "CORNER":
+        positions = positions[[loop.vertex_index for loop in mesh.loops]]
+    x, y = positions[:, 0], positions[:, 1]
+    colours = np.stack([0.5 + 0.4 * np.sin(np.pi * x), 0.5 + 0.4 * np.cos(np.pi * y), 0.3 + 0.2 * x * y,
+                        np.ones_like(x)], axis=-1)
+    attribute.data.foreach_set("color", np.ascontiguousarray(colours, np.float32).ravel())
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -264,11 +303,20 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "muted_and_rerouted": _socket_case(muted_and_rerouted), "nested_groups": _socket_case(nested_groups),
          "principled_emission_texture": principled_emission_texture,
          "emission_strength_texture": emission_strength_texture, "grouped_shader": grouped_shader,
-         "mix_shader_textured_factor": mix_shader_textured_factor}
+         "mix_shader_textured_factor": mix_shader_textured_factor, "color_attribute": _socket_case(color_attribute),
+         "color_attribute_corners": _socket_case(color_attribute), "attribute_fac": _socket_case(attribute_fac),
+         "image_times_color_attribute": _socket_case(image_times_color_attribute),
+         "color_attribute_missing": _socket_case(color_attribute)}
+# cases whose truth is 0 everywhere (scored by their largest values)
+ZERO_TRUTH = ("color_attribute_missing",)
+# the cases whose grid has the colour attribute: (domain, data type)
+COLOURED = {"color_attribute": ("POINT", "FLOAT_COLOR"), "color_attribute_corners": ("CORNER", "BYTE_COLOR"),
+            "attribute_fac": ("POINT", "FLOAT_COLOR"), "image_times_color_attribute": ("POINT", "FLOAT_COLOR")}
 
 
 def build(name, size):
-    """The case's plane (2 m, its UVs over [0, 1]) under an orthographic camera that it fills."""
+    """The case's plane (2 m, 8 x 8 faces, its UVs over [0, 1]; the colour attribute where the case has one)
+    under an orthographic camera that it fills."""
     import bpy
 
     from benchmarks import truth_suite
@@ -276,8 +324,10 @@ def build(name, size):
 
     scene = truth_suite._start(size)
     truth_suite._black_world(scene)
-    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2.0)
     plane = bpy.context.active_object
+    if name in COLOURED:
+        add_colour_attribute(plane.data, *COLOURED[name])
     plane.data.materials.append(CASES[name](name))
     camera = build_scenes._add_camera(scene, location=(0.0, 0.0, 3.0), target=(0.0, 0.0, 0.0))
     camera.data.type = "ORTHO"
@@ -286,12 +336,17 @@ def build(name, size):
     return scene
 
 
-def score(name, size, samples, log=print):
+def score(name, size, samples, log=print, scores=True):
+    """One case's row (benchmarks/cycles_truth.score); without `scores`, the largest values alone (a case whose
+    truth is 0 has no relative error)."""
     from benchmarks import cycles_truth
 
-    row = {"case": name, "size": size, **cycles_truth.score(build(name, size), samples)}
-    log(f"{name:28s} rmse {row['relative_rmse']:.4f}  bias {row['relative_bias']:+.4f}  noise floor "
-        f"{row['noise_floor']:.4f}")
+    row = {"case": name, "size": size, **cycles_truth.score(build(name, size), samples, scores)}
+    if scores:
+        log(f"{name:28s} rmse {row['relative_rmse']:.4f}  bias {row['relative_bias']:+.4f}  noise floor "
+            f"{row['noise_floor']:.4f}")
+    else:
+        log(f"{name:28s} largest {row['largest']:.4g}  truth's largest {row['truth_largest']:.4g}")
     return row
 
 
@@ -304,8 +359,11 @@ def markdown_section(data):
              "the same image as Non-Color has none.", "",
              "| case | relative RMSE | bias | noise floor |", "|---|---|---|---|"]
     for row in data["rows"]:
-        lines.append(f"| {row['case']} | {row['relative_rmse']:.4f} | {row['relative_bias']:+.4f} | "
-                     f"{row['noise_floor']:.4f} |")
+        if "relative_rmse" in row:
+            lines.append(f"| {row['case']} | {row['relative_rmse']:.4f} | {row['relative_bias']:+.4f} | "
+                         f"{row['noise_floor']:.4f} |")
+        else:
+            lines.append(f"| {row['case']} | largest {row['largest']:.3g}, Cycles' {row['truth_largest']:.3g} | | |")
     lines += ["", f"Rerun: `.venv/bin/python -m benchmarks.node_values --size {data['size']} --cycles-samples "
               f"{data['cycles_samples']}` ({data['seconds']:.0f} s), then `--update-doc`."]
     return "\n".join(lines)
@@ -324,7 +382,7 @@ def main(argv=None):
         print(f"updated {DOC_PATH}")
         return
     started = time.perf_counter()
-    rows = [score(name, args.size, args.cycles_samples) for name in args.cases.split(",")]
+    rows = [score(name, args.size, args.cycles_samples, scores=name not in ZERO_TRUTH) for name in args.cases.split(",")]
     data = {"size": args.size, "cycles_samples": args.cycles_samples, "rows": rows,
             "seconds": time.perf_counter() - started}
     JSON_PATH.write_text(json.dumps(data, indent=1))

@@ -7,8 +7,8 @@ unlinked sockets, RGB, Value, Image Texture (its Color, over the UV map), Math (
 by a constant), Invert, Mix / MixRGB (mix, multiply, add), Separate and Combine Color (RGB) and XYZ of them, a
 Normal Map in tangent space.  reflectance/principled.py maps the BSDFs' values to the model, colours and
 layering; an expression that is a constant or a factor times one image takes the engine's factor x texture
-path, any other one (a metallic map, an image's channel, a texture factor) becomes a texture computed from its
-images (export.slot_pixels).  The emission is a colour slot like the others.  What cannot be read as Blender
+path, any other one (a metallic map, an image's channel, a texture factor) is computed per pixel from its images
+(techniques/material_textures.py).  The emission is a colour slot like the others.  What cannot be read as Blender
 renders it takes the nearest reading (a socket's default value) and is named in one warning per material.
 """
 from dataclasses import dataclass, field
@@ -115,6 +115,8 @@ class SocketReader:
             return self.image_value(node, out, socket, colour)
         if node.type in SEPARATE_NODES:
             return self.separate(node, out)
+        if node.type in ("VERTEX_COLOR", "ATTRIBUTE"):
+            return self.attribute_value(node, out, socket, colour)
         reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix,
                   **dict.fromkeys(COMBINE_NODES, self.combine)}.get(node.type)
         if reader is not None:
@@ -148,6 +150,24 @@ class SocketReader:
             else:
                 result = Expression.constant(float(np.clip(value, 0.0, 1.0)))
         return result
+
+    def attribute_value(self, node, out, socket, colour):
+        """Color Attribute, or Attribute of the geometry: the mesh's default colour attribute (its Color or
+        Vector; Fac: the mean of its channels, as Cycles takes it)."""
+        if node.type == "ATTRIBUTE" and node.attribute_type != "GEOMETRY":
+            self.note(node, f"{node.attribute_type.lower()} attribute: {socket.name} uses its value "
+                            f"{_rounded(_default(socket))}")
+            return _constant(_default(socket), colour)
+        name = node.layer_name if node.type == "VERTEX_COLOR" else node.attribute_name
+        if name and self._other_colour_attribute(name):
+            self.note(node, f"attribute '{name}': each mesh's default colour attribute is read")
+        value = Expression.attribute(name)
+        if out.identifier == "Fac":
+            return sum((value.channel(k) for k in range(3)), Expression.constant(0.0)) * (1.0 / 3.0)
+        if out.identifier == "Alpha":
+            self.note(node, "its Alpha output: 1 is used")
+            return Expression.constant(1.0)
+        return value
 
     def separate(self, node, out):
         """One output of Separate Color (RGB), Separate RGB or Separate XYZ: that channel of its input."""
@@ -242,17 +262,25 @@ class SocketReader:
         return (float(matrix[0, 0]), float(matrix[0, 1]), float(offset[0]),
                 float(matrix[1, 0]), float(matrix[1, 1]), float(offset[1]))
 
-    def _other_uv_map(self, name):
-        """Whether a mesh with this material has an active UV map other than `name` (export reads the active)."""
+    def _meshes(self):
         import bpy
 
         if self.material is None:
-            return False
-        for mesh in bpy.data.meshes:
-            if self.material.name in mesh.materials and mesh.uv_layers.active is not None \
-                    and mesh.uv_layers.active.name != name:
-                return True
-        return False
+            return []
+        return [mesh for mesh in bpy.data.meshes if self.material.name in mesh.materials]
+
+    def _other_colour_attribute(self, name):
+        """Whether a mesh with this material has a default colour attribute other than `name` (export reads the
+        default one)."""
+        from .export.meshes import default_color_attribute
+
+        return any(attribute is not None and attribute.name != name
+                   for attribute in map(default_color_attribute, self._meshes()))
+
+    def _other_uv_map(self, name):
+        """Whether a mesh with this material has an active UV map other than `name` (export reads the active)."""
+        return any(mesh.uv_layers.active is not None and mesh.uv_layers.active.name != name
+                   for mesh in self._meshes())
 
     # ------------------------------------------------------------------ shaders
 
@@ -354,7 +382,7 @@ def _mean_weight(reader, weight):
 
 
 def _to_slot(reader, reading, slot, value):
-    """A parameter's Expression into the reading: a number or colour, a factor x image, or a computed texture."""
+    """A parameter's Expression into the reading: a number or colour, a factor x image, or computed per pixel."""
     value = Expression.of(value)
     colour = slot in COLOUR_SLOTS
     constant = value.as_constant()

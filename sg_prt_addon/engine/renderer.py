@@ -60,9 +60,21 @@ def _texture_2d_array(layers):
 
 
 def _texture_key(value, slot, params):
-    """(image name or Expression, decoded from sRGB: a colour slot, or a data slot a node tree reads decoded (as
-    Blender does; an Expression decodes each of its images so), a normal map: its normals made unit)."""
+    """(image name, decoded from sRGB: a colour slot, or a data slot a node tree reads decoded as Blender does,
+    a normal map: its normals made unit) of a slot's own image."""
     return value, slot in COLOUR_SLOTS or slot in params.decoded_slots, slot == "normal_map"
+
+
+def _node_image_key(name):
+    """The texture key of an image a node tree's computed slot reads (decoded as Blender decodes it)."""
+    return name, True, False
+
+
+def _texture_keys(value, slot, params):
+    """The texture keys a slot reads: its image's, or (an Expression) each of its images'."""
+    if isinstance(value, str):
+        return [_texture_key(value, slot, params)]
+    return [_node_image_key(name) for name in value.images]
 
 
 def _uniform_buffer(data):
@@ -192,6 +204,7 @@ class MeshBuffers:
         self.per_vertex = {}            # kind -> PerVertexBuffers
         self.refused = {}               # kind -> why its per-vertex data was not uploaded (the render says so)
         self.bounds = None              # (2, 3) local box
+        self.has_colors = False         # a colour attribute (MeshExport.colors) in the vertex buffer
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
         self.bounds = np.stack([mesh.positions.min(axis=0), mesh.positions.max(axis=0)])
@@ -220,6 +233,9 @@ class MeshBuffers:
         fmt.attr_add(id="normal", comp_type="F32", len=3, fetch_mode="FLOAT")
         fmt.attr_add(id="tangent", comp_type="F32", len=4, fetch_mode="FLOAT")
         fmt.attr_add(id="uv", comp_type="F32", len=2, fetch_mode="FLOAT")
+        self.has_colors = mesh.colors is not None
+        if self.has_colors:
+            fmt.attr_add(id="color", comp_type="F32", len=4, fetch_mode="FLOAT")
         if usable:
             fmt.attr_add(id="vertex_index", comp_type="I32", len=1, fetch_mode="INT")
             fmt.attr_add(id="vertex_normal", comp_type="F32", len=3, fetch_mode="FLOAT")
@@ -228,6 +244,8 @@ class MeshBuffers:
         vertices.attr_fill("normal", mesh.normals)
         vertices.attr_fill("tangent", mesh.tangents)
         vertices.attr_fill("uv", mesh.uvs)
+        if self.has_colors:
+            vertices.attr_fill("color", mesh.colors)
         if usable:
             data = next(iter(usable.values()))
             rows = data.corner_rows(mesh.corner_vertex)
@@ -328,6 +346,9 @@ class _DrawContext(techniques.DrawContext):
     def image(self, slot):
         return self.renderer.textures[_texture_key(self.params.textures[slot], slot, self.params)]
 
+    def node_image(self, name):
+        return self.renderer.textures[_node_image_key(name)]
+
     def object_target(self, name, size, sources=()):
         import gpu
 
@@ -381,7 +402,7 @@ class Renderer:
         self.mesh_buffers = {}          # mesh key -> MeshBuffers
         self.material_buffers = {}      # material name -> GPUUniformBuf
         self.material_ids = {}          # material name -> id written to the G-buffer (uv.z)
-        self.textures = {}              # (image name, slot is a colour) -> GPUTexture
+        self.textures = {}              # _texture_key -> GPUTexture
         self.texture_warnings = {}      # image name -> why it was uploaded smaller than it is
         self.tables = {}                # a technique's tables (DrawContext.table): name -> GPUTexture
         self.environment_tables = {}    # name -> (EnvironmentData, GPUTexture) (DrawContext.environment_table)
@@ -413,7 +434,7 @@ class Renderer:
         for key in list(self.mesh_buffers):
             if key not in state.meshes:
                 del self.mesh_buffers[key]
-        for key in [key for key in self.textures if any(name in dirty.images for name in texture_sources(key[0]))]:
+        for key in [key for key in self.textures if key[0] in dirty.images]:
             del self.textures[key]
         for name, params in state.materials.items():      # materials whose image changed reload it
             if name not in dirty.materials and any(image in dirty.images for value in params.textures.values()
@@ -427,11 +448,7 @@ class Renderer:
             self.material_buffers[name] = _uniform_buffer(material_block(params, material_id))
             self.uploads["materials"] += 1
             self.material_tables.pop(params.name or name, None)
-            for slot, value in params.textures.items():
-                key = _texture_key(value, slot, params)
-                pixels = state.texture_pixels(value, slot, key[1]) if key not in self.textures else None
-                if pixels is not None:
-                    self.textures[key] = self._image_texture(pixels, " x ".join(texture_sources(value)), key[2])
+            self._upload_images(state, params)
         if state.environment.prefiltered is not None and self.environment_source is not state.environment:
             self.environment_texture, self.equirect_texture = environment_textures(state.environment,
                                                                                    state.world.equirect)
@@ -449,6 +466,14 @@ class Renderer:
             self.scene_buffer = _uniform_buffer(block)
         else:
             self.scene_buffer.update(gpu_buffer(block))
+
+    def _upload_images(self, state, params):
+        """The images a material's slots read that are not uploaded yet."""
+        for slot, value in params.textures.items():
+            for key in _texture_keys(value, slot, params):
+                pixels = state.texture_pixels(key[0], slot, key[1]) if key not in self.textures else None
+                if pixels is not None:
+                    self.textures[key] = self._image_texture(pixels, key[0], key[2])
 
     def _image_texture(self, pixels, name, normal_map=False):
         """The GPU texture of an image's mip levels (spherical/texture_mips.py's atlas, half as wide again as the
@@ -530,7 +555,8 @@ class Renderer:
                 continue
             inputs = techniques.ObjectInputs(light_data, state.environment, self.gbuffer,
                                              buffers.per_vertex_layers(), buffers.bounds, entry.matrix_world,
-                                             buffers.per_vertex_data(), self.shadow_plan is not None)
+                                             buffers.per_vertex_data(), self.shadow_plan is not None,
+                                             buffers.has_colors)
             slots = []
             for slot, first_triangle, batch in buffers.batches:
                 name, params = _slot_material(state, entry, slot)

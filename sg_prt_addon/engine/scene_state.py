@@ -462,8 +462,9 @@ class SceneState:
 
     @staticmethod
     def texture_pixels(value, slot, decode):
-        """What the shader samples for a material's texture (MaterialParams.textures[slot]): (H, W, 4) float32,
-        read from Blender's images when the renderer first uploads it; None while an image it reads is gone."""
+        """What the shader samples for a material's texture (an image name in MaterialParams.textures[slot], or one
+        image of its Expression): export.slot_pixels, read from Blender's images when the renderer first uploads
+        it; None while an image it reads is gone."""
         return export.slot_pixels(value, slot, decode) if export.images_present(value) else None
 
     # ----------------------------------------------------------------- shader-side data

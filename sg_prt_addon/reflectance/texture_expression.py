@@ -1,8 +1,9 @@
 """Values a node tree computes from images: sums of products of constants and images (or an affine function
-of one, such as 1 - metallic), with the arithmetic of the formulas that use them (reflectance/principled.py
-writes kd = base (1 - metallic) once for numbers and for textures).  A value with no image is a constant;
-with one plain image it is the engine's factor x texture; anything else is evaluated into a texture of its
-own (`evaluate`, pure numpy: the images resampled to the largest one's size).
+of one, such as 1 - metallic, or one of its channels), with the arithmetic of the formulas that use them
+(reflectance/principled.py writes kd = base (1 - metallic) once for numbers and for textures).  A value with
+no image is a constant; with one plain image it is the engine's factor x texture; anything else is computed
+per pixel from its images' samples (techniques/material_textures.py writes it in GLSL; `values` and `bound`
+are its numpy mirrors).
 
 Colours are RGB triples throughout: a scalar constant c is (c, c, c), and a scalar slot reads the red channel.
 """
@@ -14,14 +15,16 @@ import numpy as np
 @dataclass(frozen=True)
 class Factor:
     """offset + scale x an image's RGB (linear, as Blender decodes it), or x one of its channels on all three
-    (channel 0, 1, 2: a Separate Color's output)."""
+    (channel 0, 1, 2: a Separate Color's output); with `attribute`, `image` names a mesh's colour attribute
+    (its corners' linear RGB, interpolated over the triangle) in place of an image."""
     image: str
     scale: float = 1.0
     offset: float = 0.0
     channel: int = None
+    attribute: bool = False
 
     def sort_key(self):
-        return (self.image, self.scale, self.offset, -1 if self.channel is None else self.channel)
+        return (self.attribute, self.image, self.scale, self.offset, -1 if self.channel is None else self.channel)
 
     def values(self, rgb):
         """Its image's RGB (..., 3) as this factor reads it."""
@@ -47,6 +50,11 @@ class Expression:
     @staticmethod
     def image(name, scale=1.0, offset=0.0):
         return Expression((((1.0, 1.0, 1.0), (Factor(name, float(scale), float(offset)),)),))
+
+    @staticmethod
+    def attribute(name):
+        """A mesh's colour attribute ("": the mesh's default one)."""
+        return Expression((((1.0, 1.0, 1.0), (Factor(name, attribute=True),)),))
 
     @staticmethod
     def of(value):
@@ -88,7 +96,7 @@ class Expression:
             key = tuple(sorted(factors, key=Factor.sort_key))
             if len(key) == 1 and key[0].offset == 0.0 and key[0].scale != 1.0:
                 coefficient = tuple(c * key[0].scale for c in coefficient)
-                key = (Factor(key[0].image, channel=key[0].channel),)
+                key = (replace(key[0], scale=1.0),)
             previous = merged.get(key, (0.0, 0.0, 0.0))
             merged[key] = tuple(a + b for a, b in zip(previous, coefficient))
         terms = tuple((c, f) for f, c in merged.items() if any(v != 0.0 for v in c))
@@ -97,11 +105,16 @@ class Expression:
     # -- what it is
     @property
     def images(self):
-        return tuple(sorted({factor.image for _, factors in self.terms for factor in factors}))
+        return tuple(sorted({factor.image for _, factors in self.terms for factor in factors if not factor.attribute}))
+
+    @property
+    def attributes(self):
+        """The colour attributes it reads."""
+        return tuple(sorted({factor.image for _, factors in self.terms for factor in factors if factor.attribute}))
 
     def as_constant(self):
-        """Its RGB value when it holds no image, else None."""
-        if self.images:
+        """Its RGB value when it holds no image or attribute, else None."""
+        if any(factors for _, factors in self.terms):
             return None
         return tuple(float(sum(c[k] for c, _ in self.terms)) for k in range(3))
 
@@ -114,38 +127,55 @@ class Expression:
             return coefficient, factors[0].image
         return None
 
-    def mean_value(self, means):
-        """Its value with every image replaced by its mean RGB (means: name -> RGB)."""
+    def mean_value(self, means, attribute_mean=(0.5, 0.5, 0.5)):
+        """Its value with every image replaced by its mean RGB (means: name -> RGB), every attribute by
+        attribute_mean."""
         total = np.zeros(3)
         for coefficient, factors in self.terms:
             product = np.asarray(coefficient, np.float64)
             for factor in factors:
-                product = product * (factor.offset + factor.scale * factor.values(np.asarray(means[factor.image],
-                                                                                             np.float64)))
+                mean = attribute_mean if factor.attribute else means[factor.image]
+                product = product * (factor.offset + factor.scale * factor.values(np.asarray(mean, np.float64)))
             total += product
         return tuple(float(v) for v in total)
 
-    def evaluate(self, images):
-        """(H, W, 4) float32: the value at every texel of the largest image (images: name -> (H, W, >=3)
-        linear pixels, Blender's row order), the others read bilinearly at its texel centres; alpha 1."""
-        from ..spherical.texture_fetch import bilinear
-
-        height, width = max((images[name].shape[:2] for name in self.images), key=lambda s: s[0] * s[1])
-        u = (np.arange(width) + 0.5) / width
-        v = (np.arange(height) + 0.5) / height
-        uv = np.stack(np.broadcast_arrays(u[None, :], v[:, None]), axis=-1)
-
-        def sample(name):
-            pixels = np.asarray(images[name], np.float32)[..., :3]
-            return pixels if pixels.shape[:2] == (height, width) else bilinear(pixels, uv.astype(np.float32))
-
-        samples = {name: sample(name) for name in self.images}
-        out = np.zeros((height, width, 4), np.float32)
-        out[..., 3] = 1.0
+    def values(self, samples, attributes=None):
+        """Its value (..., 3) float32 where each image reads samples[name] (..., 3) and each attribute
+        attributes[name]: what a pixel gets when every image is sampled there (the shader's
+        texture_value_<slot>)."""
+        sources = {**{(False, name): samples[name] for name in self.images},
+                   **{(True, name): (attributes or {})[name] for name in self.attributes}}
+        shape = np.broadcast_shapes(*(np.shape(value)[:-1] for value in sources.values())) if sources else ()
+        out = np.zeros(shape + (3,), np.float32)
         for coefficient, factors in self.terms:
-            product = np.broadcast_to(np.asarray(coefficient, np.float32), (height, width, 3))
+            product = np.broadcast_to(np.asarray(coefficient, np.float32), shape + (3,))
             for factor in factors:
-                product = product * (np.float32(factor.offset)
-                                     + np.float32(factor.scale) * factor.values(samples[factor.image]))
-            out[..., :3] += product
+                source = np.asarray(sources[factor.attribute, factor.image], np.float32)[..., :3]
+                product = product * (np.float32(factor.offset) + np.float32(factor.scale) * factor.values(source))
+            out += product
+        return out
+
+    def bound(self, images):
+        """The expression with its images' pixels (name -> (H, W, >=3) linear, Blender's row order): what the
+        numpy mirrors sample for a computed slot."""
+        return BoundExpression(self, {name: np.asarray(images[name], np.float32) for name in self.images})
+
+
+@dataclass(frozen=True, eq=False)
+class BoundExpression:
+    """An Expression and its images' pixels, sampled per pixel as the shader samples it."""
+    expression: Expression
+    images: dict
+
+    def sample(self, uv, footprint=None):
+        """(N, 4) float32 at texture coordinates uv (N, 2): each image read as a material texture
+        (spherical.texture_mips.sample, at the footprint when given), alpha 1.  An expression of colour
+        attributes has no value at a texture coordinate: ValueError."""
+        from ..spherical import texture_mips
+
+        if self.expression.attributes:
+            raise ValueError(f"colour attributes {self.expression.attributes} have no value at a texture coordinate")
+        samples = {name: texture_mips.sample(pixels, uv, footprint)[..., :3] for name, pixels in self.images.items()}
+        out = np.ones((len(uv), 4), np.float32)
+        out[:, :3] = self.expression.values(samples)
         return out

@@ -32,14 +32,16 @@ class ObjectInputs:
     writes the G-buffer outputs; per_vertex: per-vertex kind ("ssdf", "transfer") -> vec4 rows a vertex of
     the object's usable precomputation (absent: none), per_vertex_data: kind -> its
     visibility.per_vertex.PerVertexData (numpy); bounds: (2, 3) local box or None; matrix_world (4, 4);
-    shadow_maps: the frame's lights have shadow maps (lighting.shadow_maps, DrawContext.shadow_atlas).
+    shadow_maps: the frame's lights have shadow maps (lighting.shadow_maps, DrawContext.shadow_atlas);
+    vertex_colors: the mesh has a colour attribute (its vertex stream, shader_sources.surface_calls).
     Derived values a technique computes once per object go in ``memo``.  Everything but matrix_world is the
     frame's or the mesh's: reading matrix_world sets ``matrix_world_read``, and the engine reuses a variant key
     for the other objects drawing the same mesh and material only when it was made without reading it."""
 
     def __init__(self, light_data, environment, gbuffer=False, per_vertex=None, bounds=None, matrix_world=None,
-                 per_vertex_data=None, shadow_maps=False):
+                 per_vertex_data=None, shadow_maps=False, vertex_colors=False):
         self.light_data = light_data
+        self.vertex_colors = bool(vertex_colors)
         self.shadow_maps = bool(shadow_maps)
         self.environment = environment
         self.gbuffer = bool(gbuffer)
@@ -80,6 +82,7 @@ class DrawContext:
       (engine/disk_cache) under kind (a word) and key (what they are made of, by content: parts that are
       bytes or have a stable repr); the maths modules take it as their tables' `store`;
     image(slot): the material's image texture of a texture slot;
+    node_image(name): the texture of an image a computed slot reads (techniques/material_textures.py);
     object_table(name, sources, build): a GPU texture of build()'s array for the object, remade when any of
       the objects in the tuple `sources` is not the one it was made from, dropped with the object;
     object_target(name, size, sources=()): a float RGBA (texture, framebuffer, current) of the object, kept while

@@ -147,26 +147,33 @@ def vertex_source(per_vertex=()):
     return (per_vertex_fetch_source(per_vertex) + source) if per_vertex else source
 
 
-def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), push_constants=()):
+def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), push_constants=(), vertex_colors=False):
     """The create-info calls of a surface shader (see base.Technique.create_info_calls): `defines` (name ->
     value, the scene limits added), the vertex stage with `per_vertex`'s fetch (PER_VERTEX_ROWS defined;
-    the fragment source calls per_vertex_copy_source's load_per_vertex_rows), the scene and material
-    blocks at bindings 0 and 1, `samplers` ((kind, name) in slot order), the technique's own push_constants
-    ((type, name)) after the model matrix, and the outputs of output_names."""
-    defines = {**LIMITS, **defines, **({"PER_VERTEX_ROWS": 1} if per_vertex else {})}
+    the fragment source calls per_vertex_copy_source's load_per_vertex_rows), with vertex_colors the mesh's
+    colour attribute as the vertex_color varying (HAS_VERTEX_COLOR), the scene and material blocks at bindings
+    0 and 1, `samplers` ((kind, name) in slot order), the technique's own push_constants ((type, name)) after
+    the model matrix, and the outputs of output_names."""
+    defines = {**LIMITS, **defines, **({"PER_VERTEX_ROWS": 1} if per_vertex else {}),
+               **({"HAS_VERTEX_COLOR": 1} if vertex_colors else {})}
     calls = [("define", (name, str(value))) for name, value in sorted(defines.items())]
     calls.append(("typedef_source", (typedef_source(),)))
     calls += [("vertex_in", (0, "VEC3", "position")), ("vertex_in", (1, "VEC3", "normal")),
               ("vertex_in", (2, "VEC4", "tangent")), ("vertex_in", (3, "VEC2", "uv"))]
     if per_vertex:
         calls += [("vertex_in", (4, "INT", "vertex_index")), ("vertex_in", (5, "VEC3", "vertex_normal"))]
+    if vertex_colors:
+        calls.append(("vertex_in", (6, "VEC4", "color")))
     interface = [("smooth", ("VEC3", "world_position")), ("smooth", ("VEC3", "world_normal")),
                  ("smooth", ("VEC4", "world_tangent")), ("smooth", ("VEC2", "texcoord"))]
     if per_vertex:
         # the vertex's smooth normal (a bake's frame) and its rows, interpolated per pixel (wang2009 5.3)
         interface.append(("smooth", ("VEC3", "world_vertex_normal")))
         interface += [("smooth", ("VEC4", f"{item.varying}_{k}")) for item in per_vertex for k in range(item.rows)]
-    interface_name = "sgprt_surface_interface" + "".join(f"_{item.varying}{item.rows}" for item in per_vertex)
+    if vertex_colors:
+        interface.append(("smooth", ("VEC4", "vertex_color")))
+    interface_name = "sgprt_surface_interface" + "".join(f"_{item.varying}{item.rows}" for item in per_vertex) \
+        + ("_color" if vertex_colors else "")
     calls.append(("vertex_out", (interface_name, tuple(interface))))
     calls.append(("push_constant", ("MAT4", "model_matrix")))
     calls += [("push_constant", constant) for constant in push_constants]

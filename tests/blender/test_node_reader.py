@@ -184,8 +184,8 @@ def test_panel_and_copy_from_node_tree(empty_file):
 
 
 def test_metallic_map_and_texture_factors_compute_textures(empty_file):
-    """A metallic map and a Mix Shader's texture factor: the slots get textures computed from the images
-    (export.slot_pixels), equal to the formulas on the decoded pixels."""
+    """A metallic map and a Mix Shader's texture factor: the slots are computed per pixel from the images
+    (export.slot_pixels: the expression bound to the decoded pixels), equal to the formulas there."""
     from sg_prt_addon.blender import export, images
     from sg_prt_addon.reflectance.texture_expression import Expression
 
@@ -204,9 +204,9 @@ def test_metallic_map_and_texture_factors_compute_textures(empty_file):
     assert params.diffuse_color == (1.0, 1.0, 1.0) and params.specular_color == (1.0, 1.0, 1.0)
     base = export.srgb_to_linear(images.image_pixels(bpy.data.images["pbr_base"])[..., :3])    # as stored: bytes
     metal = images.image_pixels(bpy.data.images["pbr_metal"])[..., :3]
-    np.testing.assert_allclose(export.slot_pixels(params.textures["diffuse_color"], "diffuse_color")[..., :3],
-                               base * (1 - metal), atol=1e-6)
-    np.testing.assert_allclose(export.slot_pixels(params.textures["specular_color"], "specular_color")[..., :3],
+    np.testing.assert_allclose(_at_texels(params.textures["diffuse_color"], "diffuse_color"), base * (1 - metal),
+                               atol=1e-6)
+    np.testing.assert_allclose(_at_texels(params.textures["specular_color"], "specular_color"),
                                metal * base + (1 - metal) * 0.04, atol=1e-6)
 
     material, tree, output = _material("mix_map")
@@ -221,9 +221,18 @@ def test_metallic_map_and_texture_factors_compute_textures(empty_file):
     tree.links.new(mix.outputs[0], output.inputs["Surface"])
     params, warnings = _read(material)
     assert warnings == []
-    np.testing.assert_allclose(export.slot_pixels(params.textures["diffuse_color"], "diffuse_color")[..., :3],
+    np.testing.assert_allclose(_at_texels(params.textures["diffuse_color"], "diffuse_color"),
                                (1 - metal) * (0.2, 0.4, 0.6), atol=1e-6)
     assert params.textures["specular_color"] == "pbr_metal" and params.specular_color == (1.0, 1.0, 1.0)
+
+
+def _at_texels(value, slot, side=4):
+    """A computed slot sampled as the mirrors sample it, at the centres of a side x side image's texels."""
+    from sg_prt_addon.blender import export
+
+    centres = (np.arange(side) + 0.5) / side
+    uv = np.stack(np.broadcast_arrays(centres[None, :], centres[:, None]), -1).reshape(-1, 2).astype(np.float32)
+    return export.slot_pixels(value, slot).sample(uv)[:, :3].reshape(side, side, 3)
 
 
 def _link_image(tree, image, socket):

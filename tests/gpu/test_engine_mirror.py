@@ -307,6 +307,45 @@ def test_node_material_with_computed_textures(engine):
     _check(result, {material.name: textures})
 
 
+def test_node_material_with_channels_and_products(engine):
+    """A Principled BSDF whose Base Color is an image's channels recombined (Separate and Combine Color) and
+    whose Roughness is a product of two channels, offset (Math): each slot's GLSL (material_textures) against
+    the Expression sampled per pixel (texture_expression.BoundExpression)."""
+    import bpy
+
+    from benchmarks import node_values
+    from sg_prt_addon.blender import export
+
+    scene = fx.new_scene("mirror_node_channels", 96, 96)
+    fx.world_colour(scene, (0.2, 0.22, 0.25))
+    material = bpy.data.materials.new("node_channels")
+    if bpy.app.version < (5, 0, 0):
+        material.use_nodes = True
+    tree = material.node_tree
+    principled = next(node for node in tree.nodes if node.type == "BSDF_PRINCIPLED")
+    tree.links.new(node_values.combine_swizzled(tree), principled.inputs["Base Color"])
+    separate = tree.nodes.new("ShaderNodeSeparateColor")
+    tree.links.new(node_values._image_node(tree, "Non-Color").outputs["Color"], separate.inputs[0])
+    product = tree.nodes.new("ShaderNodeMath")
+    product.operation = "MULTIPLY"
+    tree.links.new(separate.outputs["Red"], product.inputs[0])
+    tree.links.new(separate.outputs["Blue"], product.inputs[1])
+    offset = tree.nodes.new("ShaderNodeMath")
+    offset.operation = "ADD"
+    tree.links.new(product.outputs[0], offset.inputs[0])
+    offset.inputs[1].default_value = 0.2
+    tree.links.new(offset.outputs[0], principled.inputs["Roughness"])
+    fx.uv_sphere(scene, "channels_sphere", (0.0, 0.0, 1.0), radius=1.2).data.materials.append(material)
+    fx.point_light(scene, "point", (1.5, -3.0, 3.0), 900.0, radius=0.1)
+    result = fx.render(scene, gbuffer=True)
+    assert "error" not in result, result.get("error")
+    params = result["state"].materials[material.name]
+    assert not isinstance(params.textures["diffuse_color"], str) and not isinstance(params.textures["roughness"], str)
+    textures = {slot: export.slot_pixels(value, slot, True if slot in params.decoded_slots else None)
+                for slot, value in params.textures.items()}
+    _check(result, {material.name: textures})
+
+
 def test_anisotropic_ggx_with_its_tails(engine):
     """Anisotropic GGX (the Principled BSDF's anisotropy) under courtyard.exr and a point light: its table
     lobes, the light tail, the environment tail from GGX's albedo at the equivalent roughness, and the layer."""

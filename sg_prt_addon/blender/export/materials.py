@@ -48,7 +48,7 @@ class MaterialParams:
     tangent_axis: tuple = (1.0, 0.0, 0.0)
     tangent_rotation: float = 0.0
     # parameter name or "normal_map" -> image name, or (node trees) a reflectance.texture_expression.Expression of
-    # images that export.slot_pixels evaluates
+    # images, computed per pixel (techniques/material_textures.py)
     textures: dict = field(default_factory=dict)
     technique: str = techniques.DEFAULT    # the registered technique that renders it (techniques/)
     fitted: object = None          # FittedLobes with the fitted-lobes technique and a VALID stored fit

@@ -27,6 +27,9 @@ class MeshExport:
     corner_vertex: np.ndarray = None   # (V,) uint32
     vertex_count: int = 0
     vertex_normals: np.ndarray = None  # (vertex_count, 3) float32
+    # the mesh's default colour attribute (what a node tree's Color Attribute reads), linear RGBA a corner
+    colors: np.ndarray = None          # (V, 4) float32, or None without one
+    color_name: str = ""
 
 
 # --------------------------------------------------------------------------- meshes
@@ -153,7 +156,35 @@ def export_mesh_data(mesh, name=None):
         corner_vertex=np.ascontiguousarray(vertex_index, np.uint32),
         vertex_count=len(mesh.vertices),
         vertex_normals=_vertex_normals(mesh),
+        **_corner_colors(mesh, vertex_index, name),
     )
+
+
+def default_color_attribute(mesh):
+    """The mesh's default colour attribute (a Color Attribute node without a name reads it), or None."""
+    attributes = getattr(mesh, "color_attributes", None)
+    if not attributes:
+        return None
+    name = getattr(attributes, "default_color_name", "") or getattr(mesh.attributes, "default_color_name", "")
+    index = getattr(attributes, "render_color_index", 0)
+    return attributes.get(name) if name else attributes[index if 0 <= index < len(attributes) else 0]
+
+
+def _corner_colors(mesh, vertex_index, name):
+    """MeshExport's colors and color_name: the default colour attribute's linear RGBA at every corner (a point
+    attribute taken at the corner's vertex), non-finite values made 0 (warned)."""
+    attribute = default_color_attribute(mesh)
+    if attribute is None or attribute.domain not in ("POINT", "CORNER"):
+        return {}
+    values = np.empty(len(attribute.data) * 4, np.float32)
+    attribute.data.foreach_get("color", values)
+    values = values.reshape(-1, 4)
+    if attribute.domain == "POINT":
+        values = values[vertex_index]
+    if not np.isfinite(values).all():
+        warn(f"object '{name or mesh.name}': colour attribute '{attribute.name}' has non-finite values: 0 used")
+        values = np.where(np.isfinite(values), values, np.float32(0.0))
+    return {"colors": np.ascontiguousarray(values, np.float32), "color_name": attribute.name}
 
 
 def _usable_normals(normals, vertex_index, mesh, name):

@@ -60,10 +60,10 @@ def images_present(value):
 
 def slot_pixels(value, slot, decode=None):
     """What the shader samples for a slot's texture (MaterialParams.textures[slot]): an image's texture_pixels,
-    or an Expression evaluated from its images, each decoded as Blender decodes it (a node tree's value)."""
+    or (an Expression) the expression bound to its images' pixels, each decoded as Blender decodes it, which the
+    mirrors sample per pixel (texture_expression.BoundExpression)."""
     import bpy
 
     if isinstance(value, str):
         return texture_pixels(bpy.data.images[value], slot, decode)
-    images = {name: texture_pixels(bpy.data.images[name], slot, decode=True) for name in value.images}
-    return value.evaluate(images)
+    return value.bound({name: texture_pixels(bpy.data.images[name], slot, decode=True) for name in value.images})

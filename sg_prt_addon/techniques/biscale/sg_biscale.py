@@ -2,6 +2,7 @@
 (its BVNDF's lobes and tables, biscale.bvndf, from export.MaterialParams.biscale) with the material's own
 isotropic model as the small-scale BRDF, or its stored lobe fit (MaterialParams.fitted: a measured small-scale
 BRDF, iwasaki2012 fig. 8) (shaders/techniques/biscale/biscale.glsl; mirror biscale_shading.py)."""
+from .. import material_textures
 from ..base import EMISSION_TEXTURE
 from ..sg import sg_fitted, sg_parametric
 from ..sg.sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
@@ -45,6 +46,7 @@ class SGBiScale(SGLobes):
         textures = tuple(sorted(name for name in params.textures if name in texture_slots(params)))
         small = biscale_shading.small_lobe_count(params.model, fitted)
         return VariantKey(self.name, model, int(tables.lobe_count) * small, textures=textures,
+                          node_values=material_textures.node_values(params, textures, inputs),
                           has_diffuse=has_diffuse, has_specular=has_specular, warp_mode=warp_mode_of(params),
                           shadowing_components=components, biscale_resolution=int(tables.resolution),
                           biscale_first_lobes=int(tables.first_lobes), biscale_small_lobes=small,

@@ -20,8 +20,9 @@ import numpy as np
 from ...measured import homomorphic
 from ...reflectance import brdf, models
 from ...spherical import lattice
-from .. import shader_sources, surface_layering
+from .. import material_textures, shader_sources, surface_layering
 from ..base import EMISSION_TEXTURE, Technique
+from ..material_textures import NodeValues
 from ..sg import sg_lobes
 from . import factored_shading
 
@@ -42,6 +43,7 @@ class FactoredKey:
     technique: str = NAME
     form: str = FORM
     textures: tuple = ()
+    node_values: NodeValues = NodeValues()   # what a node tree computes (material_textures.node_values)
     has_lights: bool = False
     has_environment: bool = False
     gbuffer: bool = False
@@ -164,7 +166,8 @@ class Factored(Technique):
     def variant_key(self, params, inputs):
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS))
         layers = int(inputs.per_vertex.get(VISIBILITY_KIND, 0))
-        return FactoredKey(textures=textures, has_lights=inputs.has_lights, has_environment=inputs.has_environment,
+        return FactoredKey(textures=textures, node_values=material_textures.node_values(params, textures, inputs),
+                           has_lights=inputs.has_lights, has_environment=inputs.has_environment,
                            gbuffer=inputs.gbuffer, visibility_layers=layers, layering=surface_layering.flags(params),
                            diffuse_visibility_rows=sg_lobes.diffuse_visibility_rows(inputs.environment) if layers else 0)
 
@@ -194,7 +197,7 @@ class Factored(Technique):
         samplers.append(("FLOAT_2D", "factored_albedo"))
         if key.has_environment:
             samplers += [("FLOAT_2D_ARRAY", "environment_texture"), ("FLOAT_2D", "equirect_texture")]
-        samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        samplers += material_textures.samplers(key)
         if key.layering:
             samplers.append(surface_layering.SAMPLER)
         if key.visibility_layers:
@@ -211,8 +214,7 @@ class Factored(Technique):
                  and (name != "env_prefilter.glsl" or key.has_environment)
                  and (name not in ("hemisphere_map.glsl", "ssdf.glsl") or key.visibility_layers)]
         sources = [shader_sources.library_source(name) for name in files]
-        sources += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl",
-                                                                                 "surface_io.glsl")]
+        sources += material_textures.sources(key)
         if key.layering:
             sources.append(surface_layering.source())
         per_vertex = self.per_vertex_inputs(key)
@@ -223,7 +225,8 @@ class Factored(Technique):
             sources.append(shader_sources.per_vertex_copy_source(per_vertex))
         sources.append(shader_sources.technique_source(GLSL_DIR, "surface.frag.glsl"))
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
-                                            per_vertex, push_constants=(("VEC4", "factor_scale"),))
+                                            per_vertex, push_constants=(("VEC4", "factor_scale"),),
+                                            vertex_colors=key.node_values.vertex_colors)
 
     def bind_reads_object(self, key):
         return key.visibility_layers > 0        # the bake's rows, the mesh's
@@ -242,8 +245,7 @@ class Factored(Technique):
             layers, equirect = context.environment_textures()
             shader.uniform_sampler("environment_texture", layers)
             shader.uniform_sampler("equirect_texture", equirect)
-        for name in key.textures:
-            shader.uniform_sampler("texture_" + name, context.image(name))
+        material_textures.bind(shader, key, context)
         if key.layering:
             surface_layering.bind(shader, context)
         if key.visibility_layers:

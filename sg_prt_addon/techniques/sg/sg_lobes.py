@@ -23,8 +23,9 @@ from dataclasses import dataclass
 from ...reflectance import brdf
 from ...spherical import clamped_cosine_table, warp
 from ...visibility import broad_lobes
-from .. import shader_sources, surface_layering
+from .. import material_textures, shader_sources, surface_layering
 from ..base import EMISSION_TEXTURE, Technique
+from ..material_textures import NodeValues
 from ..shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
 from . import sg_shading
 from .fitted_texels import FITTED_MODEL
@@ -54,6 +55,7 @@ class VariantKey:
     has_lights: bool = False
     has_environment: bool = False
     textures: tuple = ()            # sorted names from TEXTURE_SLOTS
+    node_values: NodeValues = NodeValues()   # what a node tree computes (material_textures.node_values)
     gbuffer: bool = False
     visibility_layers: int = 0      # vec4 of SSDF coefficients per vertex (0: no visibility bake)
     shadowing_components: int = 0   # sg_fitted: PCA components of the stored shadowing
@@ -274,7 +276,7 @@ class SGLobes(Technique):
     def fragment_source(self, key):
         parts = [_constants_source()]
         parts += [shader_sources.library_source(name) for name in self.library_files(key)]
-        parts += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl", "surface_io.glsl")]
+        parts += material_textures.sources(key)
         if key.layering:
             parts.append(surface_layering.source())
         parts += [shader_sources.technique_source(folder, name) for folder, name in self.technique_files(key)]
@@ -292,7 +294,7 @@ class SGLobes(Technique):
         samplers += self.model_samplers(key)
         if uses_clamped_cosine_table(key):
             samplers.append(("FLOAT_2D", "clamped_cosine_table"))
-        samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        samplers += material_textures.samplers(key)
         if key.layering:
             samplers.append(surface_layering.SAMPLER)
         if key.visibility_layers:
@@ -306,7 +308,8 @@ class SGLobes(Technique):
 
     def create_info_calls(self, key):
         return shader_sources.surface_calls(self.defines(key), self.fragment_source(key), self.samplers(key),
-                                            key.gbuffer, per_vertex_inputs(key))
+                                            key.gbuffer, per_vertex_inputs(key),
+                                            vertex_colors=key.node_values.vertex_colors)
 
     # ------------------------------------------------------------- drawing
 
@@ -333,8 +336,7 @@ class SGLobes(Technique):
         if uses_clamped_cosine_table(key):
             shader.uniform_sampler("clamped_cosine_table",
                                    context.table("clamped_cosine", clamped_cosine_table.clamped_cosine_table))
-        for name in key.textures:
-            shader.uniform_sampler("texture_" + name, context.image(name))
+        material_textures.bind(shader, key, context)
         if key.layering:
             surface_layering.bind(shader, context)
         if key.shadow_maps:

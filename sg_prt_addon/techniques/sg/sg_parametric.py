@@ -4,7 +4,7 @@ import numpy as np
 
 from ...reflectance import ggx_albedo, models, ndf_fit
 from ...spherical import warp
-from .. import surface_layering
+from .. import material_textures, surface_layering
 from . import sg_shading
 from .sg_lobes import TEXTURE_SLOTS, SGLobes, VariantKey, scene_fields, warp_mode_of
 
@@ -84,7 +84,8 @@ class SGParametric(SGLobes):
         has_diffuse, has_specular = material_terms(params)
         textures = tuple(sorted(name for name in params.textures if name in TEXTURE_SLOTS
                                 and (has_specular or name not in SPECULAR_ONLY_TEXTURES)))
-        return VariantKey(self.name, model, lobes, textures=textures, has_diffuse=has_diffuse,
+        return VariantKey(self.name, model, lobes, textures=textures,
+                          node_values=material_textures.node_values(params, textures, inputs), has_diffuse=has_diffuse,
                           has_specular=has_specular, warp_mode=warp_mode_of(params) if has_specular else
                           warp.DEFAULT_MODE, layering=surface_layering.flags(params),
                           **scene_fields(inputs, has_diffuse, has_specular))

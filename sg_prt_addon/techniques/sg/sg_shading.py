@@ -809,12 +809,15 @@ def sample_texture(image, uv):
 
 
 def sample_material_texture(image, uv):
-    """A material texture (H, W, C) at the surface's texture coordinates, as common/surface_io.glsl's
+    """A material texture (H, W, C) at the surface's texture coordinates, as common/material_textures.glsl's
     material_texture reads it (repeating as Blender's Image Texture does): float32 (N, C).  uv (N, 2), or (N, 3)
     with the G-buffer's footprint (its uv.w - 1) third: trilinear in the image's mip levels at it
-    (spherical.texture_mips.sample); without it, bilinear in the image."""
+    (spherical.texture_mips.sample); without it, bilinear in the image.  A node tree's computed slot
+    (texture_expression.BoundExpression) samples each of its images so (texture_value_<slot>)."""
     uv = np.asarray(uv, FLOAT)
     footprint = uv[:, 2] if uv.shape[-1] > 2 else None
+    if hasattr(image, "sample"):
+        return image.sample(uv[:, :2], footprint).astype(FLOAT)
     return texture_mips.sample(image, uv[:, :2], footprint).astype(FLOAT)
 
 

@@ -35,8 +35,9 @@ import numpy as np
 from ...harmonics import brdf_table, fitted_table, projection
 from ...reflectance import models
 from ...visibility import per_vertex, transfer
-from .. import shader_sources, surface_layering
+from .. import material_textures, shader_sources, surface_layering
 from ..base import EMISSION_TEXTURE, Technique
+from ..material_textures import NodeValues
 from ..sg import fitted_texels
 from . import sh_glsl, sh_shading
 
@@ -62,6 +63,7 @@ class SHKey:
     isotropic: bool = True
     parameter: str = "roughness"        # the table's axis (isotropic), None otherwise
     textures: tuple = ()
+    node_values: NodeValues = NodeValues()   # what a node tree computes (material_textures.node_values)
     has_lights: bool = False
     gbuffer: bool = False
     transfer_layers: int = 0            # vec4 rows a vertex of the transfer bake (0: none)
@@ -236,7 +238,8 @@ class SphericalHarmonics(Technique):
                    layering=()) if fitted is not None else dict(layering=surface_layering.flags(params))
         return SHKey(order=order, window=getattr(params, "sh_window", "none"),
                      isotropic=axis is not None or fitted is not None, parameter=axis[0] if axis else None,
-                     textures=textures, has_lights=inputs.has_lights, gbuffer=inputs.gbuffer,
+                     textures=textures, node_values=material_textures.node_values(params, textures, inputs),
+                     has_lights=inputs.has_lights, gbuffer=inputs.gbuffer,
                      transfer_layers=data.layers if data is not None else 0,
                      vertex_transfer=vertex_transfer_rows(order, inputs.has_lights) if data is not None else 0, **fit)
 
@@ -245,7 +248,7 @@ class SphericalHarmonics(Technique):
         if key.isotropic:
             out["SH_ISOTROPIC"] = 1
             if key.parameter in key.textures:
-                out["SH_PARAMETER_TEXTURE"] = "texture_" + key.parameter
+                out["SH_PARAMETER_TEXTURE"] = "texture_value_" + key.parameter
         if key.fitted_lobes:
             out.update(SH_FITTED=1, FITTED_LOBES=key.fitted_lobes, FITTED_COMPONENTS=key.fitted_components,
                        FITTED_SHADOWING_LAYERS=-(-key.fitted_components // 4))
@@ -274,7 +277,7 @@ class SphericalHarmonics(Technique):
             samplers += [("FLOAT_2D", "transfer_coefficients"), ("FLOAT_2D", "sh_transfer_radiance")]
             if key.has_lights:
                 samplers.append(("FLOAT_2D_ARRAY", "transfer_basis"))
-        samplers += [("FLOAT_2D", "texture_" + name) for name in key.textures]
+        samplers += material_textures.samplers(key)
         return samplers + ([surface_layering.SAMPLER] if key.layering else [])
 
     def per_vertex_inputs(self, key):
@@ -289,8 +292,7 @@ class SphericalHarmonics(Technique):
     def create_info_calls(self, key):
         files = [name for name in LIBRARY_FILES if name != "lights.glsl" or key.has_lights]
         sources = [shader_sources.library_source(name) for name in files]
-        sources += [shader_sources.technique_source("common", name) for name in ("surface_common.glsl",
-                                                                                 "surface_io.glsl")]
+        sources += material_textures.sources(key)
         if key.layering:
             sources.append(surface_layering.source())
         if key.fitted_lobes:
@@ -303,7 +305,8 @@ class SphericalHarmonics(Technique):
         sources += [shader_sources.technique_source(GLSL_DIR, name)
                     for name in ("sh_library.glsl", "sh_shading.glsl", "surface.frag.glsl")]
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
-                                            fetched, push_constants=(("VEC4", "sh_axis"),))
+                                            fetched, push_constants=(("VEC4", "sh_axis"),),
+                                            vertex_colors=key.node_values.vertex_colors)
 
     def bind_reads_object(self, key):
         # the transfer bake's rows and radiance table (the mesh's); the environment's row is the scene's
@@ -351,8 +354,7 @@ class SphericalHarmonics(Technique):
             shader.uniform_sampler("sh_transfer_radiance", context.object_table(
                 f"sh_transfer_radiance_{key.order}_{key.window}", (data, environment),
                 lambda: transfer_radiance_texture(data, environment, key.order, key.window)))
-        for name in key.textures:
-            shader.uniform_sampler("texture_" + name, context.image(name))
+        material_textures.bind(shader, key, context)
         if key.layering:
             surface_layering.bind(shader, context)
 

@@ -1,6 +1,6 @@
 /* Bi-scale materials (iwasaki2012 eq. 15): the effective BRDF's lobes and factors, mirrored by
- * sg_prt_addon/techniques/biscale/biscale_shading.py.  Needs sg.glsl, hemisphere_map.glsl, surface_io.glsl (the mask's
- * material_texture); with HAS_SPECULAR, brdf.glsl, (MODEL_GGX) ggx_two_lobes.glsl and the ggx_table sampler, and
+ * sg_prt_addon/techniques/biscale/biscale_shading.py.  Needs sg.glsl, hemisphere_map.glsl, the mask's
+ * texture_value_biscale_mask() (techniques/material_textures.py); with HAS_SPECULAR, brdf.glsl, (MODEL_GGX) ggx_two_lobes.glsl and the ggx_table sampler, and
  * sg_models.glsl before this file (its model_ndf_lobe and model_m_factor); and:
  *   biscale_lobes  (sampler2D, J x 1): texel j = (axis xyz in the local frame, sharpness) of BVNDF lobe j;
  *   biscale_tables (sampler2DArray, R^2 x R^2 RGBA32F, linear filtering): the node pair (i, o) of the lattice
@@ -41,7 +41,7 @@ void biscale_set_view(vec3 view_local)
   biscale_view_weight[2] = (1.0 - f.x) * f.y;
   biscale_view_weight[3] = f.x * f.y;
 #ifdef HAS_TEXTURE_BISCALE_MASK
-  biscale_mask = clamp(material_texture(texture_biscale_mask).r, 0.0, 1.0);
+  biscale_mask = clamp(texture_value_biscale_mask().r, 0.0, 1.0);
 #endif
 }
 

@@ -30,7 +30,7 @@ void surface_layering(vec3 shading_normal, inout vec3 diffuse_color, inout vec3 
   vec3 view = scene.camera.w > 0.5 ? normalize(scene.camera.xyz - world_position) : -normalize(scene.camera.xyz);
   float roughness = material.options.z;
 #ifdef LAYERING_TEXTURED_ROUGHNESS
-  roughness *= material_texture(texture_roughness).r;
+  roughness *= texture_value_roughness().r;
 #endif
   vec2 coords = (clamp(vec2(dot(shading_normal, view), roughness), 0.0, 1.0) * float(LAYERING_TABLE_SIZE - 1) + 0.5) /
                 float(LAYERING_TABLE_SIZE);

@@ -22,25 +22,25 @@ void main()
 #endif
   surface_colour_textures(diffuse_color, specular_color);
 #ifdef HAS_TEXTURE_ROUGHNESS
-  p.x *= material_texture(texture_roughness).r;
+  p.x *= texture_value_roughness().r;
 #endif
 #ifdef HAS_TEXTURE_IOR
-  p.y *= material_texture(texture_ior).r;
+  p.y *= texture_value_ior().r;
 #endif
 #ifdef HAS_TEXTURE_EXPONENT
-  p.z *= material_texture(texture_exponent).r;
+  p.z *= texture_value_exponent().r;
 #endif
 #ifdef HAS_TEXTURE_ALPHA_X
-  p.w *= material_texture(texture_alpha_x).r;
+  p.w *= texture_value_alpha_x().r;
 #endif
 #ifdef HAS_TEXTURE_ALPHA_Y
-  q.x *= material_texture(texture_alpha_y).r;
+  q.x *= texture_value_alpha_y().r;
 #endif
 #ifdef HAS_TEXTURE_NU
-  q.y *= material_texture(texture_nu).r;
+  q.y *= texture_value_nu().r;
 #endif
 #ifdef HAS_TEXTURE_NV
-  q.z *= material_texture(texture_nv).r;
+  q.z *= texture_value_nv().r;
 #endif
   vec4 tangent;
   vec3 shading_normal, shading_tangent;

@@ -18,7 +18,7 @@ void main()
   surface_colour_textures(diffuse_color, specular_color);
   float parameter = SH_PARAMETER;
 #ifdef SH_PARAMETER_TEXTURE
-  parameter *= material_texture(SH_PARAMETER_TEXTURE).r;
+  parameter *= SH_PARAMETER_TEXTURE().r;
 #endif
   vec4 tangent;
   vec3 shading_normal, shading_tangent;

@@ -1,0 +1,106 @@
+"""A material's textured slots in its surface shader: each slot the variant textures (its key's `textures`) is
+read as texture_value_<slot>() (shaders/techniques/common/material_textures.glsl reads the images), from the
+slot's own image (sampler texture_<slot>), or computed per pixel from a node tree's images and the mesh's colour
+attribute (a reflectance.texture_expression.Expression: the key's `node_values`), each image read once a pixel
+(sampler node_image_<k>), the colour attribute from the vertex stage (vertex_color).  The normal map is read by
+surface_io.glsl itself (its mip level too).
+
+A technique's key carries `textures` (slot names) and `node_values` (a NodeValues, from `node_values`);
+`samplers`, `bind` and `sources` give its shader the rest, shader_sources.surface_calls the colour stream."""
+from dataclasses import dataclass
+
+from . import shader_sources
+
+NORMAL_MAP = "normal_map"
+# What a colour attribute reads where the mesh has none (Cycles: an attribute not found is 0)
+MISSING_ATTRIBUTE = "vec3(0.0)"
+
+
+@dataclass(frozen=True)
+class NodeValues:
+    """The slots a node tree computes: ((slot, Expression), ...) by slot; vertex_colors: they read a colour
+    attribute and the object's mesh has one (its vertex stream)."""
+    slots: tuple = ()
+    vertex_colors: bool = False
+
+
+def node_values(params, textures, inputs):
+    """NodeValues of the slots among `textures` whose value a node tree computes (inputs: base.ObjectInputs)."""
+    slots = tuple((slot, params.textures[slot]) for slot in sorted(textures)
+                  if not isinstance(params.textures[slot], str))
+    reads_attributes = any(expression.attributes for _, expression in slots)
+    return NodeValues(slots, reads_attributes and inputs.vertex_colors)
+
+
+def images(key):
+    """The images the computed slots read, sorted: node_image_<k> is the k-th."""
+    return tuple(sorted({name for _, expression in key.node_values.slots for name in expression.images}))
+
+
+def samplers(key):
+    computed = {slot for slot, _ in key.node_values.slots}
+    out = [("FLOAT_2D", "texture_" + name) for name in key.textures if name not in computed]
+    return out + [("FLOAT_2D", f"node_image_{k}") for k in range(len(images(key)))]
+
+
+def bind(shader, key, context):
+    """The slots' images (DrawContext.image) and the computed slots' (DrawContext.node_image)."""
+    computed = {slot for slot, _ in key.node_values.slots}
+    for name in key.textures:
+        if name not in computed:
+            shader.uniform_sampler("texture_" + name, context.image(name))
+    for k, name in enumerate(images(key)):
+        shader.uniform_sampler(f"node_image_{k}", context.node_image(name))
+
+
+def expression_source(expression, rgb_of):
+    """An Expression as a GLSL vec3 expression; rgb_of(factor): the GLSL vec3 of its image or attribute at the
+    pixel."""
+    literal = shader_sources.float_literal
+
+    def factor_source(factor):
+        value = rgb_of(factor) + ("" if factor.channel is None else "." + "rgb"[factor.channel] * 3)
+        if factor.scale == 1.0 and factor.offset == 0.0:
+            return value
+        return f"({literal(factor.offset)} + {literal(factor.scale)} * {value})"
+
+    terms = [" * ".join([f"vec3({', '.join(literal(c) for c in coefficient)})"]
+                        + [factor_source(factor) for factor in factors]) for coefficient, factors in expression.terms]
+    return " + ".join(terms)
+
+
+def values_source(key):
+    """GLSL: each computed slot's image read once a pixel (node_image_<k>_rgb()), and texture_value_<slot>() of
+    every textured slot but the normal map (a colour attribute: the vertex stage's vertex_color, or
+    MISSING_ATTRIBUTE where the mesh has none)."""
+    names = images(key)
+    lines = ["/* The material's textured slots (techniques/material_textures.py) */"]
+    for k in range(len(names)):
+        lines += [f"vec3 node_image_{k}_value = vec3(0.0);", f"bool node_image_{k}_read = false;",
+                  f"vec3 node_image_{k}_rgb()", "{", f"  if (!node_image_{k}_read) {{",
+                  f"    node_image_{k}_value = material_texture(node_image_{k}).rgb;",
+                  f"    node_image_{k}_read = true;", "  }", f"  return node_image_{k}_value;", "}"]
+    computed = dict(key.node_values.slots)
+    attribute = "vertex_color.rgb" if key.node_values.vertex_colors else MISSING_ATTRIBUTE
+
+    def rgb_of(factor):
+        return attribute if factor.attribute else f"node_image_{names.index(factor.image)}_rgb()"
+
+    for slot in key.textures:
+        if slot == NORMAL_MAP:
+            continue
+        lines += [f"vec4 texture_value_{slot}()", "{"]
+        if slot in computed:
+            value = expression_source(computed[slot], rgb_of)
+            lines.append(f"  return vec4({value}, 1.0);")
+        else:
+            lines.append(f"  return material_texture(texture_{slot});")
+        lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def sources(key):
+    """The surface shader's sources from surface_common.glsl to surface_io.glsl, the slots' values between."""
+    return [shader_sources.technique_source("common", "surface_common.glsl"),
+            shader_sources.technique_source("common", "material_textures.glsl"), values_source(key),
+            shader_sources.technique_source("common", "surface_io.glsl")]
