@@ -15,6 +15,13 @@ JSON_PATH = ROOT / "docs" / "node_values.json"
 DOC_PATH = ROOT / "docs" / "ACCURACY.md"
 SECTION_TITLE = "## Node values against Cycles' evaluation"
 TEXTURE_SIDE = 16
+MATH_OPERATIONS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "LOGARITHM", "SQRT", "INVERSE_SQRT",
+                   "ABSOLUTE", "EXPONENT", "MINIMUM", "MAXIMUM", "LESS_THAN", "GREATER_THAN", "SIGN", "COMPARE",
+                   "SMOOTH_MIN", "SMOOTH_MAX", "ROUND", "FLOOR", "CEIL", "TRUNC", "FRACT", "MODULO", "FLOORED_MODULO",
+                   "WRAP", "SNAP", "PINGPONG", "SINE", "COSINE", "TANGENT", "SINH", "COSH", "TANH", "ARCSINE",
+                   "ARCCOSINE", "ARCTANGENT", "ARCTAN2", "RADIANS", "DEGREES")
+MIX_BLENDS = ("SCREEN", "OVERLAY", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN", "LIGHTEN", "DODGE", "BURN",
+              "SOFT_LIGHT", "LINEAR_LIGHT", "SUBTRACT")
 COLOUR_ATTRIBUTE = "Col"
 
 
@@ -293,6 +300,128 @@ def add_colour_attribute(mesh, domain="POINT", data_type="FLOAT_COLOR"):
     attribute.data.foreach_set("color", np.ascontiguousarray(colours, np.float32).ravel())
 
 
+def _three_inputs(tree):
+    """Three values over the plane from the Non-Color image: a = 4 red - 2 (-1.6..1.6), b = 2 green (0.2..1.8),
+    c = blue (0.2..0.8)."""
+    separate = _separate(tree, _image_node(tree, "Non-Color").outputs["Color"])
+    a = _math_node(tree, "MULTIPLY_ADD", separate.outputs["Red"], 4.0, -2.0)
+    b = _math_node(tree, "MULTIPLY", separate.outputs["Green"], 2.0)
+    return a, b, separate.outputs["Blue"]
+
+
+def _math_node(tree, operation, *inputs):
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    for socket, value in zip(node.inputs, inputs):
+        if isinstance(value, float):
+            socket.default_value = value
+        else:
+            tree.links.new(value, socket)
+    return node.outputs[0]
+
+
+# inputs moved off a pole: the base of a logarithm past 1, tan's argument within (-pi/2, pi/2), 1/sqrt's past 0
+SHIFTED_INPUTS = {"LOGARITHM": (0.0, 1.0), "TANGENT": (-0.5, 0.0), "INVERSE_SQRT": (1.7, 0.0)}
+
+
+def math_operation(operation):
+    """The Math node's `operation` of the three inputs, made positive (Absolute) for the emission."""
+    def value_of(tree):
+        a, b, c = _three_inputs(tree)
+        shift_a, shift_b = SHIFTED_INPUTS.get(operation, (0.0, 0.0))
+        if operation == "TANGENT":
+            a = _math_node(tree, "MULTIPLY", a, 0.8)
+        elif shift_a:
+            a = _math_node(tree, "ADD", a, shift_a)
+        if shift_b:
+            b = _math_node(tree, "ADD", b, shift_b)
+        return _math_node(tree, "ABSOLUTE", _math_node(tree, operation, a, b, c))
+    return value_of
+
+
+def clamp_node(clamp_type):
+    def value_of(tree):
+        a, b, c = _three_inputs(tree)
+        node = tree.nodes.new("ShaderNodeClamp")
+        node.clamp_type = clamp_type
+        tree.links.new(a, node.inputs["Value"])
+        tree.links.new(_math_node(tree, "SUBTRACT", b, 1.0), node.inputs["Min"])
+        tree.links.new(c, node.inputs["Max"])
+        return _math_node(tree, "ABSOLUTE", node.outputs[0])
+    return value_of
+
+
+def map_range_node(interpolation):
+    def value_of(tree):
+        a, b, c = _three_inputs(tree)
+        node = tree.nodes.new("ShaderNodeMapRange")
+        node.interpolation_type = interpolation
+        tree.links.new(a, node.inputs["Value"])
+        node.inputs["From Min"].default_value = -1.0
+        tree.links.new(b, node.inputs["From Max"])
+        tree.links.new(c, node.inputs["To Min"])
+        node.inputs["To Max"].default_value = 1.5
+        if interpolation == "STEPPED":
+            node.inputs["Steps"].default_value = 3.0
+        return node.outputs["Result"]
+    return value_of
+
+
+def color_ramp_node(interpolation, output="Color"):
+    """A four-stop ramp (stops at 0.1, 0.35, 0.6, 0.9) of the image's red channel."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeValToRGB")
+        ramp = node.color_ramp
+        ramp.interpolation = interpolation
+        stops = [(0.1, (0.9, 0.1, 0.1, 1.0)), (0.35, (0.1, 0.8, 0.2, 0.5)), (0.6, (0.2, 0.3, 0.9, 0.8)),
+                 (0.9, (1.0, 0.9, 0.3, 0.2))]
+        ramp.elements[0].position, ramp.elements[0].color = stops[0]
+        ramp.elements[1].position, ramp.elements[1].color = stops[-1]
+        for position, colour in stops[1:-1]:
+            ramp.elements.new(position).color = colour
+        separate = _separate(tree, _image_node(tree, "Non-Color").outputs["Color"])
+        tree.links.new(separate.outputs["Red"], node.inputs["Fac"])
+        return node.outputs[output]
+    return value_of
+
+
+def mix_blend(blend):
+    """The image (A) and its channels turned (B) blended by `blend` at a factor of its blue channel."""
+    def value_of(tree):
+        texture = _image_node(tree)
+        node = tree.nodes.new("ShaderNodeMix")
+        node.data_type = "RGBA"
+        node.blend_type = blend
+        tree.links.new(_separate(tree, texture.outputs["Color"]).outputs["Blue"], node.inputs["Factor"])
+        tree.links.new(texture.outputs["Color"], node.inputs["A"])
+        tree.links.new(combine_swizzled(tree), node.inputs["B"])
+        return node.outputs["Result"]
+    return value_of
+
+
+def colour_node(kind):
+    """Hue/Saturation/Value, Gamma, Brightness/Contrast or RGB to BW of the image, their other inputs from its
+    channels."""
+    def value_of(tree):
+        texture = _image_node(tree)
+        separate = _separate(tree, texture.outputs["Color"])
+        node = tree.nodes.new({"hue_saturation_value": "ShaderNodeHueSaturation", "gamma": "ShaderNodeGamma",
+                               "brightness_contrast": "ShaderNodeBrightContrast", "rgb_to_bw": "ShaderNodeRGBToBW"}[kind])
+        tree.links.new(texture.outputs["Color"], node.inputs["Color"])
+        if kind == "hue_saturation_value":
+            tree.links.new(separate.outputs["Red"], node.inputs["Hue"])
+            node.inputs["Saturation"].default_value = 1.4
+            tree.links.new(_math_node(tree, "ADD", separate.outputs["Green"], 0.5), node.inputs["Value"])
+            node.inputs["Fac"].default_value = 0.8
+        elif kind == "gamma":
+            tree.links.new(_math_node(tree, "MULTIPLY", separate.outputs["Green"], 3.0), node.inputs["Gamma"])
+        elif kind == "brightness_contrast":
+            tree.links.new(_math_node(tree, "SUBTRACT", separate.outputs["Red"], 0.4), node.inputs["Bright"])
+            node.inputs["Contrast"].default_value = 0.6
+        return node.outputs[0]
+    return value_of
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -306,7 +435,16 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "mix_shader_textured_factor": mix_shader_textured_factor, "color_attribute": _socket_case(color_attribute),
          "color_attribute_corners": _socket_case(color_attribute), "attribute_fac": _socket_case(attribute_fac),
          "image_times_color_attribute": _socket_case(image_times_color_attribute),
-         "color_attribute_missing": _socket_case(color_attribute)}
+         "color_attribute_missing": _socket_case(color_attribute),
+         **{f"math_{operation.lower()}": _socket_case(math_operation(operation)) for operation in MATH_OPERATIONS},
+         "clamp_minmax": _socket_case(clamp_node("MINMAX")), "clamp_range": _socket_case(clamp_node("RANGE")),
+         **{f"map_range_{kind.lower()}": _socket_case(map_range_node(kind))
+            for kind in ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")},
+         **{f"color_ramp_{kind.lower()}": _socket_case(color_ramp_node(kind)) for kind in ("LINEAR", "EASE", "CONSTANT")},
+         "color_ramp_alpha": _socket_case(color_ramp_node("LINEAR", "Alpha")),
+         **{f"mix_{blend.lower()}": _socket_case(mix_blend(blend)) for blend in MIX_BLENDS},
+         **{kind: _socket_case(colour_node(kind))
+            for kind in ("hue_saturation_value", "gamma", "brightness_contrast", "rgb_to_bw")}}
 # cases whose truth is 0 everywhere (scored by their largest values)
 ZERO_TRUTH = ("color_attribute_missing",)
 # the cases whose grid has the colour attribute: (domain, data type)

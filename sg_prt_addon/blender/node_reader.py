@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..reflectance import principled
+from ..reflectance import node_functions, principled
 from ..reflectance.texture_expression import Expression
 from .node_graph import output_node
 
@@ -66,6 +66,16 @@ def _constant(value, colour):
     return Expression.constant(value)
 
 
+def _luminance(value):
+    """A colour's Rec. 709 luminance on all three channels."""
+    return sum((value.channel(k) * weight for k, weight in enumerate(LUMINANCE)), Expression.constant(0.0))
+
+
+def _clamped(value):
+    """A value clamped to [0, 1] (a node's Clamp option)."""
+    return Expression.function("clamp", ("MINMAX",), (value, 0.0, 1.0))
+
+
 def _rounded(value):
     return tuple(round(v, 4) for v in value) if isinstance(value, tuple) else round(value, 4)
 
@@ -104,10 +114,19 @@ class SocketReader:
     # ------------------------------------------------------------------ values
 
     def value(self, socket, colour):
-        """The Expression a socket receives."""
+        """The Expression a socket receives: a colour read where a number is wanted (colour False) is its
+        luminance, as Blender converts it, but for an image's: its red channel (the grey maps numbers come from
+        keep the factor x texture path)."""
         out = follow(socket)
         if out is None:
             return _constant(_default(socket), colour)
+        value = self._output_value(out, socket, colour)
+        if not colour and out.type == "RGBA" and value.as_constant() is None:
+            value = value.channel(0) if out.node.type == "TEX_IMAGE" else _luminance(value)
+        return value
+
+    def _output_value(self, out, socket, colour):
+        """The Expression of the output socket `out` feeding `socket`."""
         node = out.node
         if node.type in ("RGB", "VALUE"):
             return _constant(_default(out), colour)
@@ -117,7 +136,11 @@ class SocketReader:
             return self.separate(node, out)
         if node.type in ("VERTEX_COLOR", "ATTRIBUTE"):
             return self.attribute_value(node, out, socket, colour)
+        if node.type == "VALTORGB":
+            return self.color_ramp(node, out)
         reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix,
+                  "CLAMP": self.clamp, "MAP_RANGE": self.map_range, "HUE_SAT": self.hue_saturation_value,
+                  "GAMMA": self.gamma, "BRIGHTCONTRAST": self.brightness_contrast, "RGBTOBW": self.luminance,
                   **dict.fromkeys(COMBINE_NODES, self.combine)}.get(node.type)
         if reader is not None:
             result = reader(node, colour)
@@ -128,28 +151,66 @@ class SocketReader:
         return _constant(_default(socket), colour)
 
     def math(self, node, colour):
-        a, b = (self.value(node.inputs[k], False) for k in range(2))
+        """Every operation of the Math node: sums and products in the algebra, the rest node functions."""
+        a, b, c = (self.value(socket, False) for socket in list(node.inputs)[:3])
         operation = node.operation
-        if operation in ("ADD", "SUBTRACT", "MULTIPLY"):
-            result = a + b if operation == "ADD" else a - b if operation == "SUBTRACT" else a * b
+        if operation in ("ADD", "SUBTRACT", "MULTIPLY", "MULTIPLY_ADD"):
+            result = {"ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
+                      "MULTIPLY_ADD": lambda: a * b + c}[operation]()
         elif operation == "DIVIDE" and scalar_of(b) not in (None, 0.0):
             result = a * (1.0 / scalar_of(b))
-        elif scalar_of(a) is not None and scalar_of(b) is not None:
-            functions = {"POWER": np.power, "MINIMUM": min, "MAXIMUM": max, "DIVIDE": lambda x, y: 0.0}
-            if operation not in functions:
-                self.note(node, f"{operation.lower()}: its output is the first input")
-                return a
-            result = Expression.constant(float(functions[operation](scalar_of(a), scalar_of(b))))
+        elif operation in node_functions.MATH:
+            result = Expression.function("math", (operation,), (a, b, c))
         else:
-            self.note(node, f"{operation.lower()} of a texture: its output is the first input")
+            self.note(node, f"{operation.lower()}: its output is the first input")
             return a
-        if node.use_clamp:
-            value = scalar_of(result)
-            if value is None:
-                self.note(node, "clamp of a texture: not clamped")
-            else:
-                result = Expression.constant(float(np.clip(value, 0.0, 1.0)))
-        return result
+        return _clamped(result) if node.use_clamp else result
+
+    def clamp(self, node, colour):
+        value, low, high = (self.value(node.inputs[name], False) for name in ("Value", "Min", "Max"))
+        return Expression.function("clamp", (node.clamp_type,), (value, low, high))
+
+    def map_range(self, node, colour):
+        """Map Range of floats (LINEAR, STEPPED, SMOOTHSTEP, SMOOTHERSTEP)."""
+        if node.data_type != "FLOAT":
+            self.note(node, f"a {node.data_type.lower()} map range: its first input is used")
+            return None
+        sockets = _sockets(node, "Value", "From Min", "From Max", "To Min", "To Max", "Steps")
+        values = [self.value(socket, False) if socket is not None else Expression.constant(4.0) for socket in sockets]
+        return Expression.function("map_range", (node.interpolation_type, bool(node.clamp)), values)
+
+    def color_ramp(self, node, out):
+        """Color Ramp's Color or Alpha (RGB interpolation: LINEAR, EASE, CONSTANT; the others read as LINEAR)."""
+        ramp = node.color_ramp
+        interpolation = ramp.interpolation
+        if interpolation not in ("LINEAR", "EASE", "CONSTANT"):
+            self.note(node, f"{interpolation.lower()} interpolation: read as linear")
+            interpolation = "LINEAR"
+        if ramp.color_mode != "RGB":
+            self.note(node, f"{ramp.color_mode} colour mode: interpolated in RGB")
+        stops = sorted(((float(e.position), tuple(float(v) for v in e.color)) for e in ramp.elements),
+                       key=lambda stop: stop[0])
+        settings = (interpolation, tuple(p for p, _ in stops), tuple(c for _, c in stops),
+                    "Alpha" if out.identifier == "Alpha" else "Color")
+        return Expression.function("color_ramp", settings, (self.value(node.inputs["Fac"], False),))
+
+    def hue_saturation_value(self, node, colour):
+        values = [self.value(node.inputs[name], name == "Color") for name in ("Color", "Hue", "Saturation", "Value",
+                                                                              "Fac")]
+        return Expression.function("hue_saturation_value", (), values)
+
+    def gamma(self, node, colour):
+        return Expression.function("gamma", (), (self.value(node.inputs["Color"], True),
+                                                 self.value(node.inputs["Gamma"], False)))
+
+    def brightness_contrast(self, node, colour):
+        return Expression.function("brightness_contrast", (), (self.value(node.inputs["Color"], True),
+                                                               self.value(node.inputs["Bright"], False),
+                                                               self.value(node.inputs["Contrast"], False)))
+
+    def luminance(self, node, colour):
+        """RGB to BW: Rec. 709 luminance (the default scene-linear space's)."""
+        return _luminance(self.value(node.inputs["Color"], True))
 
     def attribute_value(self, node, out, socket, colour):
         """Color Attribute, or Attribute of the geometry: the mesh's default colour attribute (its Color or
@@ -190,26 +251,36 @@ class SocketReader:
         return factor * (1.0 - value) + (1.0 - factor) * value
 
     def mix(self, node, colour):
-        """Mix (colour or float) and the legacy MixRGB: mix, multiply, add, with their factor."""
+        """Mix (colour, float or vector) and the legacy MixRGB: every blend but the HSV ones (hue, saturation,
+        value, color: read as mix), the factor clamped where the node clamps it, the result where it asks."""
         if node.type == "MIX":
-            if node.data_type not in ("RGBA", "FLOAT"):
+            if node.data_type not in ("RGBA", "FLOAT", "VECTOR"):
                 self.note(node, f"a {node.data_type.lower()} mix: its first input is used")
                 return None
-            suffix = "Color" if node.data_type == "RGBA" else "Float"
-            factor_socket, a_socket, b_socket = _sockets(node, "Factor_Float", f"A_{suffix}", f"B_{suffix}")
+            suffix = {"RGBA": "Color", "FLOAT": "Float", "VECTOR": "Vector"}[node.data_type]
+            per_channel = node.data_type == "VECTOR" and node.factor_mode == "NON_UNIFORM"
+            sockets = _sockets(node, "Factor_Vector" if per_channel else "Factor_Float", f"A_{suffix}", f"B_{suffix}")
             blend = node.blend_type if node.data_type == "RGBA" else "MIX"
+            clamp_factor, clamp_result = node.clamp_factor, node.data_type == "RGBA" and node.clamp_result
         else:
-            factor_socket, a_socket, b_socket = _sockets(node, "Fac", "Color1", "Color2")
-            blend = node.blend_type
-        if None in (factor_socket, a_socket, b_socket):
+            per_channel = False
+            sockets = _sockets(node, "Fac", "Color1", "Color2")
+            blend, clamp_factor, clamp_result = node.blend_type, True, node.use_clamp
+        if None in sockets:
             return None
-        factor = self.value(factor_socket, False)
-        a, b = self.value(a_socket, True), self.value(b_socket, True)
-        blended = {"MIX": lambda: b, "MULTIPLY": lambda: a * b, "ADD": lambda: a + b}.get(blend)
-        if blended is None:
-            self.note(node, f"blend {blend.lower()}: read as mix")
-            blended = lambda: b  # noqa: E731
-        return (1.0 - factor) * a + factor * blended()
+        factor = self.value(sockets[0], per_channel)
+        factor = _clamped(factor) if clamp_factor else factor
+        a, b = self.value(sockets[1], True), self.value(sockets[2], True)
+        blended = {"MIX": lambda: b, "MULTIPLY": lambda: a * b, "ADD": lambda: a + b,
+                   "SUBTRACT": lambda: a - b}.get(blend)
+        if blend in node_functions.MIX_BLENDS:
+            result = Expression.function("mix", (blend,), (factor, a, b))
+        else:
+            if blended is None:
+                self.note(node, f"blend {blend.lower()}: read as mix")
+                blended = lambda: b  # noqa: E731
+            result = (1.0 - factor) * a + factor * blended()
+        return _clamped(result) if clamp_result else result
 
     def image_value(self, node, out, socket, colour):
         image = node.image
@@ -389,7 +460,7 @@ def _to_slot(reader, reading, slot, value):
     if constant is not None:
         reading.fields[slot] = constant if colour else constant[0]
         return
-    plain = value.as_factor_times_image()
+    plain = value.as_factor_times_image(scalar=not colour)
     if plain is not None and (colour or len(set(plain[0])) == 1):
         factor, image = plain
         reading.fields[slot] = factor if colour else factor[0]

@@ -13,18 +13,30 @@ import numpy as np
 
 
 @dataclass(frozen=True)
+class Function:
+    """A node function (reflectance.node_functions.apply) of Expressions, per pixel: its name, the node's
+    fixed settings (hashable) and its inputs."""
+    name: str
+    settings: tuple
+    args: tuple
+
+
+@dataclass(frozen=True)
 class Factor:
     """offset + scale x an image's RGB (linear, as Blender decodes it), or x one of its channels on all three
     (channel 0, 1, 2: a Separate Color's output); with `attribute`, `image` names a mesh's colour attribute
-    (its corners' linear RGB, interpolated over the triangle) in place of an image."""
+    (its corners' linear RGB, interpolated over the triangle) in place of an image; with `function`, the
+    function's value takes the image's place (image "")."""
     image: str
     scale: float = 1.0
     offset: float = 0.0
     channel: int = None
     attribute: bool = False
+    function: Function = None
 
     def sort_key(self):
-        return (self.attribute, self.image, self.scale, self.offset, -1 if self.channel is None else self.channel)
+        return (self.attribute, self.image, repr(self.function), self.scale, self.offset,
+                -1 if self.channel is None else self.channel)
 
     def values(self, rgb):
         """Its image's RGB (..., 3) as this factor reads it."""
@@ -50,6 +62,18 @@ class Expression:
     @staticmethod
     def image(name, scale=1.0, offset=0.0):
         return Expression((((1.0, 1.0, 1.0), (Factor(name, float(scale), float(offset)),)),))
+
+    @staticmethod
+    def function(name, settings, args):
+        """node_functions.apply(name, settings, args) per pixel; computed now where every input is constant."""
+        args = tuple(Expression.of(arg) for arg in args)
+        constants = [arg.as_constant() for arg in args]
+        if all(value is not None for value in constants):
+            from .node_functions import apply
+
+            value = apply(name, settings, [np.asarray(c, np.float32) for c in constants])
+            return Expression.constant(tuple(float(v) for v in np.asarray(value).reshape(3)))
+        return Expression((((1.0, 1.0, 1.0), (Factor("", function=Function(name, tuple(settings), args)),)),))
 
     @staticmethod
     def attribute(name):
@@ -103,14 +127,24 @@ class Expression:
         return Expression(terms or (((0.0, 0.0, 0.0), ()),))
 
     # -- what it is
+    def _sources(self):
+        """(is an attribute, name) of every image and attribute it reads, inside its functions too."""
+        for _, factors in self.terms:
+            for factor in factors:
+                if factor.function is not None:
+                    for arg in factor.function.args:
+                        yield from arg._sources()
+                else:
+                    yield factor.attribute, factor.image
+
     @property
     def images(self):
-        return tuple(sorted({factor.image for _, factors in self.terms for factor in factors if not factor.attribute}))
+        return tuple(sorted({name for attribute, name in self._sources() if not attribute}))
 
     @property
     def attributes(self):
         """The colour attributes it reads."""
-        return tuple(sorted({factor.image for _, factors in self.terms for factor in factors if factor.attribute}))
+        return tuple(sorted({name for attribute, name in self._sources() if attribute}))
 
     def as_constant(self):
         """Its RGB value when it holds no image or attribute, else None."""
@@ -118,12 +152,14 @@ class Expression:
             return None
         return tuple(float(sum(c[k] for c, _ in self.terms)) for k in range(3))
 
-    def as_factor_times_image(self):
-        """(RGB factor, image name) when it is a constant times one plain image, else None."""
+    def as_factor_times_image(self, scalar=False):
+        """(RGB factor, image name) when it is a constant times one plain image (with `scalar`, or its red
+        channel: what a scalar slot reads of it), else None."""
         if len(self.terms) != 1:
             return None
         coefficient, factors = self.terms[0]
-        if len(factors) == 1 and factors[0] == Factor(factors[0].image):
+        plain = (Factor(factors[0].image),) + ((Factor(factors[0].image, channel=0),) if scalar else ())
+        if len(factors) == 1 and factors[0] in plain:
             return coefficient, factors[0].image
         return None
 
@@ -134,7 +170,14 @@ class Expression:
         for coefficient, factors in self.terms:
             product = np.asarray(coefficient, np.float64)
             for factor in factors:
-                mean = attribute_mean if factor.attribute else means[factor.image]
+                if factor.function is not None:
+                    from .node_functions import apply
+
+                    mean = apply(factor.function.name, factor.function.settings,
+                                 [np.asarray(arg.mean_value(means, attribute_mean), np.float32)
+                                  for arg in factor.function.args])
+                else:
+                    mean = attribute_mean if factor.attribute else means[factor.image]
                 product = product * (factor.offset + factor.scale * factor.values(np.asarray(mean, np.float64)))
             total += product
         return tuple(float(v) for v in total)
@@ -143,15 +186,24 @@ class Expression:
         """Its value (..., 3) float32 where each image reads samples[name] (..., 3) and each attribute
         attributes[name]: what a pixel gets when every image is sampled there (the shader's
         texture_value_<slot>)."""
+        from .node_functions import apply
+
         sources = {**{(False, name): samples[name] for name in self.images},
                    **{(True, name): (attributes or {})[name] for name in self.attributes}}
         shape = np.broadcast_shapes(*(np.shape(value)[:-1] for value in sources.values())) if sources else ()
+
+        def source_of(factor):
+            if factor.function is None:
+                return np.asarray(sources[factor.attribute, factor.image], np.float32)[..., :3]
+            args = [np.broadcast_to(arg.values(samples, attributes), shape + (3,)) for arg in factor.function.args]
+            return np.asarray(apply(factor.function.name, factor.function.settings, args), np.float32)
+
         out = np.zeros(shape + (3,), np.float32)
         for coefficient, factors in self.terms:
             product = np.broadcast_to(np.asarray(coefficient, np.float32), shape + (3,))
             for factor in factors:
-                source = np.asarray(sources[factor.attribute, factor.image], np.float32)[..., :3]
-                product = product * (np.float32(factor.offset) + np.float32(factor.scale) * factor.values(source))
+                product = product * (np.float32(factor.offset)
+                                     + np.float32(factor.scale) * factor.values(source_of(factor)))
             out += product
         return out
 

@@ -9,6 +9,7 @@ A technique's key carries `textures` (slot names) and `node_values` (a NodeValue
 `samplers`, `bind` and `sources` give its shader the rest, shader_sources.surface_calls the colour stream."""
 from dataclasses import dataclass
 
+from ..reflectance import node_functions
 from . import shader_sources
 
 NORMAL_MAP = "normal_map"
@@ -53,13 +54,14 @@ def bind(shader, key, context):
         shader.uniform_sampler(f"node_image_{k}", context.node_image(name))
 
 
-def expression_source(expression, rgb_of):
+def expression_source(expression, rgb_of, helpers):
     """An Expression as a GLSL vec3 expression; rgb_of(factor): the GLSL vec3 of its image or attribute at the
-    pixel."""
+    pixel; helpers: {settings: (name, GLSL)} of the helper functions it calls (a Color Ramp's), added to."""
     literal = shader_sources.float_literal
 
     def factor_source(factor):
-        value = rgb_of(factor) + ("" if factor.channel is None else "." + "rgb"[factor.channel] * 3)
+        value = function_source(factor.function, rgb_of, helpers) if factor.function is not None else rgb_of(factor)
+        value += "" if factor.channel is None else "." + "rgb"[factor.channel] * 3
         if factor.scale == 1.0 and factor.offset == 0.0:
             return value
         return f"({literal(factor.offset)} + {literal(factor.scale)} * {value})"
@@ -69,10 +71,62 @@ def expression_source(expression, rgb_of):
     return " + ".join(terms)
 
 
+def function_source(function, rgb_of, helpers):
+    """A texture_expression.Function as a GLSL vec3 expression (shaders/lib/node_functions.glsl's node_<name>,
+    a Color Ramp's helper)."""
+    args = [expression_source(arg, rgb_of, helpers) for arg in function.args]
+    name, settings = function.name, function.settings
+    if name == "math":
+        return f"node_math_{settings[0].lower()}({', '.join(args)})"
+    if name == "clamp":
+        return f"node_clamp{'_range' if settings[0] == 'RANGE' else ''}({', '.join(args)})"
+    if name == "map_range":
+        interpolation = node_functions.MAP_RANGE_INTERPOLATIONS.index(settings[0])
+        return f"node_map_range({', '.join(args)}, {interpolation}, {'true' if settings[1] else 'false'})"
+    if name == "color_ramp":
+        helper = _ramp_helper(settings[:3], helpers)
+        value = f"{helper}(({args[0]}).r)"
+        return f"{value}.rgb" if settings[3] == "Color" else f"vec3({value}.a)"
+    if name == "mix":
+        return f"node_mix_{settings[0].lower()}({', '.join(args)})"
+    return f"node_{name}({', '.join(args)})"
+
+
+def _ramp_helper(settings, helpers):
+    """The name of the GLSL function giving a Color Ramp's RGBA at x (node_functions.color_ramp), added to
+    helpers once for each ramp."""
+    if settings in helpers:
+        return helpers[settings][0]
+    literal = shader_sources.float_literal
+    interpolation, positions, colours = settings
+    name = f"node_ramp_{len(helpers)}"
+    lines = [f"vec4 {name}(float x)", "{", "  x = clamp(x, 0.0, 1.0);",
+             f"  vec4 value = vec4({', '.join(literal(c) for c in colours[0])});", "  float t;"]
+    for k in range(1, len(positions)):
+        low, high = positions[k - 1], positions[k]
+        if interpolation == "CONSTANT" or high <= low:
+            lines.append(f"  t = step({literal(high)}, x);")
+        else:
+            lines.append(f"  t = clamp((x - {literal(low)}) / {literal(high - low)}, 0.0, 1.0);")
+            if interpolation == "EASE":
+                lines.append("  t = t * t * (3.0 - 2.0 * t);")
+        lines.append(f"  value = mix(value, vec4({', '.join(literal(c) for c in colours[k])}), t);")
+    lines += ["  return value;", "}"]
+    helpers[settings] = (name, "\n".join(lines))
+    return name
+
+
+def _uses_functions(key):
+    def functions_in(expression):
+        return any(factor.function is not None for _, factors in expression.terms for factor in factors)
+
+    return any(functions_in(expression) for _, expression in key.node_values.slots)
+
+
 def values_source(key):
     """GLSL: each computed slot's image read once a pixel (node_image_<k>_rgb()), and texture_value_<slot>() of
     every textured slot but the normal map (a colour attribute: the vertex stage's vertex_color, or
-    MISSING_ATTRIBUTE where the mesh has none)."""
+    MISSING_ATTRIBUTE where the mesh has none), after the helpers they call."""
     names = images(key)
     lines = ["/* The material's textured slots (techniques/material_textures.py) */"]
     for k in range(len(names)):
@@ -86,21 +140,22 @@ def values_source(key):
     def rgb_of(factor):
         return attribute if factor.attribute else f"node_image_{names.index(factor.image)}_rgb()"
 
+    helpers, slots = {}, []
     for slot in key.textures:
         if slot == NORMAL_MAP:
             continue
-        lines += [f"vec4 texture_value_{slot}()", "{"]
+        slots += [f"vec4 texture_value_{slot}()", "{"]
         if slot in computed:
-            value = expression_source(computed[slot], rgb_of)
-            lines.append(f"  return vec4({value}, 1.0);")
+            slots.append(f"  return vec4({expression_source(computed[slot], rgb_of, helpers)}, 1.0);")
         else:
-            lines.append(f"  return material_texture(texture_{slot});")
-        lines.append("}")
-    return "\n".join(lines) + "\n"
+            slots.append(f"  return material_texture(texture_{slot});")
+        slots.append("}")
+    return "\n".join(lines + [source for _, source in helpers.values()] + slots) + "\n"
 
 
 def sources(key):
     """The surface shader's sources from surface_common.glsl to surface_io.glsl, the slots' values between."""
+    library = [shader_sources.library_source("node_functions.glsl")] if _uses_functions(key) else []
     return [shader_sources.technique_source("common", "surface_common.glsl"),
-            shader_sources.technique_source("common", "material_textures.glsl"), values_source(key),
+            shader_sources.technique_source("common", "material_textures.glsl"), *library, values_source(key),
             shader_sources.technique_source("common", "surface_io.glsl")]

@@ -307,10 +307,11 @@ def test_node_material_with_computed_textures(engine):
     _check(result, {material.name: textures})
 
 
-def test_node_material_with_channels_and_products(engine):
+def test_node_material_with_channels_products_and_functions(engine):
     """A Principled BSDF whose Base Color is an image's channels recombined (Separate and Combine Color) and
-    whose Roughness is a product of two channels, offset (Math): each slot's GLSL (material_textures) against
-    the Expression sampled per pixel (texture_expression.BoundExpression)."""
+    overlaid on the image (Mix, Overlay), and whose Roughness is a Color Ramp's colour (read as its luminance)
+    of a product of two channels (Math): each slot's GLSL (material_textures, node_functions.glsl) against the
+    Expression sampled per pixel (texture_expression.BoundExpression, node_functions.py)."""
     import bpy
 
     from benchmarks import node_values
@@ -323,18 +324,20 @@ def test_node_material_with_channels_and_products(engine):
         material.use_nodes = True
     tree = material.node_tree
     principled = next(node for node in tree.nodes if node.type == "BSDF_PRINCIPLED")
-    tree.links.new(node_values.combine_swizzled(tree), principled.inputs["Base Color"])
+    tree.links.new(node_values.mix_blend("OVERLAY")(tree), principled.inputs["Base Color"])
     separate = tree.nodes.new("ShaderNodeSeparateColor")
     tree.links.new(node_values._image_node(tree, "Non-Color").outputs["Color"], separate.inputs[0])
     product = tree.nodes.new("ShaderNodeMath")
     product.operation = "MULTIPLY"
     tree.links.new(separate.outputs["Red"], product.inputs[0])
     tree.links.new(separate.outputs["Blue"], product.inputs[1])
-    offset = tree.nodes.new("ShaderNodeMath")
-    offset.operation = "ADD"
-    tree.links.new(product.outputs[0], offset.inputs[0])
-    offset.inputs[1].default_value = 0.2
-    tree.links.new(offset.outputs[0], principled.inputs["Roughness"])
+    ramp = tree.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.interpolation = "EASE"
+    ramp.color_ramp.elements[0].color = (0.1, 0.2, 0.15, 1.0)
+    ramp.color_ramp.elements[1].position = 0.4
+    ramp.color_ramp.elements[1].color = (0.8, 0.6, 0.7, 1.0)
+    tree.links.new(product.outputs[0], ramp.inputs["Fac"])
+    tree.links.new(ramp.outputs["Color"], principled.inputs["Roughness"])
     fx.uv_sphere(scene, "channels_sphere", (0.0, 0.0, 1.0), radius=1.2).data.materials.append(material)
     fx.point_light(scene, "point", (1.5, -3.0, 3.0), 900.0, radius=0.1)
     result = fx.render(scene, gbuffer=True)

@@ -1,0 +1,281 @@
+"""Blender's shader-node functions that are not sums of products, as Cycles and EEVEE define them (Math, Clamp,
+Map Range, Color Ramp, the Mix node's blend modes, Hue/Saturation/Value, Gamma, Brightness/Contrast), on
+(..., 3) float32 arrays: a scalar socket is its value on all three channels.  shaders/lib/node_functions.glsl
+is their GLSL (each `node_<name>` there mirrors FUNCTIONS[name] here); reflectance.texture_expression applies
+them to per-pixel values.
+
+Every function takes its inputs as (..., 3) arrays and returns one; `params` are numbers fixed in the node.
+"""
+import numpy as np
+
+FLOAT = np.float32
+
+
+def _safe_divide(a, b):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(b != 0, a / np.where(b != 0, b, 1), FLOAT(0))
+
+
+def _power(a, b):
+    """a^b; a negative a only to a near-integer b (its nearest integer), else 0."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        fraction = np.mod(np.abs(b), 1)
+        near_integer = (fraction > 0.999) | (fraction < 0.001)
+        negative = np.where(near_integer, np.power(a, np.floor(b + 0.5)), 0)
+        return np.where(a >= 0, np.power(np.maximum(a, 0), b), negative)
+
+
+def _logarithm(a, b):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ok = (a > 0) & (b > 0)
+        return np.where(ok, np.log2(np.where(ok, a, 1)) / np.log2(np.where(ok, b, 2)), 0)
+
+
+def _modulo(a, b):
+    """C's fmod (the sign of a), 0 where b is 0."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(b != 0, np.fmod(a, np.where(b != 0, b, 1)), 0)
+
+
+def _floored_modulo(a, b):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        safe = np.where(b != 0, b, 1)
+        return np.where(b != 0, a - np.floor(a / safe) * safe, 0)
+
+
+def _wrap(a, high, low):
+    span = high - low
+    with np.errstate(invalid="ignore", divide="ignore"):
+        safe = np.where(span != 0, span, 1)
+        return np.where(span != 0, a - span * np.floor((a - low) / safe), low)
+
+
+def _pingpong(a, b):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        safe = np.where(b != 0, b, 1)
+        fraction = (a - safe) / (safe * 2)
+        return np.where(b != 0, np.abs((fraction - np.floor(fraction)) * safe * 2 - safe), 0)
+
+
+def _smooth_min(a, b, c):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        h = np.maximum(c - np.abs(a - b), 0) / np.where(c != 0, c, 1)
+        return np.where(c != 0, np.minimum(a, b) - h * h * h * c / 6, np.minimum(a, b))
+
+
+def _inverse_sqrt(a):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(a > 0, 1 / np.sqrt(np.where(a > 0, a, 1)), 0)
+
+
+# The Math node's operations that are not sums of products: operation -> (function of (a, b, c), inputs used)
+MATH = {
+    "DIVIDE": (lambda a, b, c: _safe_divide(a, b), 2),
+    "POWER": (lambda a, b, c: _power(a, b), 2),
+    "LOGARITHM": (lambda a, b, c: _logarithm(a, b), 2),
+    "SQRT": (lambda a, b, c: np.sqrt(np.maximum(a, 0)), 1),
+    "INVERSE_SQRT": (lambda a, b, c: _inverse_sqrt(a), 1),
+    "ABSOLUTE": (lambda a, b, c: np.abs(a), 1),
+    "EXPONENT": (lambda a, b, c: np.exp(a), 1),
+    "MINIMUM": (lambda a, b, c: np.minimum(a, b), 2),
+    "MAXIMUM": (lambda a, b, c: np.maximum(a, b), 2),
+    "LESS_THAN": (lambda a, b, c: (a < b).astype(FLOAT), 2),
+    "GREATER_THAN": (lambda a, b, c: (a > b).astype(FLOAT), 2),
+    "SIGN": (lambda a, b, c: np.sign(a), 1),
+    "COMPARE": (lambda a, b, c: (np.abs(a - b) <= np.maximum(c, 1e-5)).astype(FLOAT), 3),
+    "SMOOTH_MIN": (lambda a, b, c: _smooth_min(a, b, c), 3),
+    "SMOOTH_MAX": (lambda a, b, c: -_smooth_min(-a, -b, c), 3),
+    "ROUND": (lambda a, b, c: np.floor(a + 0.5), 1),
+    "FLOOR": (lambda a, b, c: np.floor(a), 1),
+    "CEIL": (lambda a, b, c: np.ceil(a), 1),
+    "TRUNC": (lambda a, b, c: np.trunc(a), 1),
+    "FRACT": (lambda a, b, c: a - np.floor(a), 1),
+    "MODULO": (lambda a, b, c: _modulo(a, b), 2),
+    "FLOORED_MODULO": (lambda a, b, c: _floored_modulo(a, b), 2),
+    "WRAP": (lambda a, b, c: _wrap(a, b, c), 3),
+    "SNAP": (lambda a, b, c: np.floor(_safe_divide(a, b)) * b, 2),
+    "PINGPONG": (lambda a, b, c: _pingpong(a, b), 2),
+    "SINE": (lambda a, b, c: np.sin(a), 1),
+    "COSINE": (lambda a, b, c: np.cos(a), 1),
+    "TANGENT": (lambda a, b, c: np.tan(a), 1),
+    "SINH": (lambda a, b, c: np.sinh(a), 1),
+    "COSH": (lambda a, b, c: np.cosh(a), 1),
+    "TANH": (lambda a, b, c: np.tanh(a), 1),
+    "ARCSINE": (lambda a, b, c: np.arcsin(np.clip(a, -1, 1)), 1),          # Cycles' safe_asinf clamps
+    "ARCCOSINE": (lambda a, b, c: np.arccos(np.clip(a, -1, 1)), 1),
+    "ARCTANGENT": (lambda a, b, c: np.arctan(a), 1),
+    "ARCTAN2": (lambda a, b, c: np.where((a == 0) & (b == 0), 0, np.arctan2(a, b)), 2),
+    "RADIANS": (lambda a, b, c: np.radians(a), 1),
+    "DEGREES": (lambda a, b, c: np.degrees(a), 1),
+}
+
+
+def math(operation, a, b, c):
+    """The Math node's `operation` (one of MATH) of (..., 3) inputs."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.asarray(MATH[operation][0](*(np.asarray(x, FLOAT) for x in (a, b, c))), FLOAT)
+
+
+def clamp(value, low, high, clamp_type="MINMAX"):
+    """Clamp: MINMAX clamps to [low, high] (high where low > high, as min(max(v, low), high)); RANGE to the
+    interval between them whichever is larger."""
+    if clamp_type == "RANGE":
+        low, high = np.minimum(low, high), np.maximum(low, high)
+    return np.minimum(np.maximum(value, low), high).astype(FLOAT)
+
+
+def map_range(value, from_min, from_max, to_min, to_max, steps, interpolation="LINEAR", clamped=True):
+    """Map Range (float): LINEAR, STEPPED (`steps`), SMOOTHSTEP, SMOOTHERSTEP; a zero source range gives 0
+    (as Blender's safe division); clamped to the target range where asked (LINEAR and STEPPED)."""
+    span = from_max - from_min
+    factor = _safe_divide(value - from_min, span)
+    if interpolation == "STEPPED":
+        factor = np.where(steps > 0, np.floor(factor * (steps + 1)) / np.where(steps > 0, steps, 1), 0)
+    elif interpolation in ("SMOOTHSTEP", "SMOOTHERSTEP"):
+        # Blender's smoothstep over the source range, reversed where from_min > from_max
+        edge0, edge1 = np.minimum(from_min, from_max), np.maximum(from_min, from_max)
+        t = np.clip(_safe_divide(value - edge0, edge1 - edge0), 0, 1)
+        t = t * t * (3 - 2 * t) if interpolation == "SMOOTHSTEP" else t * t * t * (t * (t * 6 - 15) + 10)
+        factor = np.where(from_min > from_max, 1 - t, t)
+    out = to_min + factor * (to_max - to_min)
+    if clamped and interpolation in ("LINEAR", "STEPPED"):
+        out = np.where(to_min > to_max, np.clip(out, to_max, to_min), np.clip(out, to_min, to_max))
+    return out.astype(FLOAT)
+
+
+def color_ramp(fac, positions, colours, interpolation="LINEAR"):
+    """Color Ramp's colour (RGBA: (..., 4)) at Fac (..., 3; its first channel): the stops' colours (K, 4)
+    at positions (K,) sorted; LINEAR, EASE (smoothstep between stops) or CONSTANT (the stop at or below);
+    clamped to the first and last stops."""
+    x = np.clip(np.asarray(fac, FLOAT)[..., :1], 0, 1)
+    positions = np.asarray(positions, FLOAT)
+    colours = np.asarray(colours, FLOAT)
+    out = np.broadcast_to(colours[0], x.shape[:-1] + (4,)).astype(FLOAT)
+    for k in range(1, len(positions)):
+        if interpolation == "CONSTANT":
+            t = (x >= positions[k]).astype(FLOAT)
+        else:
+            t = np.clip(_safe_divide(x - positions[k - 1], np.full_like(x, positions[k] - positions[k - 1])), 0, 1)
+            t = np.where(positions[k] > positions[k - 1], t, (x >= positions[k]).astype(FLOAT))
+            if interpolation == "EASE":
+                t = t * t * (3 - 2 * t)
+        out = out + t * (colours[k] - out)
+    return out
+
+
+def _rgb_to_hsv(rgb):
+    r, g = rgb[..., 0], rgb[..., 1]
+    high = np.max(rgb, axis=-1)
+    low = np.min(rgb, axis=-1)
+    delta = high - low
+    s = np.where(high != 0, _safe_divide(delta, high), 0)
+    safe = np.where(delta != 0, delta, 1)
+    c = (high[..., None] - rgb) / safe[..., None]
+    h = np.where(r == high, c[..., 2] - c[..., 1], np.where(g == high, 2 + c[..., 0] - c[..., 2],
+                                                             4 + c[..., 1] - c[..., 0]))
+    h = np.where(s != 0, h / 6, 0)
+    h = np.where(h < 0, h + 1, h)
+    return np.stack([h, s, high], axis=-1)
+
+
+def _hsv_to_rgb(hsv):
+    h, s, v = hsv[..., 0], hsv[..., 1], hsv[..., 2]
+    h = (h - np.floor(h)) * 6
+    i = np.floor(h)
+    f = h - i
+    p, q, t = v * (1 - s), v * (1 - s * f), v * (1 - s * (1 - f))
+    choices = [np.stack(c, -1) for c in ((v, t, p), (q, v, p), (p, v, t), (p, q, v), (t, p, v), (v, p, q))]
+    index = np.clip(i, 0, 5).astype(int)
+    out = np.choose(index[..., None], choices)
+    return np.where((s == 0)[..., None], v[..., None], out)
+
+
+def hue_saturation_value(colour, hue, saturation, value, factor):
+    """Hue/Saturation/Value: the hue turned by hue - 0.5, saturation and value scaled (saturation clamped to
+    [0, 1]), mixed with the input by factor; negative channels made 0."""
+    hsv = _rgb_to_hsv(colour)
+    h = hsv[..., 0] + hue[..., 0] + 0.5
+    h = h - np.floor(h)
+    s = np.clip(hsv[..., 1] * saturation[..., 0], 0, 1)
+    v = hsv[..., 2] * value[..., 0]
+    out = _hsv_to_rgb(np.stack([h, s, v], -1))
+    out = colour + factor * (out - colour)
+    return np.maximum(out, 0).astype(FLOAT)
+
+
+def gamma(colour, exponent):
+    """Gamma: each positive channel to the power `exponent` (others kept)."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        return np.where(colour > 0, np.power(np.maximum(colour, 0), exponent), colour).astype(FLOAT)
+
+
+def brightness_contrast(colour, bright, contrast):
+    """Brightness/Contrast: a = 1 + contrast, b = bright - contrast / 2, max(a c + b, 0)."""
+    return np.maximum((1 + contrast) * colour + bright - contrast * 0.5, 0).astype(FLOAT)
+
+
+def mix(blend, factor, a, b):
+    """The Mix node's colour blends that are not sums of products, as Blender's GPU and Cycles define them
+    (factor (..., 3) on every channel)."""
+    t = factor
+    s = 1 - t
+    with np.errstate(invalid="ignore", divide="ignore"):
+        if blend == "SCREEN":
+            return 1 - (s + t * (1 - b)) * (1 - a)
+        if blend == "OVERLAY":
+            return np.where(a < 0.5, a * (s + 2 * t * b), 1 - (s + 2 * t * (1 - b)) * (1 - a))
+        if blend == "DIVIDE":
+            return np.where(b != 0, s * a + t * a / np.where(b != 0, b, 1), a)
+        if blend == "DIFFERENCE":
+            return a + t * (np.abs(a - b) - a)
+        if blend == "EXCLUSION":
+            return np.maximum(a + t * (a + b - 2 * a * b - a), 0)
+        if blend == "DARKEN":
+            return a + t * (np.minimum(a, b) - a)
+        if blend == "LIGHTEN":
+            return a + t * (np.maximum(a, b) - a)
+        if blend == "DODGE":
+            tmp = 1 - t * b
+            return np.where(a != 0, np.where(tmp <= 0, 1, np.minimum(a / np.where(tmp > 0, tmp, 1), 1)), a)
+        if blend == "BURN":
+            tmp = s + t * b
+            return np.where(tmp <= 0, 0, np.clip(1 - (1 - a) / np.where(tmp > 0, tmp, 1), 0, 1))
+        if blend == "SOFT_LIGHT":
+            screen = 1 - (1 - b) * (1 - a)
+            return s * a + t * ((1 - a) * b * a + a * screen)
+        if blend == "LINEAR_LIGHT":
+            return a + t * (2 * b - 1)
+    raise KeyError(blend)
+
+
+# Blend modes that `mix` computes (Mix, Add, Multiply and Subtract are sums of products, in the algebra)
+MIX_BLENDS = ("SCREEN", "OVERLAY", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN", "LIGHTEN", "DODGE", "BURN",
+              "SOFT_LIGHT", "LINEAR_LIGHT")
+
+
+# Color Ramp's outputs a Function reads
+RAMP_OUTPUTS = ("Color", "Alpha")
+MAP_RANGE_INTERPOLATIONS = ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")
+
+
+def apply(name, settings, args):
+    """The node function `name` with the node's fixed `settings` of its inputs' values `args` ((..., 3)
+    each): what texture_expression.Function computes (names: math (operation,), clamp (type,), map_range
+    (interpolation, clamped), color_ramp (interpolation, positions, RGBA colours, output), mix (blend,),
+    hue_saturation_value, gamma, brightness_contrast)."""
+    args = [np.asarray(a, FLOAT) for a in args]
+    if name == "math":
+        return math(settings[0], *args)
+    if name == "clamp":
+        return clamp(*args, clamp_type=settings[0])
+    if name == "map_range":
+        return map_range(*args, interpolation=settings[0], clamped=settings[1])
+    if name == "color_ramp":
+        interpolation, positions, colours, output = settings
+        rgba = color_ramp(args[0], positions, colours, interpolation)
+        return rgba[..., :3] if output == "Color" else np.repeat(rgba[..., 3:], 3, axis=-1)
+    if name == "mix":
+        return np.asarray(mix(settings[0], *args), FLOAT)
+    functions = {"hue_saturation_value": hue_saturation_value, "gamma": gamma,
+                 "brightness_contrast": brightness_contrast}
+    return functions[name](*args)

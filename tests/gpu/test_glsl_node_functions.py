@@ -1,0 +1,107 @@
+"""shaders/lib/node_functions.glsl (float32, llvmpipe) against sg_prt_addon/reflectance/node_functions.py
+(float32): every Math operation, Clamp, Map Range, the Mix blends, Hue/Saturation/Value, Gamma and
+Brightness/Contrast over inputs that cross their edges (zero, negative, beyond one)."""
+import numpy as np
+import pytest
+
+from sg_prt_addon.reflectance import node_functions
+
+N = 4096
+LIB = ["node_functions.glsl"]
+
+
+def _inputs(fuzz):
+    """Three (N, 3) inputs: a spread over [-3, 3] with exact zeros, integers and halves mixed in."""
+    values = []
+    for _ in range(3):
+        x = fuzz.rng.uniform(-3.0, 3.0, (N, 3))
+        special = fuzz.rng.integers(0, 6, (N, 3))
+        x = np.where(special == 0, 0.0, np.where(special == 1, np.round(x), np.where(special == 2, np.round(x * 2) / 2, x)))
+        values.append(x.astype(np.float32))
+    return values
+
+
+def _run(glsl, call, args):
+    inputs = {name: np.c_[value, np.zeros(N)] for name, value in zip("abcdef", args)}
+    return glsl(LIB, f"result = vec4({call}, 0.0);", inputs, 3)
+
+
+def _close(record_error, label, got, expected, bound=2e-5):
+    """The largest error, relative where the value passes 1, absolute below (non-finite references left out)."""
+    expected = np.asarray(expected, np.float64)
+    finite = np.isfinite(expected) & (np.abs(expected) < 1e6)
+    error = np.abs(got - expected) / np.maximum(np.abs(expected), 1.0)
+    return record_error(f"node_functions {label}", np.max(np.where(finite, error, 0.0)))
+
+
+# operations with a jump where float32 rounding of a quotient or sum may fall either side: a few edge points
+JUMPS = {"ROUND", "FLOOR", "CEIL", "TRUNC", "FRACT", "MODULO", "FLOORED_MODULO", "WRAP", "SNAP", "PINGPONG",
+         "LESS_THAN", "GREATER_THAN", "COMPARE", "SIGN", "POWER"}
+
+
+@pytest.mark.parametrize("operation", sorted(node_functions.MATH))
+def test_math_operation(glsl, fuzz, record_error, operation):
+    a, b, c = _inputs(fuzz)
+    if operation in ("SINH", "COSH", "EXPONENT", "TANGENT"):
+        a = a * np.float32(0.5)                     # keep away from float32 overflow and tan's poles
+    got = _run(glsl, f"node_math_{operation.lower()}(a.xyz, b.xyz, c.xyz)", (a, b, c))
+    expected = np.asarray(node_functions.math(operation, a, b, c), np.float64)
+    with np.errstate(invalid="ignore"):
+        error = np.where(np.isfinite(expected), np.abs(got - expected) / np.maximum(np.abs(expected), 1.0), 0.0)
+    if operation in JUMPS:
+        # at a jump the two sides differ by the jump: allowed at a handful of points
+        assert np.mean(error > 1e-4) < 0.002, (operation, np.mean(error > 1e-4))
+        error = np.where(error > 1e-4, 0.0, error)
+    assert record_error(f"node_functions math {operation}", error.max()) < 2e-5
+
+
+@pytest.mark.parametrize("clamp_type", ["MINMAX", "RANGE"])
+def test_clamp(glsl, fuzz, record_error, clamp_type):
+    a, b, c = _inputs(fuzz)
+    name = "node_clamp" if clamp_type == "MINMAX" else "node_clamp_range"
+    got = _run(glsl, f"{name}(a.xyz, b.xyz, c.xyz)", (a, b, c))
+    assert _close(record_error, f"clamp {clamp_type}", got, node_functions.clamp(a, b, c, clamp_type)) < 1e-6
+
+
+@pytest.mark.parametrize("interpolation", node_functions.MAP_RANGE_INTERPOLATIONS)
+@pytest.mark.parametrize("clamped", [True, False])
+def test_map_range(glsl, fuzz, record_error, interpolation, clamped):
+    value, low, high = _inputs(fuzz)
+    to_low, to_high, steps = _inputs(fuzz)
+    steps = np.abs(np.round(steps * 2))
+    index = node_functions.MAP_RANGE_INTERPOLATIONS.index(interpolation)
+    got = _run(glsl, f"node_map_range(a.xyz, b.xyz, c.xyz, d.xyz, e.xyz, f.xyz, {index}, {str(clamped).lower()})",
+               (value, low, high, to_low, to_high, steps))
+    expected = node_functions.map_range(value, low, high, to_low, to_high, steps, interpolation, clamped)
+    error = np.abs(got - expected) / np.maximum(np.abs(expected), 1.0)
+    if interpolation == "STEPPED":        # floor of a quotient at a step edge
+        assert np.mean(error > 1e-4) < 0.002
+        error = np.where(error > 1e-4, 0.0, error)
+    assert record_error(f"node_functions map_range {interpolation} clamped={clamped}", error.max()) < 1e-4
+
+
+@pytest.mark.parametrize("blend", node_functions.MIX_BLENDS)
+def test_mix_blend(glsl, fuzz, record_error, blend):
+    t, a, b = _inputs(fuzz)
+    t = np.clip(t * 0.3 + 0.5, 0.0, 1.0)            # the factor a node clamps
+    a, b = np.abs(a) * np.float32(0.5), np.abs(b) * np.float32(0.5)
+    got = _run(glsl, f"node_mix_{blend.lower()}(a.xyz, b.xyz, c.xyz)", (t, a, b))
+    assert _close(record_error, f"mix {blend}", got, node_functions.mix(blend, t, a, b)) < 2e-5
+
+
+def test_colour_functions(glsl, fuzz, record_error):
+    colour, hue, other = _inputs(fuzz)
+    colour = np.abs(colour) * np.float32(0.4)
+    hue = np.repeat(np.abs(hue[:, :1]) * np.float32(0.3), 3, axis=1)
+    saturation = np.repeat(np.abs(other[:, :1]), 3, axis=1)
+    value = np.repeat(np.abs(other[:, 1:2]), 3, axis=1)
+    factor = np.repeat(np.clip(other[:, 2:] * 0.3 + 0.5, 0, 1), 3, axis=1)
+    got = _run(glsl, "node_hue_saturation_value(a.xyz, b.xyz, c.xyz, d.xyz, e.xyz)",
+               (colour, hue, saturation, value, factor))
+    expected = node_functions.hue_saturation_value(colour, hue, saturation, value, factor)
+    assert _close(record_error, "hue_saturation_value", got, expected) < 5e-5
+    got = _run(glsl, "node_gamma(a.xyz, b.xyz)", (colour, hue * 5))
+    assert _close(record_error, "gamma", got, node_functions.gamma(colour, hue * 5)) < 2e-5
+    got = _run(glsl, "node_brightness_contrast(a.xyz, b.xyz, c.xyz)", (colour, hue - 0.2, saturation - 0.5))
+    expected = node_functions.brightness_contrast(colour, hue - 0.2, saturation - 0.5)
+    assert _close(record_error, "brightness_contrast", got, expected) < 1e-6
