@@ -17,6 +17,7 @@ import numpy as np
 
 from ..reflectance import node_functions, principled
 from ..reflectance.texture_expression import Expression
+from .colour_attributes import default_color_attribute
 from .node_graph import output_node
 
 IDENTITY_UV_TRANSFORM = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
@@ -343,8 +344,6 @@ class SocketReader:
     def _other_colour_attribute(self, name):
         """Whether a mesh with this material has a default colour attribute other than `name` (export reads the
         default one)."""
-        from .export.meshes import default_color_attribute
-
         return any(attribute is not None and attribute.name != name
                    for attribute in map(default_color_attribute, self._meshes()))
 

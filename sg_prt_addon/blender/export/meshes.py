@@ -4,6 +4,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...reflectance import models
+from ..colour_attributes import default_color_attribute
 from .materials import TEXTURED_PARAMETERS
 from .messages import warn
 
@@ -158,16 +159,6 @@ def export_mesh_data(mesh, name=None):
         vertex_normals=_vertex_normals(mesh),
         **_corner_colors(mesh, vertex_index, name),
     )
-
-
-def default_color_attribute(mesh):
-    """The mesh's default colour attribute (a Color Attribute node without a name reads it), or None."""
-    attributes = getattr(mesh, "color_attributes", None)
-    if not attributes:
-        return None
-    name = getattr(attributes, "default_color_name", "") or getattr(mesh.attributes, "default_color_name", "")
-    index = getattr(attributes, "render_color_index", 0)
-    return attributes.get(name) if name else attributes[index if 0 <= index < len(attributes) else 0]
 
 
 def _corner_colors(mesh, vertex_index, name):
