@@ -422,6 +422,75 @@ def colour_node(kind):
     return value_of
 
 
+def _coordinates(tree, output, node_type="ShaderNodeTexCoord"):
+    return tree.nodes.new(node_type).outputs[output]
+
+
+def _vector_math(tree, operation, a, b=None):
+    node = tree.nodes.new("ShaderNodeVectorMath")
+    node.operation = operation
+    tree.links.new(a, node.inputs[0])
+    if b is not None:
+        tree.links.new(b, node.inputs[1])
+    return node.outputs["Value" if operation in ("DOT_PRODUCT", "DISTANCE", "LENGTH") else "Vector"]
+
+
+def coordinates_case(output, node_type="ShaderNodeTexCoord"):
+    """A Texture Coordinate (or Geometry) output as the colour, made positive (Vector Math, Absolute)."""
+    def value_of(tree):
+        return _vector_math(tree, "ABSOLUTE", _coordinates(tree, output, node_type))
+    return value_of
+
+
+def checker(vector_output=None, scale=5.0, output="Color"):
+    """The Checker texture (its default Generated coordinates, or a Texture Coordinate output)."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexChecker")
+        node.inputs["Scale"].default_value = scale
+        node.inputs["Color1"].default_value = (0.9, 0.6, 0.2, 1.0)
+        node.inputs["Color2"].default_value = (0.1, 0.3, 0.7, 1.0)
+        if vector_output is not None:
+            tree.links.new(_coordinates(tree, vector_output), node.inputs["Vector"])
+        return node.outputs[output]
+    return value_of
+
+
+def _mapping_node(tree, mapping_type, vector):
+    node = tree.nodes.new("ShaderNodeMapping")
+    node.vector_type = mapping_type
+    tree.links.new(vector, node.inputs["Vector"])
+    if "Location" in node.inputs:
+        node.inputs["Location"].default_value = (0.1, 0.2, 0.0)
+    node.inputs["Rotation"].default_value = (0.3, 0.5, 0.7)
+    node.inputs["Scale"].default_value = (1.5, 0.8, 1.2)
+    return node.outputs["Vector"]
+
+
+def gradient(gradient_type):
+    """The Gradient texture of the Object coordinates (centred on the plane) turned and scaled by a Mapping."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexGradient")
+        node.gradient_type = gradient_type
+        tree.links.new(_mapping_node(tree, "POINT", _coordinates(tree, "Object")), node.inputs["Vector"])
+        return node.outputs["Color"]
+    return value_of
+
+
+def mapping_case(mapping_type):
+    def value_of(tree):
+        return _vector_math(tree, "ABSOLUTE", _mapping_node(tree, mapping_type, _coordinates(tree, "Generated")))
+    return value_of
+
+
+def vector_math_case(operation):
+    """Vector Math of the Object and Generated coordinates, made positive."""
+    def value_of(tree):
+        value = _vector_math(tree, operation, _coordinates(tree, "Object"), _coordinates(tree, "Generated"))
+        return _math_node(tree, "ABSOLUTE", value) if operation in ("DOT_PRODUCT", "DISTANCE", "LENGTH") \
+            else _vector_math(tree, "ABSOLUTE", value)
+    return value_of
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -444,7 +513,17 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "color_ramp_alpha": _socket_case(color_ramp_node("LINEAR", "Alpha")),
          **{f"mix_{blend.lower()}": _socket_case(mix_blend(blend)) for blend in MIX_BLENDS},
          **{kind: _socket_case(colour_node(kind))
-            for kind in ("hue_saturation_value", "gamma", "brightness_contrast", "rgb_to_bw")}}
+            for kind in ("hue_saturation_value", "gamma", "brightness_contrast", "rgb_to_bw")},
+         **{f"coordinates_{output.lower()}": _socket_case(coordinates_case(output))
+            for output in ("Generated", "Object", "Normal", "UV")},
+         "geometry_position": _socket_case(coordinates_case("Position", "ShaderNodeNewGeometry")),
+         "checker": _socket_case(checker()), "checker_object_fac": _socket_case(checker("Object", 3.0, "Fac")),
+         **{f"gradient_{kind.lower()}": _socket_case(gradient(kind))
+            for kind in ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "RADIAL", "QUADRATIC_SPHERE", "SPHERICAL")},
+         **{f"mapping_{kind.lower()}": _socket_case(mapping_case(kind)) for kind in ("POINT", "TEXTURE", "VECTOR", "NORMAL")},
+         **{f"vector_math_{operation.lower()}": _socket_case(vector_math_case(operation))
+            for operation in ("CROSS_PRODUCT", "PROJECT", "REFLECT", "DOT_PRODUCT", "DISTANCE", "LENGTH", "NORMALIZE",
+                              "MODULO", "SNAP")}}
 # cases whose truth is 0 everywhere (scored by their largest values)
 ZERO_TRUTH = ("color_attribute_missing",)
 # the cases whose grid has the colour attribute: (domain, data type)

@@ -139,7 +139,13 @@ class SocketReader:
             return self.attribute_value(node, out, socket, colour)
         if node.type == "VALTORGB":
             return self.color_ramp(node, out)
-        reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix,
+        if node.type in ("TEX_COORD", "NEW_GEOMETRY"):
+            return self.coordinates_value(node, out, socket, colour)
+        if node.type in ("TEX_CHECKER", "TEX_GRADIENT"):
+            return self.procedural_texture(node, out)
+        if node.type == "VECT_MATH":
+            return self.vector_math(node, out)
+        reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix, "MAPPING": self.mapping,
                   "CLAMP": self.clamp, "MAP_RANGE": self.map_range, "HUE_SAT": self.hue_saturation_value,
                   "GAMMA": self.gamma, "BRIGHTCONTRAST": self.brightness_contrast, "RGBTOBW": self.luminance,
                   **dict.fromkeys(COMBINE_NODES, self.combine)}.get(node.type)
@@ -166,6 +172,63 @@ class SocketReader:
             self.note(node, f"{operation.lower()}: its output is the first input")
             return a
         return _clamped(result) if node.use_clamp else result
+
+    def coordinates_value(self, node, out, socket, colour):
+        """Texture Coordinate's Generated, Normal, UV and Object (of the object itself); Geometry's Position and
+        Normal (world space)."""
+        names = {"Generated": "GENERATED", "Normal": "NORMAL", "UV": "UV", "Object": "OBJECT"} \
+            if node.type == "TEX_COORD" else {"Position": "POSITION", "Normal": "WORLD_NORMAL",
+                                              "True Normal": "WORLD_NORMAL"}
+        name = names.get(out.identifier)
+        if name is None:
+            self.note(node, f"its {out.name} output: {socket.name} uses its value {_rounded(_default(socket))}")
+            return _constant(_default(socket), colour)
+        if name == "OBJECT" and getattr(node, "object", None) is not None:
+            self.note(node, f"Object coordinates of '{node.object.name}': the surface's own object is used")
+        return Expression.coordinates(name)
+
+    def texture_vector(self, node):
+        """A procedural texture's Vector: its input, or Generated coordinates where it is unlinked (Blender's
+        default for every texture but the image)."""
+        socket = node.inputs["Vector"]
+        return self.value(socket, True) if socket.is_linked else Expression.coordinates("GENERATED")
+
+    def procedural_texture(self, node, out):
+        """The Checker (Color, Fac) and Gradient (Fac, or its grey Color) textures."""
+        vector = self.texture_vector(node)
+        if node.type == "TEX_CHECKER":
+            values = [vector] + [self.value(node.inputs[name], name != "Scale") for name in ("Color1", "Color2", "Scale")]
+            return Expression.function("tex_checker", ("Color" if out.identifier == "Color" else "Fac",), values)
+        return Expression.function("tex_gradient", (node.gradient_type,), (vector,))
+
+    def mapping(self, node, colour):
+        """The Mapping node on a vector (POINT, TEXTURE, VECTOR, NORMAL)."""
+        vector, location, rotation, scale = _sockets(node, "Vector", "Location", "Rotation", "Scale")
+        values = [self.value(socket, True) if socket is not None else Expression.constant(0.0)
+                  for socket in (vector, location, rotation, scale)]
+        return Expression.function("mapping", (node.vector_type,), values)
+
+    def vector_math(self, node, out):
+        """The Vector Math node: per-component operations in the algebra and Math's functions, the others across
+        the components (node_functions.VECTOR_MATH); its Value output of an operation without one is 0."""
+        sockets = list(node.inputs)
+        a, b, c = (self.value(socket, True) for socket in sockets[:3])
+        scale = self.value(node.inputs["Scale"], False) if "Scale" in node.inputs else Expression.constant(1.0)
+        operation = node.operation
+        scalar = operation in ("DOT_PRODUCT", "DISTANCE", "LENGTH")
+        if (out.identifier == "Value") != scalar:
+            return Expression.constant(0.0)
+        per_component = {"ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
+                         "MULTIPLY_ADD": lambda: a * b + c, "SCALE": lambda: a * scale}
+        if operation in per_component:
+            return per_component[operation]()
+        if operation in node_functions.VECTOR_MATH:
+            return Expression.function("vector_math", (operation,), (a, b))
+        math_operation = {"FRACTION": "FRACT"}.get(operation, operation)
+        if math_operation in node_functions.MATH:
+            return Expression.function("math", (math_operation,), (a, b, c))
+        self.note(node, f"{operation.lower()}: its output is the first input")
+        return a
 
     def clamp(self, node, colour):
         value, low, high = (self.value(node.inputs[name], False) for name in ("Value", "Min", "Max"))

@@ -205,6 +205,10 @@ class MeshBuffers:
         self.refused = {}               # kind -> why its per-vertex data was not uploaded (the render says so)
         self.bounds = None              # (2, 3) local box
         self.has_colors = False         # a colour attribute (MeshExport.colors) in the vertex buffer
+        # object space -> Generated coordinates: (co - location) / (2 size) + 1/2 of the mesh's texture space
+        location, size = (np.asarray(v, np.float64) for v in mesh.texture_space)
+        size = np.where(size != 0.0, size, 1.0)
+        self.generated_transform = (list(0.5 / size) + [0.0], list(0.5 - location * 0.5 / size) + [0.0])
         if len(mesh.triangles) == 0:     # empty meshes, curves without fill: nothing to draw
             return
         self.bounds = np.stack([mesh.positions.min(axis=0), mesh.positions.max(axis=0)])
@@ -312,6 +316,10 @@ class _DrawContext(techniques.DrawContext):
 
     def per_vertex(self, kind):
         return self.buffers.per_vertex[kind]
+
+    @property
+    def generated_transform(self):
+        return self.buffers.generated_transform
 
     def environment_textures(self):
         return self.renderer.environment_texture, self.renderer.equirect_texture
@@ -629,6 +637,7 @@ class Renderer:
                     technique.bind(shader, key, context.for_material(name, params))
                     bound = (shader, key, name)
                 shader.uniform_float("model_matrix", context.model_matrix)
+                technique.bind_object(shader, key, context)
                 if self.gbuffer:
                     shader.uniform_int("gbuffer_object_index", object_index)
                     shader.uniform_int("gbuffer_triangle_offset", first_triangle)

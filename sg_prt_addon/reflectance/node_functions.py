@@ -1,5 +1,6 @@
 """Blender's shader-node functions that are not sums of products, as Cycles and EEVEE define them (Math, Clamp,
-Map Range, Color Ramp, the Mix node's blend modes, Hue/Saturation/Value, Gamma, Brightness/Contrast), on
+Map Range, Color Ramp, the Mix node's blend modes, Hue/Saturation/Value, Gamma, Brightness/Contrast, Mapping,
+Vector Math, the Checker and Gradient textures), on
 (..., 3) float32 arrays: a scalar socket is its value on all three channels.  shaders/lib/node_functions.glsl
 is their GLSL (each `node_<name>` there mirrors FUNCTIONS[name] here); reflectance.texture_expression applies
 them to per-pixel values.
@@ -253,6 +254,96 @@ MIX_BLENDS = ("SCREEN", "OVERLAY", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN"
               "SOFT_LIGHT", "LINEAR_LIGHT")
 
 
+def _dot(a, b):
+    return np.sum(a * b, axis=-1, keepdims=True)
+
+
+def _safe_normalize(a):
+    length = np.sqrt(_dot(a, a))
+    return np.where(length != 0, a / np.where(length != 0, length, 1), 0)
+
+
+def euler_matrix(rotation):
+    """(..., 3, 3) rotation of Blender's XYZ Euler angles (..., 3): Z after Y after X."""
+    cx, cy, cz = (np.cos(rotation[..., k]) for k in range(3))
+    sx, sy, sz = (np.sin(rotation[..., k]) for k in range(3))
+    rows = [[cy * cz, sy * sx * cz - cx * sz, sy * cx * cz + sx * sz],
+            [cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz],
+            [-sy, cy * sx, cy * cx]]
+    return np.stack([np.stack(row, -1) for row in rows], -2)
+
+
+def mapping(mapping_type, vector, location, rotation, scale):
+    """The Mapping node: POINT R (v s) + l, TEXTURE its inverse R^T (v - l) / s, VECTOR R (v s), NORMAL
+    normalize(R (v / s)) (a zero scale divides to 0)."""
+    matrix = euler_matrix(rotation)
+
+    def turn(v, transpose=False):
+        return np.einsum("...ji,...j->...i" if transpose else "...ij,...j->...i", matrix, v)
+
+    if mapping_type == "TEXTURE":
+        return _safe_divide(turn(vector - location, transpose=True), scale).astype(FLOAT)
+    if mapping_type == "NORMAL":
+        return _safe_normalize(turn(_safe_divide(vector, scale))).astype(FLOAT)
+    turned = turn(vector * scale)
+    return (turned + location if mapping_type == "POINT" else turned).astype(FLOAT)
+
+
+# The Vector Math node's operations across the three components (the others are per component: the algebra
+# and MATH); DOT_PRODUCT, DISTANCE and LENGTH give a number on all three
+VECTOR_MATH = ("CROSS_PRODUCT", "PROJECT", "REFLECT", "DOT_PRODUCT", "DISTANCE", "LENGTH", "NORMALIZE")
+
+
+def vector_math(operation, a, b):
+    if operation == "CROSS_PRODUCT":
+        return np.cross(a, b).astype(FLOAT)
+    if operation == "PROJECT":
+        length2 = _dot(b, b)
+        return np.where(length2 != 0, b * _dot(a, b) / np.where(length2 != 0, length2, 1), 0).astype(FLOAT)
+    if operation == "REFLECT":
+        n = _safe_normalize(b)
+        return (a - 2 * _dot(n, a) * n).astype(FLOAT)
+    if operation == "NORMALIZE":
+        return _safe_normalize(a).astype(FLOAT)
+    value = {"DOT_PRODUCT": lambda: _dot(a, b), "DISTANCE": lambda: np.sqrt(_dot(a - b, a - b)),
+             "LENGTH": lambda: np.sqrt(_dot(a, a))}[operation]()
+    return np.repeat(value, 3, axis=-1).astype(FLOAT)
+
+
+def tex_checker(output, vector, colour1, colour2, scale):
+    """Checker Texture's Color or Fac (output) at vector x scale (Cycles' svm_checker: the cell's parity, the
+    coordinates nudged off the cell edges)."""
+    p = (vector * scale + FLOAT(0.000001)) * FLOAT(0.999999)
+    cells = np.abs(np.floor(p).astype(np.int64)) % 2
+    fac = ((cells[..., 0] == cells[..., 1]) == (cells[..., 2] == 1)).astype(FLOAT)[..., None]
+    if output == "Fac":
+        return np.repeat(fac, 3, axis=-1)
+    return np.where(fac == 1, colour1, colour2).astype(FLOAT)
+
+
+GRADIENTS = ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "RADIAL", "QUADRATIC_SPHERE", "SPHERICAL")
+
+
+def tex_gradient(gradient_type, vector):
+    """Gradient Texture's Fac (on all three) of its type at vector, clamped to [0, 1] (Cycles' svm_gradient)."""
+    x, y, z = vector[..., 0], vector[..., 1], vector[..., 2]
+    if gradient_type == "LINEAR":
+        value = x
+    elif gradient_type == "QUADRATIC":
+        value = np.maximum(x, 0) ** 2
+    elif gradient_type == "EASING":
+        r = np.clip(x, 0, 1)
+        value = 3 * r * r - 2 * r * r * r
+    elif gradient_type == "DIAGONAL":
+        value = (x + y) * 0.5
+    elif gradient_type == "RADIAL":
+        value = np.arctan2(y, x) / (2 * np.pi) + 0.5
+    else:
+        r = np.maximum(FLOAT(0.999999) - np.sqrt(x * x + y * y + z * z), 0)
+        value = r * r if gradient_type == "QUADRATIC_SPHERE" else r
+    return np.repeat(np.clip(value, 0, 1)[..., None], 3, axis=-1).astype(FLOAT)
+
+
 # Color Ramp's outputs a Function reads
 RAMP_OUTPUTS = ("Color", "Alpha")
 MAP_RANGE_INTERPOLATIONS = ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")
@@ -262,7 +353,8 @@ def apply(name, settings, args):
     """The node function `name` with the node's fixed `settings` of its inputs' values `args` ((..., 3)
     each): what texture_expression.Function computes (names: math (operation,), clamp (type,), map_range
     (interpolation, clamped), color_ramp (interpolation, positions, RGBA colours, output), mix (blend,),
-    hue_saturation_value, gamma, brightness_contrast)."""
+    hue_saturation_value, gamma, brightness_contrast, mapping (type,), vector_math (operation,), tex_checker
+    (output,), tex_gradient (type,))."""
     args = [np.asarray(a, FLOAT) for a in args]
     if name == "math":
         return math(settings[0], *args)
@@ -276,6 +368,14 @@ def apply(name, settings, args):
         return rgba[..., :3] if output == "Color" else np.repeat(rgba[..., 3:], 3, axis=-1)
     if name == "mix":
         return np.asarray(mix(settings[0], *args), FLOAT)
+    if name == "mapping":
+        return mapping(settings[0], *args)
+    if name == "vector_math":
+        return vector_math(settings[0], *args)
+    if name == "tex_checker":
+        return tex_checker(settings[0], *args)
+    if name == "tex_gradient":
+        return tex_gradient(settings[0], *args)
     functions = {"hue_saturation_value": hue_saturation_value, "gamma": gamma,
                  "brightness_contrast": brightness_contrast}
     return functions[name](*args)

@@ -11,6 +11,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+# The surface's coordinates a value may read (Texture Coordinate and Geometry nodes): UV (the material's texture
+# coordinates), OBJECT (object space), GENERATED (object space in the mesh's texture space, [0, 1] over its
+# box), NORMAL (object space), POSITION and WORLD_NORMAL (world space)
+COORDINATES = ("UV", "OBJECT", "GENERATED", "NORMAL", "POSITION", "WORLD_NORMAL")
+
 
 @dataclass(frozen=True)
 class Function:
@@ -26,16 +31,18 @@ class Factor:
     """offset + scale x an image's RGB (linear, as Blender decodes it), or x one of its channels on all three
     (channel 0, 1, 2: a Separate Color's output); with `attribute`, `image` names a mesh's colour attribute
     (its corners' linear RGB, interpolated over the triangle) in place of an image; with `function`, the
-    function's value takes the image's place (image "")."""
+    function's value takes the image's place (image ""), with `coordinates` the surface's coordinates of that
+    name (COORDINATES)."""
     image: str
     scale: float = 1.0
     offset: float = 0.0
     channel: int = None
     attribute: bool = False
     function: Function = None
+    coordinates: str = None
 
     def sort_key(self):
-        return (self.attribute, self.image, repr(self.function), self.scale, self.offset,
+        return (self.attribute, self.image, str(self.coordinates), repr(self.function), self.scale, self.offset,
                 -1 if self.channel is None else self.channel)
 
     def values(self, rgb):
@@ -74,6 +81,11 @@ class Expression:
             value = apply(name, settings, [np.asarray(c, np.float32) for c in constants])
             return Expression.constant(tuple(float(v) for v in np.asarray(value).reshape(3)))
         return Expression((((1.0, 1.0, 1.0), (Factor("", function=Function(name, tuple(settings), args)),)),))
+
+    @staticmethod
+    def coordinates(name):
+        """The surface's coordinates `name` (one of COORDINATES) as a vector (x, y, z)."""
+        return Expression((((1.0, 1.0, 1.0), (Factor("", coordinates=name),)),))
 
     @staticmethod
     def attribute(name):
@@ -128,23 +140,33 @@ class Expression:
 
     # -- what it is
     def _sources(self):
-        """(is an attribute, name) of every image and attribute it reads, inside its functions too."""
+        """(kind: "image", "attribute" or "coordinates", name) of everything it reads, inside its functions too."""
         for _, factors in self.terms:
             for factor in factors:
                 if factor.function is not None:
                     for arg in factor.function.args:
                         yield from arg._sources()
+                elif factor.coordinates is not None:
+                    yield "coordinates", factor.coordinates
                 else:
-                    yield factor.attribute, factor.image
+                    yield "attribute" if factor.attribute else "image", factor.image
+
+    def _names(self, kind):
+        return tuple(sorted({name for source, name in self._sources() if source == kind}))
 
     @property
     def images(self):
-        return tuple(sorted({name for attribute, name in self._sources() if not attribute}))
+        return self._names("image")
 
     @property
     def attributes(self):
         """The colour attributes it reads."""
-        return tuple(sorted({name for attribute, name in self._sources() if attribute}))
+        return self._names("attribute")
+
+    @property
+    def coordinate_names(self):
+        """The surface coordinates it reads (COORDINATES)."""
+        return self._names("coordinates")
 
     def as_constant(self):
         """Its RGB value when it holds no image or attribute, else None."""
@@ -177,25 +199,30 @@ class Expression:
                                  [np.asarray(arg.mean_value(means, attribute_mean), np.float32)
                                   for arg in factor.function.args])
                 else:
-                    mean = attribute_mean if factor.attribute else means[factor.image]
+                    mean = attribute_mean if factor.attribute or factor.coordinates else means[factor.image]
                 product = product * (factor.offset + factor.scale * factor.values(np.asarray(mean, np.float64)))
             total += product
         return tuple(float(v) for v in total)
 
-    def values(self, samples, attributes=None):
-        """Its value (..., 3) float32 where each image reads samples[name] (..., 3) and each attribute
-        attributes[name]: what a pixel gets when every image is sampled there (the shader's
-        texture_value_<slot>)."""
+    def values(self, samples, attributes=None, coordinates=None):
+        """Its value (..., 3) float32 where each image reads samples[name] (..., 3), each attribute
+        attributes[name] and each of the surface's coordinates coordinates[name]: what a pixel gets when every
+        image is sampled there (the shader's texture_value_<slot>)."""
         from .node_functions import apply
 
-        sources = {**{(False, name): samples[name] for name in self.images},
-                   **{(True, name): (attributes or {})[name] for name in self.attributes}}
+        sources = {**{("image", name): samples[name] for name in self.images},
+                   **{("attribute", name): (attributes or {})[name] for name in self.attributes},
+                   **{("coordinates", name): (coordinates or {})[name] for name in self.coordinate_names}}
         shape = np.broadcast_shapes(*(np.shape(value)[:-1] for value in sources.values())) if sources else ()
 
         def source_of(factor):
+            if factor.coordinates is not None:
+                return np.asarray(sources["coordinates", factor.coordinates], np.float32)[..., :3]
             if factor.function is None:
-                return np.asarray(sources[factor.attribute, factor.image], np.float32)[..., :3]
-            args = [np.broadcast_to(arg.values(samples, attributes), shape + (3,)) for arg in factor.function.args]
+                kind = "attribute" if factor.attribute else "image"
+                return np.asarray(sources[kind, factor.image], np.float32)[..., :3]
+            args = [np.broadcast_to(arg.values(samples, attributes, coordinates), shape + (3,))
+                    for arg in factor.function.args]
             return np.asarray(apply(factor.function.name, factor.function.settings, args), np.float32)
 
         out = np.zeros(shape + (3,), np.float32)
@@ -225,8 +252,9 @@ class BoundExpression:
         attributes has no value at a texture coordinate: ValueError."""
         from ..spherical import texture_mips
 
-        if self.expression.attributes:
-            raise ValueError(f"colour attributes {self.expression.attributes} have no value at a texture coordinate")
+        if self.expression.attributes or self.expression.coordinate_names:
+            raise ValueError(f"colour attributes {self.expression.attributes} or the surface's coordinates "
+                             f"{self.expression.coordinate_names} have no value at a texture coordinate")
         samples = {name: texture_mips.sample(pixels, uv, footprint)[..., :3] for name, pixels in self.images.items()}
         out = np.ones((len(uv), 4), np.float32)
         out[:, :3] = self.expression.values(samples)

@@ -83,6 +83,8 @@ class DrawContext:
       bytes or have a stable repr); the maths modules take it as their tables' `store`;
     image(slot): the material's image texture of a texture slot;
     node_image(name): the texture of an image a computed slot reads (techniques/material_textures.py);
+    generated_transform: (scale, offset) RGBA lists taking the object-space position to Blender's Generated
+      coordinates (the mesh's texture space);
     object_table(name, sources, build): a GPU texture of build()'s array for the object, remade when any of
       the objects in the tuple `sources` is not the one it was made from, dropped with the object;
     object_target(name, size, sources=()): a float RGBA (texture, framebuffer, current) of the object, kept while
@@ -121,6 +123,13 @@ class Technique:
 
     def bind(self, shader, key, context):
         raise NotImplementedError
+
+    def bind_object(self, shader, key, context):
+        """Set the object's own push constants its variant reads (every object draw, after bind): the texture
+        space of a material's computed values (material_textures.bind_object)."""
+        from . import material_textures
+
+        material_textures.bind_object(shader, key, context)
 
     def bind_reads_object(self, key):
         """Whether bind(shader, key, context) binds anything of the object's own (context.per_vertex,

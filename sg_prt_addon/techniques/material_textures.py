@@ -13,6 +13,18 @@ from ..reflectance import node_functions
 from . import shader_sources
 
 NORMAL_MAP = "normal_map"
+MAPPING_TYPES = ("POINT", "TEXTURE", "VECTOR", "NORMAL")
+# The surface's coordinates in GLSL (texture_expression.COORDINATES): object_position is the vertex stage's
+# (HAS_OBJECT_POSITION), generated_scale and generated_offset the object's push constants (the mesh's texture
+# space, bind_object)
+COORDINATE_SOURCES = {
+    "UV": "vec3(texcoord, 0.0)",
+    "OBJECT": "object_position",
+    "GENERATED": "(object_position * generated_scale.xyz + generated_offset.xyz)",
+    "NORMAL": "normalize(transpose(mat3(model_matrix)) * world_normal)",
+    "POSITION": "world_position",
+    "WORLD_NORMAL": "normalize(world_normal)",
+}
 # What a colour attribute reads where the mesh has none (Cycles: an attribute not found is 0)
 MISSING_ATTRIBUTE = "vec3(0.0)"
 
@@ -20,9 +32,21 @@ MISSING_ATTRIBUTE = "vec3(0.0)"
 @dataclass(frozen=True)
 class NodeValues:
     """The slots a node tree computes: ((slot, Expression), ...) by slot; vertex_colors: they read a colour
-    attribute and the object's mesh has one (its vertex stream)."""
+    attribute and the object's mesh has one (its vertex stream); coordinates: the surface coordinates they read
+    (texture_expression.COORDINATES)."""
     slots: tuple = ()
     vertex_colors: bool = False
+    coordinates: tuple = ()
+
+    @property
+    def object_position(self):
+        """Whether the vertex stage passes the object-space position on."""
+        return bool({"OBJECT", "GENERATED"} & set(self.coordinates))
+
+    @property
+    def generated(self):
+        """Whether the shader takes the object's texture space (push constants generated_scale, _offset)."""
+        return "GENERATED" in self.coordinates
 
 
 def node_values(params, textures, inputs):
@@ -30,7 +54,17 @@ def node_values(params, textures, inputs):
     slots = tuple((slot, params.textures[slot]) for slot in sorted(textures)
                   if not isinstance(params.textures[slot], str))
     reads_attributes = any(expression.attributes for _, expression in slots)
-    return NodeValues(slots, reads_attributes and inputs.vertex_colors)
+    coordinates = tuple(sorted({name for _, expression in slots for name in expression.coordinate_names}))
+    return NodeValues(slots, reads_attributes and inputs.vertex_colors, coordinates)
+
+
+def bind_object(shader, key, context):
+    """The object's own values a variant reads: its mesh's texture space (DrawContext.generated_transform)."""
+    node_values = getattr(key, "node_values", None)
+    if node_values is not None and node_values.generated:
+        scale, offset = context.generated_transform
+        shader.uniform_float("generated_scale", scale)
+        shader.uniform_float("generated_offset", offset)
 
 
 def images(key):
@@ -89,6 +123,14 @@ def function_source(function, rgb_of, helpers):
         return f"{value}.rgb" if settings[3] == "Color" else f"vec3({value}.a)"
     if name == "mix":
         return f"node_mix_{settings[0].lower()}({', '.join(args)})"
+    if name == "mapping":
+        return f"node_mapping({', '.join(args)}, {MAPPING_TYPES.index(settings[0])})"
+    if name == "vector_math":
+        return f"node_vector_{settings[0].lower()}({', '.join(args)})"
+    if name == "tex_checker":
+        return f"node_tex_checker({', '.join(args)}, {'true' if settings[0] == 'Color' else 'false'})"
+    if name == "tex_gradient":
+        return f"node_tex_gradient({args[0]}, {node_functions.GRADIENTS.index(settings[0])})"
     return f"node_{name}({', '.join(args)})"
 
 
@@ -138,6 +180,8 @@ def values_source(key):
     attribute = "vertex_color.rgb" if key.node_values.vertex_colors else MISSING_ATTRIBUTE
 
     def rgb_of(factor):
+        if factor.coordinates is not None:
+            return COORDINATE_SOURCES[factor.coordinates]
         return attribute if factor.attribute else f"node_image_{names.index(factor.image)}_rgb()"
 
     helpers, slots = {}, []

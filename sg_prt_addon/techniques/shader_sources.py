@@ -147,15 +147,20 @@ def vertex_source(per_vertex=()):
     return (per_vertex_fetch_source(per_vertex) + source) if per_vertex else source
 
 
-def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), push_constants=(), vertex_colors=False):
+def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), push_constants=(), node_values=None):
     """The create-info calls of a surface shader (see base.Technique.create_info_calls): `defines` (name ->
     value, the scene limits added), the vertex stage with `per_vertex`'s fetch (PER_VERTEX_ROWS defined;
-    the fragment source calls per_vertex_copy_source's load_per_vertex_rows), with vertex_colors the mesh's
-    colour attribute as the vertex_color varying (HAS_VERTEX_COLOR), the scene and material blocks at bindings
+    the fragment source calls per_vertex_copy_source's load_per_vertex_rows), what the material's computed
+    values read (node_values: techniques.material_textures.NodeValues): the mesh's colour attribute as the
+    vertex_color varying (HAS_VERTEX_COLOR), the object-space position as object_position
+    (HAS_OBJECT_POSITION), the texture space's push constants; the scene and material blocks at bindings
     0 and 1, `samplers` ((kind, name) in slot order), the technique's own push_constants ((type, name)) after
     the model matrix, and the outputs of output_names."""
+    vertex_colors = node_values is not None and node_values.vertex_colors
+    object_position = node_values is not None and node_values.object_position
     defines = {**LIMITS, **defines, **({"PER_VERTEX_ROWS": 1} if per_vertex else {}),
-               **({"HAS_VERTEX_COLOR": 1} if vertex_colors else {})}
+               **({"HAS_VERTEX_COLOR": 1} if vertex_colors else {}),
+               **({"HAS_OBJECT_POSITION": 1} if object_position else {})}
     calls = [("define", (name, str(value))) for name, value in sorted(defines.items())]
     calls.append(("typedef_source", (typedef_source(),)))
     calls += [("vertex_in", (0, "VEC3", "position")), ("vertex_in", (1, "VEC3", "normal")),
@@ -172,11 +177,15 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
         interface += [("smooth", ("VEC4", f"{item.varying}_{k}")) for item in per_vertex for k in range(item.rows)]
     if vertex_colors:
         interface.append(("smooth", ("VEC4", "vertex_color")))
+    if object_position:
+        interface.append(("smooth", ("VEC3", "object_position")))
     interface_name = "sgprt_surface_interface" + "".join(f"_{item.varying}{item.rows}" for item in per_vertex) \
-        + ("_color" if vertex_colors else "")
+        + ("_color" if vertex_colors else "") + ("_object" if object_position else "")
     calls.append(("vertex_out", (interface_name, tuple(interface))))
     calls.append(("push_constant", ("MAT4", "model_matrix")))
     calls += [("push_constant", constant) for constant in push_constants]
+    if node_values is not None and node_values.generated:
+        calls += [("push_constant", ("VEC4", "generated_scale")), ("push_constant", ("VEC4", "generated_offset"))]
     if gbuffer:
         calls += [("push_constant", ("INT", "gbuffer_object_index")),
                   ("push_constant", ("INT", "gbuffer_triangle_offset"))]

@@ -219,3 +219,86 @@ vec3 node_mix_soft_light(vec3 t, vec3 a, vec3 b)
   return (1.0 - t) * a + t * ((1.0 - a) * b * a + a * screen);
 }
 vec3 node_mix_linear_light(vec3 t, vec3 a, vec3 b) { return a + t * (2.0 * b - 1.0); }
+
+/* Blender's XYZ Euler rotation: Z after Y after X */
+mat3 node_euler_matrix(vec3 rotation)
+{
+  vec3 c = cos(rotation), s = sin(rotation);
+  /* columns */
+  return mat3(vec3(c.y * c.z, c.y * s.z, -s.y),
+              vec3(s.y * s.x * c.z - c.x * s.z, s.y * s.x * s.z + c.x * c.z, c.y * s.x),
+              vec3(s.y * c.x * c.z + s.x * s.z, s.y * c.x * s.z - s.x * c.z, c.y * c.x));
+}
+
+vec3 node_safe_normalize(vec3 a)
+{
+  float length_a = length(a);
+  return length_a != 0.0 ? a / length_a : vec3(0.0);
+}
+
+/* mapping_type: 0 POINT, 1 TEXTURE, 2 VECTOR, 3 NORMAL */
+vec3 node_mapping(vec3 vector, vec3 location, vec3 rotation, vec3 scale, int mapping_type)
+{
+  mat3 turn = node_euler_matrix(rotation);
+  if (mapping_type == 1) {
+    return node_safe_divide(transpose(turn) * (vector - location), scale);
+  }
+  if (mapping_type == 3) {
+    return node_safe_normalize(turn * node_safe_divide(vector, scale));
+  }
+  vec3 turned = turn * (vector * scale);
+  return mapping_type == 0 ? turned + location : turned;
+}
+
+vec3 node_vector_cross_product(vec3 a, vec3 b) { return cross(a, b); }
+vec3 node_vector_project(vec3 a, vec3 b)
+{
+  float length2 = dot(b, b);
+  return length2 != 0.0 ? b * (dot(a, b) / length2) : vec3(0.0);
+}
+vec3 node_vector_reflect(vec3 a, vec3 b)
+{
+  vec3 n = node_safe_normalize(b);
+  return a - 2.0 * dot(n, a) * n;
+}
+vec3 node_vector_dot_product(vec3 a, vec3 b) { return vec3(dot(a, b)); }
+vec3 node_vector_distance(vec3 a, vec3 b) { return vec3(distance(a, b)); }
+vec3 node_vector_length(vec3 a, vec3 b) { return vec3(length(a)); }
+vec3 node_vector_normalize(vec3 a, vec3 b) { return node_safe_normalize(a); }
+
+/* Checker Texture: its Fac on all three, or (colour) its Color */
+vec3 node_tex_checker(vec3 vector, vec3 colour1, vec3 colour2, vec3 scale, bool colour)
+{
+  vec3 p = (vector * scale + 0.000001) * 0.999999;
+  ivec3 cells = abs(ivec3(floor(p))) % 2;
+  float fac = ((cells.x == cells.y) == (cells.z == 1)) ? 1.0 : 0.0;
+  return colour ? (fac == 1.0 ? colour1 : colour2) : vec3(fac);
+}
+
+/* Gradient Texture's Fac on all three: gradient_type the index in node_functions.GRADIENTS */
+vec3 node_tex_gradient(vec3 p, int gradient_type)
+{
+  float value;
+  if (gradient_type == 0) {
+    value = p.x;
+  }
+  else if (gradient_type == 1) {
+    value = max(p.x, 0.0) * max(p.x, 0.0);
+  }
+  else if (gradient_type == 2) {
+    float r = clamp(p.x, 0.0, 1.0);
+    value = 3.0 * r * r - 2.0 * r * r * r;
+  }
+  else if (gradient_type == 3) {
+    value = (p.x + p.y) * 0.5;
+  }
+  else if (gradient_type == 4) {
+    /* atan(0, 0) is undefined in GLSL, 0 in C */
+    value = (p.x == 0.0 && p.y == 0.0) ? 0.5 : atan(p.y, p.x) / 6.283185307179586 + 0.5;
+  }
+  else {
+    float r = max(0.999999 - length(p), 0.0);
+    value = gradient_type == 5 ? r * r : r;
+  }
+  return vec3(clamp(value, 0.0, 1.0));
+}

@@ -105,3 +105,35 @@ def test_colour_functions(glsl, fuzz, record_error):
     got = _run(glsl, "node_brightness_contrast(a.xyz, b.xyz, c.xyz)", (colour, hue - 0.2, saturation - 0.5))
     expected = node_functions.brightness_contrast(colour, hue - 0.2, saturation - 0.5)
     assert _close(record_error, "brightness_contrast", got, expected) < 1e-6
+
+
+@pytest.mark.parametrize("mapping_type", ["POINT", "TEXTURE", "VECTOR", "NORMAL"])
+def test_mapping(glsl, fuzz, record_error, mapping_type):
+    vector, location, rotation = _inputs(fuzz)
+    scale = _inputs(fuzz)[0]
+    index = ("POINT", "TEXTURE", "VECTOR", "NORMAL").index(mapping_type)
+    got = _run(glsl, f"node_mapping(a.xyz, b.xyz, c.xyz, d.xyz, {index})", (vector, location, rotation, scale))
+    expected = node_functions.mapping(mapping_type, vector, location, rotation, scale)
+    assert _close(record_error, f"mapping {mapping_type}", got, expected) < 5e-5
+
+
+@pytest.mark.parametrize("operation", node_functions.VECTOR_MATH)
+def test_vector_math(glsl, fuzz, record_error, operation):
+    a, b, _ = _inputs(fuzz)
+    got = _run(glsl, f"node_vector_{operation.lower()}(a.xyz, b.xyz)", (a, b))
+    assert _close(record_error, f"vector_math {operation}", got, node_functions.vector_math(operation, a, b)) < 2e-5
+
+
+def test_checker_and_gradients(glsl, fuzz, record_error):
+    vector, colour1, colour2 = _inputs(fuzz)
+    scale = np.full_like(vector, 2.5)
+    for output, flag in (("Color", "true"), ("Fac", "false")):
+        got = _run(glsl, f"node_tex_checker(a.xyz, b.xyz, c.xyz, d.xyz, {flag})", (vector, colour1, colour2, scale))
+        expected = node_functions.tex_checker(output, vector, colour1, colour2, scale)
+        # a cell's edge one rounding off: the other cell, at a few points
+        assert np.mean(np.abs(got - expected).max(axis=1) > 1e-5) < 0.002
+    vector = vector * np.float32(0.4) + np.float32(0.01)       # no signed zeros: atan2(0, -0) is pi in C
+    for index, gradient_type in enumerate(node_functions.GRADIENTS):
+        got = _run(glsl, f"node_tex_gradient(a.xyz, {index})", (vector,))
+        expected = node_functions.tex_gradient(gradient_type, vector)
+        assert _close(record_error, f"gradient {gradient_type}", got, expected) < 2e-5

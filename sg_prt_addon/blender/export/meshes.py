@@ -31,6 +31,8 @@ class MeshExport:
     # the mesh's default colour attribute (what a node tree's Color Attribute reads), linear RGBA a corner
     colors: np.ndarray = None          # (V, 4) float32, or None without one
     color_name: str = ""
+    # the mesh's texture space (location, size): what Generated coordinates span ([0, 1] over location +- size)
+    texture_space: tuple = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
 
 
 # --------------------------------------------------------------------------- meshes
@@ -157,6 +159,7 @@ def export_mesh_data(mesh, name=None):
         corner_vertex=np.ascontiguousarray(vertex_index, np.uint32),
         vertex_count=len(mesh.vertices),
         vertex_normals=_vertex_normals(mesh),
+        texture_space=(tuple(mesh.texspace_location), tuple(mesh.texspace_size)),
         **_corner_colors(mesh, vertex_index, name),
     )
 

@@ -309,7 +309,7 @@ class SGLobes(Technique):
     def create_info_calls(self, key):
         return shader_sources.surface_calls(self.defines(key), self.fragment_source(key), self.samplers(key),
                                             key.gbuffer, per_vertex_inputs(key),
-                                            vertex_colors=key.node_values.vertex_colors)
+                                            node_values=key.node_values)
 
     # ------------------------------------------------------------- drawing
 

@@ -306,7 +306,7 @@ class SphericalHarmonics(Technique):
                     for name in ("sh_library.glsl", "sh_shading.glsl", "surface.frag.glsl")]
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
                                             fetched, push_constants=(("VEC4", "sh_axis"),),
-                                            vertex_colors=key.node_values.vertex_colors)
+                                            node_values=key.node_values)
 
     def bind_reads_object(self, key):
         # the transfer bake's rows and radiance table (the mesh's); the environment's row is the scene's
