@@ -491,6 +491,23 @@ def vector_math_case(operation):
     return value_of
 
 
+def noise(noise_type="FBM", output="Fac", distortion=0.0, vector_output=None):
+    """The Noise Texture (Scale 4, Detail 3.5, its other inputs at their defaults) of its default Generated
+    coordinates or a Texture Coordinate output."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexNoise")
+        node.noise_type = noise_type
+        node.inputs["Scale"].default_value = 4.0
+        node.inputs["Detail"].default_value = 3.5
+        node.inputs["Distortion"].default_value = distortion
+        if vector_output is not None:
+            tree.links.new(_coordinates(tree, vector_output), node.inputs["Vector"])
+        value = node.outputs[output]
+        # the multifractal types pass 1 and go below 0: scaled into the emission's range
+        return value if noise_type == "FBM" else _math_node(tree, "ABSOLUTE", _math_node(tree, "MULTIPLY", value, 0.25))
+    return value_of
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -523,7 +540,11 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          **{f"mapping_{kind.lower()}": _socket_case(mapping_case(kind)) for kind in ("POINT", "TEXTURE", "VECTOR", "NORMAL")},
          **{f"vector_math_{operation.lower()}": _socket_case(vector_math_case(operation))
             for operation in ("CROSS_PRODUCT", "PROJECT", "REFLECT", "DOT_PRODUCT", "DISTANCE", "LENGTH", "NORMALIZE",
-                              "MODULO", "SNAP")}}
+                              "MODULO", "SNAP")},
+         "noise_fac": _socket_case(noise()), "noise_color": _socket_case(noise(output="Color")),
+         "noise_distorted_object": _socket_case(noise(output="Color", distortion=1.5, vector_output="Object")),
+         **{f"noise_{kind.lower()}": _socket_case(noise(kind))
+            for kind in ("MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HETERO_TERRAIN")}}
 # cases whose truth is 0 everywhere (scored by their largest values)
 ZERO_TRUTH = ("color_attribute_missing",)
 # the cases whose grid has the colour attribute: (domain, data type)

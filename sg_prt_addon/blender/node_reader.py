@@ -143,6 +143,8 @@ class SocketReader:
             return self.coordinates_value(node, out, socket, colour)
         if node.type in ("TEX_CHECKER", "TEX_GRADIENT"):
             return self.procedural_texture(node, out)
+        if node.type == "TEX_NOISE":
+            return self.noise_texture(node, out)
         if node.type == "VECT_MATH":
             return self.vector_math(node, out)
         reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix, "MAPPING": self.mapping,
@@ -200,6 +202,20 @@ class SocketReader:
             values = [vector] + [self.value(node.inputs[name], name != "Scale") for name in ("Color1", "Color2", "Scale")]
             return Expression.function("tex_checker", ("Color" if out.identifier == "Color" else "Fac",), values)
         return Expression.function("tex_gradient", (node.gradient_type,), (vector,))
+
+    def noise_texture(self, node, out):
+        """The Noise Texture in 3D, of each of its types (another dimension count is read as 3D)."""
+        if getattr(node, "noise_dimensions", "3D") != "3D":
+            self.note(node, f"{node.noise_dimensions} noise: read as 3D")
+        defaults = {"Scale": 5.0, "Detail": 2.0, "Roughness": 0.5, "Lacunarity": 2.0, "Offset": 0.0, "Gain": 1.0,
+                    "Distortion": 0.0}
+        values = [self.texture_vector(node)]
+        for name, default in defaults.items():
+            socket = _sockets(node, name)[0]
+            values.append(self.value(socket, False) if socket is not None else Expression.constant(default))
+        settings = (getattr(node, "noise_type", "FBM"), bool(getattr(node, "normalize", True)),
+                    "Color" if out.identifier == "Color" else "Fac")
+        return Expression.function("tex_noise", settings, values)
 
     def mapping(self, node, colour):
         """The Mapping node on a vector (POINT, TEXTURE, VECTOR, NORMAL)."""

@@ -1,6 +1,6 @@
 """Blender's shader-node functions that are not sums of products, as Cycles and EEVEE define them (Math, Clamp,
 Map Range, Color Ramp, the Mix node's blend modes, Hue/Saturation/Value, Gamma, Brightness/Contrast, Mapping,
-Vector Math, the Checker and Gradient textures), on
+Vector Math, the Checker, Gradient and Noise textures), on
 (..., 3) float32 arrays: a scalar socket is its value on all three channels.  shaders/lib/node_functions.glsl
 is their GLSL (each `node_<name>` there mirrors FUNCTIONS[name] here); reflectance.texture_expression applies
 them to per-pixel values.
@@ -354,7 +354,7 @@ def apply(name, settings, args):
     each): what texture_expression.Function computes (names: math (operation,), clamp (type,), map_range
     (interpolation, clamped), color_ramp (interpolation, positions, RGBA colours, output), mix (blend,),
     hue_saturation_value, gamma, brightness_contrast, mapping (type,), vector_math (operation,), tex_checker
-    (output,), tex_gradient (type,))."""
+    (output,), tex_gradient (type,), tex_noise (type, normalize, output))."""
     args = [np.asarray(a, FLOAT) for a in args]
     if name == "math":
         return math(settings[0], *args)
@@ -376,6 +376,203 @@ def apply(name, settings, args):
         return tex_checker(settings[0], *args)
     if name == "tex_gradient":
         return tex_gradient(settings[0], *args)
+    if name == "tex_noise":
+        return tex_noise(settings, *args)
     functions = {"hue_saturation_value": hue_saturation_value, "gamma": gamma,
                  "brightness_contrast": brightness_contrast}
     return functions[name](*args)
+
+
+# ----------------------------------------------------------------------------- noise
+# Cycles' Perlin noise (kernel/svm/noise.h, fractal_noise.h, noisetex.h; Bob Jenkins' lookup3 hash of
+# util/hash.h): the Noise Texture's values, bit for bit where float32 rounding agrees.
+
+_U32 = np.uint32
+
+
+def _rot(x, k):
+    return (x << _U32(k)) | (x >> _U32(32 - k))
+
+
+def _final(a, b, c):
+    c ^= b
+    c -= _rot(b, 14)
+    a ^= c
+    a -= _rot(c, 11)
+    b ^= a
+    b -= _rot(a, 25)
+    c ^= b
+    c -= _rot(b, 16)
+    a ^= c
+    a -= _rot(c, 4)
+    b ^= a
+    b -= _rot(a, 14)
+    c ^= b
+    c -= _rot(b, 24)
+    return c
+
+
+def hash_uint(*keys):
+    """lookup3's hash of one to three uint32 keys (arrays broadcast)."""
+    keys = [np.asarray(k).astype(np.int64).astype(_U32) for k in keys]
+    shape = np.broadcast_shapes(*(k.shape for k in keys))
+    start = _U32((0xDEADBEEF + (len(keys) << 2) + 13) & 0xFFFFFFFF)
+    a, b, c = (np.full(shape, start, _U32) for _ in range(3))
+    with np.errstate(over="ignore"):
+        for register, key in zip((a, b, c), keys):
+            register += key
+        return _final(a, b, c)
+
+
+def hash_float2_to_float(x, y):
+    """Cycles' hash of two floats' bits to [0, 1]."""
+    bits = [np.asarray(v, FLOAT).view(_U32) for v in (x, y)]
+    return (hash_uint(*bits).astype(np.float64) / 0xFFFFFFFF).astype(FLOAT)
+
+
+def random_float3_offset(seed):
+    """The Noise Texture's offset of seed `seed`: each component 100 + a hash of (seed, k) x 100."""
+    return np.array([FLOAT(100) + hash_float2_to_float(FLOAT(seed), FLOAT(k)) * FLOAT(100) for k in range(3)],
+                    FLOAT)
+
+
+def _fade(t):
+    return t * t * t * (t * (t * FLOAT(6) - FLOAT(15)) + FLOAT(10))
+
+
+def _grad3(h, x, y, z):
+    h = (h & _U32(15)).astype(np.int64)
+    u = np.where(h < 8, x, y)
+    vt = np.where((h == 12) | (h == 14), x, z)
+    v = np.where(h < 4, y, vt)
+    return np.where(h & 1, -u, u) + np.where(h & 2, -v, v)
+
+
+def perlin_3d(p):
+    """Perlin noise of points (..., 3) float32."""
+    cell = np.floor(p)
+    f = (p - cell).astype(FLOAT)
+    cell = cell.astype(np.int64)
+    u, v, w = (_fade(f[..., k]) for k in range(3))
+    corners = {}
+    for dz in (0, 1):
+        for dy in (0, 1):
+            for dx in (0, 1):
+                h = hash_uint(cell[..., 0] + dx, cell[..., 1] + dy, cell[..., 2] + dz)
+                corners[dx, dy, dz] = _grad3(h, f[..., 0] - dx, f[..., 1] - dy, f[..., 2] - dz)
+    x1, y1, z1 = FLOAT(1) - u, FLOAT(1) - v, FLOAT(1) - w
+    return (z1 * (y1 * (corners[0, 0, 0] * x1 + corners[1, 0, 0] * u) + v * (corners[0, 1, 0] * x1 + corners[1, 1, 0] * u))
+            + w * (y1 * (corners[0, 0, 1] * x1 + corners[1, 0, 1] * u)
+                   + v * (corners[0, 1, 1] * x1 + corners[1, 1, 1] * u))).astype(FLOAT)
+
+
+def snoise_3d(p):
+    """Signed noise in about [-1, 1]: each coordinate repeated every 100000 (shifted by half past 1e6), Perlin
+    noise scaled by 0.982."""
+    p = np.asarray(p, FLOAT)
+    p = (np.fmod(p, FLOAT(100000)) + np.where(np.abs(p) >= 1e6, FLOAT(0.5), FLOAT(0))).astype(FLOAT)
+    return (FLOAT(0.982) * perlin_3d(p)).astype(FLOAT)
+
+
+NOISE_TYPES = ("FBM", "MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HETERO_TERRAIN")
+
+
+def _noise_fractal(noise_type, p, detail, roughness, lacunarity, offset, gain, normalize):
+    """One fractal of snoise_3d at points p (N, 3), its parameters (N,) each."""
+    octaves = np.floor(detail).astype(np.int64)
+    remainder = detail - np.floor(detail)
+    count = int(octaves.max(initial=0))
+    if noise_type == "FBM":
+        fscale, amp = np.ones_like(detail), np.ones_like(detail)
+        total, maxamp = np.zeros_like(detail), np.zeros_like(detail)
+        for i in range(count + 1):
+            live = i <= octaves
+            t = snoise_3d(p * fscale[:, None])
+            total = np.where(live, total + t * amp, total)
+            maxamp = np.where(live, maxamp + amp, maxamp)
+            amp = np.where(live, amp * roughness, amp)
+            fscale = np.where(live, fscale * lacunarity, fscale)
+        t = snoise_3d(p * fscale[:, None])
+        total2 = total + t * amp
+        if normalize:
+            low = FLOAT(0.5) * total / maxamp + FLOAT(0.5)
+            high = FLOAT(0.5) * total2 / (maxamp + amp) + FLOAT(0.5)
+        else:
+            low, high = total, total2
+        return np.where(remainder != 0, low + remainder * (high - low), low)
+    if noise_type == "MULTIFRACTAL":
+        value, power = np.ones_like(detail), np.ones_like(detail)
+        for i in range(count + 1):
+            live = i <= octaves
+            value = np.where(live, value * (power * snoise_3d(p) + 1), value)
+            power = np.where(live, power * roughness, power)
+            p = np.where(live[:, None], p * lacunarity[:, None], p)
+        return np.where(remainder != 0, value * (remainder * power * snoise_3d(p) + 1), value)
+    if noise_type == "HETERO_TERRAIN":
+        power = roughness.copy()
+        value = offset + snoise_3d(p)
+        p = p * lacunarity[:, None]
+        for i in range(1, count + 1):
+            live = i <= octaves
+            increment = (snoise_3d(p) + offset) * power * value
+            value = np.where(live, value + increment, value)
+            power = np.where(live, power * roughness, power)
+            p = np.where(live[:, None], p * lacunarity[:, None], p)
+        increment = (snoise_3d(p) + offset) * power * value
+        return np.where(remainder != 0, value + remainder * increment, value)
+    if noise_type == "HYBRID_MULTIFRACTAL":
+        power, value, weight = np.ones_like(detail), np.zeros_like(detail), np.ones_like(detail)
+        for i in range(count + 1):
+            live = (weight > 0.001) & (i <= octaves)
+            weight = np.where(live, np.minimum(weight, 1), weight)
+            signal = (snoise_3d(p) + offset) * power
+            power = np.where(live, power * roughness, power)
+            value = np.where(live, value + weight * signal, value)
+            weight = np.where(live, weight * gain * signal, weight)
+            p = np.where(live[:, None], p * lacunarity[:, None], p)
+        live = (remainder != 0) & (weight > 0.001)
+        signal = (snoise_3d(p) + offset) * power
+        return np.where(live, value + remainder * np.minimum(weight, 1) * signal, value)
+    # RIDGED_MULTIFRACTAL
+    power = roughness.copy()
+    signal = offset - np.abs(snoise_3d(p))
+    signal = signal * signal
+    value = signal
+    for i in range(1, count + 1):
+        live = i <= octaves
+        p = np.where(live[:, None], p * lacunarity[:, None], p)
+        weight = np.clip(signal * gain, 0, 1)
+        new_signal = offset - np.abs(snoise_3d(p))
+        new_signal = new_signal * new_signal * weight
+        value = np.where(live, value + new_signal * power, value)
+        signal = np.where(live, new_signal, signal)
+        power = np.where(live, power * roughness, power)
+    return value
+
+
+def tex_noise(settings, vector, scale, detail, roughness, lacunarity, offset, gain, distortion):
+    """The Noise Texture in 3D (settings: noise type, normalize, output "Fac" or "Color"): the vector times
+    the scale, distorted by noise at three offsets, a fractal of snoise_3d; its Color is that and the fractal
+    at two more offsets."""
+    noise_type, normalize, output = settings
+    shape = np.shape(vector)[:-1]
+    flat = [np.asarray(a, FLOAT).reshape(-1, 3) for a in (vector, scale, detail, roughness, lacunarity, offset, gain,
+                                                          distortion)]
+    vector, scale, detail, roughness, lacunarity, offset, gain, distortion = flat
+    scalars = [a[:, 0] for a in (detail, roughness, lacunarity, offset, gain, distortion)]
+    detail, roughness, lacunarity, offset, gain, distortion = scalars
+    detail = np.clip(detail, 0, 15)
+    roughness = np.maximum(roughness, 0)
+    p = (vector * scale[:, :1]).astype(FLOAT)
+    distorted = np.stack([snoise_3d(p + random_float3_offset(k)) for k in range(3)], axis=-1) * distortion[:, None]
+    p = np.where((distortion != 0)[:, None], p + distorted, p).astype(FLOAT)
+
+    def fractal(point):
+        return _noise_fractal(noise_type, point, detail, roughness, lacunarity, offset, gain, normalize)
+
+    value = fractal(p)
+    if output == "Fac":
+        out = np.repeat(value[:, None], 3, axis=-1)
+    else:
+        out = np.stack([value, fractal(p + random_float3_offset(3)), fractal(p + random_float3_offset(4))], axis=-1)
+    return out.reshape(shape + (3,)).astype(FLOAT)

@@ -131,6 +131,11 @@ def function_source(function, rgb_of, helpers):
         return f"node_tex_checker({', '.join(args)}, {'true' if settings[0] == 'Color' else 'false'})"
     if name == "tex_gradient":
         return f"node_tex_gradient({args[0]}, {node_functions.GRADIENTS.index(settings[0])})"
+    if name == "tex_noise":
+        noise_type, normalize, output = settings
+        flags = f"{node_functions.NOISE_TYPES.index(noise_type)}, {str(bool(normalize)).lower()}, " \
+                f"{'true' if output == 'Color' else 'false'}"
+        return f"node_tex_noise({', '.join(args)}, {flags})"
     return f"node_{name}({', '.join(args)})"
 
 
@@ -197,9 +202,19 @@ def values_source(key):
     return "\n".join(lines + [source for _, source in helpers.values()] + slots) + "\n"
 
 
+def noise_offsets_source():
+    """The Noise Texture's five random offsets (node_functions.random_float3_offset) as the GLSL constant
+    node_functions.glsl reads: computed here, so GLSL and numpy read the same float32 values."""
+    literal = shader_sources.float_literal
+    offsets = ", ".join("vec3(" + ", ".join(literal(v) for v in node_functions.random_float3_offset(seed)) + ")"
+                        for seed in range(5))
+    return f"const vec3 NODE_NOISE_OFFSETS[5] = vec3[5]({offsets});\n"
+
+
 def sources(key):
     """The surface shader's sources from surface_common.glsl to surface_io.glsl, the slots' values between."""
-    library = [shader_sources.library_source("node_functions.glsl")] if _uses_functions(key) else []
+    library = [noise_offsets_source(), shader_sources.library_source("node_functions.glsl")] \
+        if _uses_functions(key) else []
     return [shader_sources.technique_source("common", "surface_common.glsl"),
             shader_sources.technique_source("common", "material_textures.glsl"), *library, values_source(key),
             shader_sources.technique_source("common", "surface_io.glsl")]

@@ -302,3 +302,155 @@ vec3 node_tex_gradient(vec3 p, int gradient_type)
   }
   return vec3(clamp(value, 0.0, 1.0));
 }
+
+/* Cycles' Perlin noise and the Noise Texture (node_functions.py's noise section): lookup3's hash on uint,
+ * NODE_NOISE_OFFSETS (the texture's five random offsets, computed on the CPU: material_textures.py writes
+ * them before this file) */
+uint node_rot(uint x, uint k) { return (x << k) | (x >> (32u - k)); }
+
+uint node_hash_uint3(uint kx, uint ky, uint kz)
+{
+  uint a = 0xDEADBEEFu + (3u << 2u) + 13u;
+  uint b = a, c = a;
+  c += kz;
+  b += ky;
+  a += kx;
+  c ^= b; c -= node_rot(b, 14u);
+  a ^= c; a -= node_rot(c, 11u);
+  b ^= a; b -= node_rot(a, 25u);
+  c ^= b; c -= node_rot(b, 16u);
+  a ^= c; a -= node_rot(c, 4u);
+  b ^= a; b -= node_rot(a, 14u);
+  c ^= b; c -= node_rot(b, 24u);
+  return c;
+}
+
+float node_fade(float t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
+
+float node_grad3(uint hash, float x, float y, float z)
+{
+  uint h = hash & 15u;
+  float u = h < 8u ? x : y;
+  float vt = (h == 12u || h == 14u) ? x : z;
+  float v = h < 4u ? y : vt;
+  return ((h & 1u) != 0u ? -u : u) + ((h & 2u) != 0u ? -v : v);
+}
+
+float node_perlin_3d(vec3 p)
+{
+  vec3 cell = floor(p);
+  vec3 f = p - cell;
+  uvec3 c = uvec3(ivec3(cell));
+  float u = node_fade(f.x), v = node_fade(f.y), w = node_fade(f.z);
+  float v0 = node_grad3(node_hash_uint3(c.x, c.y, c.z), f.x, f.y, f.z);
+  float v1 = node_grad3(node_hash_uint3(c.x + 1u, c.y, c.z), f.x - 1.0, f.y, f.z);
+  float v2 = node_grad3(node_hash_uint3(c.x, c.y + 1u, c.z), f.x, f.y - 1.0, f.z);
+  float v3 = node_grad3(node_hash_uint3(c.x + 1u, c.y + 1u, c.z), f.x - 1.0, f.y - 1.0, f.z);
+  float v4 = node_grad3(node_hash_uint3(c.x, c.y, c.z + 1u), f.x, f.y, f.z - 1.0);
+  float v5 = node_grad3(node_hash_uint3(c.x + 1u, c.y, c.z + 1u), f.x - 1.0, f.y, f.z - 1.0);
+  float v6 = node_grad3(node_hash_uint3(c.x, c.y + 1u, c.z + 1u), f.x, f.y - 1.0, f.z - 1.0);
+  float v7 = node_grad3(node_hash_uint3(c.x + 1u, c.y + 1u, c.z + 1u), f.x - 1.0, f.y - 1.0, f.z - 1.0);
+  float x1 = 1.0 - u, y1 = 1.0 - v, z1 = 1.0 - w;
+  return z1 * (y1 * (v0 * x1 + v1 * u) + v * (v2 * x1 + v3 * u)) +
+         w * (y1 * (v4 * x1 + v5 * u) + v * (v6 * x1 + v7 * u));
+}
+
+float node_snoise_3d(vec3 p)
+{
+  p = p - trunc(p / 100000.0) * 100000.0 + mix(vec3(0.0), vec3(0.5), greaterThanEqual(abs(p), vec3(1e6)));
+  return 0.982 * node_perlin_3d(p);
+}
+
+/* noise_type: the index in node_functions.NOISE_TYPES */
+float node_noise_fractal(vec3 p, float detail, float roughness, float lacunarity, float offset, float gain,
+                         int noise_type, bool normalize)
+{
+  int octaves = int(detail);
+  float remainder = detail - floor(detail);
+  if (noise_type == 0) {
+    float fscale = 1.0, amp = 1.0, maxamp = 0.0, sum = 0.0;
+    for (int i = 0; i <= octaves; i++) {
+      sum += node_snoise_3d(p * fscale) * amp;
+      maxamp += amp;
+      amp *= roughness;
+      fscale *= lacunarity;
+    }
+    float low = normalize ? 0.5 * sum / maxamp + 0.5 : sum;
+    if (remainder != 0.0) {
+      float sum2 = sum + node_snoise_3d(p * fscale) * amp;
+      float high = normalize ? 0.5 * sum2 / (maxamp + amp) + 0.5 : sum2;
+      return low + remainder * (high - low);
+    }
+    return low;
+  }
+  if (noise_type == 1) {
+    float value = 1.0, power = 1.0;
+    for (int i = 0; i <= octaves; i++) {
+      value *= power * node_snoise_3d(p) + 1.0;
+      power *= roughness;
+      p *= lacunarity;
+    }
+    return remainder != 0.0 ? value * (remainder * power * node_snoise_3d(p) + 1.0) : value;
+  }
+  if (noise_type == 4) {
+    float power = roughness;
+    float value = offset + node_snoise_3d(p);
+    p *= lacunarity;
+    for (int i = 1; i <= octaves; i++) {
+      value += (node_snoise_3d(p) + offset) * power * value;
+      power *= roughness;
+      p *= lacunarity;
+    }
+    return remainder != 0.0 ? value + remainder * (node_snoise_3d(p) + offset) * power * value : value;
+  }
+  if (noise_type == 2) {
+    float power = 1.0, value = 0.0, weight = 1.0;
+    for (int i = 0; weight > 0.001 && i <= octaves; i++) {
+      weight = min(weight, 1.0);
+      float signal = (node_snoise_3d(p) + offset) * power;
+      power *= roughness;
+      value += weight * signal;
+      weight *= gain * signal;
+      p *= lacunarity;
+    }
+    if (remainder != 0.0 && weight > 0.001) {
+      value += remainder * min(weight, 1.0) * (node_snoise_3d(p) + offset) * power;
+    }
+    return value;
+  }
+  float power = roughness;
+  float signal = offset - abs(node_snoise_3d(p));
+  signal *= signal;
+  float value = signal;
+  for (int i = 1; i <= octaves; i++) {
+    p *= lacunarity;
+    float weight = clamp(signal * gain, 0.0, 1.0);
+    signal = offset - abs(node_snoise_3d(p));
+    signal *= signal;
+    signal *= weight;
+    value += signal * power;
+    power *= roughness;
+  }
+  return value;
+}
+
+/* The Noise Texture in 3D: its Fac on all three, or (colour) its Color */
+vec3 node_tex_noise(vec3 vector, vec3 scale, vec3 detail, vec3 roughness, vec3 lacunarity, vec3 offset, vec3 gain,
+                    vec3 distortion, int noise_type, bool normalize, bool colour)
+{
+  float d = clamp(detail.x, 0.0, 15.0), r = max(roughness.x, 0.0);
+  vec3 p = vector * scale.x;
+  if (distortion.x != 0.0) {
+    p += vec3(node_snoise_3d(p + NODE_NOISE_OFFSETS[0]), node_snoise_3d(p + NODE_NOISE_OFFSETS[1]),
+              node_snoise_3d(p + NODE_NOISE_OFFSETS[2])) * distortion.x;
+  }
+  float value = node_noise_fractal(p, d, r, lacunarity.x, offset.x, gain.x, noise_type, normalize);
+  if (!colour) {
+    return vec3(value);
+  }
+  return vec3(value,
+              node_noise_fractal(p + NODE_NOISE_OFFSETS[3], d, r, lacunarity.x, offset.x, gain.x, noise_type,
+                                 normalize),
+              node_noise_fractal(p + NODE_NOISE_OFFSETS[4], d, r, lacunarity.x, offset.x, gain.x, noise_type,
+                                 normalize));
+}

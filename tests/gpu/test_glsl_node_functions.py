@@ -137,3 +137,23 @@ def test_checker_and_gradients(glsl, fuzz, record_error):
         got = _run(glsl, f"node_tex_gradient(a.xyz, {index})", (vector,))
         expected = node_functions.tex_gradient(gradient_type, vector)
         assert _close(record_error, f"gradient {gradient_type}", got, expected) < 2e-5
+
+
+@pytest.mark.parametrize("noise_type", node_functions.NOISE_TYPES)
+def test_noise_texture(glsl, fuzz, record_error, noise_type):
+    """The Noise Texture (every type, Fac and Color, with distortion and a fractional detail) against the numpy
+    mirror of Cycles' noise: the same lookup3 hash and Perlin gradients, float32 on both sides."""
+    from sg_prt_addon.techniques import material_textures
+
+    count = 512                     # the numpy mirror's octave loops are slow: fewer points
+    vector = fuzz.rng.uniform(-4.0, 4.0, (count, 3)).astype(np.float32)
+    params = [np.full((count, 3), value, np.float32) for value in (1.7, 3.4, 0.55, 2.1, 0.3, 1.2, 0.4)]
+    index = node_functions.NOISE_TYPES.index(noise_type)
+    for colour in (False, True):
+        call = (f"node_tex_noise(a.xyz, b.xyz, c.xyz, d.xyz, e.xyz, f.xyz, g.xyz, h.xyz, {index}, true, "
+                f"{str(colour).lower()})")
+        names = "abcdefgh"
+        inputs = {name: np.c_[value, np.zeros(count)] for name, value in zip(names, [vector] + params)}
+        got = glsl([material_textures.noise_offsets_source()] + LIB, f"result = vec4({call}, 0.0);", inputs, 3)
+        expected = node_functions.tex_noise((noise_type, True, "Color" if colour else "Fac"), vector, *params)
+        assert _close(record_error, f"noise {noise_type} colour={colour}", got, expected) < 1e-4

@@ -56,7 +56,7 @@ def _function_cases():
     return [name for name in node_values.CASES
             if name.startswith(("math_", "clamp_", "map_range_", "color_ramp_", "mix_", "hue_", "gamma", "brightness",
                                 "rgb_to_bw", "coordinates_", "geometry_", "checker", "gradient_", "mapping_",
-                                "vector_math_")) and name not in ("math_and_mix", "mix_shader_textured_factor")]
+                                "vector_math_", "noise_")) and name not in ("math_and_mix", "mix_shader_textured_factor")]
 
 
 # The cases with a jump (a comparison, a floor) or a pole near their inputs: Cycles' pixel filter averages the
@@ -75,9 +75,9 @@ LOOSER = {"math_logarithm": 0.15,        # 0.0913 / 0.0757: log2(a) / log2(b), b
 def test_node_function_against_cycles(node_values, case):
     """Every Math operation, Clamp, Map Range, Color Ramp, the Mix node's blends, Hue/Saturation/Value, Gamma,
     Brightness/Contrast, RGB to BW, the Texture Coordinate and Geometry outputs, Mapping, Vector Math and the
-    Checker and Gradient textures (reflectance/node_functions.py, computed per pixel in GLSL) against Cycles'
-    evaluation of the same node (docs/ACCURACY.md has each figure): relative RMSE under 0.03 (the looser cases
-    above), bias under 0.02."""
+    Checker, Gradient and Noise textures (reflectance/node_functions.py, computed per pixel in GLSL) against
+    Cycles' evaluation of the same node (docs/ACCURACY.md has each figure): relative RMSE under 0.03 (the looser
+    cases above), bias under 0.02."""
     row = node_values.score(case, 64, 16)
     assert row["pixels"] > 3000
     assert row["relative_rmse"] < LOOSER.get(case, 0.03)
