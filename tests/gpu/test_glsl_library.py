@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from sg_prt_addon.techniques import shader_sources
+from sg_prt_addon.techniques import material_textures, shader_sources
 from sg_prt_addon.techniques.sg import sg_lobes
 from sg_prt_addon.visibility.per_vertex import MAX_ROWS
 from validation import glsl_harness
@@ -27,10 +27,11 @@ DEPENDENCIES = {
     "ssdf.glsl": ["sg.glsl", "hemisphere.glsl", "hemisphere_map.glsl", f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n"],
     "ssdf_quadrature.glsl": ["sg.glsl", "hemisphere.glsl", QUADRATURE_DEFINES],
     "shadow_maps.glsl": [shader_sources.shadow_map_constants()],
+    "node_functions.glsl": [material_textures.noise_offsets_source()],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
          "lights.glsl", "env_prefilter.glsl", "hemisphere_map.glsl", "ssdf.glsl", "ssdf_quadrature.glsl",
-         "shadow_maps.glsl"]
+         "shadow_maps.glsl", "node_functions.glsl"]
 
 
 def test_every_file_is_listed():
@@ -50,8 +51,9 @@ def test_file_compiles_with_its_dependencies(glsl, file_name):
 def test_all_files_together(glsl):
     call = ("vec4(sg_sphere_integral(a.x, 1.0), fh(0.0, a.x), clamped_cosine_from_cosine(1.0, a.x),"
             " ggx_ndf_lobe(0.5).x)")
-    out = glsl(ORDER[:-3] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", "ssdf.glsl", QUADRATURE_DEFINES,
-                             "ssdf_quadrature.glsl", shader_sources.shadow_map_constants(), "shadow_maps.glsl"],
+    out = glsl(ORDER[:-4] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", "ssdf.glsl", QUADRATURE_DEFINES,
+                             "ssdf_quadrature.glsl", shader_sources.shadow_map_constants(), "shadow_maps.glsl",
+                             material_textures.noise_offsets_source(), "node_functions.glsl"],
                call, {"a": [0.0, 1.0]}, 4)
     assert out.shape == (2, 4)
     # lambda = 0: 4 pi, half of it, pi

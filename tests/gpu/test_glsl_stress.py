@@ -1121,6 +1121,71 @@ def test_shadow_maps_stress(glsl, fuzz):
         assert hostile_out.min() >= 0.0 and hostile_out.max() <= 1.0
 
 
+# ---- node_functions.glsl: a node tree's computed values
+
+NODE_ROWS = 1 << 16
+NODE_MATH = ["divide", "power", "logarithm", "sqrt", "inverse_sqrt", "absolute", "exponent", "minimum", "maximum",
+             "less_than", "greater_than", "sign", "compare", "smooth_min", "smooth_max", "round", "floor", "ceil", "trunc",
+             "fract", "modulo", "floored_modulo", "wrap", "snap", "pingpong", "sine", "cosine", "tangent", "sinh", "cosh",
+             "tanh", "arcsine", "arccosine", "arctangent", "arctan2", "radians", "degrees"]
+NODE_MIX = ["screen", "overlay", "divide", "difference", "exclusion", "darken", "lighten", "dodge", "burn", "soft_light",
+            "linear_light"]
+NODE_VECTOR = ["cross_product", "project", "reflect", "dot_product", "distance", "length", "normalize"]
+
+
+def _node_inputs(fuzz, count):
+    """Inputs of the node functions: values over [-30, 30] with zeros, tiny, integer and half values, (count, 4)."""
+    x = fuzz.rng.uniform(-30.0, 30.0, (count, 4))
+    kind = fuzz.rng.integers(0, 6, (count, 4))
+    x = np.where(kind == 0, 0.0, np.where(kind == 1, 1e-30, np.where(kind == 2, np.round(x),
+                                                                      np.where(kind == 3, np.round(x) + 0.5, x))))
+    return _f32(x)
+
+
+def test_node_functions_stress(glsl, fuzz):
+    """Every kernel of node_functions.glsl over values of +-30, zeros and tiny ones: finite wherever its numpy
+    twin (reflectance/node_functions.py) is (exp(30) is, 30^30 is not)."""
+    from sg_prt_addon.reflectance import node_functions
+    from sg_prt_addon.techniques import material_textures
+
+    library = [material_textures.noise_offsets_source(), "node_functions.glsl"]
+    a, b, c = (_node_inputs(fuzz, NODE_ROWS) for _ in range(3))
+    inputs = {"a": a, "b": b, "c": c}
+
+    def check(call, expected):
+        out = glsl(library, f"vec4({call}, 0.0)", inputs, 3)
+        finite = np.isfinite(np.asarray(expected, np.float64))
+        assert np.isfinite(out[finite]).all(), call
+
+    for operation in NODE_MATH:
+        check(f"node_math_{operation}(a.xyz, b.xyz, c.xyz)", node_functions.math(operation.upper(), a[:, :3], b[:, :3],
+                                                                                c[:, :3]))
+    t = np.clip(np.abs(c[:, :3]) / 30.0, 0.0, 1.0)
+    inputs["t"] = _f32(np.c_[t, np.zeros(NODE_ROWS)])
+    for blend in NODE_MIX:
+        check(f"node_mix_{blend}(t.xyz, a.xyz, b.xyz)", node_functions.mix(blend.upper(), t, a[:, :3], b[:, :3]))
+    for operation in NODE_VECTOR:
+        check(f"node_vector_{operation}(a.xyz, b.xyz)", node_functions.vector_math(operation.upper(), a[:, :3], b[:, :3]))
+    everything = np.zeros((NODE_ROWS, 3))            # the rest: finite on finite inputs
+    for call in ("node_clamp(a.xyz, b.xyz, c.xyz)", "node_clamp_range(a.xyz, b.xyz, c.xyz)",
+                 "node_map_range(a.xyz, b.xyz, c.xyz, a.zxy, b.zxy, abs(c.zxy), 1, true)",
+                 "node_map_range(a.xyz, b.xyz, c.xyz, a.zxy, b.zxy, c.zxy, 3, false)",
+                 "node_hue_saturation_value(abs(a.xyz), b.xxx, abs(c.yyy), abs(a.www), t.xxx)",
+                 "node_hsv_to_rgb(node_rgb_to_hsv(abs(a.xyz)))", "node_gamma(a.xyz, t.xyz * 4.0)",
+                 "node_brightness_contrast(a.xyz, b.xyz, c.xyz)", "node_safe_divide(a.xyz, b.xyz)",
+                 "vec3(node_signed_pow(a.x, round(t.x * 8.0)), node_smooth_min(a.xyz, b.xyz, c.xyz).xy)",
+                 "node_mapping(a.xyz, b.xyz, c.xyz, a.wzy, 1)", "node_mapping(a.xyz, b.xyz, c.xyz, a.wzy, 3)",
+                 "node_euler_matrix(c.xyz) * node_safe_normalize(a.xyz)",
+                 "node_tex_checker(a.xyz, b.xyz, c.xyz, t.xyz * 5.0, true)", "node_tex_gradient(a.xyz * 0.1, 4)",
+                 "vec3(float(node_hash_uint3(uint(a.x), uint(b.x), node_rot(uint(abs(c.x)), 7u)) >> 8u), "
+                 "node_fade(t.x), node_grad3(uint(abs(a.y)), a.x, b.x, c.x))",
+                 "vec3(node_perlin_3d(a.xyz), node_snoise_3d(a.xyz * 1e6), "
+                 "node_noise_fractal(a.xyz, t.x * 15.0, t.y, 2.0, 0.5, 1.0, 2, true))",
+                 "node_tex_noise(a.xyz, t.xxx * 10.0, t.yyy * 15.0, t.zzz, vec3(2.0), vec3(0.5), vec3(1.0), b.xyz, 0, "
+                 "true, true)"):
+        check(call, everything)
+
+
 # ---- coverage: every function of shaders/lib is fuzzed
 
 COVERED = {
@@ -1178,6 +1243,13 @@ COVERED = {
     test_table_lobes_stress: ["ggx_two_lobes", "anisotropic_lobes"],
     test_fitted_pieces_stress: ["fitted_layer", "fitted_select_texel", "fitted_node_theta", "fitted_node_value",
                                 "fitted_shadowing_at", "fitted_shadowing_of", "fitted_m_factor"],
+    test_node_functions_stress: [f"node_math_{name}" for name in NODE_MATH] + [f"node_mix_{name}" for name in NODE_MIX]
+    + [f"node_vector_{name}" for name in NODE_VECTOR]
+    + ["node_clamp", "node_clamp_range", "node_map_range", "node_hue_saturation_value", "node_hsv_to_rgb",
+       "node_rgb_to_hsv", "node_gamma", "node_brightness_contrast", "node_safe_divide", "node_signed_pow",
+       "node_smooth_min", "node_mapping", "node_euler_matrix", "node_safe_normalize", "node_tex_checker",
+       "node_tex_gradient", "node_hash_uint3", "node_rot", "node_fade", "node_grad3", "node_perlin_3d",
+       "node_snoise_3d", "node_noise_fractal", "node_tex_noise"],
 }
 
 _DEFINITION = re.compile(r"^\s*(?:float|int|uint|bool|void|vec[234]|ivec[234]|mat[234])\s+([A-Za-z_]\w*)\s*\(", re.M)
@@ -1203,9 +1275,17 @@ def test_every_kernel_is_fuzzed():
         assert not missing, f"techniques/sg/{file_name} no longer defines {sorted(missing)}"
         defined |= set(names)
     covered = set()
+    module_source = inspect.getsource(inspect.getmodule(test_every_kernel_is_fuzzed))
+
+    def called(name, source):
+        """Called by name, or through an f-string prefix ("node_math_{operation}(") over a listed suffix."""
+        if re.search(r"\b" + name + r"\s*\(", source):
+            return True
+        return any(f'{name[:k]}{{' in source and f'"{name[k:]}"' in module_source for k in range(1, len(name)))
+
     for test, names in COVERED.items():
         source = inspect.getsource(test)
-        not_called = [name for name in names if not re.search(r"\b" + name + r"\s*\(", source)]
+        not_called = [name for name in names if not called(name, source)]
         assert not not_called, f"{test.__name__} does not call {not_called}"
         covered |= set(names)
     assert not defined - covered, f"GLSL kernels without a stress test: {sorted(defined - covered)}"
