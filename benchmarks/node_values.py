@@ -508,6 +508,32 @@ def noise(noise_type="FBM", output="Fac", distortion=0.0, vector_output=None):
     return value_of
 
 
+def wave(wave_type="BANDS", direction="X", profile="SIN", distortion=3.0):
+    """The Wave Texture (Scale 2, its distortion's noise at Detail 2) of the Object coordinates."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexWave")
+        node.wave_type = wave_type
+        if wave_type == "BANDS":
+            node.bands_direction = direction
+        else:
+            node.rings_direction = direction
+        node.wave_profile = profile
+        node.inputs["Scale"].default_value = 2.0
+        node.inputs["Distortion"].default_value = distortion
+        tree.links.new(_coordinates(tree, "Object"), node.inputs["Vector"])
+        return node.outputs["Color"]
+    return value_of
+
+
+def magic(depth, output="Color"):
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexMagic")
+        node.turbulence_depth = depth
+        node.inputs["Scale"].default_value = 3.0
+        return node.outputs[output]
+    return value_of
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -544,7 +570,11 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "noise_fac": _socket_case(noise()), "noise_color": _socket_case(noise(output="Color")),
          "noise_distorted_object": _socket_case(noise(output="Color", distortion=1.5, vector_output="Object")),
          **{f"noise_{kind.lower()}": _socket_case(noise(kind))
-            for kind in ("MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HETERO_TERRAIN")}}
+            for kind in ("MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HETERO_TERRAIN")},
+         "wave_bands_sin": _socket_case(wave()), "wave_bands_diagonal_saw": _socket_case(wave("BANDS", "DIAGONAL", "SAW")),
+         "wave_rings_tri": _socket_case(wave("RINGS", "SPHERICAL", "TRI")),
+         "wave_rings_z_sin_plain": _socket_case(wave("RINGS", "Z", "SIN", 0.0)),
+         "magic_depth_2": _socket_case(magic(2)), "magic_depth_5_fac": _socket_case(magic(5, "Fac"))}
 # cases whose truth is 0 everywhere (scored by their largest values)
 ZERO_TRUTH = ("color_attribute_missing",)
 # the cases whose grid has the colour attribute: (domain, data type)

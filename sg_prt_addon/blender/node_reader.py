@@ -145,6 +145,8 @@ class SocketReader:
             return self.procedural_texture(node, out)
         if node.type == "TEX_NOISE":
             return self.noise_texture(node, out)
+        if node.type in ("TEX_WAVE", "TEX_MAGIC"):
+            return self.wave_or_magic_texture(node, out)
         if node.type == "VECT_MATH":
             return self.vector_math(node, out)
         reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix, "MAPPING": self.mapping,
@@ -216,6 +218,18 @@ class SocketReader:
         settings = (getattr(node, "noise_type", "FBM"), bool(getattr(node, "normalize", True)),
                     "Color" if out.identifier == "Color" else "Fac")
         return Expression.function("tex_noise", settings, values)
+
+    def wave_or_magic_texture(self, node, out):
+        """The Wave Texture (Fac, or its grey Color) and the Magic Texture (Color, Fac)."""
+        values = [self.texture_vector(node)]
+        output = "Color" if out.identifier == "Color" else "Fac"
+        if node.type == "TEX_WAVE":
+            names = ("Scale", "Distortion", "Detail", "Detail Scale", "Detail Roughness", "Phase Offset")
+            values += [self.value(node.inputs[name], False) for name in names]
+            settings = (node.wave_type, node.bands_direction, node.rings_direction, node.wave_profile, output)
+            return Expression.function("tex_wave", settings, values)
+        values += [self.value(node.inputs[name], False) for name in ("Scale", "Distortion")]
+        return Expression.function("tex_magic", (int(node.turbulence_depth), output), values)
 
     def mapping(self, node, colour):
         """The Mapping node on a vector (POINT, TEXTURE, VECTOR, NORMAL)."""

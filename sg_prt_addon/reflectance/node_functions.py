@@ -1,6 +1,6 @@
 """Blender's shader-node functions that are not sums of products, as Cycles and EEVEE define them (Math, Clamp,
 Map Range, Color Ramp, the Mix node's blend modes, Hue/Saturation/Value, Gamma, Brightness/Contrast, Mapping,
-Vector Math, the Checker, Gradient and Noise textures), on
+Vector Math, the Checker, Gradient, Noise, Wave and Magic textures), on
 (..., 3) float32 arrays: a scalar socket is its value on all three channels.  shaders/lib/node_functions.glsl
 is their GLSL (each `node_<name>` there mirrors FUNCTIONS[name] here); reflectance.texture_expression applies
 them to per-pixel values.
@@ -354,7 +354,8 @@ def apply(name, settings, args):
     each): what texture_expression.Function computes (names: math (operation,), clamp (type,), map_range
     (interpolation, clamped), color_ramp (interpolation, positions, RGBA colours, output), mix (blend,),
     hue_saturation_value, gamma, brightness_contrast, mapping (type,), vector_math (operation,), tex_checker
-    (output,), tex_gradient (type,), tex_noise (type, normalize, output))."""
+    (output,), tex_gradient (type,), tex_noise (type, normalize, output), tex_wave (type, bands direction,
+    rings direction, profile, output), tex_magic (depth, output))."""
     args = [np.asarray(a, FLOAT) for a in args]
     if name == "math":
         return math(settings[0], *args)
@@ -378,6 +379,10 @@ def apply(name, settings, args):
         return tex_gradient(settings[0], *args)
     if name == "tex_noise":
         return tex_noise(settings, *args)
+    if name == "tex_wave":
+        return tex_wave(settings, *args)
+    if name == "tex_magic":
+        return tex_magic(settings, *args)
     functions = {"hue_saturation_value": hue_saturation_value, "gamma": gamma,
                  "brightness_contrast": brightness_contrast}
     return functions[name](*args)
@@ -576,3 +581,65 @@ def tex_noise(settings, vector, scale, detail, roughness, lacunarity, offset, ga
     else:
         out = np.stack([value, fractal(p + random_float3_offset(3)), fractal(p + random_float3_offset(4))], axis=-1)
     return out.reshape(shape + (3,)).astype(FLOAT)
+
+
+WAVE_DIRECTIONS = ("X", "Y", "Z", "DIAGONAL", "SPHERICAL")
+WAVE_PROFILES = ("SIN", "SAW", "TRI")
+
+
+def tex_wave(settings, vector, scale, distortion, detail, detail_scale, detail_roughness, phase):
+    """The Wave Texture (Cycles' svm_wave; settings: BANDS or RINGS, the bands' and the rings' direction, the
+    profile, the output): its Fac on all three (its Color is the same grey)."""
+    wave_type, bands_direction, rings_direction, profile, _ = settings
+    shape = np.shape(vector)[:-1]
+    vector, scale, distortion, detail, detail_scale, detail_roughness, phase = (
+        np.asarray(a, FLOAT).reshape(-1, 3) for a in (vector, scale, distortion, detail, detail_scale,
+                                                       detail_roughness, phase))
+    p = ((vector * scale[:, :1] + FLOAT(0.000001)) * FLOAT(0.999999)).astype(FLOAT)
+    if wave_type == "BANDS":
+        n = p[:, "XYZ".index(bands_direction)] * FLOAT(20) if bands_direction != "DIAGONAL" \
+            else (p[:, 0] + p[:, 1] + p[:, 2]) * FLOAT(10)
+    else:
+        keep = {"X": (0, 1, 1), "Y": (1, 0, 1), "Z": (1, 1, 0)}.get(rings_direction, (1, 1, 1))
+        n = np.sqrt(np.sum((p * np.asarray(keep, FLOAT)) ** 2, axis=-1)) * FLOAT(20)
+    n = n + phase[:, 0]
+    fbm = _noise_fractal("FBM", p * detail_scale[:, :1], detail[:, 0], detail_roughness[:, 0],
+                         np.full(len(p), FLOAT(2)), None, None, True)
+    n = np.where(distortion[:, 0] != 0, n + distortion[:, 0] * (fbm * FLOAT(2) - FLOAT(1)), n)
+    if profile == "SIN":
+        value = FLOAT(0.5) + FLOAT(0.5) * np.sin(n - FLOAT(np.pi / 2))
+    else:
+        n = n / FLOAT(2 * np.pi)
+        value = n - np.floor(n) if profile == "SAW" else np.abs(n - np.floor(n + FLOAT(0.5))) * FLOAT(2)
+    return np.repeat(value[:, None], 3, axis=-1).reshape(shape + (3,)).astype(FLOAT)
+
+
+def tex_magic(settings, vector, scale, distortion):
+    """The Magic Texture (Cycles' svm_magic; settings: turbulence depth, output): its Color, or its Fac (the
+    colour's mean) on all three."""
+    depth, output = settings
+    shape = np.shape(vector)[:-1]
+    vector, scale, distortion = (np.asarray(a, FLOAT).reshape(-1, 3) for a in (vector, scale, distortion))
+    p = vector * scale[:, :1]
+    d = distortion[:, 0]
+    x = np.sin((p[:, 0] + p[:, 1] + p[:, 2]) * FLOAT(5))
+    y = np.cos((-p[:, 0] + p[:, 1] - p[:, 2]) * FLOAT(5))
+    z = -np.cos((-p[:, 0] - p[:, 1] + p[:, 2]) * FLOAT(5))
+    if depth > 0:
+        x, y, z = x * d, y * d, z * d
+        y = -np.cos(x - y + z) * d
+    steps = [("x", lambda x, y, z: np.cos(x - y - z)), ("z", lambda x, y, z: np.sin(-x - y - z)),
+             ("x", lambda x, y, z: -np.cos(-x + y - z)), ("y", lambda x, y, z: -np.sin(-x + y + z)),
+             ("y", lambda x, y, z: -np.cos(-x + y + z)), ("x", lambda x, y, z: np.cos(x + y + z)),
+             ("z", lambda x, y, z: np.sin(x + y - z)), ("x", lambda x, y, z: -np.cos(-x - y + z)),
+             ("y", lambda x, y, z: -np.sin(x - y + z))]
+    for level, (target, step) in enumerate(steps, start=2):
+        if depth < level:
+            break
+        value = step(x, y, z) * d
+        x, y, z = (value if target == "x" else x, value if target == "y" else y, value if target == "z" else z)
+    divisor = np.where(d != 0, d * FLOAT(2), FLOAT(1))
+    colour = np.stack([FLOAT(0.5) - x / divisor, FLOAT(0.5) - y / divisor, FLOAT(0.5) - z / divisor], axis=-1)
+    if output == "Fac":
+        colour = np.repeat(np.mean(colour, axis=-1, keepdims=True), 3, axis=-1)
+    return colour.reshape(shape + (3,)).astype(FLOAT)

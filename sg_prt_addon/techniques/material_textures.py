@@ -136,6 +136,13 @@ def function_source(function, rgb_of, helpers):
         flags = f"{node_functions.NOISE_TYPES.index(noise_type)}, {str(bool(normalize)).lower()}, " \
                 f"{'true' if output == 'Color' else 'false'}"
         return f"node_tex_noise({', '.join(args)}, {flags})"
+    if name == "tex_wave":
+        wave_type, bands, rings, profile, _ = settings
+        flags = f"{0 if wave_type == 'BANDS' else 1}, {node_functions.WAVE_DIRECTIONS.index(bands)}, " \
+                f"{node_functions.WAVE_DIRECTIONS.index(rings)}, {node_functions.WAVE_PROFILES.index(profile)}"
+        return f"node_tex_wave({', '.join(args)}, {flags})"
+    if name == "tex_magic":
+        return f"node_tex_magic({', '.join(args)}, {int(settings[0])}, {'true' if settings[1] == 'Color' else 'false'})"
     return f"node_{name}({', '.join(args)})"
 
 

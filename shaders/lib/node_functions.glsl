@@ -454,3 +454,80 @@ vec3 node_tex_noise(vec3 vector, vec3 scale, vec3 detail, vec3 roughness, vec3 l
               node_noise_fractal(p + NODE_NOISE_OFFSETS[4], d, r, lacunarity.x, offset.x, gain.x, noise_type,
                                  normalize));
 }
+
+/* The Wave Texture's Fac on all three: wave_type 0 BANDS, 1 RINGS; directions the index in
+ * node_functions.WAVE_DIRECTIONS, profile in WAVE_PROFILES */
+vec3 node_tex_wave(vec3 vector, vec3 scale, vec3 distortion, vec3 detail, vec3 detail_scale, vec3 detail_roughness,
+                   vec3 phase, int wave_type, int bands_direction, int rings_direction, int profile)
+{
+  vec3 p = (vector * scale.x + 0.000001) * 0.999999;
+  float n;
+  if (wave_type == 0) {
+    n = bands_direction == 3 ? (p.x + p.y + p.z) * 10.0 : p[bands_direction] * 20.0;
+  }
+  else {
+    vec3 keep = rings_direction == 0 ? vec3(0.0, 1.0, 1.0) : rings_direction == 1 ? vec3(1.0, 0.0, 1.0) :
+                rings_direction == 2 ? vec3(1.0, 1.0, 0.0) : vec3(1.0);
+    n = length(p * keep) * 20.0;
+  }
+  n += phase.x;
+  if (distortion.x != 0.0) {
+    float fbm = node_noise_fractal(p * detail_scale.x, detail.x, detail_roughness.x, 2.0, 0.0, 0.0, 0, true);
+    n += distortion.x * (fbm * 2.0 - 1.0);
+  }
+  float value;
+  if (profile == 0) {
+    value = 0.5 + 0.5 * sin(n - 1.5707963267948966);
+  }
+  else {
+    n /= 6.283185307179586;
+    value = profile == 1 ? n - floor(n) : abs(n - floor(n + 0.5)) * 2.0;
+  }
+  return vec3(value);
+}
+
+/* The Magic Texture: its Color, or (not colour) its Fac, the colour's mean, on all three */
+vec3 node_tex_magic(vec3 vector, vec3 scale, vec3 distortion, int depth, bool colour)
+{
+  vec3 p = vector * scale.x;
+  float d = distortion.x;
+  float x = sin((p.x + p.y + p.z) * 5.0);
+  float y = cos((-p.x + p.y - p.z) * 5.0);
+  float z = -cos((-p.x - p.y + p.z) * 5.0);
+  if (depth > 0) {
+    x *= d;
+    y *= d;
+    z *= d;
+    y = -cos(x - y + z) * d;
+    if (depth > 1) {
+      x = cos(x - y - z) * d;
+      if (depth > 2) {
+        z = sin(-x - y - z) * d;
+        if (depth > 3) {
+          x = -cos(-x + y - z) * d;
+          if (depth > 4) {
+            y = -sin(-x + y + z) * d;
+            if (depth > 5) {
+              y = -cos(-x + y + z) * d;
+              if (depth > 6) {
+                x = cos(x + y + z) * d;
+                if (depth > 7) {
+                  z = sin(x + y - z) * d;
+                  if (depth > 8) {
+                    x = -cos(-x - y + z) * d;
+                    if (depth > 9) {
+                      y = -sin(x - y + z) * d;
+                    }
+                  }
+                }
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  float divisor = d != 0.0 ? d * 2.0 : 1.0;
+  vec3 result = vec3(0.5) - vec3(x, y, z) / divisor;
+  return colour ? result : vec3((result.x + result.y + result.z) * (1.0 / 3.0));
+}

@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 from sg_prt_addon.reflectance import node_functions
+from sg_prt_addon.techniques import material_textures
 
 N = 4096
-LIB = ["node_functions.glsl"]
+LIB = [material_textures.noise_offsets_source(), "node_functions.glsl"]
 
 
 def _inputs(fuzz):
@@ -143,8 +144,6 @@ def test_checker_and_gradients(glsl, fuzz, record_error):
 def test_noise_texture(glsl, fuzz, record_error, noise_type):
     """The Noise Texture (every type, Fac and Color, with distortion and a fractional detail) against the numpy
     mirror of Cycles' noise: the same lookup3 hash and Perlin gradients, float32 on both sides."""
-    from sg_prt_addon.techniques import material_textures
-
     count = 512                     # the numpy mirror's octave loops are slow: fewer points
     vector = fuzz.rng.uniform(-4.0, 4.0, (count, 3)).astype(np.float32)
     params = [np.full((count, 3), value, np.float32) for value in (1.7, 3.4, 0.55, 2.1, 0.3, 1.2, 0.4)]
@@ -154,6 +153,42 @@ def test_noise_texture(glsl, fuzz, record_error, noise_type):
                 f"{str(colour).lower()})")
         names = "abcdefgh"
         inputs = {name: np.c_[value, np.zeros(count)] for name, value in zip(names, [vector] + params)}
-        got = glsl([material_textures.noise_offsets_source()] + LIB, f"result = vec4({call}, 0.0);", inputs, 3)
+        got = glsl(LIB, f"result = vec4({call}, 0.0);", inputs, 3)
         expected = node_functions.tex_noise((noise_type, True, "Color" if colour else "Fac"), vector, *params)
         assert _close(record_error, f"noise {noise_type} colour={colour}", got, expected) < 1e-4
+
+
+@pytest.mark.parametrize("settings", [("BANDS", "X", "X", "SIN", "Fac"), ("BANDS", "DIAGONAL", "X", "SAW", "Fac"),
+                                      ("BANDS", "Z", "X", "TRI", "Fac"), ("RINGS", "X", "SPHERICAL", "SIN", "Fac"),
+                                      ("RINGS", "X", "Y", "SAW", "Fac")])
+def test_wave_texture(glsl, fuzz, record_error, settings):
+    """The Wave texture (types, directions, profiles, with distortion) against its numpy mirror."""
+    count = 512
+    vector = fuzz.rng.uniform(-2.0, 2.0, (count, 3)).astype(np.float32)
+    params = [np.full((count, 3), value, np.float32) for value in (1.3, 2.5, 2.0, 1.5, 0.6, 0.4)]
+    inputs = {name: np.c_[value, np.zeros(count)] for name, value in zip("abcdefg", [vector] + params)}
+    wave_type, bands, rings, profile, _ = settings
+    flags = (f"{0 if wave_type == 'BANDS' else 1}, {node_functions.WAVE_DIRECTIONS.index(bands)}, "
+             f"{node_functions.WAVE_DIRECTIONS.index(rings)}, {node_functions.WAVE_PROFILES.index(profile)}")
+    got = glsl(LIB, f"result = vec4(node_tex_wave(a.xyz, b.xyz, c.xyz, d.xyz, e.xyz, f.xyz, g.xyz, "
+               f"{flags}), 0.0);", inputs, 3)
+    error = np.abs(got - node_functions.tex_wave(settings, vector, *params)).max(axis=1)
+    # the saw and triangle profiles jump: a point one rounding off lands on the other side
+    assert np.mean(error > 1e-3) < 0.01, np.mean(error > 1e-3)
+    assert record_error(f"node_functions wave {settings[:4]}", np.where(error > 1e-3, 0.0, error).max()) < 1e-4
+
+
+@pytest.mark.parametrize("depth", [0, 3, 10])
+def test_magic_texture(glsl, fuzz, record_error, depth):
+    """The Magic texture's Color and Fac against its numpy mirror: each level of its depth takes the sine or
+    cosine of the last times the distortion (2.5 here), so GLSL's sin and cos rounding grows with it: a bound of
+    1e-5 + 2e-6 x 2.5^depth (measured 7e-7, 2.7e-5, 3.8e-3 at depths 0, 3, 10)."""
+    count = 512
+    vector = fuzz.rng.uniform(-2.0, 2.0, (count, 3)).astype(np.float32)
+    scale, distortion = (np.full((count, 3), value, np.float32) for value in (1.3, 2.5))
+    inputs = {name: np.c_[value, np.zeros(count)] for name, value in zip("abc", (vector, scale, distortion))}
+    for colour in (True, False):
+        got = glsl(LIB, f"result = vec4(node_tex_magic(a.xyz, b.xyz, c.xyz, {depth}, "
+                   f"{str(colour).lower()}), 0.0);", inputs, 3)
+        expected = node_functions.tex_magic((depth, "Color" if colour else "Fac"), vector, scale, distortion)
+        assert _close(record_error, f"magic depth {depth} colour={colour}", got, expected) < 1e-5 + 2e-6 * 2.5 ** depth

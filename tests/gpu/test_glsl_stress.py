@@ -1182,7 +1182,9 @@ def test_node_functions_stress(glsl, fuzz):
                  "vec3(node_perlin_3d(a.xyz), node_snoise_3d(a.xyz * 1e6), "
                  "node_noise_fractal(a.xyz, t.x * 15.0, t.y, 2.0, 0.5, 1.0, 2, true))",
                  "node_tex_noise(a.xyz, t.xxx * 10.0, t.yyy * 15.0, t.zzz, vec3(2.0), vec3(0.5), vec3(1.0), b.xyz, 0, "
-                 "true, true)"):
+                 "true, true)",
+                 "node_tex_wave(a.xyz, t.xxx * 5.0, b.xyz, t.yyy * 15.0, t.zzz * 5.0, t.xyz, c.xyz, 1, 0, 4, 2)",
+                 "node_tex_magic(a.xyz, t.xxx * 5.0, b.xyz, 10, true)"):
         check(call, everything)
 
 
@@ -1249,7 +1251,7 @@ COVERED = {
        "node_rgb_to_hsv", "node_gamma", "node_brightness_contrast", "node_safe_divide", "node_signed_pow",
        "node_smooth_min", "node_mapping", "node_euler_matrix", "node_safe_normalize", "node_tex_checker",
        "node_tex_gradient", "node_hash_uint3", "node_rot", "node_fade", "node_grad3", "node_perlin_3d",
-       "node_snoise_3d", "node_noise_fractal", "node_tex_noise"],
+       "node_snoise_3d", "node_noise_fractal", "node_tex_noise", "node_tex_wave", "node_tex_magic"],
 }
 
 _DEFINITION = re.compile(r"^\s*(?:float|int|uint|bool|void|vec[234]|ivec[234]|mat[234])\s+([A-Za-z_]\w*)\s*\(", re.M)
