@@ -399,22 +399,16 @@ def _rot(x, k):
     return (x << _U32(k)) | (x >> _U32(32 - k))
 
 
+# lookup3's final mixing: (register mixed, register it takes, rotation), in order
+_FINAL_STEPS = ((2, 1, 14), (0, 2, 11), (1, 0, 25), (2, 1, 16), (0, 2, 4), (1, 0, 14), (2, 1, 24))
+
+
 def _final(a, b, c):
-    c ^= b
-    c -= _rot(b, 14)
-    a ^= c
-    a -= _rot(c, 11)
-    b ^= a
-    b -= _rot(a, 25)
-    c ^= b
-    c -= _rot(b, 16)
-    a ^= c
-    a -= _rot(c, 4)
-    b ^= a
-    b -= _rot(a, 14)
-    c ^= b
-    c -= _rot(b, 24)
-    return c
+    registers = [a, b, c]
+    for target, source, rotation in _FINAL_STEPS:
+        registers[target] ^= registers[source]
+        registers[target] -= _rot(registers[source], rotation)
+    return registers[2]
 
 
 def hash_uint(*keys):

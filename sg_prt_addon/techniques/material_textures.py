@@ -1,9 +1,10 @@
 """A material's textured slots in its surface shader: each slot the variant textures (its key's `textures`) is
 read as texture_value_<slot>() (shaders/techniques/common/material_textures.glsl reads the images), from the
-slot's own image (sampler texture_<slot>), or computed per pixel from a node tree's images and the mesh's colour
-attribute (a reflectance.texture_expression.Expression: the key's `node_values`), each image read once a pixel
-(sampler node_image_<k>), the colour attribute from the vertex stage (vertex_color).  The normal map is read by
-surface_io.glsl itself (its mip level too).
+slot's own image (sampler texture_<slot>), or computed per pixel from a node tree's images, the mesh's colour
+attribute, the surface's coordinates and node functions (a reflectance.texture_expression.Expression: the key's
+`node_values`; shaders/lib/node_functions.glsl), each image read once a pixel (sampler node_image_<k>), the
+colour attribute from the vertex stage (vertex_color), the coordinates as COORDINATE_SOURCES says.  The normal
+map is read by surface_io.glsl itself (its mip level too).
 
 A technique's key carries `textures` (slot names) and `node_values` (a NodeValues, from `node_values`);
 `samplers`, `bind` and `sources` give its shader the rest, shader_sources.surface_calls the colour stream."""
