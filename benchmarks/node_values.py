@@ -534,6 +534,40 @@ def magic(depth, output="Color"):
     return value_of
 
 
+def image_extended(extension):
+    """The image over UVs a Mapping spreads to [-0.5, 1.5] (Scale 2, Location -0.5), past its edges as
+    `extension` says."""
+    def value_of(tree):
+        node = _image_node(tree)
+        node.extension = extension
+        mapping = tree.nodes.new("ShaderNodeMapping")
+        mapping.inputs["Scale"].default_value = (2.0, 2.0, 1.0)
+        mapping.inputs["Location"].default_value = (-0.5, -0.5, 0.0)
+        tree.links.new(_coordinates(tree, "UV"), mapping.inputs["Vector"])
+        tree.links.new(mapping.outputs["Vector"], node.inputs["Vector"])
+        return node.outputs["Color"]
+    return value_of
+
+
+def image_at(vector_of):
+    """The image at the coordinates vector_of(tree) gives."""
+    def value_of(tree):
+        node = _image_node(tree)
+        tree.links.new(vector_of(tree), node.inputs["Vector"])
+        return node.outputs["Color"]
+    return value_of
+
+
+def uv_transformed_by_math(tree):
+    """glTF's texture transform as its importer builds it: the UV's x and y through Math into Combine XYZ."""
+    separate = tree.nodes.new("ShaderNodeSeparateXYZ")
+    tree.links.new(_coordinates(tree, "UV"), separate.inputs[0])
+    combine = tree.nodes.new("ShaderNodeCombineXYZ")
+    tree.links.new(_math_node(tree, "MULTIPLY_ADD", separate.outputs["X"], 1.5, 0.2), combine.inputs["X"])
+    tree.links.new(_math_node(tree, "MULTIPLY", separate.outputs["Y"], 0.7), combine.inputs["Y"])
+    return combine.outputs["Vector"]
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -574,7 +608,13 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "wave_bands_sin": _socket_case(wave()), "wave_bands_diagonal_saw": _socket_case(wave("BANDS", "DIAGONAL", "SAW")),
          "wave_rings_tri": _socket_case(wave("RINGS", "SPHERICAL", "TRI")),
          "wave_rings_z_sin_plain": _socket_case(wave("RINGS", "Z", "SIN", 0.0)),
-         "magic_depth_2": _socket_case(magic(2)), "magic_depth_5_fac": _socket_case(magic(5, "Fac"))}
+         "magic_depth_2": _socket_case(magic(2)), "magic_depth_5_fac": _socket_case(magic(5, "Fac")),
+         **{f"image_{extension.lower()}": _socket_case(image_extended(extension))
+            for extension in ("REPEAT", "EXTEND", "CLIP", "MIRROR")},
+         "image_generated": _socket_case(image_at(lambda tree: _coordinates(tree, "Generated"))),
+         "image_uv_by_math": _socket_case(image_at(uv_transformed_by_math)),
+         "image_turned_about_x": _socket_case(image_at(lambda tree: _mapping_node(tree, "POINT",
+                                                                                 _coordinates(tree, "UV"))))}
 # cases whose truth is 0 everywhere (scored by their largest values)
 ZERO_TRUTH = ("color_attribute_missing",)
 # the cases whose grid has the colour attribute: (domain, data type)

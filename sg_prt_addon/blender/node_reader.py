@@ -3,13 +3,13 @@
 From the Material Output EEVEE renders, the shader tree (node_graph: groups entered, reroutes and muted nodes
 passed) is walked into weighted closures: Principled, Diffuse and Glossy BSDFs, Emission, through Mix Shader
 (its factor a constant or a texture) and Add Shader.  Their inputs are read as texture_expression.Expressions:
-unlinked sockets, RGB, Value, Image Texture (its Color, over the UV map), Math (add, subtract, multiply; divide
-by a constant), Invert, Mix / MixRGB (mix, multiply, add), Separate and Combine Color (RGB) and XYZ of them, a
-Normal Map in tangent space.  reflectance/principled.py maps the BSDFs' values to the model, colours and
-layering; an expression that is a constant or a factor times one image takes the engine's factor x texture
-path, any other one (a metallic map, an image's channel, a texture factor) is computed per pixel from its images
-(techniques/material_textures.py).  The emission is a colour slot like the others.  What cannot be read as Blender
-renders it takes the nearest reading (a socket's default value) and is named in one warning per material.
+unlinked sockets, RGB and Value, Image Textures, colour attributes, the surface's coordinates, and the nodes
+that compute values from them (sums and products in the algebra, the rest reflectance/node_functions.py),
+a Normal Map in tangent space.  reflectance/principled.py maps the BSDFs' values to the model, colours and
+layering; an expression that is a constant or a factor times one image over the UV map takes the engine's
+factor x texture path, any other one is computed per pixel (techniques/material_textures.py).  The emission
+is a colour slot like the others.  What cannot be read as Blender renders it takes the nearest reading (a
+socket's default value) and is named in one warning per material.
 """
 from dataclasses import dataclass, field
 
@@ -70,6 +70,29 @@ def _constant(value, colour):
 def _luminance(value):
     """A colour's Rec. 709 luminance on all three channels."""
     return sum((value.channel(k) * weight for k, weight in enumerate(LUMINANCE)), Expression.constant(0.0))
+
+
+def _uv_source(socket):
+    """Whether what feeds `socket` is the UV map itself (unlinked, a UV Map node, Texture Coordinate's UV)."""
+    out = follow(socket)
+    return out is None or out.node.type == "UVMAP" or (out.node.type == "TEX_COORD" and out.identifier == "UV")
+
+
+def _over_the_uv_map(node):
+    """Whether an Image Texture reads the UV map repeating, through at most a Mapping whose values are its own and
+    turn about z alone: what the material's uv_transform and the plain texture path carry."""
+    if node.extension != "REPEAT":
+        return False
+    vector = follow(node.inputs["Vector"])
+    if vector is None or _uv_source(node.inputs["Vector"]):
+        return True
+    mapping = vector.node
+    if mapping.type != "MAPPING" or mapping.vector_type == "NORMAL" or not _uv_source(mapping.inputs["Vector"]):
+        return False
+    if any(name in mapping.inputs and mapping.inputs[name].is_linked for name in ("Location", "Rotation", "Scale")):
+        return False
+    rotation = mapping.inputs["Rotation"].default_value
+    return abs(rotation[0]) <= 1e-9 and abs(rotation[1]) <= 1e-9
 
 
 def _clamped(value):
@@ -139,7 +162,7 @@ class SocketReader:
             return self.attribute_value(node, out, socket, colour)
         if node.type == "VALTORGB":
             return self.color_ramp(node, out)
-        if node.type in ("TEX_COORD", "NEW_GEOMETRY"):
+        if node.type in ("TEX_COORD", "NEW_GEOMETRY", "UVMAP"):
             return self.coordinates_value(node, out, socket, colour)
         if node.type in ("TEX_CHECKER", "TEX_GRADIENT"):
             return self.procedural_texture(node, out)
@@ -179,7 +202,11 @@ class SocketReader:
 
     def coordinates_value(self, node, out, socket, colour):
         """Texture Coordinate's Generated, Normal, UV and Object (of the object itself); Geometry's Position and
-        Normal (world space)."""
+        Normal (world space); a UV Map node's UV (the active map's)."""
+        if node.type == "UVMAP":
+            if node.uv_map and self._other_uv_map(node.uv_map):
+                self.note(node, f"UV map '{node.uv_map}': each mesh's active UV map is used")
+            return Expression.coordinates("UV")
         names = {"Generated": "GENERATED", "Normal": "NORMAL", "UV": "UV", "Object": "OBJECT"} \
             if node.type == "TEX_COORD" else {"Position": "POSITION", "Normal": "WORLD_NORMAL",
                                               "True Normal": "WORLD_NORMAL"}
@@ -377,12 +404,22 @@ class SocketReader:
         return _clamped(result) if clamp_result else result
 
     def image_value(self, node, out, socket, colour):
+        """An Image Texture's Color: over the UV map (through a Mapping of it) and repeating, the engine's factor
+        x texture path; at any other coordinates or with another extension, read per pixel there
+        (Expression.image_at)."""
         image = node.image
         if image is None:
             self.note(node, f"no image: {socket.name} uses its value")
             return _constant(_default(socket), colour)
         if out.name != "Color":
             self.note(node, f"its {out.name} output is read as its Color")
+        if node.projection != "FLAT":
+            self.note(node, f"{node.projection.lower()} projection: read flat")
+        self.images[image.name] = image
+        if not _over_the_uv_map(node):
+            vector_socket = node.inputs["Vector"]
+            vector = self.value(vector_socket, True) if vector_socket.is_linked else Expression.coordinates("UV")
+            return Expression.image_at(image.name, node.extension, vector)
         vector = follow(node.inputs["Vector"])
         transform = IDENTITY_UV_TRANSFORM
         if vector is not None and vector.node.type == "MAPPING":
@@ -393,28 +430,14 @@ class SocketReader:
             source = vector.node
             if source.type == "UVMAP" and source.uv_map and self._other_uv_map(source.uv_map):
                 self.note(source, f"UV map '{source.uv_map}': each mesh's active UV map is used")
-            elif source.type not in ("UVMAP", "TEX_COORD") or (source.type == "TEX_COORD" and vector.name != "UV"):
-                self.note(source, "texture coordinates other than the UV map: the active UV map is used")
-        if node.projection != "FLAT":
-            self.note(node, f"{node.projection.lower()} projection: read flat over the UV map")
-        if node.extension != "REPEAT":
-            self.note(node, f"extension {node.extension.lower()}: read repeating")
-        self.images[image.name] = image
         return Expression.image(image.name)
 
     def uv_transform_of(self, mapping):
-        """A Mapping node on UV coordinates as the affine (a, b, c, d, e, f): u' = a u + b v + c, v' = d u + e v +
-        f (POINT: R S uv + L; TEXTURE: its inverse; VECTOR: R S uv; about z only, in the UV plane)."""
+        """A Mapping node on UV coordinates (its values its own, turning about z alone: _over_the_uv_map) as the
+        affine (a, b, c, d, e, f): u' = a u + b v + c, v' = d u + e v + f (POINT: R S uv + L; TEXTURE: its
+        inverse; VECTOR: R S uv)."""
         inputs = mapping.inputs
-        for name in ("Location", "Rotation", "Scale"):
-            if name in inputs and inputs[name].is_linked:
-                self.note(mapping, f"a linked {name}: its value is used")
         rotation = inputs["Rotation"].default_value
-        if abs(rotation[0]) > 1e-9 or abs(rotation[1]) > 1e-9:
-            self.note(mapping, "a rotation about x or y: only the turn about z applies to UVs")
-        if mapping.vector_type == "NORMAL":
-            self.note(mapping, "normal mapping type: the UVs are used as they are")
-            return IDENTITY_UV_TRANSFORM
         cos, sin = np.cos(rotation[2]), np.sin(rotation[2])
         scale = inputs["Scale"].default_value
         matrix = np.array([[cos, -sin], [sin, cos]]) @ np.diag([scale[0], scale[1]])

@@ -83,6 +83,13 @@ class Expression:
         return Expression((((1.0, 1.0, 1.0), (Factor("", function=Function(name, tuple(settings), args)),)),))
 
     @staticmethod
+    def image_at(name, extension, vector):
+        """Image `name` read at texture coordinates vector's (x, y), past its edges as `extension` says
+        (REPEAT, EXTEND, CLIP, MIRROR)."""
+        return Expression((((1.0, 1.0, 1.0), (Factor("", function=Function("image", (name, extension),
+                                                                             (Expression.of(vector),))),)),))
+
+    @staticmethod
     def coordinates(name):
         """The surface's coordinates `name` (one of COORDINATES) as a vector (x, y, z)."""
         return Expression((((1.0, 1.0, 1.0), (Factor("", coordinates=name),)),))
@@ -144,6 +151,8 @@ class Expression:
         for _, factors in self.terms:
             for factor in factors:
                 if factor.function is not None:
+                    if factor.function.name == "image":
+                        yield "image", factor.function.settings[0]
                     for arg in factor.function.args:
                         yield from arg._sources()
                 elif factor.coordinates is not None:
@@ -192,7 +201,9 @@ class Expression:
         for coefficient, factors in self.terms:
             product = np.asarray(coefficient, np.float64)
             for factor in factors:
-                if factor.function is not None:
+                if factor.function is not None and factor.function.name == "image":
+                    mean = means[factor.function.settings[0]]
+                elif factor.function is not None:
                     from .node_functions import apply
 
                     mean = apply(factor.function.name, factor.function.settings,
@@ -204,10 +215,11 @@ class Expression:
             total += product
         return tuple(float(v) for v in total)
 
-    def values(self, samples, attributes=None, coordinates=None):
+    def values(self, samples, attributes=None, coordinates=None, image_at=None):
         """Its value (..., 3) float32 where each image reads samples[name] (..., 3), each attribute
         attributes[name] and each of the surface's coordinates coordinates[name]: what a pixel gets when every
-        image is sampled there (the shader's texture_value_<slot>)."""
+        image is sampled there (the shader's texture_value_<slot>); an image read at coordinates of its own (an
+        "image" Function) reads image_at(name, extension, uv (..., 2)) -> (..., 3)."""
         from .node_functions import apply
 
         sources = {**{("image", name): samples[name] for name in self.images},
@@ -221,8 +233,11 @@ class Expression:
             if factor.function is None:
                 kind = "attribute" if factor.attribute else "image"
                 return np.asarray(sources[kind, factor.image], np.float32)[..., :3]
-            args = [np.broadcast_to(arg.values(samples, attributes, coordinates), shape + (3,))
+            args = [np.broadcast_to(arg.values(samples, attributes, coordinates, image_at), shape + (3,))
                     for arg in factor.function.args]
+            if factor.function.name == "image":
+                name, extension = factor.function.settings
+                return np.asarray(image_at(name, extension, args[0][..., :2]), np.float32)[..., :3]
             return np.asarray(apply(factor.function.name, factor.function.settings, args), np.float32)
 
         out = np.zeros(shape + (3,), np.float32)
@@ -256,6 +271,10 @@ class BoundExpression:
             raise ValueError(f"colour attributes {self.expression.attributes} or the surface's coordinates "
                              f"{self.expression.coordinate_names} have no value at a texture coordinate")
         samples = {name: texture_mips.sample(pixels, uv, footprint)[..., :3] for name, pixels in self.images.items()}
+
+        def image_at(name, extension, at):
+            return texture_mips.sample(self.images[name], at, footprint, extension)[..., :3]
+
         out = np.ones((len(uv), 4), np.float32)
-        out[:, :3] = self.expression.values(samples)
+        out[:, :3] = self.expression.values(samples, image_at=image_at)
         return out

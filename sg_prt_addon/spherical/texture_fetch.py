@@ -7,14 +7,26 @@ the prefiltered environment's layers, the SSDF basis and the material textures a
 import numpy as np
 
 
-def bilinear(image, uv, layer=None, wrap=False):
+def _texel_index(index, size, extension):
+    """Texel indices past the edge as an Image Texture's extension takes them: REPEAT wraps, EXTEND and CLIP
+    clamp to the edge (CLIP's texels past it are black: _inside), MIRROR reflects every other period."""
+    if extension in ("EXTEND", "CLIP"):
+        return np.clip(index, 0, size - 1)
+    if extension == "MIRROR":
+        folded = index % (2 * size)
+        return np.where(folded < size, folded, 2 * size - 1 - folded)
+    return index % size
+
+
+def bilinear(image, uv, layer=None, wrap=False, extension=None):
     """Samples of `image` at texture coordinates uv (..., 2) in [0, 1]^2 (u along a row, v across rows).
 
     image: (H, W, ...) indexed [row, column], row 0 at v = 0 (the GPU's and Blender's order); with `layer`,
     (L, H, W, ...) and layer (...) integer indices, as a texture array.  Returns (...) + image's trailing
     dimensions.  The arithmetic is in uv's precision (float32 coordinates: the shader's, float64: a
     reference's).  wrap: the texel indices repeat (GL_REPEAT: the material textures' manual fetch in
-    shaders/techniques/common/surface_io.glsl), else they clamp to the edge."""
+    shaders/techniques/common/material_textures.glsl), else they clamp to the edge; extension (an Image
+    Texture's: REPEAT, EXTEND, CLIP, MIRROR) in wrap's place where given."""
     uv = np.asarray(uv)
     dtype = np.result_type(uv.dtype, np.float32).type
     first = 0 if layer is None else 1
@@ -25,7 +37,18 @@ def bilinear(image, uv, layer=None, wrap=False):
     trailing = (Ellipsis,) + (None,) * (image.ndim - 2 - first)
     fx, fy = (x - x0)[trailing], (y - y0)[trailing]
     x0, y0 = x0.astype(np.int64), y0.astype(np.int64)
-    if wrap:
+    if extension is not None:
+        xa, xb = _texel_index(x0, width, extension), _texel_index(x0 + 1, width, extension)
+        ya, yb = _texel_index(y0, height, extension), _texel_index(y0 + 1, height, extension)
+        if extension == "CLIP":             # texels past the edge are black: their weights count nothing
+            def inside(index, size):
+                return ((index >= 0) & (index < size))[trailing].astype(dtype)
+            ina, inb = inside(x0, width), inside(x0 + 1, width)
+            index = () if layer is None else (layer,)
+            low = image[index + (ya, xa)] * (1 - fx) * ina + image[index + (ya, xb)] * fx * inb
+            high = image[index + (yb, xa)] * (1 - fx) * ina + image[index + (yb, xb)] * fx * inb
+            return low * (1 - fy) * inside(y0, height) + high * fy * inside(y0 + 1, height)
+    elif wrap:
         xa, xb, ya, yb = x0 % width, (x0 + 1) % width, y0 % height, (y0 + 1) % height
     else:
         xa, xb = np.clip(x0, 0, width - 1), np.clip(x0 + 1, 0, width - 1)

@@ -90,12 +90,15 @@ def level_of(footprint, width, height, count):
     return np.clip(level, np.float32(0.0), np.float32(count - 1))
 
 
-def sample(image, uv, footprint=None):
-    """The image at texture coordinates uv (N, 2), repeating: bilinear in level 0 where footprint is None, else
-    trilinear at level_of(footprint) (the mirror of material_texture)."""
+def sample(image, uv, footprint=None, extension="REPEAT"):
+    """The image at texture coordinates uv (N, 2), past its edges as the Image Texture's extension says (REPEAT,
+    EXTEND, MIRROR, CLIP: 0 outside [0, 1]): bilinear in level 0 where footprint is None, else trilinear at
+    level_of(footprint) (the mirror of material_texture and material_texture_at)."""
     uv = np.asarray(uv)
+    fetch = extension
     if footprint is None:
-        return texture_fetch.bilinear(np.asarray(image), uv, wrap=True)
+        out = texture_fetch.bilinear(np.asarray(image), uv, extension=fetch)
+        return _clipped(out, uv) if extension == "CLIP" else out
     pyramid = levels(image)
     height, width = pyramid[0].shape[:2]
     level = level_of(footprint, width, height, len(pyramid))
@@ -104,9 +107,15 @@ def sample(image, uv, footprint=None):
     out = np.zeros((len(uv), pyramid[0].shape[2]), np.float32)
     for index in np.unique(low):
         rows = low == index
-        value = texture_fetch.bilinear(pyramid[index], uv[rows], wrap=True)
+        value = texture_fetch.bilinear(pyramid[index], uv[rows], extension=fetch)
         if index + 1 < len(pyramid):
-            upper = texture_fetch.bilinear(pyramid[index + 1], uv[rows], wrap=True)
+            upper = texture_fetch.bilinear(pyramid[index + 1], uv[rows], extension=fetch)
             value = value + (upper - value) * fraction[rows]
         out[rows] = value
-    return out
+    return _clipped(out, uv) if extension == "CLIP" else out
+
+
+def _clipped(values, uv):
+    """CLIP's transparent black outside [0, 1]^2 (within it, the texels past the edge are black: texture_fetch)."""
+    inside = np.all((uv >= 0.0) & (uv <= 1.0), axis=-1)
+    return np.where(inside[..., None], values, np.float32(0.0)).astype(np.float32)

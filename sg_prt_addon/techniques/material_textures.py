@@ -15,6 +15,7 @@ from . import shader_sources
 
 NORMAL_MAP = "normal_map"
 MAPPING_TYPES = ("POINT", "TEXTURE", "VECTOR", "NORMAL")
+IMAGE_EXTENSIONS = ("REPEAT", "EXTEND", "CLIP", "MIRROR")        # material_textures.glsl's extension index
 # The surface's coordinates in GLSL (texture_expression.COORDINATES): object_position is the vertex stage's
 # (HAS_OBJECT_POSITION), generated_scale and generated_offset the object's push constants (the mesh's texture
 # space, bind_object)
@@ -89,13 +90,15 @@ def bind(shader, key, context):
         shader.uniform_sampler(f"node_image_{k}", context.node_image(name))
 
 
-def expression_source(expression, rgb_of, helpers):
+def expression_source(expression, rgb_of, helpers, sampler_of=None):
     """An Expression as a GLSL vec3 expression; rgb_of(factor): the GLSL vec3 of its image or attribute at the
-    pixel; helpers: {settings: (name, GLSL)} of the helper functions it calls (a Color Ramp's), added to."""
+    pixel; helpers: {settings: (name, GLSL)} of the helper functions it calls (a Color Ramp's), added to;
+    sampler_of(image name): the sampler an image read at coordinates of its own is read from."""
     literal = shader_sources.float_literal
 
     def factor_source(factor):
-        value = function_source(factor.function, rgb_of, helpers) if factor.function is not None else rgb_of(factor)
+        value = function_source(factor.function, rgb_of, helpers, sampler_of) if factor.function is not None \
+            else rgb_of(factor)
         value += "" if factor.channel is None else "." + "rgb"[factor.channel] * 3
         if factor.scale == 1.0 and factor.offset == 0.0:
             return value
@@ -106,11 +109,14 @@ def expression_source(expression, rgb_of, helpers):
     return " + ".join(terms)
 
 
-def function_source(function, rgb_of, helpers):
+def function_source(function, rgb_of, helpers, sampler_of=None):
     """A texture_expression.Function as a GLSL vec3 expression (shaders/lib/node_functions.glsl's node_<name>,
-    a Color Ramp's helper)."""
-    args = [expression_source(arg, rgb_of, helpers) for arg in function.args]
+    a Color Ramp's helper, an image at coordinates of its own: material_textures.glsl's material_texture_at)."""
+    args = [expression_source(arg, rgb_of, helpers, sampler_of) for arg in function.args]
     name, settings = function.name, function.settings
+    if name == "image":
+        return (f"material_texture_at({sampler_of(settings[0])}, ({args[0]}).xy, "
+                f"{IMAGE_EXTENSIONS.index(settings[1])}).rgb")
     if name == "math":
         return f"node_math_{settings[0].lower()}({', '.join(args)})"
     if name == "clamp":
@@ -203,7 +209,8 @@ def values_source(key):
             continue
         slots += [f"vec4 texture_value_{slot}()", "{"]
         if slot in computed:
-            slots.append(f"  return vec4({expression_source(computed[slot], rgb_of, helpers)}, 1.0);")
+            value = expression_source(computed[slot], rgb_of, helpers, lambda image: f"node_image_{names.index(image)}")
+            slots.append(f"  return vec4({value}, 1.0);")
         else:
             slots.append(f"  return material_texture(texture_{slot});")
         slots.append("}")

@@ -105,3 +105,18 @@ def test_spread_lobes_keep_their_integral():
     np.testing.assert_allclose(wide, sharpness / (1 + sharpness * 0.05), rtol=1e-6)
     np.testing.assert_allclose(lower / wide, amplitude / sharpness, rtol=1e-6)
     assert sg_shading.spread_lobes(sharpness, amplitude, None) == (sharpness, amplitude)
+
+
+def test_extensions_past_the_edge():
+    """An Image Texture's extensions at texel centres past the edge: EXTEND repeats the edge texel, MIRROR reflects
+    (texel -1 is texel 0, texel W is texel W - 1), REPEAT wraps, CLIP is black outside [0, 1] and fades to black
+    over the half texel inside it."""
+    image = np.arange(1.0, 5.0, dtype=np.float32).reshape(1, 4, 1).repeat(2, axis=0)      # texels 1, 2, 3, 4
+    centre = lambda k: [(k + 0.5) / 4, 0.5]                                                 # noqa: E731
+    uv = np.array([centre(-1), centre(-2), centre(4), centre(5), centre(0)], np.float32)
+    for extension, expected in (("EXTEND", [1, 1, 4, 4, 1]), ("MIRROR", [1, 2, 4, 3, 1]), ("REPEAT", [4, 3, 1, 2, 1]),
+                                ("CLIP", [0, 0, 0, 0, 1])):
+        np.testing.assert_allclose(texture_mips.sample(image, uv, None, extension)[:, 0], expected, atol=1e-6,
+                                   err_msg=extension)
+    at_edge = texture_mips.sample(image, np.array([[0.0, 0.5], [1.0, 0.5]], np.float32), None, "CLIP")[:, 0]
+    np.testing.assert_allclose(at_edge, [0.5, 2.0], atol=1e-6)          # half of texel 1, half of texel 4

@@ -56,7 +56,8 @@ def _function_cases():
     return [name for name in node_values.CASES
             if name.startswith(("math_", "clamp_", "map_range_", "color_ramp_", "mix_", "hue_", "gamma", "brightness",
                                 "rgb_to_bw", "coordinates_", "geometry_", "checker", "gradient_", "mapping_",
-                                "vector_math_", "noise_", "wave_", "magic_")) and name not in ("math_and_mix", "mix_shader_textured_factor")]
+                                "vector_math_", "noise_", "wave_", "magic_", "image_"))
+            and name not in ("math_and_mix", "mix_shader_textured_factor", "image_non_color")]
 
 
 # The cases with a jump (a comparison, a floor) or a pole near their inputs: Cycles' pixel filter averages the
@@ -69,18 +70,22 @@ LOOSER = {"math_logarithm": 0.15,        # 0.0913 / 0.0757: log2(a) / log2(b), b
           "mix_divide": 0.08,            # 0.0544 / 0.0100: dividing by the swizzled image's small channels
           "checker": 0.07, "checker_object_fac": 0.07,          # 0.0416 / 0.0156, 0.0448 / 0.0282: the cells' edges
           "vector_math_modulo": 0.05, "vector_math_snap": 0.07,  # 0.0301 / 0.0092, 0.0434 / 0.0106
-          "wave_bands_diagonal_saw": 0.06}                       # 0.0410 / 0.0352: the saw's jumps
+          "wave_bands_diagonal_saw": 0.06,                       # 0.0410 / 0.0352: the saw's jumps
+          # 0.178 / 0.023, bias +0.026: Clip's edge, a step inside the pixel filter, over a mean mostly black
+          "image_clip": 0.25}
+LOOSER_BIAS = {"image_clip": 0.04}
 
 
 @pytest.mark.parametrize("case", _function_cases())
 def test_node_function_against_cycles(node_values, case):
     """Every Math operation, Clamp, Map Range, Color Ramp, the Mix node's blends, Hue/Saturation/Value, Gamma,
     Brightness/Contrast, RGB to BW, the Texture Coordinate and Geometry outputs, Mapping, Vector Math and the
-    Checker, Gradient, Noise, Wave and Magic textures (reflectance/node_functions.py, per pixel in GLSL) against
+    Checker, Gradient, Noise, Wave and Magic textures, and images read at coordinates of the node tree's own and
+    past their edges by each extension (reflectance/node_functions.py, material_textures, per pixel) against
     Cycles' evaluation of the same node (docs/ACCURACY.md has each figure): relative RMSE under 0.03 (the looser
     cases above), bias under 0.02."""
     row = node_values.score(case, 64, 16)
     assert row["pixels"] > 3000
     assert row["relative_rmse"] < LOOSER.get(case, 0.03)
-    assert abs(row["relative_bias"]) < 0.02
+    assert abs(row["relative_bias"]) < LOOSER_BIAS.get(case, 0.02)
     assert not [w for w in row["warnings"] if "node tree" in w], row["warnings"]
