@@ -568,6 +568,36 @@ def uv_transformed_by_math(tree):
     return combine.outputs["Vector"]
 
 
+def fresnel_node(ior=1.45):
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeFresnel")
+        node.inputs["IOR"].default_value = ior
+        return node.outputs["Fac"]
+    return value_of
+
+
+def layer_weight(output, blend):
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeLayerWeight")
+        node.inputs["Blend"].default_value = blend
+        return node.outputs[output]
+    return value_of
+
+
+def mix_shader_by_fresnel(name):
+    """Two Emissions (blue; the image) mixed by Layer Weight's Fresnel: the rim takes the image."""
+    material, tree, output = _material(name)
+    blue, textured = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeEmission")
+    blue.inputs["Color"].default_value = (0.1, 0.2, 0.9, 1.0)
+    tree.links.new(_image_node(tree).outputs["Color"], textured.inputs["Color"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(layer_weight("Fresnel", 0.4)(tree), mix.inputs["Fac"])
+    tree.links.new(blue.outputs[0], mix.inputs[1])
+    tree.links.new(textured.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    return material
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -614,7 +644,15 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "image_generated": _socket_case(image_at(lambda tree: _coordinates(tree, "Generated"))),
          "image_uv_by_math": _socket_case(image_at(uv_transformed_by_math)),
          "image_turned_about_x": _socket_case(image_at(lambda tree: _mapping_node(tree, "POINT",
-                                                                                 _coordinates(tree, "UV"))))}
+                                                                                 _coordinates(tree, "UV")))),
+         "fresnel": _socket_case(fresnel_node()), "fresnel_ior_3": _socket_case(fresnel_node(3.0)),
+         "layer_weight_fresnel": _socket_case(layer_weight("Fresnel", 0.3)),
+         "layer_weight_facing": _socket_case(layer_weight("Facing", 0.3)),
+         "layer_weight_facing_0_8": _socket_case(layer_weight("Facing", 0.8)),
+         "mix_shader_by_fresnel": mix_shader_by_fresnel}
+# the cases on a sphere (what depends on the view's angle to the surface) in place of the plane
+SPHERE_CASES = ("fresnel", "fresnel_ior_3", "layer_weight_fresnel", "layer_weight_facing", "layer_weight_facing_0_8",
+                "mix_shader_by_fresnel")
 # cases whose truth is 0 everywhere (scored by their largest values)
 ZERO_TRUTH = ("color_attribute_missing",)
 # the cases whose grid has the colour attribute: (domain, data type)
@@ -624,7 +662,7 @@ COLOURED = {"color_attribute": ("POINT", "FLOAT_COLOR"), "color_attribute_corner
 
 def build(name, size):
     """The case's plane (2 m, 8 x 8 faces, its UVs over [0, 1]; the colour attribute where the case has one)
-    under an orthographic camera that it fills."""
+    under an orthographic camera that it fills; a sphere in the plane's place for SPHERE_CASES."""
     import bpy
 
     from benchmarks import truth_suite
@@ -632,7 +670,11 @@ def build(name, size):
 
     scene = truth_suite._start(size)
     truth_suite._black_world(scene)
-    bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2.0)
+    if name in SPHERE_CASES:
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=0.95)
+        bpy.context.active_object.data.shade_smooth()
+    else:
+        bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2.0)
     plane = bpy.context.active_object
     if name in COLOURED:
         add_colour_attribute(plane.data, *COLOURED[name])

@@ -170,6 +170,8 @@ class SocketReader:
             return self.noise_texture(node, out)
         if node.type in ("TEX_WAVE", "TEX_MAGIC"):
             return self.wave_or_magic_texture(node, out)
+        if node.type in ("FRESNEL", "LAYER_WEIGHT"):
+            return self.view_weight(node, out)
         if node.type == "VECT_MATH":
             return self.vector_math(node, out)
         reader = {"MATH": self.math, "INVERT": self.invert, "MIX": self.mix, "MIX_RGB": self.mix, "MAPPING": self.mapping,
@@ -201,15 +203,15 @@ class SocketReader:
         return _clamped(result) if node.use_clamp else result
 
     def coordinates_value(self, node, out, socket, colour):
-        """Texture Coordinate's Generated, Normal, UV and Object (of the object itself); Geometry's Position and
-        Normal (world space); a UV Map node's UV (the active map's)."""
+        """Texture Coordinate's Generated, Normal, UV and Object (of the object itself); Geometry's Position,
+        Normal and Incoming (world space); a UV Map node's UV (the active map's)."""
         if node.type == "UVMAP":
             if node.uv_map and self._other_uv_map(node.uv_map):
                 self.note(node, f"UV map '{node.uv_map}': each mesh's active UV map is used")
             return Expression.coordinates("UV")
         names = {"Generated": "GENERATED", "Normal": "NORMAL", "UV": "UV", "Object": "OBJECT"} \
             if node.type == "TEX_COORD" else {"Position": "POSITION", "Normal": "WORLD_NORMAL",
-                                              "True Normal": "WORLD_NORMAL"}
+                                              "True Normal": "WORLD_NORMAL", "Incoming": "INCOMING"}
         name = names.get(out.identifier)
         if name is None:
             self.note(node, f"its {out.name} output: {socket.name} uses its value {_rounded(_default(socket))}")
@@ -257,6 +259,18 @@ class SocketReader:
             return Expression.function("tex_wave", settings, values)
         values += [self.value(node.inputs[name], False) for name in ("Scale", "Distortion")]
         return Expression.function("tex_magic", (int(node.turbulence_depth), output), values)
+
+    def view_weight(self, node, out):
+        """Fresnel and Layer Weight (its Fresnel, Facing) at the view, about their Normal (unlinked: the
+        surface's)."""
+        normal_socket = node.inputs["Normal"]
+        normal = self.value(normal_socket, True) if normal_socket.is_linked else Expression.coordinates("WORLD_NORMAL")
+        incoming = Expression.coordinates("INCOMING")
+        if node.type == "FRESNEL":
+            return Expression.function("fresnel", (), (self.value(node.inputs["IOR"], False), normal, incoming))
+        output = "Facing" if out.identifier == "Facing" else "Fresnel"
+        return Expression.function("layer_weight", (output,), (self.value(node.inputs["Blend"], False), normal,
+                                                              incoming))
 
     def mapping(self, node, colour):
         """The Mapping node on a vector (POINT, TEXTURE, VECTOR, NORMAL)."""

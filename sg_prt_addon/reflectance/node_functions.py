@@ -1,6 +1,6 @@
 """Blender's shader-node functions that are not sums of products, as Cycles and EEVEE define them (Math, Clamp,
 Map Range, Color Ramp, the Mix node's blend modes, Hue/Saturation/Value, Gamma, Brightness/Contrast, Mapping,
-Vector Math, the Checker, Gradient, Noise, Wave and Magic textures), on
+Vector Math, Fresnel, Layer Weight, the Checker, Gradient, Noise, Wave and Magic textures), on
 (..., 3) float32 arrays: a scalar socket is its value on all three channels.  shaders/lib/node_functions.glsl
 is their GLSL (each `node_<name>` there mirrors FUNCTIONS[name] here); reflectance.texture_expression applies
 them to per-pixel values.
@@ -344,6 +344,49 @@ def tex_gradient(gradient_type, vector):
     return np.repeat(np.clip(value, 0, 1)[..., None], 3, axis=-1).astype(FLOAT)
 
 
+def fresnel_dielectric_cos(cosine, eta):
+    """A dielectric's Fresnel reflectance at |cosine| for the relative index eta (total internal reflection: 1)."""
+    c = np.abs(cosine)
+    g = eta * eta - 1 + c * c
+    root = np.sqrt(np.maximum(g, 0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = (root - c) / (root + c)
+        b = (c * (root + c) - 1) / (c * (root - c) + 1)
+        value = 0.5 * a * a * (1 + b * b)
+    return np.where(g > 0, value, 1).astype(FLOAT)
+
+
+def _facing(normal, incoming):
+    """(cosine of the view to the normal, whether the surface faces away from the view)."""
+    cosine = _dot(normal, incoming)[..., 0]
+    return cosine, cosine < 0
+
+
+def fresnel(ior, normal, incoming):
+    """The Fresnel node: fresnel_dielectric_cos at the view, the index inverted where the surface faces away."""
+    cosine, backfacing = _facing(normal, incoming)
+    eta = np.maximum(ior[..., 0], FLOAT(1e-5))
+    eta = np.where(backfacing, 1 / eta, eta)
+    return np.repeat(fresnel_dielectric_cos(cosine, eta)[..., None], 3, axis=-1)
+
+
+def layer_weight(output, blend, normal, incoming):
+    """The Layer Weight node's Fresnel (of the index 1 / (1 - blend)) or Facing (1 - |cos|^(2 blend) below half,
+    ^(0.5 / (1 - blend)) above)."""
+    cosine, backfacing = _facing(normal, incoming)
+    blend = blend[..., 0]
+    if output == "Fresnel":
+        eta = np.maximum(1 - blend, FLOAT(1e-5))
+        eta = np.where(backfacing, eta, 1 / eta)
+        value = fresnel_dielectric_cos(cosine, eta)
+    else:
+        clamped = np.clip(blend, 0, 1 - 1e-5)
+        exponent = np.where(clamped < 0.5, 2 * clamped, 0.5 / (1 - clamped))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            value = 1 - np.where(blend != 0.5, np.power(np.abs(cosine), exponent), np.abs(cosine))
+    return np.repeat(np.asarray(value, FLOAT)[..., None], 3, axis=-1)
+
+
 # Color Ramp's outputs a Function reads
 RAMP_OUTPUTS = ("Color", "Alpha")
 MAP_RANGE_INTERPOLATIONS = ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")
@@ -355,7 +398,7 @@ def apply(name, settings, args):
     (interpolation, clamped), color_ramp (interpolation, positions, RGBA colours, output), mix (blend,),
     hue_saturation_value, gamma, brightness_contrast, mapping (type,), vector_math (operation,), tex_checker
     (output,), tex_gradient (type,), tex_noise (type, normalize, output), tex_wave (type, bands direction,
-    rings direction, profile, output), tex_magic (depth, output))."""
+    rings direction, profile, output), tex_magic (depth, output), fresnel, layer_weight (output,))."""
     args = [np.asarray(a, FLOAT) for a in args]
     if name == "math":
         return math(settings[0], *args)
@@ -381,6 +424,10 @@ def apply(name, settings, args):
         return tex_noise(settings, *args)
     if name == "tex_wave":
         return tex_wave(settings, *args)
+    if name == "fresnel":
+        return fresnel(*args)
+    if name == "layer_weight":
+        return layer_weight(settings[0], *args)
     if name == "tex_magic":
         return tex_magic(settings, *args)
     functions = {"hue_saturation_value": hue_saturation_value, "gamma": gamma,

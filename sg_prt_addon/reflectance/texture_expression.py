@@ -13,8 +13,8 @@ import numpy as np
 
 # The surface's coordinates a value may read (Texture Coordinate and Geometry nodes): UV (the material's texture
 # coordinates), OBJECT (object space), GENERATED (object space in the mesh's texture space, [0, 1] over its
-# box), NORMAL (object space), POSITION and WORLD_NORMAL (world space)
-COORDINATES = ("UV", "OBJECT", "GENERATED", "NORMAL", "POSITION", "WORLD_NORMAL")
+# box), NORMAL (object space), POSITION, WORLD_NORMAL and INCOMING (toward the viewer; world space)
+COORDINATES = ("UV", "OBJECT", "GENERATED", "NORMAL", "POSITION", "WORLD_NORMAL", "INCOMING")
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,7 @@ COORDINATE_SOURCES = {
     "NORMAL": "normalize(transpose(mat3(model_matrix)) * world_normal)",
     "POSITION": "world_position",
     "WORLD_NORMAL": "normalize(world_normal)",
+    "INCOMING": "(scene.camera.w > 0.5 ? normalize(scene.camera.xyz - world_position) : -normalize(scene.camera.xyz))",
 }
 # What a colour attribute reads where the mesh has none (Cycles: an attribute not found is 0)
 MISSING_ATTRIBUTE = "vec3(0.0)"
@@ -148,6 +149,8 @@ def function_source(function, rgb_of, helpers, sampler_of=None):
         flags = f"{0 if wave_type == 'BANDS' else 1}, {node_functions.WAVE_DIRECTIONS.index(bands)}, " \
                 f"{node_functions.WAVE_DIRECTIONS.index(rings)}, {node_functions.WAVE_PROFILES.index(profile)}"
         return f"node_tex_wave({', '.join(args)}, {flags})"
+    if name == "layer_weight":
+        return f"node_layer_weight({', '.join(args)}, {'true' if settings[0] == 'Fresnel' else 'false'})"
     if name == "tex_magic":
         return f"node_tex_magic({', '.join(args)}, {int(settings[0])}, {'true' if settings[1] == 'Color' else 'false'})"
     return f"node_{name}({', '.join(args)})"

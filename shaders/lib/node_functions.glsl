@@ -531,3 +531,38 @@ vec3 node_tex_magic(vec3 vector, vec3 scale, vec3 distortion, int depth, bool co
   vec3 result = vec3(0.5) - vec3(x, y, z) / divisor;
   return colour ? result : vec3((result.x + result.y + result.z) * (1.0 / 3.0));
 }
+
+/* A dielectric's Fresnel reflectance at |cosine| for the relative index eta (total internal reflection: 1) */
+float node_fresnel_dielectric_cos(float cosine, float eta)
+{
+  float c = abs(cosine);
+  float g = eta * eta - 1.0 + c * c;
+  if (g <= 0.0) {
+    return 1.0;
+  }
+  g = sqrt(g);
+  float a = (g - c) / (g + c);
+  float b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return 0.5 * a * a * (1.0 + b * b);
+}
+
+/* The Fresnel node (incoming: toward the viewer) */
+vec3 node_fresnel(vec3 ior, vec3 normal, vec3 incoming)
+{
+  float cosine = dot(normal, incoming);
+  float eta = max(ior.x, 1e-5);
+  return vec3(node_fresnel_dielectric_cos(cosine, cosine < 0.0 ? 1.0 / eta : eta));
+}
+
+/* The Layer Weight node's Fresnel or (not fresnel) Facing */
+vec3 node_layer_weight(vec3 blend, vec3 normal, vec3 incoming, bool fresnel)
+{
+  float cosine = dot(normal, incoming);
+  if (fresnel) {
+    float eta = max(1.0 - blend.x, 1e-5);
+    return vec3(node_fresnel_dielectric_cos(cosine, cosine < 0.0 ? eta : 1.0 / eta));
+  }
+  float clamped = clamp(blend.x, 0.0, 1.0 - 1e-5);
+  float exponent = clamped < 0.5 ? 2.0 * clamped : 0.5 / (1.0 - clamped);
+  return vec3(1.0 - (blend.x != 0.5 ? pow(abs(cosine), exponent) : abs(cosine)));
+}

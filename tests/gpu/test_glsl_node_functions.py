@@ -192,3 +192,21 @@ def test_magic_texture(glsl, fuzz, record_error, depth):
                    f"{str(colour).lower()}), 0.0);", inputs, 3)
         expected = node_functions.tex_magic((depth, "Color" if colour else "Fac"), vector, scale, distortion)
         assert _close(record_error, f"magic depth {depth} colour={colour}", got, expected) < 1e-5 + 2e-6 * 2.5 ** depth
+
+
+def test_fresnel_and_layer_weight(glsl, fuzz, record_error):
+    """Fresnel and Layer Weight (both outputs) against their numpy mirrors, over views from either side of the
+    normal (a surface seen from behind inverts the index)."""
+    count = 2048
+    normal = fuzz.unit_vectors(count).astype(np.float32)
+    incoming = fuzz.unit_vectors(count).astype(np.float32)
+    value = np.repeat(fuzz.rng.uniform(0.0, 3.0, (count, 1)), 3, axis=1).astype(np.float32)
+    blend = np.repeat(fuzz.rng.uniform(0.0, 1.0, (count, 1)), 3, axis=1).astype(np.float32)
+    blend[::7] = 0.5
+    inputs = {name: np.c_[v, np.zeros(count)] for name, v in zip("abcd", (value, normal, incoming, blend))}
+    got = glsl(LIB, "result = vec4(node_fresnel(a.xyz, b.xyz, c.xyz), 0.0);", inputs, 3)
+    assert _close(record_error, "fresnel", got, node_functions.fresnel(value, normal, incoming)) < 2e-5
+    for output, flag in (("Fresnel", "true"), ("Facing", "false")):
+        got = glsl(LIB, f"result = vec4(node_layer_weight(d.xyz, b.xyz, c.xyz, {flag}), 0.0);", inputs, 3)
+        expected = node_functions.layer_weight(output, blend, normal, incoming)
+        assert _close(record_error, f"layer_weight {output}", got, expected) < 2e-5

@@ -1184,7 +1184,11 @@ def test_node_functions_stress(glsl, fuzz):
                  "node_tex_noise(a.xyz, t.xxx * 10.0, t.yyy * 15.0, t.zzz, vec3(2.0), vec3(0.5), vec3(1.0), b.xyz, 0, "
                  "true, true)",
                  "node_tex_wave(a.xyz, t.xxx * 5.0, b.xyz, t.yyy * 15.0, t.zzz * 5.0, t.xyz, c.xyz, 1, 0, 4, 2)",
-                 "node_tex_magic(a.xyz, t.xxx * 5.0, b.xyz, 10, true)"):
+                 "node_tex_magic(a.xyz, t.xxx * 5.0, b.xyz, 10, true)",
+                 "node_fresnel(abs(a.xyz), node_safe_normalize(b.xyz), node_safe_normalize(c.xyz))",
+                 "node_layer_weight(t.xyz, node_safe_normalize(b.xyz), node_safe_normalize(c.xyz), true) + "
+                 "node_layer_weight(t.xyz, b.xyz * 0.0, node_safe_normalize(c.xyz), false) + "
+                 "vec3(node_fresnel_dielectric_cos(t.x, 0.0))"):
         check(call, everything)
 
 
@@ -1251,7 +1255,8 @@ COVERED = {
        "node_rgb_to_hsv", "node_gamma", "node_brightness_contrast", "node_safe_divide", "node_signed_pow",
        "node_smooth_min", "node_mapping", "node_euler_matrix", "node_safe_normalize", "node_tex_checker",
        "node_tex_gradient", "node_hash_uint3", "node_rot", "node_fade", "node_grad3", "node_perlin_3d",
-       "node_snoise_3d", "node_noise_fractal", "node_tex_noise", "node_tex_wave", "node_tex_magic"],
+       "node_snoise_3d", "node_noise_fractal", "node_tex_noise", "node_tex_wave", "node_tex_magic", "node_fresnel",
+       "node_layer_weight", "node_fresnel_dielectric_cos"],
 }
 
 _DEFINITION = re.compile(r"^\s*(?:float|int|uint|bool|void|vec[234]|ivec[234]|mat[234])\s+([A-Za-z_]\w*)\s*\(", re.M)

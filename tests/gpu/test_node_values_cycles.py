@@ -56,7 +56,8 @@ def _function_cases():
     return [name for name in node_values.CASES
             if name.startswith(("math_", "clamp_", "map_range_", "color_ramp_", "mix_", "hue_", "gamma", "brightness",
                                 "rgb_to_bw", "coordinates_", "geometry_", "checker", "gradient_", "mapping_",
-                                "vector_math_", "noise_", "wave_", "magic_", "image_"))
+                                "vector_math_", "noise_", "wave_", "magic_", "image_", "fresnel", "layer_weight_",
+                                "mix_shader_by_fresnel"))
             and name not in ("math_and_mix", "mix_shader_textured_factor", "image_non_color")]
 
 
@@ -80,12 +81,12 @@ LOOSER_BIAS = {"image_clip": 0.04}
 def test_node_function_against_cycles(node_values, case):
     """Every Math operation, Clamp, Map Range, Color Ramp, the Mix node's blends, Hue/Saturation/Value, Gamma,
     Brightness/Contrast, RGB to BW, the Texture Coordinate and Geometry outputs, Mapping, Vector Math and the
-    Checker, Gradient, Noise, Wave and Magic textures, and images read at coordinates of the node tree's own and
-    past their edges by each extension (reflectance/node_functions.py, material_textures, per pixel) against
+    Checker, Gradient, Noise, Wave and Magic textures, Fresnel, Layer Weight (on a sphere), and images read at
+    coordinates of the node tree's own and past their edges by each extension (per pixel) against
     Cycles' evaluation of the same node (docs/ACCURACY.md has each figure): relative RMSE under 0.03 (the looser
     cases above), bias under 0.02."""
     row = node_values.score(case, 64, 16)
-    assert row["pixels"] > 3000
+    assert row["pixels"] > (2400 if case in node_values.SPHERE_CASES else 3000)      # the sphere's disc, the plane
     assert row["relative_rmse"] < LOOSER.get(case, 0.03)
     assert abs(row["relative_bias"]) < LOOSER_BIAS.get(case, 0.02)
     assert not [w for w in row["warnings"] if "node tree" in w], row["warnings"]
