@@ -21,7 +21,7 @@ MATH_OPERATIONS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POW
                    "WRAP", "SNAP", "PINGPONG", "SINE", "COSINE", "TANGENT", "SINH", "COSH", "TANH", "ARCSINE",
                    "ARCCOSINE", "ARCTANGENT", "ARCTAN2", "RADIANS", "DEGREES")
 MIX_BLENDS = ("SCREEN", "OVERLAY", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN", "LIGHTEN", "DODGE", "BURN",
-              "SOFT_LIGHT", "LINEAR_LIGHT", "SUBTRACT")
+              "SOFT_LIGHT", "LINEAR_LIGHT", "SUBTRACT", "HUE", "SATURATION", "VALUE", "COLOR")
 COLOUR_ATTRIBUTE = "Col"
 
 
@@ -386,7 +386,8 @@ def color_ramp_node(interpolation, output="Color"):
 
 
 def mix_blend(blend):
-    """The image (A) and its channels turned (B) blended by `blend` at a factor of its blue channel."""
+    """The image (A) and its channels turned (B; for the HSV blends, whose saturation and value a turn keeps, a
+    colour) blended by `blend` at a factor of its blue channel."""
     def value_of(tree):
         texture = _image_node(tree)
         node = tree.nodes.new("ShaderNodeMix")
@@ -394,7 +395,10 @@ def mix_blend(blend):
         node.blend_type = blend
         tree.links.new(_separate(tree, texture.outputs["Color"]).outputs["Blue"], node.inputs["Factor"])
         tree.links.new(texture.outputs["Color"], node.inputs["A"])
-        tree.links.new(combine_swizzled(tree), node.inputs["B"])
+        if blend in ("HUE", "SATURATION", "VALUE", "COLOR"):
+            node.inputs["B"].default_value = (0.9, 0.35, 0.1, 1.0)
+        else:
+            tree.links.new(combine_swizzled(tree), node.inputs["B"])
         return node.outputs["Result"]
     return value_of
 
@@ -598,6 +602,20 @@ def mix_shader_by_fresnel(name):
     return material
 
 
+def unlit(name):
+    """glTF's unlit material as its importer builds it: Light Path's Is Camera Ray mixing a Transparent BSDF and
+    an Emission of the image."""
+    material, tree, output = _material(name)
+    emission, transparent = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeBsdfTransparent")
+    tree.links.new(_image_node(tree).outputs["Color"], emission.inputs["Color"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(tree.nodes.new("ShaderNodeLightPath").outputs["Is Camera Ray"], mix.inputs["Fac"])
+    tree.links.new(transparent.outputs[0], mix.inputs[1])
+    tree.links.new(emission.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    return material
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -649,7 +667,7 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "layer_weight_fresnel": _socket_case(layer_weight("Fresnel", 0.3)),
          "layer_weight_facing": _socket_case(layer_weight("Facing", 0.3)),
          "layer_weight_facing_0_8": _socket_case(layer_weight("Facing", 0.8)),
-         "mix_shader_by_fresnel": mix_shader_by_fresnel}
+         "mix_shader_by_fresnel": mix_shader_by_fresnel, "unlit": unlit}
 # the cases on a sphere (what depends on the view's angle to the surface) in place of the plane
 SPHERE_CASES = ("fresnel", "fresnel_ior_3", "layer_weight_fresnel", "layer_weight_facing", "layer_weight_facing_0_8",
                 "mix_shader_by_fresnel")

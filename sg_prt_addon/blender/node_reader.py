@@ -162,6 +162,8 @@ class SocketReader:
             return self.attribute_value(node, out, socket, colour)
         if node.type == "VALTORGB":
             return self.color_ramp(node, out)
+        if node.type == "LIGHT_PATH":
+            return self.light_path(node, out, socket, colour)
         if node.type in ("TEX_COORD", "NEW_GEOMETRY", "UVMAP"):
             return self.coordinates_value(node, out, socket, colour)
         if node.type in ("TEX_CHECKER", "TEX_GRADIENT"):
@@ -271,6 +273,14 @@ class SocketReader:
         output = "Facing" if out.identifier == "Facing" else "Fresnel"
         return Expression.function("layer_weight", (output,), (self.value(node.inputs["Blend"], False), normal,
                                                               incoming))
+
+    def light_path(self, node, out, socket, colour):
+        """Light Path as the engine shades: every pixel a camera ray's first hit (Is Camera Ray 1, the other
+        rays' kinds and depths 0); Ray Length is named and its value used."""
+        if out.identifier == "Ray Length":
+            self.note(node, f"its Ray Length: {socket.name} uses its value {_rounded(_default(socket))}")
+            return _constant(_default(socket), colour)
+        return Expression.constant(1.0 if out.identifier == "Is Camera Ray" else 0.0)
 
     def mapping(self, node, colour):
         """The Mapping node on a vector (POINT, TEXTURE, VECTOR, NORMAL)."""
@@ -386,8 +396,8 @@ class SocketReader:
         return factor * (1.0 - value) + (1.0 - factor) * value
 
     def mix(self, node, colour):
-        """Mix (colour, float or vector) and the legacy MixRGB: every blend but the HSV ones (hue, saturation,
-        value, color: read as mix), the factor clamped where the node clamps it, the result where it asks."""
+        """Mix (colour, float or vector) and the legacy MixRGB: every blend, the factor clamped where the node
+        clamps it, the result where it asks."""
         if node.type == "MIX":
             if node.data_type not in ("RGBA", "FLOAT", "VECTOR"):
                 self.note(node, f"a {node.data_type.lower()} mix: its first input is used")

@@ -246,12 +246,33 @@ def mix(blend, factor, a, b):
             return s * a + t * ((1 - a) * b * a + a * screen)
         if blend == "LINEAR_LIGHT":
             return a + t * (2 * b - 1)
+    if blend in ("HUE", "SATURATION", "VALUE", "COLOR"):
+        return _mix_hsv(blend, t, a, b)
     raise KeyError(blend)
+
+
+def _mix_hsv(blend, t, a, b):
+    """The Mix node's HSV blends: HUE and COLOR take b's hue (and COLOR its saturation) where b has a hue,
+    SATURATION and VALUE mix a's saturation or value toward b's (SATURATION where a has one)."""
+    hsv_a, hsv_b = _rgb_to_hsv(a), _rgb_to_hsv(b)
+    t1 = t[..., :1]
+    if blend in ("HUE", "COLOR"):
+        taken = hsv_a.copy()
+        taken[..., 0] = hsv_b[..., 0]
+        if blend == "COLOR":
+            taken[..., 1] = hsv_b[..., 1]
+        turned = a + t1 * (_hsv_to_rgb(taken) - a)
+        return np.where(hsv_b[..., 1:2] != 0, turned, a)
+    channel = 1 if blend == "SATURATION" else 2
+    mixed = hsv_a.copy()
+    mixed[..., channel] = (1 - t1[..., 0]) * hsv_a[..., channel] + t1[..., 0] * hsv_b[..., channel]
+    out = _hsv_to_rgb(mixed)
+    return np.where(hsv_a[..., 1:2] != 0, out, a) if blend == "SATURATION" else out
 
 
 # Blend modes that `mix` computes (Mix, Add, Multiply and Subtract are sums of products, in the algebra)
 MIX_BLENDS = ("SCREEN", "OVERLAY", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN", "LIGHTEN", "DODGE", "BURN",
-              "SOFT_LIGHT", "LINEAR_LIGHT")
+              "SOFT_LIGHT", "LINEAR_LIGHT", "HUE", "SATURATION", "VALUE", "COLOR")
 
 
 def _dot(a, b):

@@ -566,3 +566,40 @@ vec3 node_layer_weight(vec3 blend, vec3 normal, vec3 incoming, bool fresnel)
   float exponent = clamped < 0.5 ? 2.0 * clamped : 0.5 / (1.0 - clamped);
   return vec3(1.0 - (blend.x != 0.5 ? pow(abs(cosine), exponent) : abs(cosine)));
 }
+
+/* The Mix node's HSV blends (node_functions._mix_hsv) */
+vec3 node_mix_hue(vec3 t, vec3 a, vec3 b)
+{
+  vec3 hsv_b = node_rgb_to_hsv(b);
+  if (hsv_b.y == 0.0) {
+    return a;
+  }
+  vec3 hsv = node_rgb_to_hsv(a);
+  hsv.x = hsv_b.x;
+  return mix(a, node_hsv_to_rgb(hsv), t.x);
+}
+vec3 node_mix_color(vec3 t, vec3 a, vec3 b)
+{
+  vec3 hsv_b = node_rgb_to_hsv(b);
+  if (hsv_b.y == 0.0) {
+    return a;
+  }
+  vec3 hsv = node_rgb_to_hsv(a);
+  hsv.xy = hsv_b.xy;
+  return mix(a, node_hsv_to_rgb(hsv), t.x);
+}
+vec3 node_mix_saturation(vec3 t, vec3 a, vec3 b)
+{
+  vec3 hsv = node_rgb_to_hsv(a);
+  if (hsv.y == 0.0) {
+    return a;
+  }
+  hsv.y = (1.0 - t.x) * hsv.y + t.x * node_rgb_to_hsv(b).y;
+  return node_hsv_to_rgb(hsv);
+}
+vec3 node_mix_value(vec3 t, vec3 a, vec3 b)
+{
+  vec3 hsv = node_rgb_to_hsv(a);
+  hsv.z = (1.0 - t.x) * hsv.z + t.x * node_rgb_to_hsv(b).z;
+  return node_hsv_to_rgb(hsv);
+}

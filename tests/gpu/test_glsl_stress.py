@@ -1129,7 +1129,7 @@ NODE_MATH = ["divide", "power", "logarithm", "sqrt", "inverse_sqrt", "absolute",
              "fract", "modulo", "floored_modulo", "wrap", "snap", "pingpong", "sine", "cosine", "tangent", "sinh", "cosh",
              "tanh", "arcsine", "arccosine", "arctangent", "arctan2", "radians", "degrees"]
 NODE_MIX = ["screen", "overlay", "divide", "difference", "exclusion", "darken", "lighten", "dodge", "burn", "soft_light",
-            "linear_light"]
+            "linear_light", "hue", "saturation", "value", "color"]
 NODE_VECTOR = ["cross_product", "project", "reflect", "dot_product", "distance", "length", "normalize"]
 
 
