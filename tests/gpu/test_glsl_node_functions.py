@@ -1,11 +1,15 @@
 """shaders/lib/node_functions.glsl (float32, llvmpipe) against sg_prt_addon/reflectance/node_functions.py
-(float32): every Math operation, Clamp, Map Range, the Mix blends, Hue/Saturation/Value, Gamma and
-Brightness/Contrast over inputs that cross their edges (zero, negative, beyond one)."""
+(float32): every Math operation, Clamp, Map Range, the Mix blends, the colour nodes, Mapping, Vector Math,
+Fresnel, Layer Weight and the procedural textures, over inputs that cross their edges (zero, negative, beyond
+one)."""
 import numpy as np
 import pytest
 
 from sg_prt_addon.reflectance import node_functions
 from sg_prt_addon.techniques import material_textures
+
+# pure functions of llvmpipe's float32: one Blender's run answers for all (the numpy mirrors' noise is slow)
+pytestmark = pytest.mark.one_tier
 
 N = 4096
 LIB = [material_textures.noise_offsets_source(), "node_functions.glsl"]
