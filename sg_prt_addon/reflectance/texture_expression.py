@@ -1,9 +1,10 @@
-"""Values a node tree computes from images: sums of products of constants and images (or an affine function
-of one, such as 1 - metallic, or one of its channels), with the arithmetic of the formulas that use them
-(reflectance/principled.py writes kd = base (1 - metallic) once for numbers and for textures).  A value with
-no image is a constant; with one plain image it is the engine's factor x texture; anything else is computed
-per pixel from its images' samples (techniques/material_textures.py writes it in GLSL; `values` and `bound`
-are its numpy mirrors).
+"""Values a node tree computes per pixel: sums of products of constants and factors (an affine function of an
+image, such as 1 - metallic, or of one of its channels; a colour attribute; the surface's coordinates; a node
+function of other Expressions: reflectance/node_functions.py), with the arithmetic of the formulas that use
+them (reflectance/principled.py writes kd = base (1 - metallic) once for numbers and for textures).  A value
+with no factor is a constant; with one plain image it is the engine's factor x texture; anything else is
+computed per pixel (techniques/material_textures.py writes it in GLSL; `values` and `bound` are its numpy
+mirrors).
 
 Colours are RGB triples throughout: a scalar constant c is (c, c, c), and a scalar slot reads the red channel.
 """
@@ -178,7 +179,7 @@ class Expression:
         return self._names("coordinates")
 
     def as_constant(self):
-        """Its RGB value when it holds no image or attribute, else None."""
+        """Its RGB value when it holds no factor (image, attribute, coordinates, function), else None."""
         if any(factors for _, factors in self.terms):
             return None
         return tuple(float(sum(c[k] for c, _ in self.terms)) for k in range(3))

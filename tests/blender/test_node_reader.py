@@ -330,3 +330,23 @@ def test_a_shader_inside_a_group_and_the_output_eevee_renders(empty_file):
     params, warnings = _read(material)
     assert params.roughness == pytest.approx(0.2) and params.specular_color != (0.0, 0.0, 0.0)
     assert len(warnings) == 1 and "'Outer/Brick Texture' (Brick Texture)" in warnings[0], warnings
+
+
+def test_colour_attributes_export_per_corner_and_non_finite_ones_are_named(empty_file):
+    """The mesh's default colour attribute is exported per corner (a point attribute at each corner's vertex); a
+    NaN in it becomes 0 and the warning names the attribute."""
+    from sg_prt_addon.blender import export
+    from sg_prt_addon.blender.export.meshes import export_mesh_data
+
+    mesh = bpy.data.meshes.new("coloured")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
+    attribute = mesh.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
+    attribute.data.foreach_set("color", np.array([1, 0, 0, 1, 0, 1, 0, 1, np.nan, 0, 1, 1], np.float32))
+    messages = export.collect_warnings([])
+    try:
+        exported = export_mesh_data(mesh, "coloured")
+    finally:
+        export.collect_warnings(None)
+    np.testing.assert_allclose(exported.colors, [[1, 0, 0, 1], [0, 1, 0, 1], [0, 0, 1, 1]])
+    assert len(messages) == 1 and "'Col'" in messages[0] and "non-finite" in messages[0], messages
+    assert export_mesh_data(bpy.data.meshes.new("plain"), "plain").colors is None

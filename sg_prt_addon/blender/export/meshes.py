@@ -30,7 +30,6 @@ class MeshExport:
     vertex_normals: np.ndarray = None  # (vertex_count, 3) float32
     # the mesh's default colour attribute (what a node tree's Color Attribute reads), linear RGBA a corner
     colors: np.ndarray = None          # (V, 4) float32, or None without one
-    color_name: str = ""
     # the mesh's texture space (location, size): what Generated coordinates span ([0, 1] over location +- size)
     texture_space: tuple = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
 
@@ -165,8 +164,8 @@ def export_mesh_data(mesh, name=None):
 
 
 def _corner_colors(mesh, vertex_index, name):
-    """MeshExport's colors and color_name: the default colour attribute's linear RGBA at every corner (a point
-    attribute taken at the corner's vertex), non-finite values made 0 (warned)."""
+    """MeshExport's colors: the default colour attribute's linear RGBA at every corner (a point attribute taken
+    at the corner's vertex), non-finite values made 0 (warned)."""
     attribute = default_color_attribute(mesh)
     if attribute is None or attribute.domain not in ("POINT", "CORNER"):
         return {}
@@ -178,7 +177,7 @@ def _corner_colors(mesh, vertex_index, name):
     if not np.isfinite(values).all():
         warn(f"object '{name or mesh.name}': colour attribute '{attribute.name}' has non-finite values: 0 used")
         values = np.where(np.isfinite(values), values, np.float32(0.0))
-    return {"colors": np.ascontiguousarray(values, np.float32), "color_name": attribute.name}
+    return {"colors": np.ascontiguousarray(values, np.float32)}
 
 
 def _usable_normals(normals, vertex_index, mesh, name):
