@@ -23,7 +23,7 @@ def node_materials(blender):
                                               # normal map: light below the mesh's horizon reaches bumps facing
                                               # it; Cycles cuts it)
     ("principled_pbr_metallic_map", 0.25, 0.04),  # 0.185 / -0.001 / 0.163: colours computed per pixel from two
-                                                  # images (0.243 / +0.008 computed into textures over the texels)
+                                                  # images
     ("principled_tiled", 0.20, 0.05),         # 0.155 / +0.022 / 0.097: a Mapping node tiling and turning the UVs
                                               # (its turn read the other way round: 1.16)
     ("mix_diffuse_glossy", 0.17, 0.03),       # 0.125 / +0.001 / 0.103

@@ -1,8 +1,7 @@
 """Node values against Cycles' own evaluation (benchmarks/node_values.py): a node's output routed into an
 Emission on a plane filling an orthographic view, so Cycles' image is the socket's value; SG-PRT reads the same
 nodes.  64 x 64, 16 spp x 2 seeds.  Bounds from the figures measured at this size (in comments: RMSE / bias /
-noise floor); before node groups, channels and emission textures were read, every case scored 0.99-5.8 (the
-emission read as white, a grouped shader as nothing)."""
+noise floor)."""
 import pytest
 
 pytestmark = pytest.mark.cycles
@@ -24,8 +23,7 @@ def node_values(blender):
     ("separate_color", *SRGB_IMAGE),                # 0.0108 / +0.0083 / 0.0022
     ("combine_color", *SRGB_IMAGE),                 # 0.0139 / +0.0075 / 0.0023
     ("separate_combine_xyz", 0.005, 0.002),         # 0.0012 / +0.0000 / 0.0009
-    ("math_and_mix", 0.03, 0.02),                   # 0.0169 / +0.0099 / 0.0044 (0.0381 / +0.0188 with the product
-                                                    # computed into a texture over the image's texels)
+    ("math_and_mix", 0.03, 0.02),                   # 0.0169 / +0.0099 / 0.0044: a product of two images' values
     ("muted_and_rerouted", *SRGB_IMAGE),            # 0.0139 / +0.0075 / 0.0023
     ("nested_groups", *SRGB_IMAGE),                 # 0.0091 / +0.0048 / 0.0014
     ("principled_emission_texture", *SRGB_IMAGE),   # 0.0136 / +0.0075 / 0.0023
