@@ -37,26 +37,19 @@ def bilinear(image, uv, layer=None, wrap=False, extension=None):
     trailing = (Ellipsis,) + (None,) * (image.ndim - 2 - first)
     fx, fy = (x - x0)[trailing], (y - y0)[trailing]
     x0, y0 = x0.astype(np.int64), y0.astype(np.int64)
-    if extension is not None:
-        xa, xb = _texel_index(x0, width, extension), _texel_index(x0 + 1, width, extension)
-        ya, yb = _texel_index(y0, height, extension), _texel_index(y0 + 1, height, extension)
-        if extension == "CLIP":             # texels past the edge are black: their weights count nothing
-            def inside(index, size):
-                return ((index >= 0) & (index < size))[trailing].astype(dtype)
-            ina, inb = inside(x0, width), inside(x0 + 1, width)
-            index = () if layer is None else (layer,)
-            low = image[index + (ya, xa)] * (1 - fx) * ina + image[index + (ya, xb)] * fx * inb
-            high = image[index + (yb, xa)] * (1 - fx) * ina + image[index + (yb, xb)] * fx * inb
-            return low * (1 - fy) * inside(y0, height) + high * fy * inside(y0 + 1, height)
-    elif wrap:
-        xa, xb, ya, yb = x0 % width, (x0 + 1) % width, y0 % height, (y0 + 1) % height
-    else:
-        xa, xb = np.clip(x0, 0, width - 1), np.clip(x0 + 1, 0, width - 1)
-        ya, yb = np.clip(y0, 0, height - 1), np.clip(y0 + 1, 0, height - 1)
+    extension = extension or ("REPEAT" if wrap else "EXTEND")
+    xa, xb = _texel_index(x0, width, extension), _texel_index(x0 + 1, width, extension)
+    ya, yb = _texel_index(y0, height, extension), _texel_index(y0 + 1, height, extension)
+    wx0, wx1, wy0, wy1 = 1 - fx, fx, 1 - fy, fy
+    if extension == "CLIP":             # texels past the edge are black: their weights count nothing
+        def inside(index, size):
+            return ((index >= 0) & (index < size))[trailing].astype(dtype)
+        wx0, wx1 = wx0 * inside(x0, width), wx1 * inside(x0 + 1, width)
+        wy0, wy1 = wy0 * inside(y0, height), wy1 * inside(y0 + 1, height)
     index = () if layer is None else (layer,)
-    low = image[index + (ya, xa)] * (1 - fx) + image[index + (ya, xb)] * fx
-    high = image[index + (yb, xa)] * (1 - fx) + image[index + (yb, xb)] * fx
-    return low * (1 - fy) + high * fy
+    low = image[index + (ya, xa)] * wx0 + image[index + (ya, xb)] * wx1
+    high = image[index + (yb, xa)] * wx0 + image[index + (yb, xb)] * wx1
+    return low * wy0 + high * wy1
 
 
 def bilinear_channels_first(images, uv):
