@@ -567,8 +567,9 @@ vec3 node_layer_weight(vec3 blend, vec3 normal, vec3 incoming, bool fresnel)
   return vec3(1.0 - (blend.x != 0.5 ? pow(abs(cosine), exponent) : abs(cosine)));
 }
 
-/* The Mix node's HSV blends (node_functions._mix_hsv) */
-vec3 node_mix_hue(vec3 t, vec3 a, vec3 b)
+/* The Mix node's HSV blends (node_functions._mix_hsv): Hue takes b's hue, Color its hue and saturation, where b
+ * has a hue */
+vec3 node_mix_hue_of(vec3 t, vec3 a, vec3 b, bool saturation)
 {
   vec3 hsv_b = node_rgb_to_hsv(b);
   if (hsv_b.y == 0.0) {
@@ -576,18 +577,11 @@ vec3 node_mix_hue(vec3 t, vec3 a, vec3 b)
   }
   vec3 hsv = node_rgb_to_hsv(a);
   hsv.x = hsv_b.x;
+  hsv.y = saturation ? hsv_b.y : hsv.y;
   return mix(a, node_hsv_to_rgb(hsv), t.x);
 }
-vec3 node_mix_color(vec3 t, vec3 a, vec3 b)
-{
-  vec3 hsv_b = node_rgb_to_hsv(b);
-  if (hsv_b.y == 0.0) {
-    return a;
-  }
-  vec3 hsv = node_rgb_to_hsv(a);
-  hsv.xy = hsv_b.xy;
-  return mix(a, node_hsv_to_rgb(hsv), t.x);
-}
+vec3 node_mix_hue(vec3 t, vec3 a, vec3 b) { return node_mix_hue_of(t, a, b, false); }
+vec3 node_mix_color(vec3 t, vec3 a, vec3 b) { return node_mix_hue_of(t, a, b, true); }
 vec3 node_mix_saturation(vec3 t, vec3 a, vec3 b)
 {
   vec3 hsv = node_rgb_to_hsv(a);

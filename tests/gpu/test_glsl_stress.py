@@ -1188,7 +1188,7 @@ def test_node_functions_stress(glsl, fuzz):
                  "node_fresnel(abs(a.xyz), node_safe_normalize(b.xyz), node_safe_normalize(c.xyz))",
                  "node_layer_weight(t.xyz, node_safe_normalize(b.xyz), node_safe_normalize(c.xyz), true) + "
                  "node_layer_weight(t.xyz, b.xyz * 0.0, node_safe_normalize(c.xyz), false) + "
-                 "vec3(node_fresnel_dielectric_cos(t.x, 0.0))"):
+                 "vec3(node_fresnel_dielectric_cos(t.x, 0.0)) + node_mix_hue_of(t.xyz, abs(a.xyz), abs(b.xyz), true)"):
         check(call, everything)
 
 
@@ -1256,7 +1256,7 @@ COVERED = {
        "node_smooth_min", "node_mapping", "node_euler_matrix", "node_safe_normalize", "node_tex_checker",
        "node_tex_gradient", "node_hash_uint3", "node_rot", "node_fade", "node_grad3", "node_perlin_3d",
        "node_snoise_3d", "node_noise_fractal", "node_tex_noise", "node_tex_wave", "node_tex_magic", "node_fresnel",
-       "node_layer_weight", "node_fresnel_dielectric_cos"],
+       "node_layer_weight", "node_fresnel_dielectric_cos", "node_mix_hue_of"],
 }
 
 _DEFINITION = re.compile(r"^\s*(?:float|int|uint|bool|void|vec[234]|ivec[234]|mat[234])\s+([A-Za-z_]\w*)\s*\(", re.M)
