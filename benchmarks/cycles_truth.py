@@ -49,3 +49,32 @@ def score(scene, samples, scores=True):
                    relative_bias=image_error.relative_mean_bias(image, truth, mask),
                    noise_floor=image_error.relative_rmse(seeds[0][1], seeds[1][1], mask) / 2)
     return row
+
+
+def cases_main(argv, description, option, cases, size, samples, score_case, json_path, doc_path, title,
+               markdown_section):
+    """The command line of a benchmark of named cases scored against Cycles: run the cases `option` lists (all
+    of `cases` by default) at --size and --cycles-samples through score_case(name, size, samples), write their
+    rows to json_path and print markdown_section(data); or, with --update-doc, write that section from the JSON
+    into doc_path under `title`."""
+    import argparse
+    import json
+
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--size", type=int, default=size)
+    parser.add_argument("--cycles-samples", type=int, default=samples)
+    parser.add_argument(option, default=",".join(cases))
+    parser.add_argument("--update-doc", action="store_true", help="write the section from the JSON (no run)")
+    args = parser.parse_args(argv)
+    if args.update_doc:
+        from benchmarks import markdown_sections
+        markdown_sections.update_file(str(doc_path), title, markdown_section(json.loads(json_path.read_text())))
+        print(f"updated {doc_path}")
+        return
+    started = time.perf_counter()
+    names = getattr(args, option.lstrip("-").replace("-", "_")).split(",")
+    rows = [score_case(name, args.size, args.cycles_samples) for name in names]
+    data = {"size": args.size, "cycles_samples": args.cycles_samples, "rows": rows,
+            "seconds": time.perf_counter() - started}
+    json_path.write_text(json.dumps(data, indent=1))
+    print(markdown_section(data))

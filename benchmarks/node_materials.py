@@ -8,9 +8,6 @@ Scores over the sphere's pixels (one pixel in from its silhouette): relative RMS
 
     .venv/bin/python -m benchmarks.node_materials [--size 128] [--cycles-samples 256] [--update-doc]
 """
-import argparse
-import json
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -241,23 +238,10 @@ def markdown_section(data):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=int, default=128)
-    parser.add_argument("--cycles-samples", type=int, default=256)
-    parser.add_argument("--scenes", default=",".join(SCENES))
-    parser.add_argument("--update-doc", action="store_true", help="write the section from the JSON (no run)")
-    args = parser.parse_args(argv)
-    if args.update_doc:
-        from benchmarks import markdown_sections
-        markdown_sections.update_file(str(DOC_PATH), SECTION_TITLE, markdown_section(json.loads(JSON_PATH.read_text())))
-        print(f"updated {DOC_PATH}")
-        return
-    started = time.perf_counter()
-    rows = [score(name, args.size, args.cycles_samples) for name in args.scenes.split(",")]
-    data = {"size": args.size, "cycles_samples": args.cycles_samples, "rows": rows,
-            "seconds": time.perf_counter() - started}
-    JSON_PATH.write_text(json.dumps(data, indent=1))
-    print(markdown_section(data))
+    from benchmarks import cycles_truth
+
+    cycles_truth.cases_main(argv, __doc__.splitlines()[0], "--scenes", SCENES, 128, 256,
+                            score, JSON_PATH, DOC_PATH, SECTION_TITLE, markdown_section)
 
 
 if __name__ == "__main__":

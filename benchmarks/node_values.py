@@ -5,9 +5,6 @@ bias over the plane against the mean of two Cycles seeds, and the noise floor (b
 
     .venv/bin/python -m benchmarks.node_values [--size 64] [--cycles-samples 16] [--update-doc]
 """
-import argparse
-import json
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -738,23 +735,13 @@ def markdown_section(data):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=int, default=64)
-    parser.add_argument("--cycles-samples", type=int, default=16)
-    parser.add_argument("--cases", default=",".join(CASES))
-    parser.add_argument("--update-doc", action="store_true", help="write the section from the JSON (no run)")
-    args = parser.parse_args(argv)
-    if args.update_doc:
-        from benchmarks import markdown_sections
-        markdown_sections.update_file(str(DOC_PATH), SECTION_TITLE, markdown_section(json.loads(JSON_PATH.read_text())))
-        print(f"updated {DOC_PATH}")
-        return
-    started = time.perf_counter()
-    rows = [score(name, args.size, args.cycles_samples, scores=name not in ZERO_TRUTH) for name in args.cases.split(",")]
-    data = {"size": args.size, "cycles_samples": args.cycles_samples, "rows": rows,
-            "seconds": time.perf_counter() - started}
-    JSON_PATH.write_text(json.dumps(data, indent=1))
-    print(markdown_section(data))
+    from benchmarks import cycles_truth
+
+    def score_case(name, size, samples):
+        return score(name, size, samples, scores=name not in ZERO_TRUTH)
+
+    cycles_truth.cases_main(argv, __doc__.splitlines()[0], "--cases", CASES, 64, 16, score_case, JSON_PATH, DOC_PATH,
+                            SECTION_TITLE, markdown_section)
 
 
 if __name__ == "__main__":
