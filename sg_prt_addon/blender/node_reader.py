@@ -67,9 +67,14 @@ def _constant(value, colour):
     return Expression.constant(value)
 
 
+def _weighted_channels(value, weights):
+    """sum_k weights[k] x a colour's channel k, on all three channels."""
+    return sum((value.channel(k) * weight for k, weight in enumerate(weights)), Expression.constant(0.0))
+
+
 def _luminance(value):
     """A colour's Rec. 709 luminance on all three channels."""
-    return sum((value.channel(k) * weight for k, weight in enumerate(LUMINANCE)), Expression.constant(0.0))
+    return _weighted_channels(value, LUMINANCE)
 
 
 def _uv_source(socket):
@@ -369,7 +374,7 @@ class SocketReader:
             self.note(node, f"attribute '{name}': each mesh's default colour attribute is read")
         value = Expression.attribute(name)
         if out.identifier == "Fac":
-            return sum((value.channel(k) for k in range(3)), Expression.constant(0.0)) * (1.0 / 3.0)
+            return _weighted_channels(value, (1.0 / 3.0,) * 3)
         if out.identifier == "Alpha":
             self.note(node, "its Alpha output: 1 is used")
             return Expression.constant(1.0)
