@@ -50,6 +50,15 @@ def _bits(array):
     return np.ascontiguousarray(array, np.float32).view(np.uint32)
 
 
+def _same_fit(stored, direct, names):
+    """The stored fit is the direct fit's float32, up to rounding: BLAS sums in an order that
+    depends on threads and alignment, so two fits of one file may differ in the last bits
+    (an axis's zero components came out 1e-16 and 5e-16)."""
+    for name in names:
+        expected = np.float32(getattr(direct, name))
+        assert np.allclose(getattr(stored, name), expected, rtol=1e-5, atol=1e-6), name
+
+
 def _snapshot(material):
     """Everything a fit stores: metadata and the raw pixels of each image, by role."""
     settings = material.sgprt.lobe_fit
@@ -89,12 +98,11 @@ def test_merl_fit_stores_packed_float_images_that_survive_save_and_reopen(materi
         assert image.is_float and image.packed_file is not None and image.channels == 4
     assert lf.fit_status(material)[0] == "VALID"
 
-    # the stored numbers are the float32 of a direct fit of the same file (the fit is deterministic)
+    # the stored numbers are the float32 of a direct fit of the same file
     direct = microfacet_fit.fit_merl(merl.read_merl(data["merl"]), 2)
     stored = lf.stored_lobe_fit(material)
-    for name in ("diffuse", "eta", "axis", "sharpness", "amplitude", "shadowing_theta", "shadowing_mean",
-                 "shadowing_basis", "shadowing_coefficients", "ndf_error"):
-        assert np.array_equal(getattr(stored, name), np.float32(getattr(direct, name))), name
+    _same_fit(stored, direct, ("diffuse", "eta", "axis", "sharpness", "amplitude", "shadowing_theta",
+                               "shadowing_mean", "shadowing_basis", "shadowing_coefficients", "ndf_error"))
     # the lobes are the microfacet model's: two lobes on z+, sharper second
     assert np.allclose(stored.axis[0, :, 2], 1) and stored.sharpness[0, 0] < stored.sharpness[0, 1]
 
@@ -126,8 +134,7 @@ def test_table_fit_per_texel_layout_and_round_trip(material, data, tmp_path):
     base = base.reshape(6, 5, 4)
     assert np.array_equal(base[::-1, :, :3], table.diffuse) and np.array_equal(base[::-1, :, 3], table.eta)
     stored = lf.stored_lobe_fit(material)
-    for name in ("axis", "sharpness", "amplitude", "shadowing_coefficients", "shadowing_basis"):
-        assert np.array_equal(getattr(stored, name), np.float32(getattr(direct, name))), name
+    _same_fit(stored, direct, ("axis", "sharpness", "amplitude", "shadowing_coefficients", "shadowing_basis"))
     # per-texel: roughness grows along x, so the sharpest lobe is sharper at column 0 than at column 4
     sharpest = stored.sharpness[:, -1].reshape(6, 5)
     assert np.all(sharpest[:, 0] > sharpest[:, 4])
