@@ -613,6 +613,81 @@ def unlit(name):
     return material
 
 
+def alpha_image():
+    """A 16 x 16 image whose alpha is a ramp across u (0.1 to 0.9) and a wave along v, its colour the waves'."""
+    import bpy
+    import numpy as np
+
+    if "alpha_waves" in bpy.data.images:
+        return bpy.data.images["alpha_waves"]
+    source = colour_image()
+    pixels = np.empty(TEXTURE_SIDE * TEXTURE_SIDE * 4, np.float32)
+    source.pixels.foreach_get(pixels)
+    pixels = pixels.reshape(TEXTURE_SIDE, TEXTURE_SIDE, 4)
+    u, v = np.meshgrid((np.arange(TEXTURE_SIDE) + 0.5) / TEXTURE_SIDE, (np.arange(TEXTURE_SIDE) + 0.5) / TEXTURE_SIDE)
+    pixels[..., 3] = np.clip(0.1 + 0.8 * u + 0.1 * np.sin(2 * np.pi * v), 0.0, 1.0)
+    image = bpy.data.images.new("alpha_waves", TEXTURE_SIDE, TEXTURE_SIDE, alpha=True)
+    image.pixels.foreach_set(np.ascontiguousarray(pixels).ravel())
+    image.pack()
+    return image
+
+
+def _emitting_principled(tree, colour_socket=None):
+    """A black Principled BSDF emitting the image (or colour_socket's value), Strength 1."""
+    node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    node.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    node.inputs["Emission Strength"].default_value = 1.0
+    tree.links.new(colour_socket or _image_node(tree).outputs["Color"], node.inputs["Emission Color"])
+    return node
+
+
+def alpha_constant(name):
+    """The emitting Principled BSDF at Alpha 0.4 over the backdrop (BACKDROP_CASES)."""
+    material, tree, output = _material(name)
+    node = _emitting_principled(tree)
+    node.inputs["Alpha"].default_value = 0.4
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def alpha_texture(name):
+    """The emitting Principled BSDF whose Alpha is an image's Alpha output (glTF's alpha blend and mask)."""
+    material, tree, output = _material(name)
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = alpha_image()
+    node = _emitting_principled(tree, texture.outputs["Color"])
+    tree.links.new(texture.outputs["Alpha"], node.inputs["Alpha"])
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def transparent_mix(name):
+    """A Transparent BSDF mixed with an Emission of the image by the image's green channel."""
+    material, tree, output = _material(name)
+    texture = _image_node(tree)
+    emission, transparent = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeBsdfTransparent")
+    tree.links.new(texture.outputs["Color"], emission.inputs["Color"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(_separate(tree, texture.outputs["Color"]).outputs["Green"], mix.inputs["Fac"])
+    tree.links.new(transparent.outputs[0], mix.inputs[1])
+    tree.links.new(emission.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def _backdrop_material():
+    """The backdrop's: an Emission of (0.1, 0.3, 0.8)."""
+    import bpy
+
+    if "backdrop" in bpy.data.materials:
+        return bpy.data.materials["backdrop"]
+    material, tree, output = _material("backdrop")
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (0.1, 0.3, 0.8, 1.0)
+    tree.links.new(emission.outputs[0], output.inputs["Surface"])
+    return material
+
+
 def _socket_case(value_of):
     return lambda name: _emitting(name, value_of)
 
@@ -664,10 +739,13 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "layer_weight_fresnel": _socket_case(layer_weight("Fresnel", 0.3)),
          "layer_weight_facing": _socket_case(layer_weight("Facing", 0.3)),
          "layer_weight_facing_0_8": _socket_case(layer_weight("Facing", 0.8)),
-         "mix_shader_by_fresnel": mix_shader_by_fresnel, "unlit": unlit}
+         "mix_shader_by_fresnel": mix_shader_by_fresnel, "unlit": unlit,
+         "alpha_constant": alpha_constant, "alpha_texture": alpha_texture, "transparent_mix": transparent_mix}
 # the cases on a sphere (what depends on the view's angle to the surface) in place of the plane
 SPHERE_CASES = ("fresnel", "fresnel_ior_3", "layer_weight_fresnel", "layer_weight_facing", "layer_weight_facing_0_8",
                 "mix_shader_by_fresnel")
+# the cases over a backdrop: a second plane behind, which shows through their transparency
+BACKDROP_CASES = ("alpha_constant", "alpha_texture", "transparent_mix")
 # cases whose truth is 0 everywhere (scored by their largest values)
 ZERO_TRUTH = ("color_attribute_missing",)
 # the cases whose grid has the colour attribute: (domain, data type)
@@ -677,7 +755,8 @@ COLOURED = {"color_attribute": ("POINT", "FLOAT_COLOR"), "color_attribute_corner
 
 def build(name, size):
     """The case's plane (2 m, 8 x 8 faces, its UVs over [0, 1]; the colour attribute where the case has one)
-    under an orthographic camera that it fills; a sphere in the plane's place for SPHERE_CASES."""
+    under an orthographic camera that it fills; a sphere in the plane's place for SPHERE_CASES; a larger plane
+    behind it for BACKDROP_CASES."""
     import bpy
 
     from benchmarks import truth_suite
@@ -694,6 +773,9 @@ def build(name, size):
     if name in COLOURED:
         add_colour_attribute(plane.data, *COLOURED[name])
     plane.data.materials.append(CASES[name](name))
+    if name in BACKDROP_CASES:
+        bpy.ops.mesh.primitive_plane_add(size=3.0, location=(0.0, 0.0, -0.5))
+        bpy.context.active_object.data.materials.append(_backdrop_material())
     camera = build_scenes._add_camera(scene, location=(0.0, 0.0, 3.0), target=(0.0, 0.0, 0.0))
     camera.data.type = "ORTHO"
     camera.data.ortho_scale = 2.0
@@ -721,7 +803,9 @@ def markdown_section(data):
              "2 seeds: Cycles' image is the socket's value.  SG-PRT reads the same nodes.  Relative RMSE and bias "
              "over the plane.  The cases of an 8-bit sRGB image keep a bias of +0.5-0.8%: Cycles filters the "
              "encoded texels and decodes the result, the GPU (SG-PRT, EEVEE) decodes the texels before it filters; "
-             "the same image as Non-Color has none.", "",
+             "the same image as Non-Color has none.  The transparency cases (alpha_constant, alpha_texture, "
+             "transparent_mix) lie over a plane emitting (0.1, 0.3, 0.8) that shows through them: SG-PRT's dithered "
+             "coverage at Edges Only's 4 x 4 grid against Cycles' samples.", "",
              "| case | relative RMSE | bias | noise floor |", "|---|---|---|---|"]
     for row in data["rows"]:
         if "relative_rmse" in row:

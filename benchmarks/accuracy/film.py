@@ -1,8 +1,10 @@
-"""Accuracy of what a pixel averages: the pixel filter's reconstruction (engine/pixel_filter.py) and the material
-textures' mip levels (spherical/texture_mips.py) with a minified normal map's spread of normals.
+"""Accuracy of what a pixel averages: the pixel filter's reconstruction (engine/pixel_filter.py), the material
+textures' mip levels (spherical/texture_mips.py) with a minified normal map's spread of normals, and the dithered
+coverage of a transparent surface (anti_aliasing.coverage_threshold).
 
 References: the filtered row of an image by dense quadrature (2001 points over the filter's support); the mean
-of the texels under a pixel's square footprint; the von Mises-Fisher mean length coth kappa - 1 / kappa.
+of the texels under a pixel's square footprint; the von Mises-Fisher mean length coth kappa - 1 / kappa; the
+surface's alpha.
 """
 import numpy as np
 
@@ -98,6 +100,25 @@ def mip_errors(footprint, count=4000, seed=11):
     return np.abs(filtered - exact), np.abs(point - exact)
 
 
+def coverage_errors(offsets, trials=3000, seed=3):
+    """A pixel's coverage after the pixel filter (Blackman-Harris 1.5 px, one frame an offset) minus its alpha, for
+    uniform alphas at random pixels: each frame's sample of each neighbour keeps the surface where the alpha
+    exceeds its threshold (anti_aliasing.coverage_threshold at that frame's offset)."""
+    weights = HARRIS.frame_weights(HARRIS.jitter_offsets(anti_aliasing.pixel_jitter(len(offsets))))
+    reach = HARRIS.reach
+    rng = np.random.default_rng(seed)
+    alpha = rng.uniform(size=trials)
+    x, y = rng.integers(0, 4096, (2, trials))
+    covered = np.zeros(trials)
+    for dy in range(-reach, reach + 1):
+        for dx in range(-reach, reach + 1):
+            thresholds = anti_aliasing.coverage_threshold((x + dx)[:, None], (y + dy)[:, None],
+                                                          np.asarray(offsets)[None, :])
+            frame_weights = weights[:, 0, dx + reach] * weights[:, 1, dy + reach]
+            covered += ((alpha[:, None] > thresholds) * frame_weights[None, :]).sum(axis=1)
+    return covered - alpha
+
+
 def measure():
     errors = filter_errors()
     rows = [dict(name="Blackman-Harris 1.5 px, Edges Only's 4 x 4 grid a pixel weighted",
@@ -115,6 +136,14 @@ def measure():
                          metric="absolute error on a white-noise image in [0, 1] (max / mean)",
                          max_error=float(trilinear.max()), mean_error=float(trilinear.mean()),
                          note=f"bilinear in the image (no levels): mean {bilinear.mean():.3g}"))
+    coverage = np.abs(coverage_errors(anti_aliasing.coverage_offsets(16)))
+    plain = np.abs(coverage_errors(np.arange(16) / 16.0))
+    rows.append(dict(name="dithered coverage, 16 jittered frames, thresholds offset by k x the golden ratio",
+                     reference="the surface's alpha", metric="absolute error of the filtered coverage over uniform "
+                     "alphas (max / RMS)", max_error=float(coverage.max()),
+                     mean_error=float(np.sqrt(np.mean(coverage ** 2))),
+                     note=f"offsets k / 16: RMS {np.sqrt(np.mean(plain ** 2)):.3g}; Cycles' 16 random samples: "
+                          f"RMS {np.sqrt(1.0 / 96.0):.3g}"))
     kappa = kappa_errors()
     rows.append(dict(name="a minified normal map's spread: kappa from the mean normal's length",
                      reference="the von Mises-Fisher mean length coth kappa - 1 / kappa",

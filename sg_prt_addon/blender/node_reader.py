@@ -1,9 +1,10 @@
 """A material's shader nodes read as the engine's parameters (material.sgprt.source = Node Tree).
 
 From the Material Output EEVEE renders, the shader tree (node_graph: groups entered, reroutes and muted nodes
-passed) is walked into weighted closures: Principled, Diffuse and Glossy BSDFs, Emission, through Mix Shader
-(its factor a constant or a texture) and Add Shader.  Their inputs are read as texture_expression.Expressions:
-unlinked sockets, RGB and Value, Image Textures, colour attributes, the surface's coordinates, and the nodes
+passed) is walked into weighted closures: Principled, Diffuse and Glossy BSDFs, Emission, Transparent BSDF and
+Holdout, through Mix Shader (its factor a constant or a texture) and Add Shader; transparency (Principled Alpha
+too) becomes the surface's coverage (reflectance/coverage.py).  Their inputs are read as
+texture_expression.Expressions: unlinked sockets, RGB and Value, Image Textures, colour attributes, the surface's coordinates, and the nodes
 that compute values from them (sums and products in the algebra, the rest reflectance/node_functions.py),
 a Normal Map in tangent space.  reflectance/principled.py maps the BSDFs' values to the model, colours and
 layering; an expression that is a constant or a factor times one image over the UV map takes the engine's
@@ -15,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..reflectance import node_functions, principled
+from ..reflectance import coverage, node_functions, principled
 from ..reflectance.texture_expression import Expression
 from .colour_attributes import default_color_attribute
 from .node_graph import output_node
@@ -24,6 +25,8 @@ IDENTITY_UV_TRANSFORM = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
 # Blender's implicit colour -> float conversion (Rec. 709 luminance)
 LUMINANCE = (0.2126, 0.7152, 0.0722)
 COLOUR_SLOTS = ("diffuse_color", "specular_color", "emission")
+# closures that take the place of what is behind, not light of their own (reflectance/coverage.py)
+TRANSPARENT, HOLDOUT = "transparent", "holdout"
 SEPARATE_NODES = ("SEPARATE_COLOR", "SEPRGB", "SEPXYZ")
 COMBINE_NODES = ("COMBINE_COLOR", "COMBRGB", "COMBXYZ")
 
@@ -41,7 +44,7 @@ class Reading:
 
 @dataclass
 class _Closure:
-    kind: str            # "principled", "diffuse", "glossy", "emission"
+    kind: str            # "principled", "diffuse", "glossy", "emission", TRANSPARENT, HOLDOUT
     weight: object       # float or Expression
     node: object
 
@@ -440,15 +443,13 @@ class SocketReader:
         if image is None:
             self.note(node, f"no image: {socket.name} uses its value")
             return _constant(_default(socket), colour)
-        if out.name != "Color":
-            self.note(node, f"its {out.name} output is read as its Color")
         if node.projection != "FLAT":
             self.note(node, f"{node.projection.lower()} projection: read flat")
         self.images[image.name] = image
         if not _over_the_uv_map(node):
             vector_socket = node.inputs["Vector"]
             vector = self.value(vector_socket, True) if vector_socket.is_linked else Expression.coordinates("UV")
-            return Expression.image_at(image.name, node.extension, vector)
+            return Expression.image_at(image.name, node.extension, vector, out.name)
         vector = follow(node.inputs["Vector"])
         transform = IDENTITY_UV_TRANSFORM
         if vector is not None and vector.node.type == "MAPPING":
@@ -459,6 +460,8 @@ class SocketReader:
             source = vector.node
             if source.type == "UVMAP" and source.uv_map and self._other_uv_map(source.uv_map):
                 self.note(source, f"UV map '{source.uv_map}': each mesh's active UV map is used")
+        if out.name == "Alpha":     # at the material's texture coordinates, as its Color
+            return Expression.image_at(image.name, "REPEAT", Expression.coordinates("UV"), "Alpha")
         return Expression.image(image.name)
 
     def uv_transform_of(self, mapping):
@@ -506,8 +509,22 @@ class SocketReader:
         node = out.node
         kind = {"BSDF_PRINCIPLED": "principled", "BSDF_DIFFUSE": "diffuse", "BSDF_GLOSSY": "glossy",
                 "BSDF_ANISOTROPIC": "glossy", "EMISSION": "emission"}.get(node.type)
+        if node.type == "BSDF_PRINCIPLED" and "Alpha" in node.inputs:
+            # Cycles: the BSDF mixed with a Transparent BSDF by its Alpha
+            alpha = self.value(node.inputs["Alpha"], False)
+            constant = scalar_of(alpha)
+            if constant is None or constant < 1.0:
+                alpha = max(0.0, constant) if constant is not None else _clamped(alpha)
+                return [_Closure("principled", weight * alpha, node), _Closure(TRANSPARENT, weight * (1.0 - alpha), node)]
         if kind is not None:
             return [_Closure(kind, weight, node)]
+        if node.type == "BSDF_TRANSPARENT":
+            colour = self.value(node.inputs["Color"], True)
+            if colour.as_constant() is None or len(set(colour.as_constant())) > 1:
+                self.note(node, "a tinted Transparent BSDF: what is behind shows untinted, by its colour's mean")
+            return [_Closure(TRANSPARENT, weight * _weighted_channels(colour, (1.0 / 3.0,) * 3), node)]
+        if node.type == "HOLDOUT":
+            return [_Closure(HOLDOUT, weight, node)]
         if node.type == "ADD_SHADER":
             return self.closures(node.inputs[0], weight) + self.closures(node.inputs[1], weight)
         if node.type == "MIX_SHADER":
@@ -539,13 +556,18 @@ def read_material(material):
 
 def _combine(reader, closures, reading):
     """The closures' weighted sum as one parameter set: diffuse colours add, the heaviest glossy lobe gives the
-    model (others are named), emissions add."""
+    model (others are named), emissions add, holdouts add into the holdout slot; the transparent ones set the
+    coverage (_drawn)."""
     fields = reading.fields
-    diffuse = emission = Expression.constant(0.0)
+    closures = _drawn(reader, closures, reading)
+    diffuse = emission = holdout = Expression.constant(0.0)
     specular = None
     for closure in closures:
-        values = _closure_values(reader, closure)
         weight = closure.weight
+        if closure.kind == HOLDOUT:
+            holdout = holdout + weight
+            continue
+        values = _closure_values(reader, closure)
         if "normal_map" in values and "normal_map" not in reading.textures:
             reading.textures["normal_map"] = values.pop("normal_map")
             fields["normal_strength"] = values.pop("normal_strength")
@@ -563,6 +585,9 @@ def _combine(reader, closures, reading):
             emission = emission + weight * Expression.of(values["emission"])
     _to_slot(reader, reading, "diffuse_color", diffuse)
     _to_slot(reader, reading, "emission", emission)
+    if holdout.as_constant() != (0.0, 0.0, 0.0):
+        _to_slot(reader, reading, "holdout", _clamped(holdout) if holdout.as_constant() is None
+                 else min(max(scalar_of(holdout), 0.0), 1.0))
     if specular is not None:
         _, closure, values = specular
         for name, value in values.items():
@@ -579,6 +604,22 @@ def _combine(reader, closures, reading):
     reading.decoded_slots = tuple(sorted(slot for slot, value in reading.textures.items()
                                          if isinstance(value, str) and slot not in COLOUR_SLOTS + ("normal_map",)
                                          and _is_srgb(reader.images[value])))
+
+
+def _drawn(reader, closures, reading):
+    """The closures but the transparent ones, weighted as the surface drawn over the coverage carries them
+    (reflectance/coverage.py), the coverage into the reading's alpha slot."""
+    transparent = [closure for closure in closures if closure.kind == TRANSPARENT]
+    if not transparent:
+        return closures
+    others = [closure for closure in closures if closure.kind != TRANSPARENT]
+    transparency = sum((Expression.of(closure.weight) for closure in transparent), Expression.constant(0.0))
+    weights, alpha = coverage.drawn_weights([closure.weight for closure in others], transparency)
+    _to_slot(reader, reading, "alpha", alpha)
+    if reading.fields.get("alpha", 0.0) < 1.0 or "alpha" in reading.textures:
+        reader.note(transparent[0].node, "transparency: shadows are cast as by an opaque surface")
+    return [_Closure(closure.kind, weight, closure.node) for closure, weight in zip(others, weights)
+            if isinstance(weight, Expression) or weight > 0.0]
 
 
 def _uv_transform(reader, fields):
@@ -703,7 +744,7 @@ def _principled_values(reader, node):
     inputs = node.inputs
     optional = {name: _constant_input(reader, node, name, default)
                 for name, default in (("Specular IOR Level", 0.5), ("Anisotropic", 0.0), ("Anisotropic Rotation", 0.0),
-                                      ("Transmission Weight", 0.0), ("Alpha", 1.0),
+                                      ("Transmission Weight", 0.0),
                                       ("Coat Weight", 0.0), ("Sheen Weight", 0.0), ("Subsurface Weight", 0.0))}
     values = principled.principled(
         reader.value(inputs["Base Color"], True), reader.value(inputs["Metallic"], False),
@@ -716,8 +757,6 @@ def _principled_values(reader, node):
                        ("Sheen Weight", "sheen"), ("Subsurface Weight", "subsurface scattering")):
         if optional[name] > 0.0:
             reader.note(node, f"{what} ({name} {optional[name]:.3g}) is not rendered")
-    if optional["Alpha"] < 1.0:
-        reader.note(node, f"Alpha {optional['Alpha']:.3g}: rendered opaque")
     if optional["Anisotropic"] > 0.0:
         _tangent_input(reader, node)
     return values

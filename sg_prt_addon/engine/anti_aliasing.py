@@ -29,6 +29,23 @@ def pixel_jitter(samples):
     return np.stack([(k + 0.5) / samples, (step * k % samples + 0.5) / samples], axis=1) - 0.5
 
 
+def coverage_offsets(samples):
+    """(samples,) offsets of the dithered coverage's thresholds (surface_io.glsl surface_coverage), one a jittered
+    frame: k times the golden ratio, mod 1.  A pixel keeps the surface in the frames whose thresholds fall below
+    its alpha, a run of these offsets; k / samples would make that run adjacent rows of pixel_jitter's grid, whose
+    pixel-filter weights differ, where the golden ratio spreads it over the grid."""
+    return np.mod(np.arange(max(int(samples), 1)) * 0.6180339887498949, 1.0)
+
+
+def coverage_threshold(x, y, offset):
+    """The threshold of pixel (x, y) (integers) in a frame of coverage offset `offset`: interleaved gradient
+    noise moved by the offset (mirror of surface_io.glsl surface_coverage; a sample keeps the surface where
+    its alpha exceeds it)."""
+    noise = np.mod(52.9829189 * np.mod(0.06711056 * np.asarray(x, np.float64) + 0.00583715 * np.asarray(y), 1.0),
+                   1.0)
+    return np.mod(noise + offset, 1.0)
+
+
 def jittered_projection(projection, offset, width, height):
     """The projection matrix moved by ``offset`` pixels (x right, y DOWN as in this module): clip x and y
     shifted by 2 offset / size times w, so every NDC point moves by that many pixels."""

@@ -293,6 +293,7 @@ def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, t
         sums.start(width, height)
         offsets = chosen_filter.jitter_offsets(anti_aliasing.pixel_jitter(samples))
         weights = chosen_filter.frame_weights(offsets)
+        coverage_offsets = anti_aliasing.coverage_offsets(len(offsets))
         for done, offset in enumerate(offsets):
             if done and cancelled():
                 timings["cancelled"] = True
@@ -302,7 +303,8 @@ def _sampled_passes(scene, state, renderer, camera, samples, background_alpha, t
                 return {name: summed[name.lower()] * np.float32(1.0 / taken) for name in renderer_module.PASS_NAMES}
             # the view-projection is in the scene block: upload it moved (the shadow maps keep the centred plan)
             frame_camera = dataclasses.replace(
-                camera, projection=anti_aliasing.jittered_projection(camera.projection, offset, width, height))
+                camera, projection=anti_aliasing.jittered_projection(camera.projection, offset, width, height),
+                coverage_offset=float(coverage_offsets[done]))
             renderer.upload(state, state.consume_dirty(), frame_camera, shadow_camera=camera)
             renderer.draw(state, frame_camera, background_alpha=background_alpha)
             sums.add(renderer, weights[done])

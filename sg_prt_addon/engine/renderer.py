@@ -14,7 +14,7 @@ from .. import techniques
 from ..blender.export import COLOUR_SLOTS, texture_sources
 from ..lighting import shadow_maps
 from ..spherical import clamped_cosine, texture_mips
-from ..techniques import shader_sources, surface_layering
+from ..techniques import material_textures, shader_sources, surface_layering
 from ..techniques.shader_sources import MAX_ENV_LOBES, MAX_LAYERS, MAX_POINT_LIGHTS, MAX_SUNS
 from ..visibility import per_vertex as per_vertex_layout  # the layout of every per-vertex texture
 from . import disk_cache, gpu_limits, multi_sample, scene_state, shader_cache, shadow_pass
@@ -135,7 +135,8 @@ def scene_block(camera, light_data, environment, shadow_plan=None):
         vec4_array(2 * MAX_ENV_LOBES, clamped_cosine.sharpness_terms(environment.lobe_sharpness[:env_lobes], np.float32)
                    if env_lobes else []),
         np.asarray(_column_major(camera.projection @ camera.view), np.float32).reshape(4, 4),   # mat4 columns
-        np.array([[camera.shading_footprint, camera.footprint_grid_limit, camera.texture_footprint, 0.0]], np.float32),
+        np.array([[camera.shading_footprint, camera.footprint_grid_limit, camera.texture_footprint,
+                   camera.coverage_offset]], np.float32),
         shadow_pass.scene_rows(shadow_plan, light_data),
     ]
     return np.concatenate(parts, axis=0)
@@ -150,8 +151,8 @@ def material_block(params, material_id=0):
         [params.alpha_y, params.nu, params.nv, params.normal_strength],
         list(params.tangent_axis) + [params.tangent_rotation],
         [1.0 if params.tangent_source == "OBJECT_AXIS" else 0.0, float(material_id),
-         surface_layering.layer_roughness(params), 0.0],
-        list(params.emission) + [0.0],
+         surface_layering.layer_roughness(params), params.alpha],
+        list(params.emission) + [params.holdout],
         list(params.uv_transform[:3]) + [0.0],
         list(params.uv_transform[3:]) + [0.0],
     ], np.float32)
@@ -615,20 +616,27 @@ class Renderer:
             if self.depth_prepass:
                 gpu.state.depth_mask_set(False)     # the shading pass tests against the final depth
             self._draw_surfaces(draws)
+            # surfaces with a coverage below 1 last, writing the depth of the samples they keep (the pre-pass
+            # left them out: its depth would hide what shows through them)
+            gpu.state.depth_mask_set(True)
+            self._draw_surfaces(draws, covered=True)
             if not self.gbuffer:
                 self._draw_background(camera, state.environment.prefiltered is not None, background_alpha)
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
 
-    def _draw_surfaces(self, draws):
-        """The shading pass.  A run of draws with one variant and material binds the shader and the
-        technique's resources once (a uniform block and texture binding per run, not per object), unless
+    def _draw_surfaces(self, draws, covered=False):
+        """The shading pass over the opaque materials' slots, or (covered) those with a coverage below 1
+        (material_textures.has_coverage).  A run of draws with one variant and material binds the shader and
+        the technique's resources once (a uniform block and texture binding per run, not per object), unless
         the technique's bind reads the object's own (Technique.bind_reads_object): then per object."""
         bound = None        # (shader, variant key, material name) of the bindings in place
         for object_index, _object_key, entry, context, slots in draws:
             if entry.holdout:       # a holdout's pixels keep the clear: (0, 0, 0, 0)
                 continue
             for first_triangle, batch, name, params, technique, key in slots:
+                if material_textures.has_coverage(params) != covered:
+                    continue
                 shader = shader_cache.get_shader(technique, key)
                 in_place = bound is not None and shader is bound[0] and name == bound[2] and (
                     key is bound[1] or key == bound[1])
@@ -661,22 +669,23 @@ class Renderer:
                 technique.prepare_object(keys, context)
 
     def _draw_depth(self, draws, holdouts_only=False):
-        """Depth of every surface of object_draws' `draws`, no colour: the surface shaders then shade each
-        pixel once instead of every surface drawn over it (they are the frame's whole cost; the pre-pass is
-        vertex work).  holdouts_only: the holdouts' depth alone (without the pre-pass the shading pass writes
-        the rest)."""
+        """Depth of every opaque surface of object_draws' `draws` (a holdout object's all), no colour: the
+        surface shaders then shade each pixel once instead of every surface drawn over it (they are the frame's
+        whole cost; the pre-pass is vertex work).  holdouts_only: the holdouts' depth alone (without the
+        pre-pass the shading pass writes the rest)."""
         import gpu
 
         shader = shader_cache.get_depth_shader()
         shader.bind()
         shader.uniform_block("scene", self.scene_buffer)
         gpu.state.color_mask_set(False, False, False, False)
-        for _index, _object_key, entry, context, _slots in draws:
+        for _index, _object_key, entry, context, slots in draws:
             if holdouts_only and not entry.holdout:
                 continue
             shader.uniform_float("model_matrix", context.model_matrix)
-            for _slot, _first_triangle, batch in context.buffers.batches:
-                batch.draw(shader)
+            for _first_triangle, batch, _name, params, *_ in slots:
+                if entry.holdout or not material_textures.has_coverage(params):
+                    batch.draw(shader)
         gpu.state.color_mask_set(True, True, True, True)
 
     def _draw_background(self, camera, has_environment, alpha):

@@ -84,11 +84,11 @@ class Expression:
         return Expression((((1.0, 1.0, 1.0), (Factor("", function=Function(name, tuple(settings), args)),)),))
 
     @staticmethod
-    def image_at(name, extension, vector):
+    def image_at(name, extension, vector, output="Color"):
         """Image `name` read at texture coordinates vector's (x, y), past its edges as `extension` says
-        (REPEAT, EXTEND, CLIP, MIRROR)."""
-        return Expression((((1.0, 1.0, 1.0), (Factor("", function=Function("image", (name, extension),
-                                                                             (Expression.of(vector),))),)),))
+        (REPEAT, EXTEND, CLIP, MIRROR): its Color, or its Alpha on all three."""
+        function = Function("image", (name, extension, output), (Expression.of(vector),))
+        return Expression((((1.0, 1.0, 1.0), (Factor("", function=function),)),))
 
     @staticmethod
     def coordinates(name):
@@ -220,7 +220,7 @@ class Expression:
         """Its value (..., 3) float32 where each image reads samples[name] (..., 3), each attribute
         attributes[name] and each of the surface's coordinates coordinates[name]: what a pixel gets when every
         image is sampled there (the shader's texture_value_<slot>); an image read at coordinates of its own (an
-        "image" Function) reads image_at(name, extension, uv (..., 2)) -> (..., 3)."""
+        "image" Function) reads image_at(name, extension, uv (..., 2)) -> RGBA (..., 4)."""
         from .node_functions import apply
 
         sources = {**{("image", name): samples[name] for name in self.images},
@@ -237,8 +237,9 @@ class Expression:
             args = [np.broadcast_to(arg.values(samples, attributes, coordinates, image_at), shape + (3,))
                     for arg in factor.function.args]
             if factor.function.name == "image":
-                name, extension = factor.function.settings
-                return np.asarray(image_at(name, extension, args[0][..., :2]), np.float32)[..., :3]
+                name, extension, output = factor.function.settings
+                rgba = np.asarray(image_at(name, extension, args[0][..., :2]), np.float32)
+                return np.repeat(rgba[..., 3:4], 3, axis=-1) if output == "Alpha" else rgba[..., :3]
             return np.asarray(apply(factor.function.name, factor.function.settings, args), np.float32)
 
         out = np.zeros(shape + (3,), np.float32)
@@ -264,18 +265,21 @@ class BoundExpression:
 
     def sample(self, uv, footprint=None):
         """(N, 4) float32 at texture coordinates uv (N, 2): each image read as a material texture
-        (spherical.texture_mips.sample, at the footprint when given), alpha 1.  An expression of colour
-        attributes has no value at a texture coordinate: ValueError."""
+        (spherical.texture_mips.sample, at the footprint when given), the UV coordinates uv, alpha 1.  An
+        expression of colour attributes or other coordinates has no value at a texture coordinate: ValueError."""
         from ..spherical import texture_mips
 
-        if self.expression.attributes or self.expression.coordinate_names:
+        others = tuple(name for name in self.expression.coordinate_names if name != "UV")
+        if self.expression.attributes or others:
             raise ValueError(f"colour attributes {self.expression.attributes} or the surface's coordinates "
-                             f"{self.expression.coordinate_names} have no value at a texture coordinate")
+                             f"{others} have no value at a texture coordinate")
         samples = {name: texture_mips.sample(pixels, uv, footprint)[..., :3] for name, pixels in self.images.items()}
 
         def image_at(name, extension, at):
-            return texture_mips.sample(self.images[name], at, footprint, extension)[..., :3]
+            return texture_mips.sample(self.images[name], at, footprint, extension)
 
+        uv = np.asarray(uv, np.float32)
+        coordinates = {"UV": np.concatenate([uv, np.zeros((len(uv), 1), np.float32)], axis=1)}
         out = np.ones((len(uv), 4), np.float32)
-        out[:, :3] = self.expression.values(samples, image_at=image_at)
+        out[:, :3] = self.expression.values(samples, coordinates=coordinates, image_at=image_at)
         return out

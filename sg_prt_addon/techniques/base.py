@@ -20,9 +20,13 @@ import functools
 
 import numpy as np
 
-# The texture slot every technique applies the same way (shaders/techniques/common/surface_io.glsl
-# surface_write): the emitted radiance's colour
+# The texture slots every technique applies the same way (shaders/techniques/common/surface_io.glsl): the
+# emitted radiance's colour (surface_write), the coverage (surface_coverage: Principled Alpha, a Transparent
+# BSDF) and the holdout's share of the drawn surface (surface_write's alpha)
 EMISSION_TEXTURE = "emission"
+ALPHA_TEXTURE = "alpha"
+HOLDOUT_TEXTURE = "holdout"
+SURFACE_TEXTURES = (EMISSION_TEXTURE, ALPHA_TEXTURE, HOLDOUT_TEXTURE)
 
 
 class ObjectInputs:

@@ -36,10 +36,13 @@ MISSING_ATTRIBUTE = "vec3(0.0)"
 class NodeValues:
     """The slots a node tree computes: ((slot, Expression), ...) by slot; vertex_colors: they read a colour
     attribute and the object's mesh has one (its vertex stream); coordinates: the surface coordinates they read
-    (texture_expression.COORDINATES)."""
+    (texture_expression.COORDINATES); coverage: the surface's alpha is below 1 somewhere (HAS_COVERAGE: dithered
+    coverage, and drawn after the depth pre-pass); holdout: some of it is a holdout (HAS_HOLDOUT)."""
     slots: tuple = ()
     vertex_colors: bool = False
     coordinates: tuple = ()
+    coverage: bool = False
+    holdout: bool = False
 
     @property
     def object_position(self):
@@ -58,7 +61,13 @@ def node_values(params, textures, inputs):
                   if not isinstance(params.textures[slot], str))
     reads_attributes = any(expression.attributes for _, expression in slots)
     coordinates = tuple(sorted({name for _, expression in slots for name in expression.coordinate_names}))
-    return NodeValues(slots, reads_attributes and inputs.vertex_colors, coordinates)
+    return NodeValues(slots, reads_attributes and inputs.vertex_colors, coordinates,
+                      coverage=has_coverage(params, textures), holdout=params.holdout > 0.0 or "holdout" in textures)
+
+
+def has_coverage(params, textures=None):
+    """Whether a material's surface is drawn over less than all of a pixel somewhere (its alpha slot)."""
+    return params.alpha < 1.0 or "alpha" in (params.textures if textures is None else textures)
 
 
 def bind_object(shader, key, context):
@@ -116,8 +125,8 @@ def function_source(function, rgb_of, helpers, sampler_of=None):
     args = [expression_source(arg, rgb_of, helpers, sampler_of) for arg in function.args]
     name, settings = function.name, function.settings
     if name == "image":
-        return (f"material_texture_at({sampler_of(settings[0])}, ({args[0]}).xy, "
-                f"{IMAGE_EXTENSIONS.index(settings[1])}).rgb")
+        value = f"material_texture_at({sampler_of(settings[0])}, ({args[0]}).xy, {IMAGE_EXTENSIONS.index(settings[1])})"
+        return f"vec3({value}.a)" if settings[2] == "Alpha" else f"{value}.rgb"
     if name == "math":
         return f"node_math_{settings[0].lower()}({', '.join(args)})"
     if name == "clamp":

@@ -153,14 +153,18 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
     the fragment source calls per_vertex_copy_source's load_per_vertex_rows), what the material's computed
     values read (node_values: techniques.material_textures.NodeValues): the mesh's colour attribute as the
     vertex_color varying (HAS_VERTEX_COLOR), the object-space position as object_position
-    (HAS_OBJECT_POSITION), the texture space's push constants; the scene and material blocks at bindings
+    (HAS_OBJECT_POSITION), the texture space's push constants, the coverage and holdout (HAS_COVERAGE,
+    HAS_HOLDOUT); the scene and material blocks at bindings
     0 and 1, `samplers` ((kind, name) in slot order), the technique's own push_constants ((type, name)) after
     the model matrix, and the outputs of output_names."""
     vertex_colors = node_values is not None and node_values.vertex_colors
     object_position = node_values is not None and node_values.object_position
+    coverage = node_values is not None and node_values.coverage
+    holdout = node_values is not None and node_values.holdout
     defines = {**LIMITS, **defines, **({"PER_VERTEX_ROWS": 1} if per_vertex else {}),
                **({"HAS_VERTEX_COLOR": 1} if vertex_colors else {}),
-               **({"HAS_OBJECT_POSITION": 1} if object_position else {})}
+               **({"HAS_OBJECT_POSITION": 1} if object_position else {}),
+               **({"HAS_COVERAGE": 1} if coverage else {}), **({"HAS_HOLDOUT": 1} if holdout else {})}
     calls = [("define", (name, str(value))) for name, value in sorted(defines.items())]
     calls.append(("typedef_source", (typedef_source(),)))
     calls += [("vertex_in", (0, "VEC3", "position")), ("vertex_in", (1, "VEC3", "normal")),

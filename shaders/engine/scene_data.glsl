@@ -37,7 +37,8 @@ struct SceneData {
   /* x: the side, in pixels, of the square each pixel's shading averages its specular over (engine/
    * anti_aliasing.py specular_footprint): 1 one frame, 1/m each of m x m jittered frames, 0 the centre alone;
    * y: the most samples a side of that square (anti_aliasing.footprint_grid_limit); z: the side, in pixels, of
-   * the square each pixel's material textures are read over (anti_aliasing.texture_footprint) */
+   * the square each pixel's material textures are read over (anti_aliasing.texture_footprint); w: the frame's
+   * offset of the dithered coverage's thresholds (common/surface_io.glsl surface_coverage) */
   vec4 shading_footprint;
   /* the lights' shadow maps (lighting/shadow_maps.py ShadowPlan): x tile side (texels, 0: none), y tiles a row,
    * z a face's share of its tile, w lights with a map */
@@ -63,9 +64,10 @@ struct MaterialData {
   vec4 parameters1;
   /* xyz object-space tangent axis, w tangent rotation (radians) */
   vec4 tangent_axis_rotation;
-  /* x tangent source: 0 UV map, 1 object axis; y the material's G-buffer id; z the layer's GGX roughness */
+  /* x tangent source: 0 UV map, 1 object axis; y the material's G-buffer id; z the layer's GGX roughness;
+   * w the surface's coverage (alpha: common/surface_io.glsl surface_coverage) */
   vec4 options;
-  /* rgb emitted radiance (Combined only) */
+  /* rgb emitted radiance (Combined only); w the holdout's share of the drawn surface (Combined's alpha 1 - w) */
   vec4 emission;
   /* the texture coordinates from the UV map (a node tree's Mapping): u' = dot(xyz, (u, v, 1)), v' likewise */
   vec4 uv_transform_u;

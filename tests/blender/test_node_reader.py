@@ -129,7 +129,7 @@ def test_unsupported_nodes_give_one_warning_naming_them(empty_file):
     assert len(warnings) == 1, warnings
     text = warnings[0]
     assert "'odd' (node tree)" in text and "Brick Texture" in text and "(0.3, 0.3, 0.3)" in text
-    assert "the coat" in text and "Alpha 0.5" in text
+    assert "the coat" in text and "transparency: shadows are cast as by an opaque surface" in text
     assert params.diffuse_color == pytest.approx((0.3, 0.3, 0.3))
 
 
@@ -350,3 +350,48 @@ def test_colour_attributes_export_per_corner_and_non_finite_ones_are_named(empty
     np.testing.assert_allclose(exported.colors, [[1, 0, 0, 1], [0, 1, 0, 1], [0, 0, 1, 1]])
     assert len(messages) == 1 and "'Col'" in messages[0] and "non-finite" in messages[0], messages
     assert export_mesh_data(bpy.data.meshes.new("plain"), "plain").colors is None
+
+
+def test_transparency_and_holdout_read_as_coverage(empty_file):
+    """Principled Alpha: the BSDF drawn whole over a coverage of alpha (its colours unscaled); an image's Alpha
+    output read per pixel; a Transparent BSDF in a Mix Shader: the coverage is the other shader's share, which
+    is drawn whole; a tinted one is named; a Holdout's share of the drawn surface."""
+    material, tree, output = _material("alpha_constant")
+    _principled(tree, output, Base_Color=(0.8, 0.4, 0.2, 1.0), Alpha=0.25)
+    params, warnings = _read(material)
+    assert params.alpha == pytest.approx(0.25) and params.diffuse_color == pytest.approx((0.8, 0.4, 0.2))
+    assert len(warnings) == 1 and warnings[0].endswith("transparency: shadows are cast as by an opaque surface")
+
+    pixels = np.ones((4, 4, 4), np.float32)
+    pixels[..., 3] = np.linspace(0.0, 1.0, 16).reshape(4, 4)
+    image = _image("alpha_ramp", pixels, "Non-Color")
+    material, tree, output = _material("alpha_texture")
+    texture = _link_image(tree, image, _principled(tree, output).inputs["Base Color"])
+    tree.links.new(texture.outputs["Alpha"], tree.nodes["Principled BSDF"].inputs["Alpha"])
+    params, _ = _read(material)
+    assert params.alpha == 1.0 and params.textures["diffuse_color"] == "alpha_ramp"
+    np.testing.assert_allclose(_at_texels(params.textures["alpha"], "alpha")[..., 0], pixels[..., 3], atol=1e-6)
+
+    material, tree, output = _material("transparent_mix")
+    emission, transparent, mix = (tree.nodes.new(kind) for kind in ("ShaderNodeEmission", "ShaderNodeBsdfTransparent",
+                                                                    "ShaderNodeMixShader"))
+    mix.inputs["Fac"].default_value = 0.7
+    tree.links.new(transparent.outputs[0], mix.inputs[1])
+    tree.links.new(emission.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    params, warnings = _read(material)
+    assert params.alpha == pytest.approx(0.7) and params.emission == pytest.approx((1.0, 1.0, 1.0))
+    transparent.inputs["Color"].default_value = (1.0, 0.5, 0.0, 1.0)
+    params, warnings = _read(material)
+    assert params.alpha == pytest.approx(1.0 - 0.3 * 0.5) and "a tinted Transparent BSDF" in warnings[0]
+
+    material, tree, output = _material("holdout")
+    emission, holdout, mix = (tree.nodes.new(kind) for kind in ("ShaderNodeEmission", "ShaderNodeHoldout",
+                                                                "ShaderNodeMixShader"))
+    mix.inputs["Fac"].default_value = 0.4
+    tree.links.new(emission.outputs[0], mix.inputs[1])
+    tree.links.new(holdout.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    params, warnings = _read(material)
+    assert params.alpha == 1.0 and params.holdout == pytest.approx(0.4) and warnings == []
+    assert params.emission == pytest.approx((0.6, 0.6, 0.6))

@@ -1,6 +1,8 @@
-"""Render Samples' maths (engine/anti_aliasing.py): Edges Only's edge test, its tiles and their projection."""
+"""Render Samples' maths (engine/anti_aliasing.py): Edges Only's edge test, its tiles and their projection, the
+dithered coverage's thresholds."""
 import numpy as np
 
+from benchmarks.accuracy import film
 from sg_prt_addon.engine import anti_aliasing
 
 
@@ -92,3 +94,16 @@ def test_tile_projection_maps_the_tile_onto_the_whole_target():
         np.testing.assert_allclose(in_tile, (image - origin) * side, atol=1e-9)
         # depth is untouched
         np.testing.assert_allclose((cropped @ np.append(point, 1))[2:], (projection @ np.append(point, 1))[2:])
+
+
+def test_coverage_offsets_spread_a_pixels_kept_frames_over_the_grid():
+    """16 frames: a pixel's filtered coverage is its alpha within 0.035 RMS (0.12 at most; measured 0.029 and
+    0.090), where plain k / 16 offsets, whose kept frames are adjacent rows of the jitter grid, give 0.047;
+    Cycles' 16 random samples give sqrt(alpha (1 - alpha) / 16), 0.10 RMS over uniform alphas."""
+    offsets = anti_aliasing.coverage_offsets(16)
+    assert len(set(offsets)) == 16 and offsets.min() >= 0.0 and offsets.max() < 1.0
+    errors = film.coverage_errors(offsets)
+    rms = np.sqrt(np.mean(errors ** 2))
+    assert rms < 0.035 and np.abs(errors).max() < 0.12, (rms, np.abs(errors).max())
+    plain = np.sqrt(np.mean(film.coverage_errors(np.arange(16) / 16.0) ** 2))
+    assert plain > 1.3 * rms

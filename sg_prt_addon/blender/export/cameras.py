@@ -17,6 +17,7 @@ class CameraExport:
     shading_footprint: float = 0.0  # pixels a side each pixel's specular averages over (anti_aliasing.specular_footprint)
     footprint_grid_limit: int = 4   # at most this many specular samples a side of that footprint (sg_shading.glsl)
     texture_footprint: float = 1.0  # pixels a side each pixel's material textures are read over (anti_aliasing)
+    coverage_offset: float = 0.0    # added to the dithered coverage's thresholds: each jittered frame its own
 
 
 def camera_from_view(view_matrix, projection_matrix, is_perspective):

@@ -39,6 +39,10 @@ class MaterialParams:
     multiscatter: bool = False
     layered_f0: float = -1.0
     emission: tuple = (0.0, 0.0, 0.0)
+    # the surface's coverage (a node tree's transparency: reflectance/coverage.py) and the holdout's share of
+    # the drawn surface (its alpha is 1 - holdout)
+    alpha: float = 1.0
+    holdout: float = 0.0
     source: str = "SETTINGS"       # what the look was read from: material.sgprt.source (NODE_TREE, SETTINGS)
     # texture coordinates from the UV map: u' = a u + b v + c, v' = d u + e v + f (a node tree's Mapping node)
     uv_transform: tuple = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
@@ -154,8 +158,8 @@ def export_material(material):
 # What a node tree's reading replaces of the SG-PRT settings: the look (the technique's own controls, the
 # lobe count and the view warp stay the material's)
 NODE_TREE_FIELDS = COLOUR_PARAMETERS + SCALAR_PARAMETERS + (
-    "model", "fresnel", "multiscatter", "layered_f0", "emission", "normal_strength", "tangent_source",
-    "tangent_axis", "tangent_rotation", "uv_transform")
+    "model", "fresnel", "multiscatter", "layered_f0", "emission", "alpha", "holdout", "normal_strength",
+    "tangent_source", "tangent_axis", "tangent_rotation", "uv_transform")
 
 
 def _read_node_tree(material, params):
@@ -180,7 +184,7 @@ def _finite_settings(params):
     """Non-finite scalar or colour settings (scripts can store them) -> the defaults, warned."""
     defaults = MaterialParams()
     for name in COLOUR_PARAMETERS + SCALAR_PARAMETERS + ("normal_strength", "tangent_rotation", "tangent_axis",
-                                                         "layered_f0", "emission"):
+                                                         "layered_f0", "emission", "alpha", "holdout"):
         value = getattr(params, name)
         if not np.all(np.isfinite(value)):
             setattr(params, name, getattr(defaults, name))

@@ -3,7 +3,7 @@
 isotropic model as the small-scale BRDF, or its stored lobe fit (MaterialParams.fitted: a measured small-scale
 BRDF, iwasaki2012 fig. 8) (shaders/techniques/biscale/biscale.glsl; mirror biscale_shading.py)."""
 from .. import material_textures
-from ..base import EMISSION_TEXTURE
+from ..base import SURFACE_TEXTURES
 from ..sg import sg_fitted, sg_parametric
 from ..sg.sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
 from ..sg.sg_parametric import material_terms
@@ -12,8 +12,8 @@ from . import biscale_shading
 NAME = "SG_BISCALE"
 # the small-scale parameters a texture may scale per pixel, and the colours and normal map
 TEXTURES = ("diffuse_color", "specular_color", "roughness", "ior", "exponent", "alpha_x", "normal_map",
-            EMISSION_TEXTURE, biscale_shading.MASK_SLOT)
-FITTED_TEXTURES = ("normal_map", EMISSION_TEXTURE, biscale_shading.MASK_SLOT)   # a fit holds its colours and lobes
+            *SURFACE_TEXTURES, biscale_shading.MASK_SLOT)
+FITTED_TEXTURES = ("normal_map", *SURFACE_TEXTURES, biscale_shading.MASK_SLOT)   # a fit holds its colours and lobes
 
 
 def texture_slots(params):

@@ -21,7 +21,7 @@ from ...measured import homomorphic
 from ...reflectance import brdf, models
 from ...spherical import lattice
 from .. import material_textures, shader_sources, surface_layering
-from ..base import EMISSION_TEXTURE, Technique
+from ..base import SURFACE_TEXTURES, Technique
 from ..material_textures import NodeValues
 from ..sg import sg_lobes
 from . import factored_shading
@@ -31,7 +31,7 @@ GLSL_DIR = "factored"
 FORM = "pqpr"
 RESOLUTION = 64
 SAMPLES = 256                   # views x lights of the fit: SAMPLES^2 pairs
-TEXTURE_SLOTS = ("diffuse_color", "specular_color", "normal_map", EMISSION_TEXTURE)
+TEXTURE_SLOTS = ("diffuse_color", "specular_color", "normal_map", *SURFACE_TEXTURES)
 LIBRARY_FILES = ("sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "lights.glsl", "env_prefilter.glsl",
                  "hemisphere_map.glsl", "ssdf.glsl")
 VISIBILITY_KIND = "ssdf"        # the per-vertex precomputation it reads (visibility.per_vertex kinds)

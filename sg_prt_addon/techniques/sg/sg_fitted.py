@@ -1,7 +1,7 @@
 """wang2009 with lobes fitted to measured data (blender.lobe_fit, export.FittedLobes): per texel SG
 lobes, kd and eta, and the PCA-compressed shadowing, fetched at the UV's nearest texel."""
 from .. import material_textures
-from ..base import EMISSION_TEXTURE
+from ..base import SURFACE_TEXTURES
 from .sg_lobes import SGLobes, VariantKey, scene_fields, warp_mode_of
 
 NAME = "SG_FITTED"
@@ -22,7 +22,7 @@ class SGFitted(SGLobes):
         fitted = params.fitted
         if fitted is None:
             raise ValueError(f"material '{params.name}' has no usable lobe fit for {self.label}")
-        textures = tuple(name for name in (EMISSION_TEXTURE, "normal_map") if name in params.textures)
+        textures = tuple(name for name in (*SURFACE_TEXTURES, "normal_map") if name in params.textures)
         return VariantKey(self.name, MODEL, int(fitted.lobe_count), textures=textures,
                           node_values=material_textures.node_values(params, textures, inputs),
                           shadowing_components=int(fitted.components), warp_mode=warp_mode_of(params),

@@ -24,7 +24,7 @@ from ...reflectance import brdf
 from ...spherical import clamped_cosine_table, warp
 from ...visibility import broad_lobes
 from .. import material_textures, shader_sources, surface_layering
-from ..base import EMISSION_TEXTURE, Technique
+from ..base import SURFACE_TEXTURES, Technique
 from ..material_textures import NodeValues
 from ..shader_sources import MAX_ENV_LOBES, MAX_LAYERS, PerVertexInput
 from . import sg_shading
@@ -44,7 +44,7 @@ VISIBILITY_KIND = "ssdf"
 # texels a vertex of the SSDF's coverage at the quadrature points (vertex_coverage.frag.glsl), four points each
 COVERAGE_TEXELS = broad_lobes.QUADRATURE_POINTS // 4
 TEXTURE_SLOTS = ("diffuse_color", "specular_color", "roughness", "ior", "exponent",
-                 "alpha_x", "alpha_y", "nu", "nv", "normal_map", EMISSION_TEXTURE)
+                 "alpha_x", "alpha_y", "nu", "nv", "normal_map", *SURFACE_TEXTURES)
 
 
 @dataclass(frozen=True)

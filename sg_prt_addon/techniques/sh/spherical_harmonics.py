@@ -36,7 +36,7 @@ from ...harmonics import brdf_table, fitted_table, projection
 from ...reflectance import models
 from ...visibility import per_vertex, transfer
 from .. import material_textures, shader_sources, surface_layering
-from ..base import EMISSION_TEXTURE, Technique
+from ..base import SURFACE_TEXTURES, Technique
 from ..material_textures import NodeValues
 from ..sg import fitted_texels
 from . import sh_glsl, sh_shading
@@ -47,7 +47,7 @@ ORDERS = tuple(range(2, 9))
 DEFAULT_ORDER = 5
 WINDOWS = ("none",) + projection.WINDOWS
 SH_ENVIRONMENT_ORDER = max(ORDERS)
-COLOUR_SLOTS = ("diffuse_color", "specular_color", "normal_map", EMISSION_TEXTURE)
+COLOUR_SLOTS = ("diffuse_color", "specular_color", "normal_map", *SURFACE_TEXTURES)
 LIBRARY_FILES = ("sg.glsl", "lights.glsl")
 # the MaterialData field each axis parameter is in (shaders/engine/scene_data.glsl)
 PARAMETER_FIELDS = {"roughness": "material.parameters0.x", "exponent": "material.parameters0.z",
@@ -90,11 +90,11 @@ class SHKey:
 
 
 def texture_slots(params):
-    """The texture slots the technique applies for a material: the colours, the normal map, the emission and
-    the table axis parameter's texture; with a lobe fit the normal map and the emission (the fit holds the
-    look)."""
+    """The texture slots the technique applies for a material: the colours, the normal map, the surface's
+    (base.SURFACE_TEXTURES) and the table axis parameter's texture; with a lobe fit the normal map and the
+    surface's (the fit holds the look)."""
     if getattr(params, "fitted", None) is not None:
-        return ("normal_map", EMISSION_TEXTURE)
+        return ("normal_map", *SURFACE_TEXTURES)
     axis = brdf_table.PARAMETER_AXES.get(params.model)
     return COLOUR_SLOTS + ((axis[0],) if axis else ())
 

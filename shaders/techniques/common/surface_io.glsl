@@ -11,6 +11,25 @@ vec3 surface_facing_normal()
   return front ? world_normal : -world_normal;
 }
 
+/* The surface's coverage (a node tree's transparency, reflectance/coverage.py) as dithered samples: a sample
+ * keeps the surface where the alpha exceeds its threshold.  Interleaved gradient noise spreads the thresholds
+ * over [0, 1) across neighbouring pixels, and each jittered frame moves them by its own offset
+ * (scene.shading_footprint.w), so a pixel's Render Samples converge to alpha x surface + (1 - alpha) x what is
+ * behind, as Cycles and EEVEE's dithered transparency do.  Call it first: a dropped sample shades nothing. */
+void surface_coverage()
+{
+#ifdef HAS_COVERAGE
+  float alpha = material.options.w;
+#  ifdef HAS_TEXTURE_ALPHA
+  alpha *= texture_value_alpha().r;
+#  endif
+  float noise = fract(52.9829189 * fract(dot(floor(gl_FragCoord.xy), vec2(0.06711056, 0.00583715))));
+  if (alpha <= fract(noise + scene.shading_footprint.w)) {
+    discard;
+  }
+#endif
+}
+
 /* The spread of the normal map's normals over the pixel (normal_spread), which widens the NDF lobes
  * (spread_lobe): 0 without a normal map or where it is not minified. */
 float normal_map_spread = 0.0;
@@ -43,7 +62,7 @@ void surface_geometry(vec3 normal, out vec4 tangent, out vec3 shading_normal, ou
   shading_tangent = rotate_tangent(shading_normal, tangent.xyz, material.tangent_axis_rotation.w);
 }
 
-/* Combined (with the emission, its texture applied), Diffuse, Specular, and the GBUFFER variant's shading inputs
+/* Combined (with the emission, its texture applied; alpha 1 less the holdout's share), Diffuse, Specular, and the GBUFFER variant's shading inputs
  * for the numpy mirrors (framebuffers take 6 attachments: that variant has no Combined, the CPU sums Diffuse and
  * Specular, without the emission); w: the triangle (index into the mesh's triangle list) and the object (draw
  * order) + 1. */
@@ -54,7 +73,15 @@ void surface_write(vec3 diffuse, vec3 specular, vec3 normal, vec4 tangent)
 #  ifdef HAS_TEXTURE_EMISSION
   emission *= texture_value_emission().rgb;
 #  endif
-  out_combined = vec4(diffuse + specular + emission, 1.0);
+  float alpha = 1.0;
+#  ifdef HAS_HOLDOUT
+  float holdout = material.emission.w;
+#    ifdef HAS_TEXTURE_HOLDOUT
+  holdout *= texture_value_holdout().r;
+#    endif
+  alpha = 1.0 - clamp(holdout, 0.0, 1.0);
+#  endif
+  out_combined = vec4(diffuse + specular + emission, alpha);
 #endif
   out_diffuse = vec4(diffuse, 1.0);
   out_specular = vec4(specular, 1.0);

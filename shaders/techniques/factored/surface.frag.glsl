@@ -2,6 +2,7 @@
  * shade_factored (factored_shading.glsl).  Writes the passes as the SG techniques' surface does. */
 void main()
 {
+  surface_coverage();
   vec3 normal = surface_facing_normal();
 #ifdef HAS_VISIBILITY
   set_visibility_frame(world_vertex_normal);     /* the bake's frame: not flipped for back faces */

@@ -3,6 +3,7 @@
  * shade_footprint).  Writes Combined, Diffuse and Specular; the GBUFFER variant writes Diffuse, Specular and the shading inputs for the numpy mirror. */
 void main()
 {
+  surface_coverage();
   vec3 normal = surface_facing_normal();
 #ifdef HAS_VISIBILITY
   set_visibility_frame(world_vertex_normal);     /* the bake's frame: not flipped for back faces */

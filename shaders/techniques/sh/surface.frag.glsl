@@ -4,6 +4,7 @@
  * (techniques/sh/spherical_harmonics.py).  SH_FITTED: kd from the lobe fit's texel, the colours in its lobes. */
 void main()
 {
+  surface_coverage();
   vec3 normal = surface_facing_normal();
 #ifdef HAS_TRANSFER
   load_per_vertex_rows();                        /* transfer_rows: the vertex's [1, w_0, ...], interpolated */
