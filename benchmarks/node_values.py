@@ -423,6 +423,43 @@ def colour_node(kind):
     return value_of
 
 
+def _shape_curve(curve, points):
+    """A curve's points set to `points` ((x, y), ...), the first two moved, the rest added."""
+    for k, (x, y) in enumerate(points):
+        if k < len(curve.points):
+            curve.points[k].location = (x, y)
+        else:
+            curve.points.new(x, y)
+
+
+def curves_node(kind, extend="EXTRAPOLATED"):
+    """RGB Curves of the image (an S on the combined curve, red lifted, Fac 0.9), Vector Curves of the Object
+    coordinates (x bent, y inverted) or a Float Curve of the image's red channel (a bump), with the mapping's
+    `extend`: the values past the points' span (Object x reaches -1 and 1) test it."""
+    def value_of(tree):
+        node = tree.nodes.new({"rgb": "ShaderNodeRGBCurve", "vector": "ShaderNodeVectorCurve",
+                               "float": "ShaderNodeFloatCurve"}[kind])
+        mapping = node.mapping
+        mapping.extend = extend
+        if kind == "rgb":
+            _shape_curve(mapping.curves[3], [(0.0, 0.0), (1.0, 1.0), (0.3, 0.2), (0.7, 0.85)])
+            _shape_curve(mapping.curves[0], [(0.0, 0.15), (1.0, 1.0)])
+            node.inputs["Fac"].default_value = 0.9
+            tree.links.new(_image_node(tree).outputs["Color"], node.inputs["Color"])
+        elif kind == "vector":
+            _shape_curve(mapping.curves[0], [(-0.5, -0.8), (0.5, 0.9), (0.0, 0.3)])
+            _shape_curve(mapping.curves[1], [(-1.0, 1.0), (1.0, -1.0)])
+            tree.links.new(_coordinates(tree, "Object"), node.inputs["Vector"])
+        else:
+            _shape_curve(mapping.curves[0], [(0.1, 0.2), (0.9, 0.3), (0.5, 0.9)])
+            separate = _separate(tree, _image_node(tree, "Non-Color").outputs["Color"])
+            tree.links.new(separate.outputs["Red"], node.inputs["Value"])
+        mapping.update()
+        output = node.outputs[0]
+        return _vector_math(tree, "ABSOLUTE", output) if kind == "vector" else output
+    return value_of
+
+
 def _coordinates(tree, output, node_type="ShaderNodeTexCoord"):
     return tree.nodes.new(node_type).outputs[output]
 
@@ -506,6 +543,27 @@ def noise(noise_type="FBM", output="Fac", distortion=0.0, vector_output=None):
         value = node.outputs[output]
         # the multifractal types pass 1 and go below 0: scaled into the emission's range
         return value if noise_type == "FBM" else _math_node(tree, "ABSOLUTE", _math_node(tree, "MULTIPLY", value, 0.25))
+    return value_of
+
+
+def white_noise(dimensions, output):
+    """The White Noise Texture of Generated coordinates (moved by 0.1, so that none lies on a cell's edge, where
+    a rounding sends the snap either way) snapped to cells a quarter of the plane wide, its W (1D, 4D) the
+    snapped x: one random value a cell (of every sample inside it), as it is used to colour cells."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexWhiteNoise")
+        node.noise_dimensions = dimensions
+        moved = _vector_math(tree, "ADD", _coordinates(tree, "Generated"))
+        moved.node.inputs[1].default_value = (0.1, 0.1, 0.1)
+        snapped = _vector_math(tree, "SNAP", moved)
+        snapped.node.inputs[1].default_value = (0.25, 0.25, 0.25)
+        if dimensions != "1D":
+            tree.links.new(snapped, node.inputs["Vector"])
+        if dimensions in ("1D", "4D"):
+            separate = tree.nodes.new("ShaderNodeSeparateXYZ")
+            tree.links.new(snapped, separate.inputs[0])
+            tree.links.new(separate.outputs["X"], node.inputs["W"])
+        return node.outputs[output]
     return value_of
 
 
@@ -709,6 +767,9 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          **{f"color_ramp_{kind.lower()}": _socket_case(color_ramp_node(kind)) for kind in ("LINEAR", "EASE", "CONSTANT")},
          "color_ramp_alpha": _socket_case(color_ramp_node("LINEAR", "Alpha")),
          **{f"mix_{blend.lower()}": _socket_case(mix_blend(blend)) for blend in MIX_BLENDS},
+         "rgb_curves": _socket_case(curves_node("rgb")), "vector_curves": _socket_case(curves_node("vector")),
+         "vector_curves_horizontal": _socket_case(curves_node("vector", "HORIZONTAL")),
+         "float_curve": _socket_case(curves_node("float")),
          **{kind: _socket_case(colour_node(kind))
             for kind in ("hue_saturation_value", "gamma", "brightness_contrast", "rgb_to_bw")},
          **{f"coordinates_{output.lower()}": _socket_case(coordinates_case(output))
@@ -728,6 +789,9 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "wave_bands_sin": _socket_case(wave()), "wave_bands_diagonal_saw": _socket_case(wave("BANDS", "DIAGONAL", "SAW")),
          "wave_rings_tri": _socket_case(wave("RINGS", "SPHERICAL", "TRI")),
          "wave_rings_z_sin_plain": _socket_case(wave("RINGS", "Z", "SIN", 0.0)),
+         **{f"white_noise_{dimensions.lower()}_{output.lower()}": _socket_case(white_noise(dimensions, output))
+            for dimensions, output in (("1D", "Value"), ("2D", "Color"), ("3D", "Color"), ("4D", "Color"),
+                                       ("3D", "Value"))},
          "magic_depth_2": _socket_case(magic(2)), "magic_depth_5_fac": _socket_case(magic(5, "Fac")),
          **{f"image_{extension.lower()}": _socket_case(image_extended(extension))
             for extension in ("REPEAT", "EXTEND", "CLIP", "MIRROR")},

@@ -175,6 +175,17 @@ class GraphNode:
         return Sockets(self._node.outputs, self._groups)
 
 
+def enabled_inputs(node, *names):
+    """A node's enabled inputs by identifier or name (None where it has none), for nodes whose sockets changed
+    names across versions."""
+    found = []
+    for name in names:
+        socket = next((s for s in node.inputs if s.identifier == name and s.enabled), None) \
+            or next((s for s in node.inputs if s.name == name and s.enabled), None)
+        found.append(socket)
+    return found
+
+
 def output_node(tree, node_type="OUTPUT_MATERIAL"):
     """A node tree's output node that EEVEE renders (its active one for EEVEE or all engines; else its first of
     `node_type`) as a GraphNode, or None."""

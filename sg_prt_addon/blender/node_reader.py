@@ -18,8 +18,9 @@ import numpy as np
 
 from ..reflectance import coverage, node_functions, principled
 from ..reflectance.texture_expression import Expression
+from . import curve_nodes, texture_nodes
 from .colour_attributes import default_color_attribute
-from .node_graph import output_node
+from .node_graph import enabled_inputs, output_node
 
 IDENTITY_UV_TRANSFORM = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
 # Blender's implicit colour -> float conversion (Rec. 709 luminance)
@@ -118,16 +119,6 @@ def scalar_of(expression):
     return None if value is None else value[0]
 
 
-def _sockets(node, *names):
-    """Inputs of a node by identifier or name, for nodes whose sockets changed names across versions."""
-    found = []
-    for name in names:
-        socket = next((s for s in node.inputs if s.identifier == name and s.enabled), None) \
-            or next((s for s in node.inputs if s.name == name and s.enabled), None)
-        found.append(socket)
-    return found
-
-
 class SocketReader:
     """Reads sockets as Expressions and shader trees as closures, collecting notes (material: the one read,
     whose meshes' UV maps an Image Texture's UV Map node is checked against; None for a world)."""
@@ -174,12 +165,10 @@ class SocketReader:
             return self.light_path(node, out, socket, colour)
         if node.type in ("TEX_COORD", "NEW_GEOMETRY", "UVMAP"):
             return self.coordinates_value(node, out, socket, colour)
-        if node.type in ("TEX_CHECKER", "TEX_GRADIENT"):
-            return self.procedural_texture(node, out)
-        if node.type == "TEX_NOISE":
-            return self.noise_texture(node, out)
-        if node.type in ("TEX_WAVE", "TEX_MAGIC"):
-            return self.wave_or_magic_texture(node, out)
+        if node.type in texture_nodes.NODE_TYPES:
+            return texture_nodes.value(self, node, out)
+        if node.type in curve_nodes.NODE_TYPES:
+            return curve_nodes.value(self, node, out)
         if node.type in ("FRESNEL", "LAYER_WEIGHT"):
             return self.view_weight(node, out)
         if node.type == "VECT_MATH":
@@ -230,46 +219,6 @@ class SocketReader:
             self.note(node, f"Object coordinates of '{node.object.name}': the surface's own object is used")
         return Expression.coordinates(name)
 
-    def texture_vector(self, node):
-        """A procedural texture's Vector: its input, or Generated coordinates where it is unlinked (Blender's
-        default for every texture but the image)."""
-        socket = node.inputs["Vector"]
-        return self.value(socket, True) if socket.is_linked else Expression.coordinates("GENERATED")
-
-    def procedural_texture(self, node, out):
-        """The Checker (Color, Fac) and Gradient (Fac, or its grey Color) textures."""
-        vector = self.texture_vector(node)
-        if node.type == "TEX_CHECKER":
-            values = [vector] + [self.value(node.inputs[name], name != "Scale") for name in ("Color1", "Color2", "Scale")]
-            return Expression.function("tex_checker", ("Color" if out.identifier == "Color" else "Fac",), values)
-        return Expression.function("tex_gradient", (node.gradient_type,), (vector,))
-
-    def noise_texture(self, node, out):
-        """The Noise Texture in 3D, of each of its types (another dimension count is read as 3D)."""
-        if getattr(node, "noise_dimensions", "3D") != "3D":
-            self.note(node, f"{node.noise_dimensions} noise: read as 3D")
-        defaults = {"Scale": 5.0, "Detail": 2.0, "Roughness": 0.5, "Lacunarity": 2.0, "Offset": 0.0, "Gain": 1.0,
-                    "Distortion": 0.0}
-        values = [self.texture_vector(node)]
-        for name, default in defaults.items():
-            socket = _sockets(node, name)[0]
-            values.append(self.value(socket, False) if socket is not None else Expression.constant(default))
-        settings = (getattr(node, "noise_type", "FBM"), bool(getattr(node, "normalize", True)),
-                    "Color" if out.identifier == "Color" else "Fac")
-        return Expression.function("tex_noise", settings, values)
-
-    def wave_or_magic_texture(self, node, out):
-        """The Wave Texture (Fac, or its grey Color) and the Magic Texture (Color, Fac)."""
-        values = [self.texture_vector(node)]
-        output = "Color" if out.identifier == "Color" else "Fac"
-        if node.type == "TEX_WAVE":
-            names = ("Scale", "Distortion", "Detail", "Detail Scale", "Detail Roughness", "Phase Offset")
-            values += [self.value(node.inputs[name], False) for name in names]
-            settings = (node.wave_type, node.bands_direction, node.rings_direction, node.wave_profile, output)
-            return Expression.function("tex_wave", settings, values)
-        values += [self.value(node.inputs[name], False) for name in ("Scale", "Distortion")]
-        return Expression.function("tex_magic", (int(node.turbulence_depth), output), values)
-
     def view_weight(self, node, out):
         """Fresnel and Layer Weight (its Fresnel, Facing) at the view, about their Normal (unlinked: the
         surface's)."""
@@ -292,7 +241,7 @@ class SocketReader:
 
     def mapping(self, node, colour):
         """The Mapping node on a vector (POINT, TEXTURE, VECTOR, NORMAL)."""
-        vector, location, rotation, scale = _sockets(node, "Vector", "Location", "Rotation", "Scale")
+        vector, location, rotation, scale = enabled_inputs(node, "Vector", "Location", "Rotation", "Scale")
         values = [self.value(socket, True) if socket is not None else Expression.constant(0.0)
                   for socket in (vector, location, rotation, scale)]
         return Expression.function("mapping", (node.vector_type,), values)
@@ -328,7 +277,7 @@ class SocketReader:
         if node.data_type != "FLOAT":
             self.note(node, f"a {node.data_type.lower()} map range: its first input is used")
             return None
-        sockets = _sockets(node, "Value", "From Min", "From Max", "To Min", "To Max", "Steps")
+        sockets = enabled_inputs(node, "Value", "From Min", "From Max", "To Min", "To Max", "Steps")
         values = [self.value(socket, False) if socket is not None else Expression.constant(4.0) for socket in sockets]
         return Expression.function("map_range", (node.interpolation_type, bool(node.clamp)), values)
 
@@ -412,12 +361,12 @@ class SocketReader:
                 return None
             suffix = {"RGBA": "Color", "FLOAT": "Float", "VECTOR": "Vector"}[node.data_type]
             per_channel = node.data_type == "VECTOR" and node.factor_mode == "NON_UNIFORM"
-            sockets = _sockets(node, "Factor_Vector" if per_channel else "Factor_Float", f"A_{suffix}", f"B_{suffix}")
+            sockets = enabled_inputs(node, "Factor_Vector" if per_channel else "Factor_Float", f"A_{suffix}", f"B_{suffix}")
             blend = node.blend_type if node.data_type == "RGBA" else "MIX"
             clamp_factor, clamp_result = node.clamp_factor, node.data_type == "RGBA" and node.clamp_result
         else:
             per_channel = False
-            sockets = _sockets(node, "Fac", "Color1", "Color2")
+            sockets = enabled_inputs(node, "Fac", "Color1", "Color2")
             blend, clamp_factor, clamp_result = node.blend_type, True, node.use_clamp
         if None in sockets:
             return None

@@ -164,6 +164,37 @@ def color_ramp(fac, positions, colours, interpolation="LINEAR"):
     return out
 
 
+def curve_lookup(column, position, extrapolate):
+    """Cycles' ramp lookup of a curve's table `column` (T,) at relative positions (...,): linear between its T
+    evenly spaced entries over [0, 1]; outside, the end segments' slopes extended (extrapolate) or the ends."""
+    column = np.asarray(column, FLOAT)
+    last = len(column) - 1
+    f = np.asarray(position, FLOAT)
+    scaled = np.clip(f, FLOAT(0), FLOAT(1)) * FLOAT(last)
+    index = np.clip(scaled.astype(np.int64), 0, last)
+    t = (scaled - index).astype(FLOAT)
+    low = column[index]
+    inside = np.where(t > 0, (FLOAT(1) - t) * low + t * column[np.minimum(index + 1, last)], low)
+    if not extrapolate:
+        return inside.astype(FLOAT)
+    below = column[0] + (column[0] - column[1]) * -f * FLOAT(last)
+    above = column[last] + (column[last] - column[last - 1]) * (f - FLOAT(1)) * FLOAT(last)
+    return np.where(f < 0, below, np.where(f > 1, above, inside)).astype(FLOAT)
+
+
+def curves(settings, fac, value):
+    """RGB, Vector and Float Curves (settings: min_x, max_x, extrapolate, the table's rows: T RGB triples, the
+    curves evaluated at T positions evenly over [min_x, max_x]): each channel through its column at
+    (value - min_x) / (max_x - min_x), mixed with the input by Fac."""
+    min_x, max_x, extrapolate, table = settings
+    table = np.asarray(table, FLOAT)
+    value = np.asarray(value, FLOAT)
+    relative = (value - FLOAT(min_x)) / FLOAT(max_x - min_x)
+    curved = np.stack([curve_lookup(table[:, k], relative[..., k], extrapolate) for k in range(3)], axis=-1)
+    fac = np.asarray(fac, FLOAT)[..., :1]
+    return ((FLOAT(1) - fac) * value + fac * curved).astype(FLOAT)
+
+
 def _rgb_to_hsv(rgb):
     r, g = rgb[..., 0], rgb[..., 1]
     high = np.max(rgb, axis=-1)
@@ -416,44 +447,44 @@ MAP_RANGE_INTERPOLATIONS = ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")
 def apply(name, settings, args):
     """The node function `name` with the node's fixed `settings` of its inputs' values `args` ((..., 3)
     each): what texture_expression.Function computes (names: math (operation,), clamp (type,), map_range
-    (interpolation, clamped), color_ramp (interpolation, positions, RGBA colours, output), mix (blend,),
+    (interpolation, clamped), color_ramp (interpolation, positions, RGBA colours, output), curves (min_x,
+    max_x, extrapolate, table), mix (blend,),
     hue_saturation_value, gamma, brightness_contrast, mapping (type,), vector_math (operation,), tex_checker
     (output,), tex_gradient (type,), tex_noise (type, normalize, output), tex_wave (type, bands direction,
-    rings direction, profile, output), tex_magic (depth, output), fresnel, layer_weight (output,))."""
+    rings direction, profile, output), tex_magic (depth, output), tex_white_noise (dimensions, output), fresnel,
+    layer_weight (output,))."""
     args = [np.asarray(a, FLOAT) for a in args]
-    if name == "math":
-        return math(settings[0], *args)
-    if name == "clamp":
-        return clamp(*args, clamp_type=settings[0])
-    if name == "map_range":
-        return map_range(*args, interpolation=settings[0], clamped=settings[1])
-    if name == "color_ramp":
-        interpolation, positions, colours, output = settings
-        rgba = color_ramp(args[0], positions, colours, interpolation)
-        return rgba[..., :3] if output == "Color" else np.repeat(rgba[..., 3:], 3, axis=-1)
-    if name == "mix":
-        return np.asarray(mix(settings[0], *args), FLOAT)
-    if name == "mapping":
-        return mapping(settings[0], *args)
-    if name == "vector_math":
-        return vector_math(settings[0], *args)
-    if name == "tex_checker":
-        return tex_checker(settings[0], *args)
-    if name == "tex_gradient":
-        return tex_gradient(settings[0], *args)
-    if name == "tex_noise":
-        return tex_noise(settings, *args)
-    if name == "tex_wave":
-        return tex_wave(settings, *args)
-    if name == "fresnel":
-        return fresnel(*args)
-    if name == "layer_weight":
-        return layer_weight(settings[0], *args)
-    if name == "tex_magic":
-        return tex_magic(settings, *args)
-    functions = {"hue_saturation_value": hue_saturation_value, "gamma": gamma,
-                 "brightness_contrast": brightness_contrast}
-    return functions[name](*args)
+    return _CALLS[name](settings, args)
+
+
+def _ramp_output(settings, args):
+    interpolation, positions, colours, output = settings
+    rgba = color_ramp(args[0], positions, colours, interpolation)
+    return rgba[..., :3] if output == "Color" else np.repeat(rgba[..., 3:], 3, axis=-1)
+
+
+# name -> the call of its function with the node's settings and the inputs' values (apply)
+_CALLS = {
+    "math": lambda settings, args: math(settings[0], *args),
+    "clamp": lambda settings, args: clamp(*args, clamp_type=settings[0]),
+    "map_range": lambda settings, args: map_range(*args, interpolation=settings[0], clamped=settings[1]),
+    "color_ramp": _ramp_output,
+    "curves": lambda settings, args: curves(settings, *args),
+    "mix": lambda settings, args: np.asarray(mix(settings[0], *args), FLOAT),
+    "mapping": lambda settings, args: mapping(settings[0], *args),
+    "vector_math": lambda settings, args: vector_math(settings[0], *args),
+    "tex_checker": lambda settings, args: tex_checker(settings[0], *args),
+    "tex_gradient": lambda settings, args: tex_gradient(settings[0], *args),
+    "tex_noise": lambda settings, args: tex_noise(settings, *args),
+    "tex_wave": lambda settings, args: tex_wave(settings, *args),
+    "tex_magic": lambda settings, args: tex_magic(settings, *args),
+    "tex_white_noise": lambda settings, args: tex_white_noise(settings, *args),
+    "fresnel": lambda settings, args: fresnel(*args),
+    "layer_weight": lambda settings, args: layer_weight(settings[0], *args),
+    "hue_saturation_value": lambda settings, args: hue_saturation_value(*args),
+    "gamma": lambda settings, args: gamma(*args),
+    "brightness_contrast": lambda settings, args: brightness_contrast(*args),
+}
 
 
 # ----------------------------------------------------------------------------- noise
@@ -479,16 +510,38 @@ def _final(a, b, c):
     return registers[2]
 
 
+# lookup3's mix: (register changed, register subtracted and rotated in, register it then adds to, rotation)
+_MIX_STEPS = ((0, 2, 1, 4), (1, 0, 2, 6), (2, 1, 0, 8), (0, 2, 1, 16), (1, 0, 2, 19), (2, 1, 0, 4))
+
+
+def _mix(a, b, c):
+    registers = [a, b, c]
+    for target, source, added, rotation in _MIX_STEPS:
+        registers[target] -= registers[source]
+        registers[target] ^= _rot(registers[source], rotation)
+        registers[source] += registers[added]
+    return registers
+
+
 def hash_uint(*keys):
-    """lookup3's hash of one to three uint32 keys (arrays broadcast)."""
+    """lookup3's hash of one to four uint32 keys (arrays broadcast)."""
     keys = [np.asarray(k).astype(np.int64).astype(_U32) for k in keys]
     shape = np.broadcast_shapes(*(k.shape for k in keys))
     start = _U32((0xDEADBEEF + (len(keys) << 2) + 13) & 0xFFFFFFFF)
     a, b, c = (np.full(shape, start, _U32) for _ in range(3))
     with np.errstate(over="ignore"):
-        for register, key in zip((a, b, c), keys):
+        for register, key in zip((a, b, c), keys[:3]):
             register += key
+        if len(keys) == 4:
+            a, b, c = _mix(a, b, c)
+            a += keys[3]
         return _final(a, b, c)
+
+
+def hash_floats(*values):
+    """Cycles' hash_float<n>_to_float of one to four floats' bits: the uint hash over 0xFFFFFFFF, in float32."""
+    bits = [np.asarray(v, FLOAT).view(_U32) for v in values]
+    return (hash_uint(*bits).astype(FLOAT) / FLOAT(0xFFFFFFFF)).astype(FLOAT)
 
 
 def hash_float2_to_float(x, y):
@@ -642,6 +695,30 @@ def tex_noise(settings, vector, scale, detail, roughness, lacunarity, offset, ga
         out = np.repeat(value[:, None], 3, axis=-1)
     else:
         out = np.stack([value, fractal(p + random_float3_offset(3)), fractal(p + random_float3_offset(4))], axis=-1)
+    return out.reshape(shape + (3,)).astype(FLOAT)
+
+
+NOISE_DIMENSIONS = ("1D", "2D", "3D", "4D")
+
+
+def tex_white_noise(settings, vector, w):
+    """The White Noise Texture (settings: dimensions, output "Value" or "Color"): a hash of the coordinates'
+    bits (1D: W; 2D: x, y; 3D: x, y, z; 4D: x, y, z, W); its Color hashes them with 1 and 2 appended (4D: the
+    coordinates in two other orders)."""
+    dimensions, output = settings
+    shape = np.shape(vector)[:-1]
+    vector, w = (np.asarray(a, FLOAT).reshape(-1, 3) for a in (vector, w))
+    keys = {"1D": [w[:, 0]], "2D": [vector[:, 0], vector[:, 1]], "3D": [vector[:, k] for k in range(3)],
+            "4D": [vector[:, 0], vector[:, 1], vector[:, 2], w[:, 0]]}[dimensions]
+    value = hash_floats(*keys)
+    if output == "Value":
+        out = np.repeat(value[:, None], 3, axis=-1)
+    elif dimensions == "4D":
+        x, y, z, fourth = keys
+        out = np.stack([value, hash_floats(z, x, fourth, y), hash_floats(fourth, z, y, x)], axis=-1)
+    else:
+        one, two = np.full(len(value), FLOAT(1)), np.full(len(value), FLOAT(2))
+        out = np.stack([value, hash_floats(*keys, one), hash_floats(*keys, two)], axis=-1)
     return out.reshape(shape + (3,)).astype(FLOAT)
 
 

@@ -127,42 +127,46 @@ def function_source(function, rgb_of, helpers, sampler_of=None):
     if name == "image":
         value = f"material_texture_at({sampler_of(settings[0])}, ({args[0]}).xy, {IMAGE_EXTENSIONS.index(settings[1])})"
         return f"vec3({value}.a)" if settings[2] == "Alpha" else f"{value}.rgb"
-    if name == "math":
-        return f"node_math_{settings[0].lower()}({', '.join(args)})"
-    if name == "clamp":
-        return f"node_clamp{'_range' if settings[0] == 'RANGE' else ''}({', '.join(args)})"
-    if name == "map_range":
-        interpolation = node_functions.MAP_RANGE_INTERPOLATIONS.index(settings[0])
-        return f"node_map_range({', '.join(args)}, {interpolation}, {'true' if settings[1] else 'false'})"
     if name == "color_ramp":
         helper = _ramp_helper(settings[:3], helpers)
         value = f"{helper}(({args[0]}).r)"
         return f"{value}.rgb" if settings[3] == "Color" else f"vec3({value}.a)"
-    if name == "mix":
-        return f"node_mix_{settings[0].lower()}({', '.join(args)})"
-    if name == "mapping":
-        return f"node_mapping({', '.join(args)}, {MAPPING_TYPES.index(settings[0])})"
-    if name == "vector_math":
-        return f"node_vector_{settings[0].lower()}({', '.join(args)})"
-    if name == "tex_checker":
-        return f"node_tex_checker({', '.join(args)}, {'true' if settings[0] == 'Color' else 'false'})"
-    if name == "tex_gradient":
-        return f"node_tex_gradient({args[0]}, {node_functions.GRADIENTS.index(settings[0])})"
-    if name == "tex_noise":
-        noise_type, normalize, output = settings
-        flags = f"{node_functions.NOISE_TYPES.index(noise_type)}, {str(bool(normalize)).lower()}, " \
-                f"{'true' if output == 'Color' else 'false'}"
-        return f"node_tex_noise({', '.join(args)}, {flags})"
-    if name == "tex_wave":
-        wave_type, bands, rings, profile, _ = settings
-        flags = f"{0 if wave_type == 'BANDS' else 1}, {node_functions.WAVE_DIRECTIONS.index(bands)}, " \
-                f"{node_functions.WAVE_DIRECTIONS.index(rings)}, {node_functions.WAVE_PROFILES.index(profile)}"
-        return f"node_tex_wave({', '.join(args)}, {flags})"
-    if name == "layer_weight":
-        return f"node_layer_weight({', '.join(args)}, {'true' if settings[0] == 'Fresnel' else 'false'})"
-    if name == "tex_magic":
-        return f"node_tex_magic({', '.join(args)}, {int(settings[0])}, {'true' if settings[1] == 'Color' else 'false'})"
-    return f"node_{name}({', '.join(args)})"
+    if name == "curves":
+        return f"{_curves_helper(settings, helpers)}({', '.join(args)})"
+    glsl_name, flags = _GLSL_CALLS[name](settings) if name in _GLSL_CALLS else (f"node_{name}", ())
+    return f"{glsl_name}({', '.join([*args, *flags])})"
+
+
+def _bool(value):
+    return "true" if value else "false"
+
+
+def _index(names, name):
+    return str(names.index(name))
+
+
+# name -> settings -> (the node_functions.glsl function, the arguments after the inputs that pass the settings)
+_GLSL_CALLS = {
+    "math": lambda settings: (f"node_math_{settings[0].lower()}", ()),
+    "clamp": lambda settings: ("node_clamp_range" if settings[0] == "RANGE" else "node_clamp", ()),
+    "map_range": lambda settings: ("node_map_range", (_index(node_functions.MAP_RANGE_INTERPOLATIONS, settings[0]),
+                                                      _bool(settings[1]))),
+    "mix": lambda settings: (f"node_mix_{settings[0].lower()}", ()),
+    "mapping": lambda settings: ("node_mapping", (_index(MAPPING_TYPES, settings[0]),)),
+    "vector_math": lambda settings: (f"node_vector_{settings[0].lower()}", ()),
+    "tex_checker": lambda settings: ("node_tex_checker", (_bool(settings[0] == "Color"),)),
+    "tex_gradient": lambda settings: ("node_tex_gradient", (_index(node_functions.GRADIENTS, settings[0]),)),
+    "tex_noise": lambda settings: ("node_tex_noise", (_index(node_functions.NOISE_TYPES, settings[0]),
+                                                      _bool(settings[1]), _bool(settings[2] == "Color"))),
+    "tex_wave": lambda settings: ("node_tex_wave", ("0" if settings[0] == "BANDS" else "1",
+                                                    _index(node_functions.WAVE_DIRECTIONS, settings[1]),
+                                                    _index(node_functions.WAVE_DIRECTIONS, settings[2]),
+                                                    _index(node_functions.WAVE_PROFILES, settings[3]))),
+    "tex_magic": lambda settings: ("node_tex_magic", (str(int(settings[0])), _bool(settings[1] == "Color"))),
+    "tex_white_noise": lambda settings: ("node_tex_white_noise", (_index(node_functions.NOISE_DIMENSIONS, settings[0]),
+                                                                  _bool(settings[1] == "Color"))),
+    "layer_weight": lambda settings: ("node_layer_weight", (_bool(settings[0] == "Fresnel"),)),
+}
 
 
 def _ramp_helper(settings, helpers):
@@ -185,6 +189,35 @@ def _ramp_helper(settings, helpers):
                 lines.append("  t = t * t * (3.0 - 2.0 * t);")
         lines.append(f"  value = mix(value, vec4({', '.join(literal(c) for c in colours[k])}), t);")
     lines += ["  return value;", "}"]
+    helpers[settings] = (name, "\n".join(lines))
+    return name
+
+
+def _curves_helper(settings, helpers):
+    """The name of the GLSL function (fac, value) of a curves node (node_functions.curves): its table as a
+    constant array, added to helpers once for each table."""
+    if settings in helpers:
+        return helpers[settings][0]
+    literal = shader_sources.float_literal
+    min_x, max_x, extrapolate, table = settings
+    name, last = f"node_curves_{len(helpers)}", len(table) - 1
+    rows = ",\n  ".join(f"vec3({', '.join(literal(v) for v in row)})" for row in table)
+    lines = [f"const vec3 {name}_table[{len(table)}] = vec3[{len(table)}](\n  {rows});",
+             f"float {name}_channel(int k, float f)", "{"]
+    if extrapolate:
+        lines += ["  if (f < 0.0) {",
+                  f"    return {name}_table[0][k] + ({name}_table[0][k] - {name}_table[1][k]) * -f * {literal(last)};",
+                  "  }", "  if (f > 1.0) {",
+                  f"    return {name}_table[{last}][k] + ({name}_table[{last}][k] - {name}_table[{last - 1}][k]) * "
+                  f"(f - 1.0) * {literal(last)};", "  }"]
+    lines += [f"  float scaled = clamp(f, 0.0, 1.0) * {literal(last)};", f"  int i = clamp(int(scaled), 0, {last});",
+              "  float t = scaled - float(i);", f"  float low = {name}_table[i][k];",
+              f"  return t > 0.0 ? (1.0 - t) * low + t * {name}_table[min(i + 1, {last})][k] : low;", "}",
+              f"vec3 {name}(vec3 fac, vec3 value)", "{",
+              f"  vec3 relative = (value - vec3({literal(min_x)})) / {literal(max_x - min_x)};",
+              f"  vec3 curved = vec3({name}_channel(0, relative.x), {name}_channel(1, relative.y), "
+              f"{name}_channel(2, relative.z));",
+              "  return (1.0 - fac.x) * value + fac.x * curved;", "}"]
     helpers[settings] = (name, "\n".join(lines))
     return name
 

@@ -308,13 +308,9 @@ vec3 node_tex_gradient(vec3 p, int gradient_type)
  * them before this file) */
 uint node_rot(uint x, uint k) { return (x << k) | (x >> (32u - k)); }
 
-uint node_hash_uint3(uint kx, uint ky, uint kz)
+/* lookup3's final mixing of (a, b, c): c is the hash */
+uint node_hash_final(uint a, uint b, uint c)
 {
-  uint a = 0xDEADBEEFu + (3u << 2u) + 13u;
-  uint b = a, c = a;
-  c += kz;
-  b += ky;
-  a += kx;
   c ^= b; c -= node_rot(b, 14u);
   a ^= c; a -= node_rot(c, 11u);
   b ^= a; b -= node_rot(a, 25u);
@@ -323,6 +319,55 @@ uint node_hash_uint3(uint kx, uint ky, uint kz)
   b ^= a; b -= node_rot(a, 14u);
   c ^= b; c -= node_rot(b, 24u);
   return c;
+}
+
+uint node_hash_uint3(uint kx, uint ky, uint kz)
+{
+  uint start = 0xDEADBEEFu + (3u << 2u) + 13u;
+  return node_hash_final(start + kx, start + ky, start + kz);
+}
+
+uint node_hash_uint1(uint kx)
+{
+  uint start = 0xDEADBEEFu + (1u << 2u) + 13u;
+  return node_hash_final(start + kx, start, start);
+}
+
+uint node_hash_uint2(uint kx, uint ky)
+{
+  uint start = 0xDEADBEEFu + (2u << 2u) + 13u;
+  return node_hash_final(start + kx, start + ky, start);
+}
+
+/* lookup3 of four keys: the first three mixed in before the fourth */
+uint node_hash_uint4(uint kx, uint ky, uint kz, uint kw)
+{
+  uint start = 0xDEADBEEFu + (4u << 2u) + 13u;
+  uint a = start + kx, b = start + ky, c = start + kz;
+  a -= c; a ^= node_rot(c, 4u); c += b;
+  b -= a; b ^= node_rot(a, 6u); a += c;
+  c -= b; c ^= node_rot(b, 8u); b += a;
+  a -= c; a ^= node_rot(c, 16u); c += b;
+  b -= a; b ^= node_rot(a, 19u); a += c;
+  c -= b; c ^= node_rot(b, 4u); b += a;
+  return node_hash_final(a + kw, b, c);
+}
+
+/* Cycles' hash_float<n>_to_float: the hash of the floats' bits over 0xFFFFFFFF */
+float node_hash_to_float(uint hash) { return float(hash) / float(0xFFFFFFFFu); }
+float node_hash_float1(float x) { return node_hash_to_float(node_hash_uint1(floatBitsToUint(x))); }
+float node_hash_float2(float x, float y)
+{
+  return node_hash_to_float(node_hash_uint2(floatBitsToUint(x), floatBitsToUint(y)));
+}
+float node_hash_float3(float x, float y, float z)
+{
+  return node_hash_to_float(node_hash_uint3(floatBitsToUint(x), floatBitsToUint(y), floatBitsToUint(z)));
+}
+float node_hash_float4(float x, float y, float z, float w)
+{
+  return node_hash_to_float(node_hash_uint4(floatBitsToUint(x), floatBitsToUint(y), floatBitsToUint(z),
+                                            floatBitsToUint(w)));
 }
 
 float node_fade(float t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
@@ -596,4 +641,25 @@ vec3 node_mix_value(vec3 t, vec3 a, vec3 b)
   vec3 hsv = node_rgb_to_hsv(a);
   hsv.z = (1.0 - t.x) * hsv.z + t.x * node_rgb_to_hsv(b).z;
   return node_hsv_to_rgb(hsv);
+}
+
+/* The White Noise Texture (dimensions: index in node_functions.NOISE_DIMENSIONS): its Value on all three, or
+ * (colour) its Color */
+vec3 node_tex_white_noise(vec3 vector, vec3 w, int dimensions, bool colour)
+{
+  float x = vector.x, y = vector.y, z = vector.z, t = w.x;
+  if (dimensions == 0) {
+    float value = node_hash_float1(t);
+    return colour ? vec3(value, node_hash_float2(t, 1.0), node_hash_float2(t, 2.0)) : vec3(value);
+  }
+  if (dimensions == 1) {
+    float value = node_hash_float2(x, y);
+    return colour ? vec3(value, node_hash_float3(x, y, 1.0), node_hash_float3(x, y, 2.0)) : vec3(value);
+  }
+  if (dimensions == 2) {
+    float value = node_hash_float3(x, y, z);
+    return colour ? vec3(value, node_hash_float4(x, y, z, 1.0), node_hash_float4(x, y, z, 2.0)) : vec3(value);
+  }
+  float value = node_hash_float4(x, y, z, t);
+  return colour ? vec3(value, node_hash_float4(z, x, t, y), node_hash_float4(t, z, y, x)) : vec3(value);
 }

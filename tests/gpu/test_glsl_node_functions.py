@@ -198,6 +198,37 @@ def test_magic_texture(glsl, fuzz, record_error, depth):
         assert _close(record_error, f"magic depth {depth} colour={colour}", got, expected) < 1e-5 + 2e-6 * 2.5 ** depth
 
 
+@pytest.mark.parametrize("dimensions", node_functions.NOISE_DIMENSIONS)
+def test_white_noise_texture(glsl, fuzz, record_error, dimensions):
+    """The White Noise texture's Value and Color: the same lookup3 hash of the same float bits, so equal to the
+    last bit (float32 division on both sides)."""
+    vector, w, _ = _inputs(fuzz)
+    index = node_functions.NOISE_DIMENSIONS.index(dimensions)
+    for output in ("Value", "Color"):
+        got = _run(glsl, f"node_tex_white_noise(a.xyz, b.xyz, {index}, {str(output == 'Color').lower()})",
+                   (vector, w))
+        expected = node_functions.tex_white_noise((dimensions, output), vector, w)
+        assert record_error(f"node_functions white noise {dimensions} {output}",
+                            np.abs(got - expected).max()) == 0.0
+
+
+@pytest.mark.parametrize("extrapolate", [True, False])
+def test_curves(glsl, fuzz, record_error, extrapolate):
+    """A curves node's GLSL helper (its table a constant array) against node_functions.curves, inside the
+    points' span and past it (extended by the end slopes, or held)."""
+    table = tuple(tuple(float(v) for v in row) for row in fuzz.rng.uniform(-1.0, 2.0, (256, 3)).astype(np.float32))
+    settings = (-0.5, 1.5, extrapolate, table)
+    helpers = {}
+    name = material_textures._curves_helper(settings, helpers)
+    fac, value, _ = _inputs(fuzz)
+    fac = np.abs(fac) / 3.0
+    source = helpers[settings][1] + "\n"
+    got = glsl([source], f"result = vec4({name}(a.xyz, b.xyz), 0.0);",
+               {"a": np.c_[fac, np.zeros(N)], "b": np.c_[value, np.zeros(N)]}, 3)
+    expected = node_functions.curves(settings, fac, value)
+    assert _close(record_error, f"curves extrapolate={extrapolate}", got, expected) < 1e-5
+
+
 def test_fresnel_and_layer_weight(glsl, fuzz, record_error):
     """Fresnel and Layer Weight (both outputs) against their numpy mirrors, over views from either side of the
     normal (a surface seen from behind inverts the index)."""

@@ -63,7 +63,8 @@ def _function_cases():
     return [name for name in node_values.CASES
             if name.startswith(("math_", "clamp_", "map_range_", "color_ramp_", "mix_", "hue_", "gamma", "brightness",
                                 "rgb_to_bw", "coordinates_", "geometry_", "checker", "gradient_", "mapping_",
-                                "vector_math_", "noise_", "wave_", "magic_", "image_", "fresnel", "layer_weight_",
+                                "vector_math_", "noise_", "wave_", "magic_", "white_noise_", "image_", "rgb_curves",
+                                "vector_curves", "float_curve", "fresnel", "layer_weight_",
                                 "mix_shader_by_fresnel", "unlit"))
             and name not in ("math_and_mix", "mix_shader_textured_factor", "image_non_color")]
 
@@ -79,6 +80,10 @@ LOOSER = {"math_logarithm": 0.15,        # 0.0913 / 0.0757: log2(a) / log2(b), b
           "checker": 0.07, "checker_object_fac": 0.07,          # 0.0416 / 0.0156, 0.0448 / 0.0282: the cells' edges
           "vector_math_modulo": 0.05, "vector_math_snap": 0.07,  # 0.0301 / 0.0092, 0.0434 / 0.0106
           "wave_bands_diagonal_saw": 0.06,                       # 0.0410 / 0.0352: the saw's jumps
+          # a random value a cell: the cells' edges (0.0170 / 0.0046, 0.0361 / 0.0106, 0.0387 / 0.0112,
+          # 0.0381 / 0.0113, 0.0381 / 0.0105)
+          **dict.fromkeys(("white_noise_1d_value", "white_noise_2d_color", "white_noise_3d_color",
+                           "white_noise_4d_color", "white_noise_3d_value"), 0.06),
           # 0.178 / 0.023, bias +0.026: Clip's edge, a step inside the pixel filter, over a mean mostly black
           "image_clip": 0.25}
 LOOSER_BIAS = {"image_clip": 0.04}
@@ -86,9 +91,9 @@ LOOSER_BIAS = {"image_clip": 0.04}
 
 @pytest.mark.parametrize("case", _function_cases())
 def test_node_function_against_cycles(node_values, case):
-    """Every Math operation, Clamp, Map Range, Color Ramp, the Mix node's blends, Hue/Saturation/Value, Gamma,
+    """Every Math operation, Clamp, Map Range, Color Ramp, RGB, Vector and Float Curves, the Mix node's blends, Hue/Saturation/Value, Gamma,
     Brightness/Contrast, RGB to BW, the Texture Coordinate and Geometry outputs, Mapping, Vector Math and the
-    Checker, Gradient, Noise, Wave and Magic textures, Fresnel, Layer Weight (on a sphere), and images read at
+    Checker, Gradient, Noise, Wave, Magic and White Noise textures, Fresnel, Layer Weight (on a sphere), and images read at
     coordinates of the node tree's own and past their edges by each extension (per pixel) against
     Cycles' evaluation of the same node (docs/ACCURACY.md has each figure): relative RMSE under 0.03 (the looser
     cases above), bias under 0.02."""
