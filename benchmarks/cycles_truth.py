@@ -55,7 +55,8 @@ def cases_main(argv, description, option, cases, size, samples, score_case, json
                markdown_section):
     """The command line of a benchmark of named cases scored against Cycles: run the cases `option` lists (all
     of `cases` by default) at --size and --cycles-samples through score_case(name, size, samples), write their
-    rows to json_path and print markdown_section(data); or, with --update-doc, write that section from the JSON
+    rows to json_path (some of the cases: merged into its rows when they were run at the same size and samples,
+    else not written) and print markdown_section(data); or, with --update-doc, write that section from the JSON
     into doc_path under `title`."""
     import argparse
     import json
@@ -76,5 +77,41 @@ def cases_main(argv, description, option, cases, size, samples, score_case, json
     rows = [score_case(name, args.size, args.cycles_samples) for name in names]
     data = {"size": args.size, "cycles_samples": args.cycles_samples, "rows": rows,
             "seconds": time.perf_counter() - started}
-    json_path.write_text(json.dumps(data, indent=1))
-    print(markdown_section(data))
+    if set(names) != set(cases):
+        data = _merged(data, json_path, list(cases))
+    if data is not None:
+        json_path.write_text(json.dumps(data, indent=1))
+        print(markdown_section(data))
+    else:
+        print(f"{json_path} holds another size or sample count: this run of some cases is not written into it")
+
+
+def merged_note(data, option):
+    """The line a section adds for the cases run later into its JSON (_merged), or ""."""
+    merged = data.get("merged_cases")
+    if not merged:
+        return ""
+    return (f"  Run later into the table at the same size and samples: {', '.join(merged)} "
+            f"(`{option} {','.join(merged)}`).")
+
+
+def _case_name(row):
+    return row.get("case", row.get("scene"))
+
+
+def _merged(data, json_path, order):
+    """A run of some cases put into json_path's earlier run (rows of the same case replaced, the rest kept, in
+    the cases' order; its seconds the earlier run's), or None where that run had another size or sample count."""
+    import json
+
+    if not json_path.exists():
+        return data
+    earlier = json.loads(json_path.read_text())
+    if (earlier.get("size"), earlier.get("cycles_samples")) != (data["size"], data["cycles_samples"]):
+        return None
+    rows = {_case_name(row): row for row in earlier["rows"]}
+    rows.update({_case_name(row): row for row in data["rows"]})
+    rank = {name: index for index, name in enumerate(order)}
+    earlier["rows"] = sorted(rows.values(), key=lambda row: rank.get(_case_name(row), len(rank)))
+    earlier["merged_cases"] = sorted(set(earlier.get("merged_cases", [])) | {_case_name(row) for row in data["rows"]})
+    return earlier

@@ -194,11 +194,25 @@ def glossy_beckmann(roughness):
     return build
 
 
+def bumped():
+    """A rough dielectric whose Normal is a Bump node over a Noise Texture (Scale 6, Distance 0.05): a shading
+    normal computed per pixel."""
+    material, tree, node = _principled("bumped", Base_Color=(0.7, 0.35, 0.15, 1.0), Roughness=0.4)
+    noise_node = tree.nodes.new("ShaderNodeTexNoise")
+    noise_node.inputs["Scale"].default_value = 6.0
+    bump_node = tree.nodes.new("ShaderNodeBump")
+    bump_node.inputs["Distance"].default_value = 0.05
+    tree.links.new(noise_node.outputs["Fac"], bump_node.inputs["Height"])
+    tree.links.new(bump_node.outputs["Normal"], node.inputs["Normal"])
+    return material
+
+
 SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5), "principled_r080": dielectric(0.8),
           "principled_gold_r030": gold, "principled_black_metal": black_metal, "principled_textured": textured, "principled_pbr_metallic_map": pbr_metallic_map,
           "principled_tiled": tiled, "mix_diffuse_glossy": mix_diffuse_glossy,
           "principled_anisotropic": anisotropic, "glossy_anisotropic": glossy_anisotropic(0.6),
-          "glossy_anisotropic_negative": glossy_anisotropic(-0.6), "glossy_beckmann_r030": glossy_beckmann(0.3)}
+          "glossy_anisotropic_negative": glossy_anisotropic(-0.6), "glossy_beckmann_r030": glossy_beckmann(0.3),
+          "principled_bumped": bumped}
 
 
 def build(name, size):
@@ -232,8 +246,11 @@ def markdown_section(data):
     for row in data["rows"]:
         lines.append(f"| {row['scene']} | {row['relative_rmse']:.3f} | {row['relative_bias']:+.3f} | "
                      f"{row['noise_floor']:.3f} |")
+    from benchmarks import cycles_truth
+
     lines += ["", f"Rerun: `.venv/bin/python -m benchmarks.node_materials --size {data['size']} "
-              f"--cycles-samples {data['cycles_samples']}` ({data['seconds']:.0f} s), then `--update-doc`."]
+              f"--cycles-samples {data['cycles_samples']}` ({data['seconds']:.0f} s), then `--update-doc`."
+              + cycles_truth.merged_note(data, "--scenes")]
     return "\n".join(lines)
 
 

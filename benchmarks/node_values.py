@@ -627,6 +627,25 @@ def uv_transformed_by_math(tree):
     return combine.outputs["Vector"]
 
 
+def bump(strength=1.0, distance=0.2, invert=False):
+    """The Bump node's Normal over a Noise Texture's Fac (Scale 3), as a colour: normal x 0.5 + 0.5."""
+    def value_of(tree):
+        noise_node = tree.nodes.new("ShaderNodeTexNoise")
+        noise_node.inputs["Scale"].default_value = 3.0
+        node = tree.nodes.new("ShaderNodeBump")
+        node.invert = invert
+        node.inputs["Strength"].default_value = strength
+        node.inputs["Distance"].default_value = distance
+        tree.links.new(noise_node.outputs["Fac"], node.inputs["Height"])
+        shift = tree.nodes.new("ShaderNodeVectorMath")
+        shift.operation = "MULTIPLY_ADD"
+        tree.links.new(node.outputs["Normal"], shift.inputs[0])
+        shift.inputs[1].default_value = (0.5, 0.5, 0.5)
+        shift.inputs[2].default_value = (0.5, 0.5, 0.5)
+        return shift.outputs["Vector"]
+    return value_of
+
+
 def fresnel_node(ior=1.45):
     def value_of(tree):
         node = tree.nodes.new("ShaderNodeFresnel")
@@ -799,6 +818,7 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "image_uv_by_math": _socket_case(image_at(uv_transformed_by_math)),
          "image_turned_about_x": _socket_case(image_at(lambda tree: _mapping_node(tree, "POINT",
                                                                                  _coordinates(tree, "UV")))),
+         "bump": _socket_case(bump()), "bump_inverted_half": _socket_case(bump(0.5, 0.4, True)),
          "fresnel": _socket_case(fresnel_node()), "fresnel_ior_3": _socket_case(fresnel_node(3.0)),
          "layer_weight_fresnel": _socket_case(layer_weight("Fresnel", 0.3)),
          "layer_weight_facing": _socket_case(layer_weight("Facing", 0.3)),
@@ -877,8 +897,11 @@ def markdown_section(data):
                          f"{row['noise_floor']:.4f} |")
         else:
             lines.append(f"| {row['case']} | largest {row['largest']:.3g}, Cycles' {row['truth_largest']:.3g} | | |")
+    from benchmarks import cycles_truth
+
     lines += ["", f"Rerun: `.venv/bin/python -m benchmarks.node_values --size {data['size']} --cycles-samples "
-              f"{data['cycles_samples']}` ({data['seconds']:.0f} s), then `--update-doc`."]
+              f"{data['cycles_samples']}` ({data['seconds']:.0f} s), then `--update-doc`."
+              + cycles_truth.merged_note(data, "--cases")]
     return "\n".join(lines)
 
 

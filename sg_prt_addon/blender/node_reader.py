@@ -18,7 +18,7 @@ import numpy as np
 
 from ..reflectance import coverage, node_functions, principled
 from ..reflectance.texture_expression import Expression
-from . import curve_nodes, texture_nodes
+from . import curve_nodes, normal_nodes, texture_nodes
 from .colour_attributes import default_color_attribute
 from .node_graph import enabled_inputs, output_node
 
@@ -169,6 +169,8 @@ class SocketReader:
             return texture_nodes.value(self, node, out)
         if node.type in curve_nodes.NODE_TYPES:
             return curve_nodes.value(self, node, out)
+        if node.type in normal_nodes.NODE_TYPES:
+            return normal_nodes.value(self, node, out)
         if node.type in ("FRESNEL", "LAYER_WEIGHT"):
             return self.view_weight(node, out)
         if node.type == "VECT_MATH":
@@ -517,9 +519,7 @@ def _combine(reader, closures, reading):
             holdout = holdout + weight
             continue
         values = _closure_values(reader, closure)
-        if "normal_map" in values and "normal_map" not in reading.textures:
-            reading.textures["normal_map"] = values.pop("normal_map")
-            fields["normal_strength"] = values.pop("normal_strength")
+        _take_normals(values, reading)
         if "diffuse_color" in values:
             diffuse = diffuse + weight * Expression.of(values["diffuse_color"])
         if "specular_color" in values:
@@ -553,6 +553,18 @@ def _combine(reader, closures, reading):
     reading.decoded_slots = tuple(sorted(slot for slot, value in reading.textures.items()
                                          if isinstance(value, str) and slot not in COLOUR_SLOTS + ("normal_map",)
                                          and _is_srgb(reader.images[value])))
+
+
+def _take_normals(values, reading):
+    """A closure's normal map (and strength) and computed shading normal into the reading: the first closure's
+    that has one."""
+    if "normal_map" in values:
+        image, strength = values.pop("normal_map"), values.pop("normal_strength")
+        if "normal_map" not in reading.textures:
+            reading.textures["normal_map"] = image
+            reading.fields["normal_strength"] = strength
+    if "shading_normal" in values:
+        reading.textures.setdefault("shading_normal", values.pop("shading_normal"))
 
 
 def _drawn(reader, closures, reading):
@@ -619,11 +631,17 @@ def _image_mean(image):
 
 
 def _normal_input(reader, node, values):
-    """A Normal input fed by a Normal Map node (tangent space) over an image: the normal map and strength."""
+    """A Normal input fed by a Normal Map node (tangent space) over an image: the normal map and strength; by a
+    Bump node: the shading normal computed per pixel."""
     out = follow(node.inputs["Normal"])
     if out is None:
         return
     source = out.node
+    if source.type in normal_nodes.NODE_TYPES:
+        normal = reader.value(node.inputs["Normal"], True)
+        if normal != Expression.coordinates("WORLD_NORMAL"):      # (a constant height bumps nothing)
+            values["shading_normal"] = normal
+        return
     if source.type != "NORMAL_MAP":
         reader.note(source, "not read as a normal: the mesh normal is used")
         return

@@ -439,6 +439,21 @@ def layer_weight(output, blend, normal, incoming):
     return np.repeat(np.asarray(value, FLOAT)[..., None], 3, axis=-1)
 
 
+def bump_normal(strength, distance, height_dx, height_dy, position_dx, position_dy, normal, invert=False):
+    """The Bump node's normal (Cycles' svm_node_set_bump) from the height's and the position's differences
+    across a pixel (..., 3 each; the heights' first channel): the surface gradient of the height in the
+    tangent plane of `normal` moves it by Distance, mixed back toward it by Strength (clamped to [0, 1])."""
+    normal = np.asarray(normal, FLOAT)
+    position_dx, position_dy = np.asarray(position_dx, FLOAT), np.asarray(position_dy, FLOAT)
+    rx, ry = np.cross(position_dy, normal), np.cross(normal, position_dx)
+    det = np.sum(position_dx * rx, axis=-1, keepdims=True)
+    gradient = np.asarray(height_dx, FLOAT)[..., :1] * rx + np.asarray(height_dy, FLOAT)[..., :1] * ry
+    distance = np.asarray(distance, FLOAT)[..., :1] * FLOAT(-1 if invert else 1)
+    strength = np.clip(np.asarray(strength, FLOAT)[..., :1], 0, 1)
+    bumped = _safe_normalize(np.abs(det) * normal - distance * np.sign(det) * gradient)
+    return _safe_normalize(strength * bumped + (FLOAT(1) - strength) * normal).astype(FLOAT)
+
+
 # Color Ramp's outputs a Function reads
 RAMP_OUTPUTS = ("Color", "Alpha")
 MAP_RANGE_INTERPOLATIONS = ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")
@@ -452,9 +467,14 @@ def apply(name, settings, args):
     hue_saturation_value, gamma, brightness_contrast, mapping (type,), vector_math (operation,), tex_checker
     (output,), tex_gradient (type,), tex_noise (type, normalize, output), tex_wave (type, bands direction,
     rings direction, profile, output), tex_magic (depth, output), tex_white_noise (dimensions, output), fresnel,
-    layer_weight (output,))."""
+    layer_weight (output,)); bump (invert,) needs its inputs' differences across the pixel: bump_normal."""
     args = [np.asarray(a, FLOAT) for a in args]
     return _CALLS[name](settings, args)
+
+
+def _no_derivatives(name):
+    raise ValueError(f"{name} takes its inputs' differences across the pixel: a shader computes it (GLSL dFdx, "
+                     "dFdy), a value at a point alone has none (node_functions.bump_normal from the differences)")
 
 
 def _ramp_output(settings, args):
@@ -481,6 +501,7 @@ _CALLS = {
     "tex_white_noise": lambda settings, args: tex_white_noise(settings, *args),
     "fresnel": lambda settings, args: fresnel(*args),
     "layer_weight": lambda settings, args: layer_weight(settings[0], *args),
+    "bump": lambda settings, args: _no_derivatives("bump"),
     "hue_saturation_value": lambda settings, args: hue_saturation_value(*args),
     "gamma": lambda settings, args: gamma(*args),
     "brightness_contrast": lambda settings, args: brightness_contrast(*args),

@@ -22,11 +22,13 @@ import numpy as np
 
 # The texture slots every technique applies the same way (shaders/techniques/common/surface_io.glsl): the
 # emitted radiance's colour (surface_write), the coverage (surface_coverage: Principled Alpha, a Transparent
-# BSDF) and the holdout's share of the drawn surface (surface_write's alpha)
+# BSDF), the holdout's share of the drawn surface (surface_write's alpha) and a node tree's shading normal
+# (surface_geometry: a Bump node's, computed per pixel)
 EMISSION_TEXTURE = "emission"
 ALPHA_TEXTURE = "alpha"
 HOLDOUT_TEXTURE = "holdout"
-SURFACE_TEXTURES = (EMISSION_TEXTURE, ALPHA_TEXTURE, HOLDOUT_TEXTURE)
+SHADING_NORMAL_TEXTURE = "shading_normal"
+SURFACE_TEXTURES = (EMISSION_TEXTURE, ALPHA_TEXTURE, HOLDOUT_TEXTURE, SHADING_NORMAL_TEXTURE)
 
 
 class ObjectInputs:

@@ -166,6 +166,7 @@ _GLSL_CALLS = {
     "tex_white_noise": lambda settings: ("node_tex_white_noise", (_index(node_functions.NOISE_DIMENSIONS, settings[0]),
                                                                   _bool(settings[1] == "Color"))),
     "layer_weight": lambda settings: ("node_layer_weight", (_bool(settings[0] == "Fresnel"),)),
+    "bump": lambda settings: ("node_bump", (_bool(settings[0]),)),
 }
 
 

@@ -663,3 +663,25 @@ vec3 node_tex_white_noise(vec3 vector, vec3 w, int dimensions, bool colour)
   float value = node_hash_float4(x, y, z, t);
   return colour ? vec3(value, node_hash_float4(z, x, t, y), node_hash_float4(t, z, y, x)) : vec3(value);
 }
+
+/* The Bump node's normal (node_functions.bump_normal) from the height's and the position's differences across
+ * the pixel */
+vec3 node_bump_normal(vec3 strength, vec3 distance, float height_dx, float height_dy, vec3 position_dx,
+                      vec3 position_dy, vec3 normal, bool invert)
+{
+  vec3 rx = cross(position_dy, normal), ry = cross(normal, position_dx);
+  float det = dot(position_dx, rx);
+  vec3 gradient = height_dx * rx + height_dy * ry;
+  float d = invert ? -distance.x : distance.x;
+  float s = clamp(strength.x, 0.0, 1.0);
+  vec3 bumped = node_safe_normalize(abs(det) * normal - d * sign(det) * gradient);
+  return node_safe_normalize(s * bumped + (1.0 - s) * normal);
+}
+
+/* The Bump node in a fragment shader: the differences across the pixel its derivatives (the height's first
+ * channel, the surface position) */
+vec3 node_bump(vec3 strength, vec3 distance, vec3 height, vec3 normal, vec3 position, bool invert)
+{
+  return node_bump_normal(strength, distance, dFdx(height.x), dFdy(height.x), dFdx(position), dFdy(position),
+                          normal, invert);
+}

@@ -395,3 +395,20 @@ def test_transparency_and_holdout_read_as_coverage(empty_file):
     params, warnings = _read(material)
     assert params.alpha == 1.0 and params.holdout == pytest.approx(0.4) and warnings == []
     assert params.emission == pytest.approx((0.6, 0.6, 0.6))
+
+
+def test_a_bump_node_on_the_normal_is_a_computed_shading_normal(empty_file):
+    """A Bump node over a texture feeds the shading_normal slot (a function of the height, the surface normal
+    and position); over a constant height it bumps nothing and no slot is made; nothing is named."""
+    material, tree, output = _material("bumped")
+    node = _principled(tree, output)
+    bump = tree.nodes.new("ShaderNodeBump")
+    tree.links.new(bump.outputs["Normal"], node.inputs["Normal"])
+    params, warnings = _read(material)
+    assert "shading_normal" not in params.textures and warnings == []
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+    params, warnings = _read(material)
+    normal = params.textures["shading_normal"]
+    assert warnings == [] and normal.terms[0][1][0].function.name == "bump"
+    assert set(normal.coordinate_names) == {"GENERATED", "POSITION", "WORLD_NORMAL"}

@@ -229,6 +229,24 @@ def test_curves(glsl, fuzz, record_error, extrapolate):
     assert _close(record_error, f"curves extrapolate={extrapolate}", got, expected) < 1e-5
 
 
+def test_bump_normal(glsl, fuzz, record_error):
+    """The Bump node's normal from the height's and the position's differences across the pixel (inverted and
+    not, strengths past [0, 1]) against node_functions.bump_normal."""
+    normal = fuzz.rng.normal(size=(N, 3)).astype(np.float32)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    dpdx, dpdy = (fuzz.rng.normal(scale=0.01, size=(N, 3)).astype(np.float32) for _ in range(2))
+    heights = fuzz.rng.normal(scale=0.02, size=(N, 3)).astype(np.float32)
+    strength, distance = (fuzz.rng.uniform(-0.5, 1.5, (N, 3)).astype(np.float32) for _ in range(2))
+    inputs = {name: np.c_[value, np.zeros(N)] for name, value in zip("abcdef", (strength, distance, heights, dpdx,
+                                                                               dpdy, normal))}
+    for invert in (False, True):
+        got = glsl(LIB, f"result = vec4(node_bump_normal(a.xyz, b.xyz, c.x, c.y, d.xyz, e.xyz, f.xyz, "
+                   f"{str(invert).lower()}), 0.0);", inputs, 3)
+        expected = node_functions.bump_normal(strength, distance, heights[:, :1], heights[:, 1:2], dpdx, dpdy,
+                                              normal, invert)
+        assert _close(record_error, f"bump invert={invert}", got, expected) < 1e-5
+
+
 def test_fresnel_and_layer_weight(glsl, fuzz, record_error):
     """Fresnel and Layer Weight (both outputs) against their numpy mirrors, over views from either side of the
     normal (a surface seen from behind inverts the index)."""

@@ -64,7 +64,7 @@ def _function_cases():
             if name.startswith(("math_", "clamp_", "map_range_", "color_ramp_", "mix_", "hue_", "gamma", "brightness",
                                 "rgb_to_bw", "coordinates_", "geometry_", "checker", "gradient_", "mapping_",
                                 "vector_math_", "noise_", "wave_", "magic_", "white_noise_", "image_", "rgb_curves",
-                                "vector_curves", "float_curve", "fresnel", "layer_weight_",
+                                "vector_curves", "float_curve", "bump", "fresnel", "layer_weight_",
                                 "mix_shader_by_fresnel", "unlit"))
             and name not in ("math_and_mix", "mix_shader_textured_factor", "image_non_color")]
 

@@ -46,8 +46,8 @@ void surface_colour_textures(inout vec3 diffuse_color, inout vec3 specular_color
 #endif
 }
 
-/* The tangent input (the UV map's, or the object axis in world space), the shading normal (normal map) and
- * the shading tangent (rotated about it). */
+/* The tangent input (the UV map's, or the object axis in world space), the shading normal (normal map, or a
+ * node tree's computed normal) and the shading tangent (rotated about it). */
 void surface_geometry(vec3 normal, out vec4 tangent, out vec3 shading_normal, out vec3 shading_tangent)
 {
   tangent = material.options.x > 0.5 ? vec4(mat3(model_matrix) * material.tangent_axis_rotation.xyz, 1.0)
@@ -58,6 +58,11 @@ void surface_geometry(vec3 normal, out vec4 tangent, out vec3 shading_normal, ou
   vec3 mapped = material_texture_level(texture_normal_map, level).rgb;
   shading_normal = apply_normal_map(normal, tangent, mapped, material.parameters1.w);
   normal_map_spread = normal_spread(2.0 * mapped - 1.0, level, material.parameters1.w);
+#endif
+#ifdef HAS_TEXTURE_SHADING_NORMAL
+  /* a node tree's normal (a Bump node's, world space), turned to the side the viewer sees */
+  vec3 computed = normalize(texture_value_shading_normal().xyz);
+  shading_normal = dot(computed, normal) < 0.0 ? -computed : computed;
 #endif
   shading_tangent = rotate_tangent(shading_normal, tangent.xyz, material.tangent_axis_rotation.w);
 }
