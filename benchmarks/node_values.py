@@ -567,6 +567,23 @@ def white_noise(dimensions, output):
     return value_of
 
 
+def voronoi(feature="F1", output="Distance", metric="EUCLIDEAN", detail=0.0, normalize=False):
+    """The Voronoi Texture in 3D of the Object coordinates (Scale 3, Randomness 0.9, Smoothness 0.6, Exponent
+    1.5); a Position made positive (Vector Math Absolute)."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexVoronoi")
+        node.feature, node.distance, node.normalize = feature, metric, normalize
+        node.inputs["Scale"].default_value = 3.0
+        node.inputs["Randomness"].default_value = 0.9
+        for name, value in (("Smoothness", 0.6), ("Exponent", 1.5), ("Detail", detail)):
+            if name in node.inputs:
+                node.inputs[name].default_value = value
+        tree.links.new(_coordinates(tree, "Object"), node.inputs["Vector"])
+        socket = node.outputs[output]
+        return _vector_math(tree, "ABSOLUTE", socket) if output == "Position" else socket
+    return value_of
+
+
 def wave(wave_type="BANDS", direction="X", profile="SIN", distortion=3.0):
     """The Wave Texture (Scale 2, its distortion's noise at Detail 2) of the Object coordinates."""
     def value_of(tree):
@@ -811,6 +828,16 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          **{f"white_noise_{dimensions.lower()}_{output.lower()}": _socket_case(white_noise(dimensions, output))
             for dimensions, output in (("1D", "Value"), ("2D", "Color"), ("3D", "Color"), ("4D", "Color"),
                                        ("3D", "Value"))},
+         "voronoi_f1": _socket_case(voronoi()), "voronoi_f1_color": _socket_case(voronoi(output="Color")),
+         "voronoi_f1_position": _socket_case(voronoi(output="Position")),
+         "voronoi_f2_manhattan": _socket_case(voronoi("F2", metric="MANHATTAN")),
+         "voronoi_f1_minkowski": _socket_case(voronoi(metric="MINKOWSKI")),
+         "voronoi_smooth_f1": _socket_case(voronoi("SMOOTH_F1")),
+         "voronoi_smooth_f1_color": _socket_case(voronoi("SMOOTH_F1", "Color")),
+         "voronoi_distance_to_edge": _socket_case(voronoi("DISTANCE_TO_EDGE")),
+         "voronoi_n_sphere_radius": _socket_case(voronoi("N_SPHERE_RADIUS", "Radius")),
+         "voronoi_fractal": _socket_case(voronoi(detail=2.5, normalize=True)),
+         "voronoi_fractal_edge": _socket_case(voronoi("DISTANCE_TO_EDGE", detail=1.5, normalize=True)),
          "magic_depth_2": _socket_case(magic(2)), "magic_depth_5_fac": _socket_case(magic(5, "Fac")),
          **{f"image_{extension.lower()}": _socket_case(image_extended(extension))
             for extension in ("REPEAT", "EXTEND", "CLIP", "MIRROR")},

@@ -1,10 +1,11 @@
-"""The procedural texture nodes read as node functions of their inputs (reflectance/node_functions.py): Checker,
-Gradient, Noise, Wave, Magic and White Noise, as Cycles defines them.  `value(reader, node, out)` is what
+"""The procedural texture nodes read as node functions of their inputs (reflectance/node_functions.py, voronoi.py):
+Checker, Gradient, Noise, Wave, Magic, White Noise and Voronoi, as Cycles defines them.  `value(reader, node, out)` is what
 node_reader.SocketReader reads for an output of one of NODE_TYPES."""
+from ..reflectance import voronoi
 from ..reflectance.texture_expression import Expression
 from .node_graph import enabled_inputs
 
-NODE_TYPES = ("TEX_CHECKER", "TEX_GRADIENT", "TEX_NOISE", "TEX_WAVE", "TEX_MAGIC", "TEX_WHITE_NOISE")
+NODE_TYPES = ("TEX_CHECKER", "TEX_GRADIENT", "TEX_NOISE", "TEX_WAVE", "TEX_MAGIC", "TEX_WHITE_NOISE", "TEX_VORONOI")
 NOISE_DEFAULTS = {"Scale": 5.0, "Detail": 2.0, "Roughness": 0.5, "Lacunarity": 2.0, "Offset": 0.0, "Gain": 1.0,
                   "Distortion": 0.0}
 
@@ -12,7 +13,8 @@ NOISE_DEFAULTS = {"Scale": 5.0, "Detail": 2.0, "Roughness": 0.5, "Lacunarity": 2
 def value(reader, node, out):
     """The Expression of a procedural texture's output `out` (reader: the node_reader.SocketReader)."""
     return {"TEX_CHECKER": checker, "TEX_GRADIENT": gradient, "TEX_NOISE": noise, "TEX_WAVE": wave,
-            "TEX_MAGIC": magic, "TEX_WHITE_NOISE": white_noise}[node.type](reader, node, out)
+            "TEX_MAGIC": magic, "TEX_WHITE_NOISE": white_noise, "TEX_VORONOI": voronoi_texture}[node.type](
+                reader, node, out)
 
 
 def texture_vector(reader, node, unlinked="GENERATED"):
@@ -73,3 +75,21 @@ def white_noise(reader, node, out):
     w = reader.value(w_socket, False) if w_socket is not None else Expression.constant(0.0)
     settings = (getattr(node, "noise_dimensions", "3D"), _output(out, "Color", "Value"))
     return Expression.function("tex_white_noise", settings, (texture_vector(reader, node, "POSITION"), w))
+
+
+def voronoi_texture(reader, node, out):
+    """The Voronoi Texture in 3D (another dimension count is read as 3D): its Distance, Color, Position or
+    Radius for every feature and metric, with its fractal Detail."""
+    if getattr(node, "voronoi_dimensions", "3D") != "3D":
+        reader.note(node, f"{node.voronoi_dimensions} Voronoi: read as 3D")
+    defaults = {"Scale": 5.0, "Detail": 0.0, "Roughness": 0.5, "Lacunarity": 2.0, "Smoothness": 1.0,
+                "Exponent": 0.5, "Randomness": 1.0}
+    values = [texture_vector(reader, node)]
+    for name, default in defaults.items():
+        socket = enabled_inputs(node, name)[0]
+        values.append(reader.value(socket, False) if socket is not None else Expression.constant(default))
+    if out.identifier not in voronoi.OUTPUTS:
+        reader.note(node, f"its {out.name} output (1D and 4D): 0 is used")
+        return Expression.constant(0.0)
+    settings = (node.feature, node.distance, bool(getattr(node, "normalize", False)), out.identifier)
+    return Expression.function("tex_voronoi", settings, values)

@@ -1,13 +1,15 @@
 """Blender's shader-node functions that are not sums of products, as Cycles and EEVEE define them (Math, Clamp,
 Map Range, Color Ramp, the Mix node's blend modes, Hue/Saturation/Value, Gamma, Brightness/Contrast, Mapping,
-Vector Math, Fresnel, Layer Weight, the Checker, Gradient, Noise, Wave and Magic textures), on
-(..., 3) float32 arrays: a scalar socket is its value on all three channels.  shaders/lib/node_functions.glsl
-is their GLSL (each `node_<name>` there mirrors FUNCTIONS[name] here); reflectance.texture_expression applies
-them to per-pixel values.
+Vector Math, Fresnel, Layer Weight, Bump, the curves, the Checker, Gradient, Noise, Wave, Magic and White Noise
+textures; the Voronoi texture in reflectance/voronoi.py), on (..., 3) float32 arrays: a scalar socket is its
+value on all three channels.  shaders/lib/node_functions.glsl is their GLSL (each `node_<name>` there mirrors
+<name> here); reflectance.texture_expression applies them to per-pixel values.
 
 Every function takes its inputs as (..., 3) arrays and returns one; `params` are numbers fixed in the node.
 """
 import numpy as np
+
+from . import voronoi
 
 FLOAT = np.float32
 
@@ -466,7 +468,8 @@ def apply(name, settings, args):
     max_x, extrapolate, table), mix (blend,),
     hue_saturation_value, gamma, brightness_contrast, mapping (type,), vector_math (operation,), tex_checker
     (output,), tex_gradient (type,), tex_noise (type, normalize, output), tex_wave (type, bands direction,
-    rings direction, profile, output), tex_magic (depth, output), tex_white_noise (dimensions, output), fresnel,
+    rings direction, profile, output), tex_magic (depth, output), tex_white_noise (dimensions, output), tex_voronoi
+    (feature, metric, normalize, output: reflectance/voronoi.py), fresnel,
     layer_weight (output,)); bump (invert,) needs its inputs' differences across the pixel: bump_normal."""
     args = [np.asarray(a, FLOAT) for a in args]
     return _CALLS[name](settings, args)
@@ -499,6 +502,7 @@ _CALLS = {
     "tex_wave": lambda settings, args: tex_wave(settings, *args),
     "tex_magic": lambda settings, args: tex_magic(settings, *args),
     "tex_white_noise": lambda settings, args: tex_white_noise(settings, *args),
+    "tex_voronoi": lambda settings, args: voronoi.tex_voronoi(settings, *args),
     "fresnel": lambda settings, args: fresnel(*args),
     "layer_weight": lambda settings, args: layer_weight(settings[0], *args),
     "bump": lambda settings, args: _no_derivatives("bump"),

@@ -10,7 +10,7 @@ A technique's key carries `textures` (slot names) and `node_values` (a NodeValue
 `samplers`, `bind` and `sources` give its shader the rest, shader_sources.surface_calls the colour stream."""
 from dataclasses import dataclass
 
-from ..reflectance import node_functions
+from ..reflectance import node_functions, voronoi
 from . import shader_sources
 
 NORMAL_MAP = "normal_map"
@@ -166,6 +166,9 @@ _GLSL_CALLS = {
     "tex_white_noise": lambda settings: ("node_tex_white_noise", (_index(node_functions.NOISE_DIMENSIONS, settings[0]),
                                                                   _bool(settings[1] == "Color"))),
     "layer_weight": lambda settings: ("node_layer_weight", (_bool(settings[0] == "Fresnel"),)),
+    "tex_voronoi": lambda settings: ("node_tex_voronoi", (_index(voronoi.FEATURES, settings[0]),
+                                                          _index(voronoi.METRICS, settings[1]), _bool(settings[2]),
+                                                          _index(voronoi.OUTPUTS, settings[3]))),
     "bump": lambda settings: ("node_bump", (_bool(settings[0]),)),
 }
 
@@ -223,11 +226,17 @@ def _curves_helper(settings, helpers):
     return name
 
 
-def _uses_functions(key):
+def _functions_used(key):
+    """The names of the node functions the computed slots call, inside other functions' inputs too."""
     def functions_in(expression):
-        return any(factor.function is not None for _, factors in expression.terms for factor in factors)
+        for _, factors in expression.terms:
+            for factor in factors:
+                if factor.function is not None:
+                    yield factor.function.name
+                    for arg in factor.function.args:
+                        yield from functions_in(arg)
 
-    return any(functions_in(expression) for _, expression in key.node_values.slots)
+    return {name for _, expression in key.node_values.slots for name in functions_in(expression)}
 
 
 def values_source(key):
@@ -274,8 +283,10 @@ def noise_offsets_source():
 
 def sources(key):
     """The surface shader's sources from surface_common.glsl to surface_io.glsl, the slots' values between."""
-    library = [noise_offsets_source(), shader_sources.library_source("node_functions.glsl")] \
-        if _uses_functions(key) else []
+    used = _functions_used(key)
+    library = [noise_offsets_source(), shader_sources.library_source("node_functions.glsl")] if used else []
+    if "tex_voronoi" in used:
+        library.append(shader_sources.library_source("voronoi.glsl"))
     return [shader_sources.technique_source("common", "surface_common.glsl"),
             shader_sources.technique_source("common", "material_textures.glsl"), *library, values_source(key),
             shader_sources.technique_source("common", "surface_io.glsl")]

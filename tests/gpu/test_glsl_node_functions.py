@@ -247,6 +247,31 @@ def test_bump_normal(glsl, fuzz, record_error):
         assert _close(record_error, f"bump invert={invert}", got, expected) < 1e-5
 
 
+@pytest.mark.parametrize("feature, metric, detail", [
+    ("F1", "EUCLIDEAN", 0.0), ("F2", "MANHATTAN", 0.0), ("SMOOTH_F1", "EUCLIDEAN", 0.0), ("F1", "CHEBYCHEV", 2.5),
+    ("F2", "MINKOWSKI", 1.0), ("DISTANCE_TO_EDGE", "EUCLIDEAN", 1.5), ("N_SPHERE_RADIUS", "EUCLIDEAN", 0.0)])
+def test_voronoi_texture(glsl, fuzz, record_error, feature, metric, detail):
+    """The Voronoi texture (features, metrics, fractal detail with a fractional octave, normalized) against its
+    numpy mirror, every output: the same PCG hash of the same cells; the distances' float32 rounding apart,
+    equal where no two points are nearly equally near (a few points may take the other)."""
+    from sg_prt_addon.reflectance import voronoi
+
+    count = 512
+    vector = fuzz.rng.uniform(-3.0, 3.0, (count, 3)).astype(np.float32)
+    params = [np.full((count, 3), value, np.float32) for value in (2.3, detail, 0.6, 2.1, 0.7, 1.3, 0.85)]
+    inputs = {name: np.c_[value, np.zeros(count)] for name, value in zip("abcdefgh", [vector] + params)}
+    for output in voronoi.OUTPUTS:
+        flags = (f"{voronoi.FEATURES.index(feature)}, {voronoi.METRICS.index(metric)}, true, "
+                 f"{voronoi.OUTPUTS.index(output)}")
+        got = glsl(LIB + ["voronoi.glsl"], f"result = vec4(node_tex_voronoi(a.xyz, b.xyz, c.xyz, d.xyz, e.xyz, "
+                   f"f.xyz, g.xyz, h.xyz, {flags}), 0.0);", inputs, 3)
+        expected = voronoi.tex_voronoi((feature, metric, True, output), vector, *params)
+        error = np.abs(got - expected).max(axis=1) / np.maximum(np.abs(expected).max(axis=1), 1.0)
+        assert np.mean(error > 1e-4) < 0.01, (output, np.mean(error > 1e-4))
+        assert record_error(f"voronoi {feature} {metric} detail {detail} {output}",
+                            np.where(error > 1e-4, 0.0, error).max()) < 1e-4
+
+
 def test_fresnel_and_layer_weight(glsl, fuzz, record_error):
     """Fresnel and Layer Weight (both outputs) against their numpy mirrors, over views from either side of the
     normal (a surface seen from behind inverts the index)."""

@@ -63,7 +63,7 @@ def _function_cases():
     return [name for name in node_values.CASES
             if name.startswith(("math_", "clamp_", "map_range_", "color_ramp_", "mix_", "hue_", "gamma", "brightness",
                                 "rgb_to_bw", "coordinates_", "geometry_", "checker", "gradient_", "mapping_",
-                                "vector_math_", "noise_", "wave_", "magic_", "white_noise_", "image_", "rgb_curves",
+                                "vector_math_", "noise_", "wave_", "magic_", "white_noise_", "voronoi_", "image_", "rgb_curves",
                                 "vector_curves", "float_curve", "bump", "fresnel", "layer_weight_",
                                 "mix_shader_by_fresnel", "unlit"))
             and name not in ("math_and_mix", "mix_shader_textured_factor", "image_non_color")]
@@ -93,7 +93,7 @@ LOOSER_BIAS = {"image_clip": 0.04}
 def test_node_function_against_cycles(node_values, case):
     """Every Math operation, Clamp, Map Range, Color Ramp, RGB, Vector and Float Curves, the Mix node's blends, Hue/Saturation/Value, Gamma,
     Brightness/Contrast, RGB to BW, the Texture Coordinate and Geometry outputs, Mapping, Vector Math and the
-    Checker, Gradient, Noise, Wave, Magic and White Noise textures, Fresnel, Layer Weight (on a sphere), and images read at
+    Checker, Gradient, Noise, Wave, Magic, White Noise and Voronoi textures, Fresnel, Layer Weight (on a sphere), and images read at
     coordinates of the node tree's own and past their edges by each extension (per pixel) against
     Cycles' evaluation of the same node (docs/ACCURACY.md has each figure): relative RMSE under 0.03 (the looser
     cases above), bias under 0.02."""
