@@ -1188,8 +1188,49 @@ def test_node_functions_stress(glsl, fuzz):
                  "node_fresnel(abs(a.xyz), node_safe_normalize(b.xyz), node_safe_normalize(c.xyz))",
                  "node_layer_weight(t.xyz, node_safe_normalize(b.xyz), node_safe_normalize(c.xyz), true) + "
                  "node_layer_weight(t.xyz, b.xyz * 0.0, node_safe_normalize(c.xyz), false) + "
-                 "vec3(node_fresnel_dielectric_cos(t.x, 0.0)) + node_mix_hue_of(t.xyz, abs(a.xyz), abs(b.xyz), true)"):
+                 "vec3(node_fresnel_dielectric_cos(t.x, 0.0)) + node_mix_hue_of(t.xyz, abs(a.xyz), abs(b.xyz), true)",
+                 "node_tex_white_noise(a.xyz, b.xyz, 3, true) + node_tex_white_noise(a.xyz, b.xyz, 0, true) + "
+                 "node_tex_white_noise(a.xyz, b.xyz, 1, false) + node_tex_white_noise(a.xyz, b.xyz, 2, true)",
+                 "vec3(node_hash_to_float(node_hash_final(uint(abs(a.x)), node_hash_uint1(uint(abs(b.x))), "
+                 "node_hash_uint2(uint(abs(c.x)), 3u))), node_hash_float1(a.x) + node_hash_float2(a.x, b.x), "
+                 "node_hash_float3(a.x, b.x, c.x) + node_hash_float4(a.x, b.x, c.x, a.y) + "
+                 "node_hash_to_float(node_hash_uint4(1u, 2u, 3u, uint(abs(a.z)))))",
+                 "node_bump(b.xxx, c.xxx, a.xyz, node_safe_normalize(b.xyz), a.xyz * 1e-3, true) + "
+                 "node_bump_normal(t.xxx, c.yyy, a.x, b.x, c.xyz * 1e-6, a.yzx * 1e-6, b.xyz * 0.0, false)"):
         check(call, everything)
+
+
+def test_voronoi_stress(glsl, fuzz):
+    """Every kernel of voronoi.glsl over coordinates of +-3e5, zeros, tiny steps, Exponents from 0.1 to 30,
+    Smoothness down to 1e-30 and Detail up to 15: finite (a Minkowski distance of points 60 apart overflows
+    float32, as numpy's does, past an Exponent of 21: the direct check of voronoi_distance keeps it under 3.1)."""
+    a, b, c = (_node_inputs(fuzz, NODE_ROWS) for _ in range(3))
+    t = np.clip(np.abs(c[:, :3]) / 30.0, 0.0, 1.0)
+    inputs = {"a": a, "b": b, "c": c, "t": _f32(np.c_[t, np.zeros(NODE_ROWS)])}
+    for feature in range(5):
+        for metric in range(4):
+            call = (f"node_tex_voronoi(a.xyz * 1e4, vec3(1.0), t.xxx * 15.0, t.yyy, vec3(2.0) + t.zzz, t.xxx * 2.0, "
+                    f"vec3(0.1) + abs(b.xxx), t.yyy, {feature}, {metric}, true, {feature % 4})")
+            out = glsl(["voronoi.glsl"], f"vec4({call}, 0.0)", inputs, 3)
+            assert np.isfinite(out).all(), call
+    out = glsl(["voronoi.glsl"], "vec4(voronoi_cell_hash(ivec3(a.xyz)) + vec3(voronoi_distance(a.xyz, b.xyz, 3, "
+               "t.z * 3.0 + 0.1), voronoi_distance_to_edge(a.xyz, t.x), voronoi_n_sphere_radius(a.xyz, t.y)), 0.0)",
+               inputs, 3)
+    assert np.isfinite(out).all()
+    # the kernels with out parameters, through a wrapper
+    wrapper = """
+vec3 voronoi_outputs(vec3 coord, float randomness, float smoothness)
+{
+  float d1, d2, d3;
+  vec3 c1, c2, c3, p1, p2, p3;
+  voronoi_f1_f2(coord, 3, 0.5, randomness, true, d1, c1, p1);
+  voronoi_smooth_f1(coord, 1, 1.0, randomness, smoothness, d2, c2, p2);
+  voronoi_octave(coord, 2, 0, 1.0, randomness, smoothness, d3, c3, p3);
+  return vec3(d1 + d2 + d3) + c1 + c2 + c3 + p1 + p2 + p3;
+}
+"""
+    out = glsl(["voronoi.glsl", wrapper], "vec4(voronoi_outputs(a.xyz * 1e4, t.x, t.y * 0.5 + 1e-30), 0.0)", inputs, 3)
+    assert np.isfinite(out).all()
 
 
 # ---- coverage: every function of shaders/lib is fuzzed
@@ -1256,7 +1297,12 @@ COVERED = {
        "node_smooth_min", "node_mapping", "node_euler_matrix", "node_safe_normalize", "node_tex_checker",
        "node_tex_gradient", "node_hash_uint3", "node_rot", "node_fade", "node_grad3", "node_perlin_3d",
        "node_snoise_3d", "node_noise_fractal", "node_tex_noise", "node_tex_wave", "node_tex_magic", "node_fresnel",
-       "node_layer_weight", "node_fresnel_dielectric_cos", "node_mix_hue_of"],
+       "node_layer_weight", "node_fresnel_dielectric_cos", "node_mix_hue_of", "node_tex_white_noise",
+       "node_hash_final", "node_hash_to_float", "node_hash_uint1", "node_hash_uint2", "node_hash_uint4",
+       "node_hash_float1", "node_hash_float2", "node_hash_float3", "node_hash_float4", "node_bump",
+       "node_bump_normal"],
+    test_voronoi_stress: ["node_tex_voronoi", "voronoi_cell_hash", "voronoi_distance", "voronoi_distance_to_edge",
+                          "voronoi_n_sphere_radius", "voronoi_f1_f2", "voronoi_smooth_f1", "voronoi_octave"],
 }
 
 _DEFINITION = re.compile(r"^\s*(?:float|int|uint|bool|void|vec[234]|ivec[234]|mat[234])\s+([A-Za-z_]\w*)\s*\(", re.M)
