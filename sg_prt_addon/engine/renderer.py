@@ -352,6 +352,14 @@ class _DrawContext(techniques.DrawContext):
             tables[name] = _texture(build())
         return tables[name]
 
+    def material_uniforms(self, rows):
+        tables = self.renderer.material_tables.setdefault(self.params.name or self.material_name, {})
+        rows = np.ascontiguousarray(rows, np.float32)
+        key = ("uniforms", rows.tobytes())
+        if key not in tables:
+            tables[key] = _uniform_buffer(rows)
+        return tables[key]
+
     def image(self, slot):
         return self.renderer.textures[_texture_key(self.params.textures[slot], slot, self.params)]
 

@@ -84,6 +84,8 @@ class DrawContext:
       for the renderer and kept on disk (engine/disk_cache): build() must depend on the code alone, and
       name say which table it is; material_table(name, build): the same in memory only, remade when the
       material changes; environment_table(name, build): remade when the scene's environment changes;
+    material_uniforms(rows): a uniform block of the (k, 4) float32 rows for the material, kept until it changes
+      (a node tree's numbers: material_textures.constant_rows);
     cached_arrays(kind, key, build): build()'s dict of named numpy arrays, kept on disk for the next process
       (engine/disk_cache) under kind (a word) and key (what they are made of, by content: parts that are
       bytes or have a stable repr); the maths modules take it as their tables' `store`;

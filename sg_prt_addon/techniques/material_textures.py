@@ -4,11 +4,16 @@ slot's own image (sampler texture_<slot>), or computed per pixel from a node tre
 attribute, the surface's coordinates and node functions (a reflectance.texture_expression.Expression: the key's
 `node_values`; shaders/lib/node_functions.glsl), each image read once a pixel (sampler node_image_<k>), the
 colour attribute from the vertex stage (vertex_color), the coordinates as COORDINATE_SOURCES says.  The normal
-map is read by surface_io.glsl itself (its mip level too).
+map is read by surface_io.glsl itself (its mip level too).  The computed slots' numbers are read from a
+uniform block (NodeConstants), so a value edited in the node tree assembles the same shader.
 
 A technique's key carries `textures` (slot names) and `node_values` (a NodeValues, from `node_values`);
-`samplers`, `bind` and `sources` give its shader the rest, shader_sources.surface_calls the colour stream."""
+`samplers`, `bind` and `sources` give its shader the rest, shader_sources.surface_calls the colour stream and
+the block (node_constants: len(constant_rows(key)))."""
+import functools
 from dataclasses import dataclass
+
+import numpy as np
 
 from ..reflectance import node_functions, voronoi
 from . import shader_sources
@@ -91,7 +96,11 @@ def samplers(key):
 
 
 def bind(shader, key, context):
-    """The slots' images (DrawContext.image) and the computed slots' (DrawContext.node_image)."""
+    """The slots' images (DrawContext.image), the computed slots' (DrawContext.node_image) and their numbers
+    (DrawContext.material_uniforms)."""
+    rows = constant_rows(key)
+    if len(rows):
+        shader.uniform_block("node_constants", context.material_uniforms(rows))
     computed = {slot for slot, _ in key.node_values.slots}
     for name in key.textures:
         if name not in computed:
@@ -100,29 +109,56 @@ def bind(shader, key, context):
         shader.uniform_sampler(f"node_image_{k}", context.node_image(name))
 
 
-def expression_source(expression, rgb_of, helpers, sampler_of=None):
+class NodeConstants:
+    """The numbers of a material's computed slots (the terms' coefficients, the factors' scales and offsets),
+    gathered as their GLSL is written: the GLSL reads them from the NodeConstants block (node_constants.values[k],
+    bound per material: bind), so a value edited in a node tree changes the block, not the shader.  Without
+    `uniform`, they are written as literals."""
+
+    def __init__(self, uniform=True):
+        self.uniform = uniform
+        self.rows = []
+
+    def vec3(self, rgb):
+        if not self.uniform:
+            return f"vec3({', '.join(shader_sources.float_literal(c) for c in rgb)})"
+        self.rows.append((*(float(c) for c in rgb), 0.0))
+        return f"node_constants.values[{len(self.rows) - 1}].xyz"
+
+    def affine(self, scale, offset, value):
+        """offset + scale x value (a GLSL expression)."""
+        if not self.uniform:
+            literal = shader_sources.float_literal
+            return f"({literal(offset)} + {literal(scale)} * {value})"
+        self.rows.append((float(scale), float(offset), 0.0, 0.0))
+        row = f"node_constants.values[{len(self.rows) - 1}]"
+        return f"({row}.y + {row}.x * {value})"
+
+
+def expression_source(expression, rgb_of, helpers, sampler_of=None, constants=None):
     """An Expression as a GLSL vec3 expression; rgb_of(factor): the GLSL vec3 of its image or attribute at the
     pixel; helpers: {settings: (name, GLSL)} of the helper functions it calls (a Color Ramp's), added to;
-    sampler_of(image name): the sampler an image read at coordinates of its own is read from."""
-    literal = shader_sources.float_literal
+    sampler_of(image name): the sampler an image read at coordinates of its own is read from; constants: the
+    NodeConstants its numbers go to (None: literals)."""
+    constants = constants or NodeConstants(uniform=False)
 
     def factor_source(factor):
-        value = function_source(factor.function, rgb_of, helpers, sampler_of) if factor.function is not None \
-            else rgb_of(factor)
+        value = function_source(factor.function, rgb_of, helpers, sampler_of, constants) \
+            if factor.function is not None else rgb_of(factor)
         value += "" if factor.channel is None else "." + "rgb"[factor.channel] * 3
         if factor.scale == 1.0 and factor.offset == 0.0:
             return value
-        return f"({literal(factor.offset)} + {literal(factor.scale)} * {value})"
+        return constants.affine(factor.scale, factor.offset, value)
 
-    terms = [" * ".join([f"vec3({', '.join(literal(c) for c in coefficient)})"]
-                        + [factor_source(factor) for factor in factors]) for coefficient, factors in expression.terms]
+    terms = [" * ".join([constants.vec3(coefficient)] + [factor_source(factor) for factor in factors])
+             for coefficient, factors in expression.terms]
     return " + ".join(terms)
 
 
-def function_source(function, rgb_of, helpers, sampler_of=None):
+def function_source(function, rgb_of, helpers, sampler_of=None, constants=None):
     """A texture_expression.Function as a GLSL vec3 expression (shaders/lib/node_functions.glsl's node_<name>,
     a Color Ramp's helper, an image at coordinates of its own: material_textures.glsl's material_texture_at)."""
-    args = [expression_source(arg, rgb_of, helpers, sampler_of) for arg in function.args]
+    args = [expression_source(arg, rgb_of, helpers, sampler_of, constants) for arg in function.args]
     name, settings = function.name, function.settings
     if name == "image":
         value = f"material_texture_at({sampler_of(settings[0])}, ({args[0]}).xy, {IMAGE_EXTENSIONS.index(settings[1])})"
@@ -242,7 +278,19 @@ def _functions_used(key):
 def values_source(key):
     """GLSL: each computed slot's image read once a pixel (node_image_<k>_rgb()), and texture_value_<slot>() of
     every textured slot but the normal map (a colour attribute: the vertex stage's vertex_color, or
-    MISSING_ATTRIBUTE where the mesh has none), after the helpers they call."""
+    MISSING_ATTRIBUTE where the mesh has none), after the helpers they call; their numbers from the
+    NodeConstants block (constant_rows)."""
+    return _values(key)[0]
+
+
+def constant_rows(key):
+    """The NodeConstants block's rows of a variant ((k, 4) float32; k may be 0): its material's numbers in the
+    order values_source's GLSL reads them."""
+    return _values(key)[1]
+
+
+@functools.lru_cache(maxsize=256)
+def _values(key):
     names = images(key)
     lines = ["/* The material's textured slots (techniques/material_textures.py) */"]
     for k in range(len(names)):
@@ -258,18 +306,20 @@ def values_source(key):
             return COORDINATE_SOURCES[factor.coordinates]
         return attribute if factor.attribute else f"node_image_{names.index(factor.image)}_rgb()"
 
-    helpers, slots = {}, []
+    helpers, slots, constants = {}, [], NodeConstants()
     for slot in key.textures:
         if slot == NORMAL_MAP:
             continue
         slots += [f"vec4 texture_value_{slot}()", "{"]
         if slot in computed:
-            value = expression_source(computed[slot], rgb_of, helpers, lambda image: f"node_image_{names.index(image)}")
+            value = expression_source(computed[slot], rgb_of, helpers, lambda image: f"node_image_{names.index(image)}",
+                                      constants)
             slots.append(f"  return vec4({value}, 1.0);")
         else:
             slots.append(f"  return material_texture(texture_{slot});")
         slots.append("}")
-    return "\n".join(lines + [source for _, source in helpers.values()] + slots) + "\n"
+    source = "\n".join(lines + [source for _, source in helpers.values()] + slots) + "\n"
+    return source, np.asarray(constants.rows, np.float32).reshape(-1, 4)
 
 
 def noise_offsets_source():

@@ -147,7 +147,8 @@ def vertex_source(per_vertex=()):
     return (per_vertex_fetch_source(per_vertex) + source) if per_vertex else source
 
 
-def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), push_constants=(), node_values=None):
+def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), push_constants=(), node_values=None,
+                  node_constants=0):
     """The create-info calls of a surface shader (see base.Technique.create_info_calls): `defines` (name ->
     value, the scene limits added), the vertex stage with `per_vertex`'s fetch (PER_VERTEX_ROWS defined;
     the fragment source calls per_vertex_copy_source's load_per_vertex_rows), what the material's computed
@@ -156,7 +157,8 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
     (HAS_OBJECT_POSITION), the texture space's push constants, the coverage and holdout (HAS_COVERAGE,
     HAS_HOLDOUT); the scene and material blocks at bindings
     0 and 1, `samplers` ((kind, name) in slot order), the technique's own push_constants ((type, name)) after
-    the model matrix, and the outputs of output_names."""
+    the model matrix, the NodeConstants block of `node_constants` rows at binding 2 where there are any
+    (techniques.material_textures.constant_rows), and the outputs of output_names."""
     vertex_colors = node_values is not None and node_values.vertex_colors
     object_position = node_values is not None and node_values.object_position
     coverage = node_values is not None and node_values.coverage
@@ -166,7 +168,10 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
                **({"HAS_OBJECT_POSITION": 1} if object_position else {}),
                **({"HAS_COVERAGE": 1} if coverage else {}), **({"HAS_HOLDOUT": 1} if holdout else {})}
     calls = [("define", (name, str(value))) for name, value in sorted(defines.items())]
-    calls.append(("typedef_source", (typedef_source(),)))
+    typedefs = typedef_source()
+    if node_constants:
+        typedefs += f"struct NodeConstants {{\n  vec4 values[{node_constants}];\n}};\n"
+    calls.append(("typedef_source", (typedefs,)))
     calls += [("vertex_in", (0, "VEC3", "position")), ("vertex_in", (1, "VEC3", "normal")),
               ("vertex_in", (2, "VEC4", "tangent")), ("vertex_in", (3, "VEC2", "uv"))]
     if per_vertex:
@@ -194,6 +199,8 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
         calls += [("push_constant", ("INT", "gbuffer_object_index")),
                   ("push_constant", ("INT", "gbuffer_triangle_offset"))]
     calls += [("uniform_buf", (0, "SceneData", "scene")), ("uniform_buf", (1, "MaterialData", "material"))]
+    if node_constants:
+        calls.append(("uniform_buf", (2, "NodeConstants", "node_constants")))
     calls += [("sampler", (slot, kind, name)) for slot, (kind, name) in enumerate(samplers)]
     calls += [("fragment_out", (index, "VEC4", "out_" + name)) for index, name in enumerate(output_names(gbuffer))]
     calls.append(("vertex_source", (vertex_source(per_vertex),)))

@@ -226,7 +226,8 @@ class Factored(Technique):
         sources.append(shader_sources.technique_source(GLSL_DIR, "surface.frag.glsl"))
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
                                             per_vertex, push_constants=(("VEC4", "factor_scale"),),
-                                            node_values=key.node_values)
+                                            node_values=key.node_values,
+                                            node_constants=len(material_textures.constant_rows(key)))
 
     def bind_reads_object(self, key):
         return key.visibility_layers > 0        # the bake's rows, the mesh's

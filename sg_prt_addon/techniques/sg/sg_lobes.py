@@ -309,7 +309,8 @@ class SGLobes(Technique):
     def create_info_calls(self, key):
         return shader_sources.surface_calls(self.defines(key), self.fragment_source(key), self.samplers(key),
                                             key.gbuffer, per_vertex_inputs(key),
-                                            node_values=key.node_values)
+                                            node_values=key.node_values,
+                                            node_constants=len(material_textures.constant_rows(key)))
 
     # ------------------------------------------------------------- drawing
 

@@ -306,7 +306,8 @@ class SphericalHarmonics(Technique):
                     for name in ("sh_library.glsl", "sh_shading.glsl", "surface.frag.glsl")]
         return shader_sources.surface_calls(self.defines(key), "\n".join(sources), self.samplers(key), key.gbuffer,
                                             fetched, push_constants=(("VEC4", "sh_axis"),),
-                                            node_values=key.node_values)
+                                            node_values=key.node_values,
+                                            node_constants=len(material_textures.constant_rows(key)))
 
     def bind_reads_object(self, key):
         # the transfer bake's rows and radiance table (the mesh's); the environment's row is the scene's
