@@ -364,11 +364,12 @@ def map_range_node(interpolation):
     return value_of
 
 
-def color_ramp_node(interpolation, output="Color"):
+def color_ramp_node(interpolation, output="Color", color_mode="RGB"):
     """A four-stop ramp (stops at 0.1, 0.35, 0.6, 0.9) of the image's red channel."""
     def value_of(tree):
         node = tree.nodes.new("ShaderNodeValToRGB")
         ramp = node.color_ramp
+        ramp.color_mode = color_mode
         ramp.interpolation = interpolation
         stops = [(0.1, (0.9, 0.1, 0.1, 1.0)), (0.35, (0.1, 0.8, 0.2, 0.5)), (0.6, (0.2, 0.3, 0.9, 0.8)),
                  (0.9, (1.0, 0.9, 0.3, 0.2))]
@@ -802,6 +803,11 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
             for kind in ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")},
          **{f"color_ramp_{kind.lower()}": _socket_case(color_ramp_node(kind)) for kind in ("LINEAR", "EASE", "CONSTANT")},
          "color_ramp_alpha": _socket_case(color_ramp_node("LINEAR", "Alpha")),
+         "color_ramp_b_spline": _socket_case(color_ramp_node("B_SPLINE")),
+         "color_ramp_cardinal": _socket_case(color_ramp_node("CARDINAL")),
+         "color_ramp_cardinal_alpha": _socket_case(color_ramp_node("CARDINAL", "Alpha")),
+         "color_ramp_hsv": _socket_case(color_ramp_node("LINEAR", color_mode="HSV")),
+         "color_ramp_hsl_ease": _socket_case(color_ramp_node("EASE", color_mode="HSL")),
          **{f"mix_{blend.lower()}": _socket_case(mix_blend(blend)) for blend in MIX_BLENDS},
          "rgb_curves": _socket_case(curves_node("rgb")), "vector_curves": _socket_case(curves_node("vector")),
          "vector_curves_horizontal": _socket_case(curves_node("vector", "HORIZONTAL")),

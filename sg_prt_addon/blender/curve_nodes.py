@@ -1,6 +1,6 @@
 """RGB Curves, Vector Curves and Float Curve read as node_functions.curves: each node's curves tabulated as
 Cycles tabulates them (TABLE_SIZE evaluations evenly over the span of the curves' points; RGB Curves' channels
-through the combined curve first), looked up per pixel.  `value(reader, node, out)` is what
+through the combined curve first), looked up per pixel; a Color Ramp's table likewise (ramp_value).  `value(reader, node, out)` is what
 node_reader.SocketReader reads for an output of one of NODE_TYPES."""
 import numpy as np
 
@@ -37,6 +37,19 @@ def curve_table(mapping, node_type):
             row = [mapping.evaluate(curves[0], t)] * 3
         rows.append(tuple(float(np.float32(v)) for v in row))
     return float(min_x), float(max_x), tuple(rows)
+
+
+def ramp_value(ramp, output, fac):
+    """A Color Ramp's Color or Alpha at `fac` (an Expression) through its table: TABLE_SIZE evaluations of the
+    ramp (ColorRamp.evaluate: every interpolation and colour mode) over [0, 1], looked up linearly between
+    entries, clamped to [0, 1], as Cycles' svm_node_rgb_ramp does (for all but Constant interpolation, which
+    blends nothing: node_reader reads it from its stops)."""
+    rows = []
+    for k in range(TABLE_SIZE):
+        rgba = ramp.evaluate(k / (TABLE_SIZE - 1))
+        row = (rgba[3],) * 3 if output == "Alpha" else tuple(rgba[:3])
+        rows.append(tuple(float(np.float32(v)) for v in row))
+    return Expression.function("curves", (0.0, 1.0, False, tuple(rows)), (Expression.constant(1.0), fac))
 
 
 def value(reader, node, out):

@@ -284,19 +284,18 @@ class SocketReader:
         return Expression.function("map_range", (node.interpolation_type, bool(node.clamp)), values)
 
     def color_ramp(self, node, out):
-        """Color Ramp's Color or Alpha (RGB interpolation: LINEAR, EASE, CONSTANT; the others read as LINEAR)."""
+        """Color Ramp's Color or Alpha: its stops interpolated per pixel in RGB (LINEAR, EASE, CONSTANT), or its
+        table as Cycles makes it (curve_nodes.ramp_table: B-spline, Cardinal, HSV and HSL blending)."""
         ramp = node.color_ramp
-        interpolation = ramp.interpolation
-        if interpolation not in ("LINEAR", "EASE", "CONSTANT"):
-            self.note(node, f"{interpolation.lower()} interpolation: read as linear")
-            interpolation = "LINEAR"
-        if ramp.color_mode != "RGB":
-            self.note(node, f"{ramp.color_mode} colour mode: interpolated in RGB")
+        fac = self.value(node.inputs["Fac"], False)
+        output = "Alpha" if out.identifier == "Alpha" else "Color"
+        if ramp.interpolation not in ("LINEAR", "EASE", "CONSTANT") or (ramp.color_mode != "RGB"
+                                                                       and ramp.interpolation != "CONSTANT"):
+            return curve_nodes.ramp_value(ramp, output, fac)
         stops = sorted(((float(e.position), tuple(float(v) for v in e.color)) for e in ramp.elements),
                        key=lambda stop: stop[0])
-        settings = (interpolation, tuple(p for p, _ in stops), tuple(c for _, c in stops),
-                    "Alpha" if out.identifier == "Alpha" else "Color")
-        return Expression.function("color_ramp", settings, (self.value(node.inputs["Fac"], False),))
+        settings = (ramp.interpolation, tuple(p for p, _ in stops), tuple(c for _, c in stops), output)
+        return Expression.function("color_ramp", settings, (fac,))
 
     def hue_saturation_value(self, node, colour):
         values = [self.value(node.inputs[name], name == "Color") for name in ("Color", "Hue", "Saturation", "Value",
