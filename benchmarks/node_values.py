@@ -585,6 +585,22 @@ def voronoi(feature="F1", output="Distance", metric="EUCLIDEAN", detail=0.0, nor
     return value_of
 
 
+def brick(output="Color", offset_frequency=2, squash=1.0, squash_frequency=2, smooth=0.3):
+    """The Brick Texture of the Object coordinates (Scale 2.3, Mortar Size 0.06: lines two pixels wide, which
+    Edges Only's first frame at the pixels' centres sees; its colours the defaults'), rows offset and squashed
+    by the node's settings."""
+    def value_of(tree):
+        node = tree.nodes.new("ShaderNodeTexBrick")
+        node.offset_frequency, node.squash, node.squash_frequency = offset_frequency, squash, squash_frequency
+        node.inputs["Scale"].default_value = 2.3
+        node.inputs["Mortar Size"].default_value = 0.06
+        node.inputs["Mortar Smooth"].default_value = smooth
+        node.inputs["Bias"].default_value = 0.1
+        tree.links.new(_coordinates(tree, "Object"), node.inputs["Vector"])
+        return node.outputs[output]
+    return value_of
+
+
 def wave(wave_type="BANDS", direction="X", profile="SIN", distortion=3.0):
     """The Wave Texture (Scale 2, its distortion's noise at Detail 2) of the Object coordinates."""
     def value_of(tree):
@@ -844,6 +860,8 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "voronoi_n_sphere_radius": _socket_case(voronoi("N_SPHERE_RADIUS", "Radius")),
          "voronoi_fractal": _socket_case(voronoi(detail=2.5, normalize=True)),
          "voronoi_fractal_edge": _socket_case(voronoi("DISTANCE_TO_EDGE", detail=1.5, normalize=True)),
+         "brick": _socket_case(brick()), "brick_fac_hard_mortar": _socket_case(brick("Fac", smooth=0.0)),
+         "brick_squashed": _socket_case(brick(offset_frequency=3, squash=0.6, squash_frequency=2)),
          "magic_depth_2": _socket_case(magic(2)), "magic_depth_5_fac": _socket_case(magic(5, "Fac")),
          **{f"image_{extension.lower()}": _socket_case(image_extended(extension))
             for extension in ("REPEAT", "EXTEND", "CLIP", "MIRROR")},

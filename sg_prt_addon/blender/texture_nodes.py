@@ -1,11 +1,12 @@
 """The procedural texture nodes read as node functions of their inputs (reflectance/node_functions.py, voronoi.py):
-Checker, Gradient, Noise, Wave, Magic, White Noise and Voronoi, as Cycles defines them.  `value(reader, node, out)` is what
+Checker, Gradient, Noise, Wave, Magic, White Noise, Voronoi and Brick, as Cycles defines them.  `value(reader, node, out)` is what
 node_reader.SocketReader reads for an output of one of NODE_TYPES."""
 from ..reflectance import voronoi
 from ..reflectance.texture_expression import Expression
 from .node_graph import enabled_inputs
 
-NODE_TYPES = ("TEX_CHECKER", "TEX_GRADIENT", "TEX_NOISE", "TEX_WAVE", "TEX_MAGIC", "TEX_WHITE_NOISE", "TEX_VORONOI")
+NODE_TYPES = ("TEX_CHECKER", "TEX_GRADIENT", "TEX_NOISE", "TEX_WAVE", "TEX_MAGIC", "TEX_WHITE_NOISE", "TEX_VORONOI",
+              "TEX_BRICK")
 NOISE_DEFAULTS = {"Scale": 5.0, "Detail": 2.0, "Roughness": 0.5, "Lacunarity": 2.0, "Offset": 0.0, "Gain": 1.0,
                   "Distortion": 0.0}
 
@@ -13,7 +14,8 @@ NOISE_DEFAULTS = {"Scale": 5.0, "Detail": 2.0, "Roughness": 0.5, "Lacunarity": 2
 def value(reader, node, out):
     """The Expression of a procedural texture's output `out` (reader: the node_reader.SocketReader)."""
     return {"TEX_CHECKER": checker, "TEX_GRADIENT": gradient, "TEX_NOISE": noise, "TEX_WAVE": wave,
-            "TEX_MAGIC": magic, "TEX_WHITE_NOISE": white_noise, "TEX_VORONOI": voronoi_texture}[node.type](
+            "TEX_MAGIC": magic, "TEX_WHITE_NOISE": white_noise, "TEX_VORONOI": voronoi_texture,
+            "TEX_BRICK": brick}[node.type](
                 reader, node, out)
 
 
@@ -93,3 +95,14 @@ def voronoi_texture(reader, node, out):
         return Expression.constant(0.0)
     settings = (node.feature, node.distance, bool(getattr(node, "normalize", False)), out.identifier)
     return Expression.function("tex_voronoi", settings, values)
+
+
+def brick(reader, node, out):
+    """The Brick Texture's Color or Fac (its Offset and Squash and their frequencies are the node's settings)."""
+    names = ("Color1", "Color2", "Mortar", "Scale", "Mortar Size", "Mortar Smooth", "Bias", "Brick Width",
+             "Row Height")
+    values = [texture_vector(reader, node)] + [reader.value(node.inputs[name], name in ("Color1", "Color2", "Mortar"))
+                                               for name in names]
+    settings = (float(node.offset), int(node.offset_frequency), float(node.squash), int(node.squash_frequency),
+                _output(out))
+    return Expression.function("tex_brick", settings, values)

@@ -503,6 +503,7 @@ _CALLS = {
     "tex_magic": lambda settings, args: tex_magic(settings, *args),
     "tex_white_noise": lambda settings, args: tex_white_noise(settings, *args),
     "tex_voronoi": lambda settings, args: voronoi.tex_voronoi(settings, *args),
+    "tex_brick": lambda settings, args: tex_brick(settings, *args),
     "fresnel": lambda settings, args: fresnel(*args),
     "layer_weight": lambda settings, args: layer_weight(settings[0], *args),
     "bump": lambda settings, args: _no_derivatives("bump"),
@@ -721,6 +722,54 @@ def tex_noise(settings, vector, scale, detail, roughness, lacunarity, offset, ga
     else:
         out = np.stack([value, fractal(p + random_float3_offset(3)), fractal(p + random_float3_offset(4))], axis=-1)
     return out.reshape(shape + (3,)).astype(FLOAT)
+
+
+def brick_noise(n):
+    """Cycles' fast integer noise of the Brick texture, in [0, 1) (uint32 n, wrapping)."""
+    with np.errstate(over="ignore"):
+        n = (np.asarray(n).astype(np.int64).astype(_U32) + _U32(1013)) & _U32(0x7FFFFFFF)
+        n = (n >> _U32(13)) ^ n
+        nn = (n * (n * n * _U32(60493) + _U32(19990303)) + _U32(1376312589)) & _U32(0x7FFFFFFF)
+    return (FLOAT(0.5) * (nn.astype(FLOAT) / FLOAT(1073741824.0))).astype(FLOAT)
+
+
+def tex_brick(settings, vector, colour1, colour2, mortar, scale, mortar_size, mortar_smooth, bias, brick_width,
+              row_height):
+    """The Brick Texture (Cycles' svm_brick; settings: offset, offset frequency, squash, squash frequency,
+    output "Color" or "Fac"): rows of bricks, every offset-frequency-th row shifted, every squash-frequency-th
+    squashed, each brick's tint an integer noise of its row and number, the mortar where a brick's edge is
+    nearer than Mortar Size (smoothed by Mortar Smooth)."""
+    offset_amount, offset_frequency, squash_amount, squash_frequency, output = settings
+    shape = np.shape(vector)[:-1]
+    arrays = [np.asarray(a, FLOAT).reshape(-1, 3) for a in (vector, colour1, colour2, mortar, scale, mortar_size,
+                                                              mortar_smooth, bias, brick_width, row_height)]
+    vector, colour1, colour2, mortar = arrays[:4]
+    scale, mortar_size, mortar_smooth, bias, width, height = (a[:, 0] for a in arrays[4:])
+    p = vector * scale[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        row = np.floor(p[:, 1] / height).astype(np.int64)
+        offset = np.zeros_like(width)
+        if offset_frequency and squash_frequency:
+            width = np.where(np.fmod(row, squash_frequency) != 0, width, width * FLOAT(squash_amount)).astype(FLOAT)
+            offset = np.where(np.fmod(row, offset_frequency) != 0, FLOAT(0), width * FLOAT(offset_amount))
+        brick = np.floor((p[:, 0] + offset) / width).astype(np.int64)
+        x = (p[:, 0] + offset) - width * brick
+        y = p[:, 1] - height * row
+        tint = np.clip(brick_noise((row << 16) + (brick & 0xFFFF)) + bias, 0, 1).astype(FLOAT)
+        nearest = np.minimum(np.minimum(x, y), np.minimum(width - x, height - y))
+        ramp = FLOAT(1) - nearest / mortar_size
+        smooth = np.where(ramp < mortar_smooth, _smoothstep01(ramp / mortar_smooth), FLOAT(1))
+        fac = np.where(nearest >= mortar_size, FLOAT(0), np.where(mortar_smooth == 0, FLOAT(1), smooth))
+    fac = fac.astype(FLOAT)
+    tinted = np.where((fac != 1)[:, None], (FLOAT(1) - tint[:, None]) * colour1 + tint[:, None] * colour2, colour1)
+    out = tinted * (FLOAT(1) - fac[:, None]) + mortar * fac[:, None] if output == "Color" else \
+        np.repeat(fac[:, None], 3, axis=-1)
+    return out.reshape(shape + (3,)).astype(FLOAT)
+
+
+def _smoothstep01(t):
+    """Cycles' smoothstepf: 3t^2 - 2t^3 (no clamp: its callers keep t in [0, 1])."""
+    return (t * t * (FLOAT(3) - FLOAT(2) * t)).astype(FLOAT)
 
 
 NOISE_DIMENSIONS = ("1D", "2D", "3D", "4D")

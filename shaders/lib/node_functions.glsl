@@ -685,3 +685,49 @@ vec3 node_bump(vec3 strength, vec3 distance, vec3 height, vec3 normal, vec3 posi
   return node_bump_normal(strength, distance, dFdx(height.x), dFdy(height.x), dFdx(position), dFdy(position),
                           normal, invert);
 }
+
+/* The Brick Texture's integer noise (node_functions.brick_noise) */
+float node_brick_noise(uint n)
+{
+  n = (n + 1013u) & 0x7FFFFFFFu;
+  n = (n >> 13u) ^ n;
+  uint nn = (n * (n * n * 60493u + 19990303u) + 1376312589u) & 0x7FFFFFFFu;
+  return 0.5 * (float(nn) / 1073741824.0);
+}
+
+/* The Brick Texture (node_functions.tex_brick): its Color, or (not colour) its Fac on all three */
+vec3 node_tex_brick(vec3 vector, vec3 colour1, vec3 colour2, vec3 mortar, vec3 scale, vec3 mortar_size,
+                    vec3 mortar_smooth, vec3 bias, vec3 brick_width, vec3 row_height, float offset_amount,
+                    int offset_frequency, float squash_amount, int squash_frequency, bool colour)
+{
+  vec3 p = vector * scale.x;
+  float width = brick_width.x, height = row_height.x, offset = 0.0;
+  int row = int(floor(p.y / height));
+  if (offset_frequency != 0 && squash_frequency != 0) {
+    /* C's remainder is nonzero where |row|'s is (GLSL's % of a negative operand is undefined) */
+    width *= (abs(row) % squash_frequency) != 0 ? 1.0 : squash_amount;
+    offset = (abs(row) % offset_frequency) != 0 ? 0.0 : width * offset_amount;
+  }
+  int brick = int(floor((p.x + offset) / width));
+  float x = (p.x + offset) - width * float(brick);
+  float y = p.y - height * float(row);
+  float tint = clamp(node_brick_noise(uint((row << 16) + (brick & 0xFFFF))) + bias.x, 0.0, 1.0);
+  float nearest = min(min(x, y), min(width - x, height - y));
+  float fac;
+  if (nearest >= mortar_size.x) {
+    fac = 0.0;
+  }
+  else if (mortar_smooth.x == 0.0) {
+    fac = 1.0;
+  }
+  else {
+    float ramp = 1.0 - nearest / mortar_size.x;
+    float t = ramp / mortar_smooth.x;
+    fac = ramp < mortar_smooth.x ? t * t * (3.0 - 2.0 * t) : 1.0;
+  }
+  if (!colour) {
+    return vec3(fac);
+  }
+  vec3 tinted = fac != 1.0 ? (1.0 - tint) * colour1 + tint * colour2 : colour1;
+  return tinted * (1.0 - fac) + mortar * fac;
+}
