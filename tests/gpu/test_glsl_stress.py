@@ -1195,6 +1195,8 @@ def test_node_functions_stress(glsl, fuzz):
                  "node_hash_uint2(uint(abs(c.x)), 3u))), node_hash_float1(a.x) + node_hash_float2(a.x, b.x), "
                  "node_hash_float3(a.x, b.x, c.x) + node_hash_float4(a.x, b.x, c.x, a.y) + "
                  "node_hash_to_float(node_hash_uint4(1u, 2u, 3u, uint(abs(a.z)))))",
+                 "node_tex_brick(a.xyz, b.xyz, c.xyz, a.zxy, t.xxx * 5.0, t.yyy, t.zzz, b.zxy, abs(c.zxy), "
+                 "abs(a.yzx), 0.5, 2, 0.7, 3, true) + vec3(node_brick_noise(uint(abs(a.x) * 1e6)))",
                  "node_bump(b.xxx, c.xxx, a.xyz, node_safe_normalize(b.xyz), a.xyz * 1e-3, true) + "
                  "node_bump_normal(t.xxx, c.yyy, a.x, b.x, c.xyz * 1e-6, a.yzx * 1e-6, b.xyz * 0.0, false)"):
         check(call, everything)
@@ -1300,7 +1302,7 @@ COVERED = {
        "node_layer_weight", "node_fresnel_dielectric_cos", "node_mix_hue_of", "node_tex_white_noise",
        "node_hash_final", "node_hash_to_float", "node_hash_uint1", "node_hash_uint2", "node_hash_uint4",
        "node_hash_float1", "node_hash_float2", "node_hash_float3", "node_hash_float4", "node_bump",
-       "node_bump_normal"],
+       "node_bump_normal", "node_tex_brick", "node_brick_noise"],
     test_voronoi_stress: ["node_tex_voronoi", "voronoi_cell_hash", "voronoi_distance", "voronoi_distance_to_edge",
                           "voronoi_n_sphere_radius", "voronoi_f1_f2", "voronoi_smooth_f1", "voronoi_octave"],
 }
