@@ -28,10 +28,11 @@ DEPENDENCIES = {
     "ssdf_quadrature.glsl": ["sg.glsl", "hemisphere.glsl", QUADRATURE_DEFINES],
     "shadow_maps.glsl": [shader_sources.shadow_map_constants()],
     "node_functions.glsl": [material_textures.noise_offsets_source()],
+    "voronoi.glsl": [],
 }
 ORDER = ["sg.glsl", "hemisphere.glsl", "clamped_cosine.glsl", "clamped_cosine_table.glsl", "brdf.glsl", "warp.glsl",
          "lights.glsl", "env_prefilter.glsl", "hemisphere_map.glsl", "ssdf.glsl", "ssdf_quadrature.glsl",
-         "shadow_maps.glsl", "node_functions.glsl"]
+         "shadow_maps.glsl", "node_functions.glsl", "voronoi.glsl"]
 
 
 def test_every_file_is_listed():
@@ -51,9 +52,9 @@ def test_file_compiles_with_its_dependencies(glsl, file_name):
 def test_all_files_together(glsl):
     call = ("vec4(sg_sphere_integral(a.x, 1.0), fh(0.0, a.x), clamped_cosine_from_cosine(1.0, a.x),"
             " ggx_ndf_lobe(0.5).x)")
-    out = glsl(ORDER[:-4] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", "ssdf.glsl", QUADRATURE_DEFINES,
+    out = glsl(ORDER[:-5] + [f"#define SSDF_MAX_LAYERS {MAX_ROWS}\n", "ssdf.glsl", QUADRATURE_DEFINES,
                              "ssdf_quadrature.glsl", shader_sources.shadow_map_constants(), "shadow_maps.glsl",
-                             material_textures.noise_offsets_source(), "node_functions.glsl"],
+                             material_textures.noise_offsets_source(), "node_functions.glsl", "voronoi.glsl"],
                call, {"a": [0.0, 1.0]}, 4)
     assert out.shape == (2, 4)
     # lambda = 0: 4 pi, half of it, pi
