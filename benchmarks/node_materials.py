@@ -212,7 +212,7 @@ SCENES = {"principled_r020": dielectric(0.2), "principled_r050": dielectric(0.5)
           "principled_tiled": tiled, "mix_diffuse_glossy": mix_diffuse_glossy,
           "principled_anisotropic": anisotropic, "glossy_anisotropic": glossy_anisotropic(0.6),
           "glossy_anisotropic_negative": glossy_anisotropic(-0.6), "glossy_beckmann_r030": glossy_beckmann(0.3),
-          "principled_bumped": bumped}
+          "principled_bumped": bumped, "no_material": lambda: None}
 
 
 def build(name, size):

@@ -581,7 +581,8 @@ def _sphere(material):
     sphere = bpy.context.active_object
     sphere.name = "Sphere"
     sphere.data.shade_smooth()
-    sphere.data.materials.append(material)
+    if material is not None:            # None: no material, Blender's default surface
+        sphere.data.materials.append(material)
     return sphere
 
 

@@ -154,7 +154,7 @@ class SceneState:
         self.per_vertex.clear()
         self.per_vertex_status.clear()
         self.bake_occluders.clear()
-        self.materials = {"": export.MaterialParams()}
+        self.materials = {"": export.default_surface()}
         self.lights = []
         self.area_patches = _area_patches(depsgraph.scene)
         self.shadow_map_size = _shadow_map_size(depsgraph.scene)

@@ -37,6 +37,9 @@ def node_materials(blender):
     # a Bump node over a Noise Texture on the Normal: 0.085 / -0.001 / 0.079 (the mesh normal: 0.097 / +0.009;
     # at 128 px and 1024 spp 0.040 against 0.073, noise floor 0.021)
     ("principled_bumped", 0.12, 0.03),
+    # no material: Cycles' default surface, a 0.8 Diffuse BSDF: 0.089 / +0.005 / 0.074 (the SG-PRT settings'
+    # defaults before: 0.560 / -0.147)
+    ("no_material", 0.12, 0.03),
 ])
 def test_node_material_against_cycles(node_materials, name, rmse_bound, bias_bound):
     row = node_materials.score(name, 64, 32)

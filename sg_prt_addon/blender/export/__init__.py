@@ -27,6 +27,7 @@ from .materials import (
     TEXTURED_PARAMETERS,
     FittedLobes,
     MaterialParams,
+    default_surface,
     export_fitted_lobes,
     export_material,
 )
@@ -46,7 +47,7 @@ from .world import WorldExport, export_world
 
 __all__ = ["COLOUR_PARAMETERS", "COLOUR_SLOTS", "SCALAR_PARAMETERS", "TEXTURED_PARAMETERS", "CameraExport", "FittedLobes",
            "LightExport", "MaterialParams", "MeshExport", "RenderRoles", "WorldExport", "camera_from_view",
-           "collect_warnings", "export_camera", "export_counter", "export_fitted_lobes", "export_light",
+           "collect_warnings", "default_surface", "export_camera", "export_counter", "export_fitted_lobes", "export_light",
            "export_material", "export_mesh_data", "export_object_mesh", "export_world", "finite_texels",
            "images_present", "matrix_to_numpy", "mesh_corner_normals", "render_roles", "slot_pixels",
            "srgb_to_linear", "texture_pixels", "texture_sources", "to_world", "warn"]

@@ -113,14 +113,20 @@ def export_fitted_lobes(material):
 
 # --------------------------------------------------------------------------- materials
 
+def default_surface():
+    """What Blender renders where an object or a slot has no material: Cycles' default surface, a Diffuse BSDF
+    of 0.8 grey."""
+    return MaterialParams(diffuse_color=(0.8, 0.8, 0.8), specular_color=(0.0, 0.0, 0.0), layered_f0=layering.NO_LAYER)
+
+
 def export_material(material):
-    """MaterialParams of a bpy Material (None, or without `sgprt`: the defaults): its SG-PRT settings, or its
-    node tree's reading when its Source is the node tree."""
+    """MaterialParams of a bpy Material (None: Blender's default surface; without `sgprt`: the defaults): its
+    SG-PRT settings, or its node tree's reading when its Source is the node tree."""
     from .. import properties
 
-    params = MaterialParams()
     if material is None:
-        return params
+        return default_surface()
+    params = MaterialParams()
     params.name = material.name
     settings = getattr(material, "sgprt", None)
     if settings is None:
