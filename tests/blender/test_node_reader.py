@@ -122,13 +122,13 @@ def test_mix_add_emission_and_math(empty_file):
 def test_unsupported_nodes_give_one_warning_naming_them(empty_file):
     material, tree, output = _material("odd")
     node = _principled(tree, output, Coat_Weight=0.5, Alpha=0.5)
-    brick = tree.nodes.new("ShaderNodeTexBrick")
-    tree.links.new(brick.outputs["Color"], node.inputs["Base Color"])
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    tree.links.new(blackbody.outputs["Color"], node.inputs["Base Color"])
     node.inputs["Base Color"].default_value = (0.3, 0.3, 0.3, 1.0)
     params, warnings = _read(material)
     assert len(warnings) == 1, warnings
     text = warnings[0]
-    assert "'odd' (node tree)" in text and "Brick Texture" in text and "(0.3, 0.3, 0.3)" in text
+    assert "'odd' (node tree)" in text and "Blackbody" in text and "(0.3, 0.3, 0.3)" in text
     assert "the coat" in text and "transparency: shadows are cast as by an opaque surface" in text
     assert params.diffuse_color == pytest.approx((0.3, 0.3, 0.3))
 
@@ -319,8 +319,8 @@ def test_a_shader_inside_a_group_and_the_output_eevee_renders(empty_file):
     group_input, group_output = group.nodes.new("NodeGroupInput"), group.nodes.new("NodeGroupOutput")
     principled = group.nodes.new("ShaderNodeBsdfPrincipled")
     group.links.new(group_input.outputs["Roughness"], principled.inputs["Roughness"])
-    brick = group.nodes.new("ShaderNodeTexBrick")
-    group.links.new(brick.outputs["Color"], principled.inputs["Base Color"])
+    blackbody = group.nodes.new("ShaderNodeBlackbody")
+    group.links.new(blackbody.outputs["Color"], principled.inputs["Base Color"])
     group.links.new(principled.outputs[0], group_output.inputs["Shader"])
     node = tree.nodes.new("ShaderNodeGroup")
     node.node_tree = group
@@ -329,7 +329,7 @@ def test_a_shader_inside_a_group_and_the_output_eevee_renders(empty_file):
     tree.links.new(node.outputs["Shader"], eevee_output.inputs["Surface"])
     params, warnings = _read(material)
     assert params.roughness == pytest.approx(0.2) and params.specular_color != (0.0, 0.0, 0.0)
-    assert len(warnings) == 1 and "'Outer/Brick Texture' (Brick Texture)" in warnings[0], warnings
+    assert len(warnings) == 1 and "'Outer/Blackbody' (Blackbody)" in warnings[0], warnings
 
 
 def test_colour_attributes_export_per_corner_and_non_finite_ones_are_named(empty_file):

@@ -67,9 +67,10 @@ def test_compile_error_names_variant_and_line(engine, monkeypatch):
     assert "frame_that_does_not_exist' undeclared" in str(raised.value)      # what the UI reports
     message = render_engine.last_render["error"]
     from sg_prt_addon import techniques
-    from sg_prt_addon.techniques.sg.sg_shading import GGX_NDF_LOBES
+    from sg_prt_addon.blender.export import default_surface
     technique = techniques.get("SG_PARAMETRIC")
-    lines = broken(technique, sg_lobes.VariantKey(ndf_lobes=GGX_NDF_LOBES)).split("\n")
+    key = fx.variant_key(default_surface())                 # the sphere has no material: Blender's default surface
+    lines = broken(technique, key).split("\n")
     number = next(n for n, line in enumerate(lines, 1) if broken_line in line)
     assert f"fragment line {number}: `frame_that_does_not_exist' undeclared" in message
     assert f"{number:5d}> {lines[number - 1]}" in message
