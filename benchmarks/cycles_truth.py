@@ -8,6 +8,19 @@ import time
 SEEDS = (1, 2)
 
 
+def empty_node_material(name):
+    """(material, node tree, Material Output) of a new material whose node tree holds the output alone."""
+    import bpy
+
+    material = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        material.use_nodes = True
+    tree = material.node_tree
+    for node in list(tree.nodes):
+        tree.nodes.remove(node)
+    return material, tree, tree.nodes.new("ShaderNodeOutputMaterial")
+
+
 def render_engine_image(scene):
     """(seconds of the second render, RGB (H, W, 3) row 0 at the top, alpha, warnings)."""
     from benchmarks import engine_vs_eevee

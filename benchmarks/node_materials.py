@@ -10,6 +10,8 @@ Scores over the sphere's pixels (one pixel in from its silhouette): relative RMS
 """
 from pathlib import Path
 
+from benchmarks.cycles_truth import empty_node_material
+
 ROOT = Path(__file__).resolve().parents[1]
 JSON_PATH = ROOT / "docs" / "node_materials.json"
 DOC_PATH = ROOT / "docs" / "ACCURACY.md"
@@ -17,20 +19,8 @@ SECTION_TITLE = "## Blender node materials against Cycles"
 GOLD = (1.0, 0.766, 0.336, 1.0)
 
 
-def _nodes(name):
-    import bpy
-
-    material = bpy.data.materials.new(name)
-    if bpy.app.version < (5, 0, 0):
-        material.use_nodes = True
-    tree = material.node_tree
-    for node in list(tree.nodes):
-        tree.nodes.remove(node)
-    return material, tree, tree.nodes.new("ShaderNodeOutputMaterial")
-
-
 def _principled(name, **inputs):
-    material, tree, output = _nodes(name)
+    material, tree, output = empty_node_material(name)
     node = tree.nodes.new("ShaderNodeBsdfPrincipled")
     for socket, value in inputs.items():
         node.inputs[socket.replace("_", " ")].default_value = value
@@ -137,7 +127,7 @@ def tiled():
 
 
 def mix_diffuse_glossy():
-    material, tree, output = _nodes("mix_diffuse_glossy")
+    material, tree, output = empty_node_material("mix_diffuse_glossy")
     diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = (0.2, 0.5, 0.8, 1.0)
     glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
@@ -167,7 +157,7 @@ def glossy_anisotropic(anisotropy):
     """A Glossy BSDF (GGX) with Anisotropy along the UV map's tangent: the Glossy node's own mapping (positive:
     the lobe widened across the tangent; negative: along it), not the Principled BSDF's."""
     def build():
-        material, tree, output = _nodes(f"glossy_anisotropic_{anisotropy:+.1f}")
+        material, tree, output = empty_node_material(f"glossy_anisotropic_{anisotropy:+.1f}")
         glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
         glossy.distribution = "GGX"
         glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
@@ -184,7 +174,7 @@ def glossy_anisotropic(anisotropy):
 def glossy_beckmann(roughness):
     """A Glossy BSDF of the Beckmann distribution, its colour white."""
     def build():
-        material, tree, output = _nodes(f"glossy_beckmann_{roughness}")
+        material, tree, output = empty_node_material(f"glossy_beckmann_{roughness}")
         glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
         glossy.distribution = "BECKMANN"
         glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)

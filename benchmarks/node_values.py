@@ -7,6 +7,8 @@ bias over the plane against the mean of two Cycles seeds, and the noise floor (b
 """
 from pathlib import Path
 
+from benchmarks.cycles_truth import empty_node_material
+
 ROOT = Path(__file__).resolve().parents[1]
 JSON_PATH = ROOT / "docs" / "node_values.json"
 DOC_PATH = ROOT / "docs" / "ACCURACY.md"
@@ -22,21 +24,9 @@ MIX_BLENDS = ("SCREEN", "OVERLAY", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN"
 COLOUR_ATTRIBUTE = "Col"
 
 
-def _material(name):
-    import bpy
-
-    material = bpy.data.materials.new(name)
-    if bpy.app.version < (5, 0, 0):
-        material.use_nodes = True
-    tree = material.node_tree
-    for node in list(tree.nodes):
-        tree.nodes.remove(node)
-    return material, tree, tree.nodes.new("ShaderNodeOutputMaterial")
-
-
 def _emitting(name, value_of):
     """A material whose surface is an Emission of Strength 1 whose Color is value_of(tree) (an output socket)."""
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.inputs["Strength"].default_value = 1.0
     tree.links.new(value_of(tree), emission.inputs["Color"])
@@ -195,7 +185,7 @@ def nested_groups(tree):
 
 def principled_emission_texture(name):
     """A black Principled BSDF (nothing to reflect here) whose Emission Color is the image, Strength 3."""
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     node = tree.nodes.new("ShaderNodeBsdfPrincipled")
     node.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     node.inputs["Emission Strength"].default_value = 3.0
@@ -206,7 +196,7 @@ def principled_emission_texture(name):
 
 def emission_strength_texture(name):
     """An Emission of a constant colour whose Strength is four times the image's red channel."""
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.inputs["Color"].default_value = (1.0, 0.5, 0.2, 1.0)
     strength = tree.nodes.new("ShaderNodeMath")
@@ -236,7 +226,7 @@ def grouped_shader(name):
     group.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
     group_input, group_output = group.nodes.new("NodeGroupInput"), group.nodes.new("NodeGroupOutput")
     group.links.new(build(group, group_input), group_output.inputs["Shader"])
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     node = tree.nodes.new("ShaderNodeGroup")
     node.node_tree = group
     tree.links.new(_image_node(tree).outputs["Color"], node.inputs["Color"])
@@ -246,7 +236,7 @@ def grouped_shader(name):
 
 def mix_shader_textured_factor(name):
     """Two Emissions (red; the image) mixed by the image's green channel."""
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     red, textured = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeEmission")
     red.inputs["Color"].default_value = (1.0, 0.1, 0.1, 1.0)
     texture = _image_node(tree)
@@ -698,7 +688,7 @@ def layer_weight(output, blend):
 
 def mix_shader_by_fresnel(name):
     """Two Emissions (blue; the image) mixed by Layer Weight's Fresnel: the rim takes the image."""
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     blue, textured = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeEmission")
     blue.inputs["Color"].default_value = (0.1, 0.2, 0.9, 1.0)
     tree.links.new(_image_node(tree).outputs["Color"], textured.inputs["Color"])
@@ -710,18 +700,24 @@ def mix_shader_by_fresnel(name):
     return material
 
 
-def unlit(name):
-    """glTF's unlit material as its importer builds it: Light Path's Is Camera Ray mixing a Transparent BSDF and
-    an Emission of the image."""
-    material, tree, output = _material(name)
+def _transparent_or_image(name, factor_of):
+    """A Transparent BSDF mixed with an Emission of the image by factor_of(tree, image node) (an output)."""
+    material, tree, output = empty_node_material(name)
+    texture = _image_node(tree)
     emission, transparent = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeBsdfTransparent")
-    tree.links.new(_image_node(tree).outputs["Color"], emission.inputs["Color"])
+    tree.links.new(texture.outputs["Color"], emission.inputs["Color"])
     mix = tree.nodes.new("ShaderNodeMixShader")
-    tree.links.new(tree.nodes.new("ShaderNodeLightPath").outputs["Is Camera Ray"], mix.inputs["Fac"])
+    tree.links.new(factor_of(tree, texture), mix.inputs["Fac"])
     tree.links.new(transparent.outputs[0], mix.inputs[1])
     tree.links.new(emission.outputs[0], mix.inputs[2])
     tree.links.new(mix.outputs[0], output.inputs["Surface"])
     return material
+
+
+def unlit(name):
+    """glTF's unlit material as its importer builds it: Light Path's Is Camera Ray mixing a Transparent BSDF and
+    an Emission of the image."""
+    return _transparent_or_image(name, lambda tree, _: tree.nodes.new("ShaderNodeLightPath").outputs["Is Camera Ray"])
 
 
 def alpha_image():
@@ -754,7 +750,7 @@ def _emitting_principled(tree, colour_socket=None):
 
 def alpha_constant(name):
     """The emitting Principled BSDF at Alpha 0.4 over the backdrop (BACKDROP_CASES)."""
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     node = _emitting_principled(tree)
     node.inputs["Alpha"].default_value = 0.4
     tree.links.new(node.outputs[0], output.inputs["Surface"])
@@ -763,7 +759,7 @@ def alpha_constant(name):
 
 def alpha_texture(name):
     """The emitting Principled BSDF whose Alpha is an image's Alpha output (glTF's alpha blend and mask)."""
-    material, tree, output = _material(name)
+    material, tree, output = empty_node_material(name)
     texture = tree.nodes.new("ShaderNodeTexImage")
     texture.image = alpha_image()
     node = _emitting_principled(tree, texture.outputs["Color"])
@@ -774,16 +770,7 @@ def alpha_texture(name):
 
 def transparent_mix(name):
     """A Transparent BSDF mixed with an Emission of the image by the image's green channel."""
-    material, tree, output = _material(name)
-    texture = _image_node(tree)
-    emission, transparent = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeBsdfTransparent")
-    tree.links.new(texture.outputs["Color"], emission.inputs["Color"])
-    mix = tree.nodes.new("ShaderNodeMixShader")
-    tree.links.new(_separate(tree, texture.outputs["Color"]).outputs["Green"], mix.inputs["Fac"])
-    tree.links.new(transparent.outputs[0], mix.inputs[1])
-    tree.links.new(emission.outputs[0], mix.inputs[2])
-    tree.links.new(mix.outputs[0], output.inputs["Surface"])
-    return material
+    return _transparent_or_image(name, lambda tree, texture: _separate(tree, texture.outputs["Color"]).outputs["Green"])
 
 
 def _backdrop_material():
@@ -792,7 +779,7 @@ def _backdrop_material():
 
     if "backdrop" in bpy.data.materials:
         return bpy.data.materials["backdrop"]
-    material, tree, output = _material("backdrop")
+    material, tree, output = empty_node_material("backdrop")
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.inputs["Color"].default_value = (0.1, 0.3, 0.8, 1.0)
     tree.links.new(emission.outputs[0], output.inputs["Surface"])

@@ -170,24 +170,28 @@ def _mix(a, b, t):
     return a + (b - a) * t
 
 
+def _octave_masks(detail, roughness):
+    """For each octave of the fractal sum (as fBM Noise sums them), the points where it is (first) the one octave
+    (Detail or Roughness 0), (whole) a whole octave, (part) the fractional last one."""
+    zero_input = (detail == 0) | (roughness == 0)
+    fractional = detail != np.floor(detail)
+    for i in range(int(np.ceil(detail.max())) + 1 if detail.size else 1):
+        live = (i <= np.ceil(detail)) & ~(zero_input & (i > 0))
+        if not live.any():
+            return
+        yield live & zero_input, live & ~zero_input & (i <= detail), live & ~zero_input & (i > detail) & fractional
+
+
 def fractal(coord, params):
     """(distance, colour, position) summed over the octaves as fBM sums noise (the position blended, not
     summed), normalized by the amplitudes' sum and the largest distance where Normalize is on."""
     detail, roughness, lacunarity = params["detail"], params["roughness"], params["lacunarity"]
     shape = detail.shape
-    zero_input = (detail == 0) | (roughness == 0)
     amplitude, max_amplitude, scale = np.ones(shape, FLOAT), np.zeros(shape, FLOAT), np.ones(shape, FLOAT)
     out_distance, colour, position = np.zeros(shape, FLOAT), np.zeros(shape + (3,), FLOAT), np.zeros(shape + (3,), FLOAT)
     remainder = detail - np.floor(detail)
-    done = np.zeros(shape, bool)
-    for i in range(int(np.ceil(detail.max())) + 1 if detail.size else 1):
-        live = ~done & (i <= np.ceil(detail))
-        if not live.any():
-            break
+    for first, whole, part in _octave_masks(detail, roughness):
         d, c, p = _octave(coord * scale[..., None], params)
-        first = live & zero_input
-        whole = live & ~zero_input & (i <= detail)
-        part = live & ~zero_input & (i > detail) & (remainder != 0)
         out_distance = np.where(first, d, out_distance)
         colour = np.where(first[..., None], c, colour)
         position = np.where(first[..., None], p, position)
@@ -206,7 +210,6 @@ def fractal(coord, params):
         max_amplitude = new_max
         scale = np.where(whole, scale * lacunarity, scale)
         amplitude = np.where(whole, amplitude * roughness, amplitude)
-        done = done | first
     normalize = params["normalize"]
     if normalize:
         out_distance = out_distance / (max_amplitude * params["max_distance"])
@@ -222,19 +225,11 @@ def fractal_distance_to_edge(coord, params):
     detail, roughness, lacunarity, largest = (params[name] for name in ("detail", "roughness", "lacunarity",
                                                                          "max_distance"))
     shape = detail.shape
-    zero_input = (detail == 0) | (roughness == 0)
     amplitude, max_amplitude, scale = np.ones(shape, FLOAT), largest.astype(FLOAT), np.ones(shape, FLOAT)
     out = np.full(shape, FLOAT(8), FLOAT)
     remainder = detail - np.floor(detail)
-    done = np.zeros(shape, bool)
-    for i in range(int(np.ceil(detail.max())) + 1 if detail.size else 1):
-        live = ~done & (i <= np.ceil(detail))
-        if not live.any():
-            break
+    for first, whole, part in _octave_masks(detail, roughness):
         octave = distance_to_edge(coord * scale[..., None], params)
-        first = live & zero_input
-        whole = live & ~zero_input & (i <= detail)
-        part = live & ~zero_input & (i > detail) & (remainder != 0)
         nearer = _mix(out, np.minimum(out, octave / scale), amplitude)
         lerp_amplitude = _mix(max_amplitude, largest / scale, amplitude)
         out = np.where(first, octave, np.where(whole, nearer, np.where(part, _mix(out, np.minimum(out, nearer),
@@ -243,7 +238,6 @@ def fractal_distance_to_edge(coord, params):
                                  np.where(part, _mix(max_amplitude, lerp_amplitude, remainder), max_amplitude))
         scale = np.where(whole, scale * lacunarity, scale)
         amplitude = np.where(whole, amplitude * roughness, amplitude)
-        done = done | first
     if params["normalize"]:
         out = out / max_amplitude
     return out.astype(FLOAT)

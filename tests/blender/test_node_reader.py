@@ -352,6 +352,19 @@ def test_colour_attributes_export_per_corner_and_non_finite_ones_are_named(empty
     assert export_mesh_data(bpy.data.meshes.new("plain"), "plain").colors is None
 
 
+def _mixed(name, first, second, factor):
+    """A material whose surface is a Mix Shader (Fac `factor`) of a `first` and a `second` shader node; returns
+    (material, first node, second node)."""
+    material, tree, output = _material(name)
+    nodes = [tree.nodes.new(kind) for kind in (first, second)]
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = factor
+    for k, node in enumerate(nodes, start=1):
+        tree.links.new(node.outputs[0], mix.inputs[k])
+    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    return material, *nodes
+
+
 def test_transparency_and_holdout_read_as_coverage(empty_file):
     """Principled Alpha: the BSDF drawn whole over a coverage of alpha (its colours unscaled); an image's Alpha
     output read per pixel; a Transparent BSDF in a Mix Shader: the coverage is the other shader's share, which
@@ -372,26 +385,14 @@ def test_transparency_and_holdout_read_as_coverage(empty_file):
     assert params.alpha == 1.0 and params.textures["diffuse_color"] == "alpha_ramp"
     np.testing.assert_allclose(_at_texels(params.textures["alpha"], "alpha")[..., 0], pixels[..., 3], atol=1e-6)
 
-    material, tree, output = _material("transparent_mix")
-    emission, transparent, mix = (tree.nodes.new(kind) for kind in ("ShaderNodeEmission", "ShaderNodeBsdfTransparent",
-                                                                    "ShaderNodeMixShader"))
-    mix.inputs["Fac"].default_value = 0.7
-    tree.links.new(transparent.outputs[0], mix.inputs[1])
-    tree.links.new(emission.outputs[0], mix.inputs[2])
-    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    material, transparent, emission = _mixed("transparent_mix", "ShaderNodeBsdfTransparent", "ShaderNodeEmission", 0.7)
     params, warnings = _read(material)
     assert params.alpha == pytest.approx(0.7) and params.emission == pytest.approx((1.0, 1.0, 1.0))
     transparent.inputs["Color"].default_value = (1.0, 0.5, 0.0, 1.0)
     params, warnings = _read(material)
     assert params.alpha == pytest.approx(1.0 - 0.3 * 0.5) and "a tinted Transparent BSDF" in warnings[0]
 
-    material, tree, output = _material("holdout")
-    emission, holdout, mix = (tree.nodes.new(kind) for kind in ("ShaderNodeEmission", "ShaderNodeHoldout",
-                                                                "ShaderNodeMixShader"))
-    mix.inputs["Fac"].default_value = 0.4
-    tree.links.new(emission.outputs[0], mix.inputs[1])
-    tree.links.new(holdout.outputs[0], mix.inputs[2])
-    tree.links.new(mix.outputs[0], output.inputs["Surface"])
+    material, _, _ = _mixed("holdout", "ShaderNodeEmission", "ShaderNodeHoldout", 0.4)
     params, warnings = _read(material)
     assert params.alpha == 1.0 and params.holdout == pytest.approx(0.4) and warnings == []
     assert params.emission == pytest.approx((0.6, 0.6, 0.6))

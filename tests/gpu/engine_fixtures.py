@@ -121,6 +121,16 @@ def fit_lobes(material, path, **options):
         assert bpy.ops.sgprt.fit_lobes(filepath=path, **options) == {"FINISHED"}
 
 
+def waves(side=8):
+    """(side, side, 4) pixels of three slow waves, one a channel (a smooth colour image the tests read back)."""
+    u, v = np.meshgrid((np.arange(side) + 0.5) / side, (np.arange(side) + 0.5) / side)
+    pixels = np.ones((side, side, 4), np.float32)
+    pixels[..., 0] = 0.5 + 0.4 * np.sin(2 * np.pi * u)
+    pixels[..., 1] = 0.5 + 0.4 * np.cos(2 * np.pi * v)
+    pixels[..., 2] = 0.2 + 0.6 * u * v
+    return pixels
+
+
 def image(name, pixels):
     """A float image from (H, W, 4) pixels in Blender's row order (row 0 at the bottom)."""
     import bpy

@@ -14,15 +14,6 @@ def engine(blender):
     fx.ensure_registered()
 
 
-def _waves():
-    u, v = np.meshgrid((np.arange(8) + 0.5) / 8, (np.arange(8) + 0.5) / 8)
-    pixels = np.ones((8, 8, 4), np.float32)
-    pixels[..., 0] = 0.5 + 0.4 * np.sin(2 * np.pi * u)
-    pixels[..., 1] = 0.5 + 0.4 * np.cos(2 * np.pi * v)
-    pixels[..., 2] = 0.2 + 0.6 * u * v
-    return pixels
-
-
 def _emitting_material(name, image, **settings):
     """SG-PRT settings (the technique and what it needs) with the look read from a node tree: a black
     Principled BSDF whose Emission Color is `image`."""
@@ -63,7 +54,7 @@ def test_emission_texture_renders_alike_under_every_technique(engine, tmp_path):
     from sg_prt_addon.blender import lobe_fit
     from sg_prt_addon.spherical import texture_fetch
 
-    image = fx.image("emission_waves", _waves())
+    image = fx.image("emission_waves", fx.waves())
     fitted = _emitting_material("emission_fitted", image, technique="SG_FITTED")
     fx.fit_lobes(fitted, fx.svbrdf_table_file(tmp_path), lobe_count=1, shadowing_components=1)
     assert lobe_fit.fit_status(fitted)[0] == "VALID"
@@ -82,7 +73,7 @@ def test_emission_texture_renders_alike_under_every_technique(engine, tmp_path):
     # the image at the pixels' UVs (row 0 at the bottom, as the passes), away from the border the filter reaches
     centres = (np.arange(SIZE) + 0.5) / SIZE
     uv = np.stack(np.broadcast_arrays(centres[None, :], centres[:, None]), -1).astype(np.float32)
-    expected = STRENGTH * texture_fetch.bilinear(_waves(), uv, wrap=True)[..., :3]
+    expected = STRENGTH * texture_fetch.bilinear(fx.waves(), uv, wrap=True)[..., :3]
     inner = (slice(2, -2), slice(2, -2))
     for technique, combined in images.items():
         np.testing.assert_allclose(combined, images["SG_PARAMETRIC"], atol=1e-5, err_msg=technique)

@@ -15,15 +15,10 @@ def engine(blender):
 
 def _mixing_material(name, factor):
     """An Emission whose Color mixes a Noise Texture's colour with red by a Value node."""
-    import bpy
+    from benchmarks.cycles_truth import empty_node_material
 
-    material = bpy.data.materials.new(name)
-    if bpy.app.version < (5, 0, 0):
-        material.use_nodes = True
-    tree = material.node_tree
-    for node in list(tree.nodes):
-        tree.nodes.remove(node)
-    output, emission = tree.nodes.new("ShaderNodeOutputMaterial"), tree.nodes.new("ShaderNodeEmission")
+    material, tree, output = empty_node_material(name)
+    emission = tree.nodes.new("ShaderNodeEmission")
     noise, mix, value = (tree.nodes.new(kind) for kind in ("ShaderNodeTexNoise", "ShaderNodeMix", "ShaderNodeValue"))
     mix.data_type = "RGBA"
     value.outputs[0].default_value = factor

@@ -17,15 +17,6 @@ def engine(blender):
     fx.ensure_registered()
 
 
-def _waves():
-    u, v = np.meshgrid((np.arange(8) + 0.5) / 8, (np.arange(8) + 0.5) / 8)
-    pixels = np.ones((8, 8, 4), np.float32)
-    pixels[..., 0] = 0.5 + 0.4 * np.sin(2 * np.pi * u)
-    pixels[..., 1] = 0.5 + 0.4 * np.cos(2 * np.pi * v)
-    pixels[..., 2] = 0.2 + 0.6 * u * v
-    return pixels
-
-
 def _node_material(name, **settings):
     import bpy
 
@@ -80,7 +71,7 @@ def test_a_transparent_surface_shows_what_is_behind_under_every_technique(engine
     depth pre-pass would have hidden the backdrop)."""
     from sg_prt_addon.blender import lobe_fit
 
-    image = fx.image("coverage_waves", _waves())
+    image = fx.image("coverage_waves", fx.waves())
     opaque = _render("coverage_opaque", _emitting("coverage_opaque", image), backdrop=False)
     emitted = opaque["passes"]["Combined"][..., :3].copy()
     expected = ALPHA * emitted + (1.0 - ALPHA) * BACKDROP
@@ -114,7 +105,7 @@ def test_a_transparent_surface_shows_what_is_behind_under_every_technique(engine
 def test_a_holdout_takes_its_share_of_the_alpha(engine):
     """Mix Shader (0.3) of an Emission and a Holdout: Combined is 0.7 x the emission with alpha 0.7, exactly,
     and nothing behind shows through (Cycles' holdout)."""
-    image = fx.image("holdout_waves", _waves())
+    image = fx.image("holdout_waves", fx.waves())
     emitted = _render("holdout_opaque", _emitting("holdout_opaque", image), backdrop=False, samples=1)
     expected = emitted["passes"]["Combined"].copy()      # (the next render replaces last_render's passes)
     material, tree = _node_material("holdout_mix")
