@@ -773,6 +773,32 @@ def transparent_mix(name):
     return _transparent_or_image(name, lambda tree, texture: _separate(tree, texture.outputs["Color"]).outputs["Green"])
 
 
+SECOND_UV_MAP = "Second"
+
+
+def add_second_uv_map(mesh):
+    """A second UV map on the mesh: its first UV map turned a quarter and scaled 1.5 times."""
+    import numpy as np
+
+    first = mesh.uv_layers[0]
+    uvs = np.empty(len(first.data) * 2, np.float32)
+    first.data.foreach_get("uv", uvs)
+    uvs = uvs.reshape(-1, 2)
+    second = mesh.uv_layers.new(name=SECOND_UV_MAP)
+    second.data.foreach_set("uv", np.ascontiguousarray(np.stack([1.5 * uvs[:, 1], 1.5 * (1.0 - uvs[:, 0])], -1)).ravel())
+    mesh.uv_layers.active = first
+    first.active_render = True
+
+
+def image_second_uv(tree):
+    """The image read over the mesh's second UV map (a UV Map node naming it)."""
+    node = _image_node(tree)
+    uv_map = tree.nodes.new("ShaderNodeUVMap")
+    uv_map.uv_map = SECOND_UV_MAP
+    tree.links.new(uv_map.outputs["UV"], node.inputs["Vector"])
+    return node.outputs["Color"]
+
+
 def _backdrop_material():
     """The backdrop's: an Emission of (0.1, 0.3, 0.8)."""
     import bpy
@@ -862,6 +888,7 @@ CASES = {"image": _socket_case(image), "image_non_color": _socket_case(image_non
          "layer_weight_facing": _socket_case(layer_weight("Facing", 0.3)),
          "layer_weight_facing_0_8": _socket_case(layer_weight("Facing", 0.8)),
          "mix_shader_by_fresnel": mix_shader_by_fresnel, "unlit": unlit,
+         "image_second_uv_map": _socket_case(image_second_uv),
          "alpha_constant": alpha_constant, "alpha_texture": alpha_texture, "transparent_mix": transparent_mix}
 # the cases on a sphere (what depends on the view's angle to the surface) in place of the plane
 SPHERE_CASES = ("fresnel", "fresnel_ior_3", "layer_weight_fresnel", "layer_weight_facing", "layer_weight_facing_0_8",
@@ -894,6 +921,8 @@ def build(name, size):
     plane = bpy.context.active_object
     if name in COLOURED:
         add_colour_attribute(plane.data, *COLOURED[name])
+    if name == "image_second_uv_map":
+        add_second_uv_map(plane.data)
     plane.data.materials.append(CASES[name](name))
     if name in BACKDROP_CASES:
         bpy.ops.mesh.primitive_plane_add(size=3.0, location=(0.0, 0.0, -0.5))

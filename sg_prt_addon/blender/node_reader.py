@@ -18,7 +18,7 @@ import numpy as np
 
 from ..reflectance import coverage, node_functions, principled
 from ..reflectance.texture_expression import Expression
-from . import curve_nodes, normal_nodes, texture_nodes
+from . import curve_nodes, normal_nodes, texture_nodes, uv_maps
 from .colour_attributes import default_color_attribute
 from .node_graph import enabled_inputs, output_node
 
@@ -81,22 +81,26 @@ def _luminance(value):
     return _weighted_channels(value, LUMINANCE)
 
 
-def _uv_source(socket):
-    """Whether what feeds `socket` is the UV map itself (unlinked, a UV Map node, Texture Coordinate's UV)."""
+def _uv_source(socket, meshes):
+    """Whether what feeds `socket` is the UV map renders use (unlinked, a UV Map node naming it or none, Texture
+    Coordinate's UV) on every mesh of `meshes`."""
     out = follow(socket)
-    return out is None or out.node.type == "UVMAP" or (out.node.type == "TEX_COORD" and out.identifier == "UV")
+    if out is not None and out.node.type == "UVMAP":
+        return uv_maps.coordinates_of(meshes, out.node.uv_map) != "SECOND_UV"
+    return out is None or (out.node.type == "TEX_COORD" and out.identifier == "UV")
 
 
-def _over_the_uv_map(node):
+def _over_the_uv_map(node, meshes):
     """Whether an Image Texture reads the UV map repeating, through at most a Mapping whose values are its own and
     turn about z alone: what the material's uv_transform and the plain texture path carry."""
     if node.extension != "REPEAT":
         return False
     vector = follow(node.inputs["Vector"])
-    if vector is None or _uv_source(node.inputs["Vector"]):
+    if vector is None or _uv_source(node.inputs["Vector"], meshes):
         return True
     mapping = vector.node
-    if mapping.type != "MAPPING" or mapping.vector_type == "NORMAL" or not _uv_source(mapping.inputs["Vector"]):
+    if mapping.type != "MAPPING" or mapping.vector_type == "NORMAL" or not _uv_source(mapping.inputs["Vector"],
+                                                                                    meshes):
         return False
     if any(name in mapping.inputs and mapping.inputs[name].is_linked for name in ("Location", "Rotation", "Scale")):
         return False
@@ -207,9 +211,11 @@ class SocketReader:
         """Texture Coordinate's Generated, Normal, UV and Object (of the object itself); Geometry's Position,
         Normal and Incoming (world space); a UV Map node's UV (the active map's)."""
         if node.type == "UVMAP":
-            if node.uv_map and self._other_uv_map(node.uv_map):
-                self.note(node, f"UV map '{node.uv_map}': each mesh's active UV map is used")
-            return Expression.coordinates("UV")
+            name = uv_maps.coordinates_of(self._meshes(), node.uv_map)
+            if name is None:
+                self.note(node, f"UV map '{node.uv_map}': neither the UV map renders use nor the second one of "
+                                "each mesh with this material: each mesh's render UV map is used")
+            return Expression.coordinates(name or "UV")
         names = {"Generated": "GENERATED", "Normal": "NORMAL", "UV": "UV", "Object": "OBJECT"} \
             if node.type == "TEX_COORD" else {"Position": "POSITION", "Normal": "WORLD_NORMAL",
                                               "True Normal": "WORLD_NORMAL", "Incoming": "INCOMING"}
@@ -396,7 +402,7 @@ class SocketReader:
         if node.projection != "FLAT":
             self.note(node, f"{node.projection.lower()} projection: read flat")
         self.images[image.name] = image
-        if not _over_the_uv_map(node):
+        if not _over_the_uv_map(node, self._meshes()):
             vector_socket = node.inputs["Vector"]
             vector = self.value(vector_socket, True) if vector_socket.is_linked else Expression.coordinates("UV")
             return Expression.image_at(image.name, node.extension, vector, out.name)
@@ -406,10 +412,8 @@ class SocketReader:
             transform = self.uv_transform_of(vector.node)
             vector = follow(vector.node.inputs["Vector"])
         self.uv_transforms.append(transform)
-        if vector is not None:
-            source = vector.node
-            if source.type == "UVMAP" and source.uv_map and self._other_uv_map(source.uv_map):
-                self.note(source, f"UV map '{source.uv_map}': each mesh's active UV map is used")
+        if vector is not None and vector.node.type == "UVMAP":
+            self.coordinates_value(vector.node, vector, node.inputs["Vector"], True)     # its note, if any
         if out.name == "Alpha":     # at the material's texture coordinates, as its Color
             return Expression.image_at(image.name, "REPEAT", Expression.coordinates("UV"), "Alpha")
         return Expression.image(image.name)
@@ -444,11 +448,6 @@ class SocketReader:
         default one)."""
         return any(attribute is not None and attribute.name != name
                    for attribute in map(default_color_attribute, self._meshes()))
-
-    def _other_uv_map(self, name):
-        """Whether a mesh with this material has an active UV map other than `name` (export reads the active)."""
-        return any(mesh.uv_layers.active is not None and mesh.uv_layers.active.name != name
-                   for mesh in self._meshes())
 
     # ------------------------------------------------------------------ shaders
 

@@ -206,6 +206,7 @@ class MeshBuffers:
         self.refused = {}               # kind -> why its per-vertex data was not uploaded (the render says so)
         self.bounds = None              # (2, 3) local box
         self.has_colors = False         # a colour attribute (MeshExport.colors) in the vertex buffer
+        self.has_second_uv = False      # the second UV map (MeshExport.second_uvs) in the vertex buffer
         # object space -> Generated coordinates: (co - location) / (2 size) + 1/2 of the mesh's texture space
         location, size = (np.asarray(v, np.float64) for v in mesh.texture_space)
         size = np.where(size != 0.0, size, 1.0)
@@ -241,6 +242,9 @@ class MeshBuffers:
         self.has_colors = mesh.colors is not None
         if self.has_colors:
             fmt.attr_add(id="color", comp_type="F32", len=4, fetch_mode="FLOAT")
+        self.has_second_uv = mesh.second_uvs is not None
+        if self.has_second_uv:
+            fmt.attr_add(id="second_uv", comp_type="F32", len=2, fetch_mode="FLOAT")
         if usable:
             fmt.attr_add(id="vertex_index", comp_type="I32", len=1, fetch_mode="INT")
             fmt.attr_add(id="vertex_normal", comp_type="F32", len=3, fetch_mode="FLOAT")
@@ -251,6 +255,8 @@ class MeshBuffers:
         vertices.attr_fill("uv", mesh.uvs)
         if self.has_colors:
             vertices.attr_fill("color", mesh.colors)
+        if self.has_second_uv:
+            vertices.attr_fill("second_uv", mesh.second_uvs)
         if usable:
             data = next(iter(usable.values()))
             rows = data.corner_rows(mesh.corner_vertex)
@@ -573,7 +579,7 @@ class Renderer:
             inputs = techniques.ObjectInputs(light_data, state.environment, self.gbuffer,
                                              buffers.per_vertex_layers(), buffers.bounds, entry.matrix_world,
                                              buffers.per_vertex_data(), self.shadow_plan is not None,
-                                             buffers.has_colors)
+                                             buffers.has_colors, buffers.has_second_uv)
             slots = []
             for slot, first_triangle, batch in buffers.batches:
                 name, params = _slot_material(state, entry, slot)

@@ -12,10 +12,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-# The surface's coordinates a value may read (Texture Coordinate and Geometry nodes): UV (the material's texture
-# coordinates), OBJECT (object space), GENERATED (object space in the mesh's texture space, [0, 1] over its
-# box), NORMAL (object space), POSITION, WORLD_NORMAL and INCOMING (toward the viewer; world space)
-COORDINATES = ("UV", "OBJECT", "GENERATED", "NORMAL", "POSITION", "WORLD_NORMAL", "INCOMING")
+# The surface's coordinates a value may read (Texture Coordinate, Geometry and UV Map nodes): UV (the material's
+# texture coordinates), SECOND_UV (the mesh's second UV map), OBJECT (object space), GENERATED (object space in
+# the mesh's texture space, [0, 1] over its box), NORMAL (object space), POSITION, WORLD_NORMAL and INCOMING
+# (toward the viewer; world space)
+COORDINATES = ("UV", "SECOND_UV", "OBJECT", "GENERATED", "NORMAL", "POSITION", "WORLD_NORMAL", "INCOMING")
 
 
 @dataclass(frozen=True)

@@ -39,15 +39,17 @@ class ObjectInputs:
     the object's usable precomputation (absent: none), per_vertex_data: kind -> its
     visibility.per_vertex.PerVertexData (numpy); bounds: (2, 3) local box or None; matrix_world (4, 4);
     shadow_maps: the frame's lights have shadow maps (lighting.shadow_maps, DrawContext.shadow_atlas);
-    vertex_colors: the mesh has a colour attribute (its vertex stream, shader_sources.surface_calls).
+    vertex_colors: the mesh has a colour attribute (its vertex stream, shader_sources.surface_calls); second_uv:
+    it has a second UV map (likewise).
     Derived values a technique computes once per object go in ``memo``.  Everything but matrix_world is the
     frame's or the mesh's: reading matrix_world sets ``matrix_world_read``, and the engine reuses a variant key
     for the other objects drawing the same mesh and material only when it was made without reading it."""
 
     def __init__(self, light_data, environment, gbuffer=False, per_vertex=None, bounds=None, matrix_world=None,
-                 per_vertex_data=None, shadow_maps=False, vertex_colors=False):
+                 per_vertex_data=None, shadow_maps=False, vertex_colors=False, second_uv=False):
         self.light_data = light_data
         self.vertex_colors = bool(vertex_colors)
+        self.second_uv = bool(second_uv)
         self.shadow_maps = bool(shadow_maps)
         self.environment = environment
         self.gbuffer = bool(gbuffer)

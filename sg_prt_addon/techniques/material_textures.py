@@ -26,6 +26,7 @@ IMAGE_EXTENSIONS = ("REPEAT", "EXTEND", "CLIP", "MIRROR")        # material_text
 # space, bind_object)
 COORDINATE_SOURCES = {
     "UV": "vec3(texcoord, 0.0)",
+    "SECOND_UV": "vec3(texcoord_second, 0.0)",
     "OBJECT": "object_position",
     "GENERATED": "(object_position * generated_scale.xyz + generated_offset.xyz)",
     "NORMAL": "normalize(transpose(mat3(model_matrix)) * world_normal)",
@@ -33,7 +34,7 @@ COORDINATE_SOURCES = {
     "WORLD_NORMAL": "normalize(world_normal)",
     "INCOMING": "(scene.camera.w > 0.5 ? normalize(scene.camera.xyz - world_position) : -normalize(scene.camera.xyz))",
 }
-# What a colour attribute reads where the mesh has none (Cycles: an attribute not found is 0)
+# What a colour attribute or the second UV map reads where the mesh has none (Cycles: an attribute not found is 0)
 MISSING_ATTRIBUTE = "vec3(0.0)"
 
 
@@ -48,6 +49,7 @@ class NodeValues:
     coordinates: tuple = ()
     coverage: bool = False
     holdout: bool = False
+    second_uv: bool = False      # they read the second UV map and the object's mesh has one (its vertex stream)
 
     @property
     def object_position(self):
@@ -67,7 +69,8 @@ def node_values(params, textures, inputs):
     reads_attributes = any(expression.attributes for _, expression in slots)
     coordinates = tuple(sorted({name for _, expression in slots for name in expression.coordinate_names}))
     return NodeValues(slots, reads_attributes and inputs.vertex_colors, coordinates,
-                      coverage=has_coverage(params, textures), holdout=params.holdout > 0.0 or "holdout" in textures)
+                      coverage=has_coverage(params, textures), holdout=params.holdout > 0.0 or "holdout" in textures,
+                      second_uv="SECOND_UV" in coordinates and inputs.second_uv)
 
 
 def has_coverage(params, textures=None):
@@ -305,6 +308,8 @@ def _values(key):
     attribute = "vertex_color.rgb" if key.node_values.vertex_colors else MISSING_ATTRIBUTE
 
     def rgb_of(factor):
+        if factor.coordinates == "SECOND_UV" and not key.node_values.second_uv:
+            return MISSING_ATTRIBUTE
         if factor.coordinates is not None:
             return COORDINATE_SOURCES[factor.coordinates]
         return attribute if factor.attribute else f"node_image_{names.index(factor.image)}_rgb()"

@@ -154,19 +154,21 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
     the fragment source calls per_vertex_copy_source's load_per_vertex_rows), what the material's computed
     values read (node_values: techniques.material_textures.NodeValues): the mesh's colour attribute as the
     vertex_color varying (HAS_VERTEX_COLOR), the object-space position as object_position
-    (HAS_OBJECT_POSITION), the texture space's push constants, the coverage and holdout (HAS_COVERAGE,
-    HAS_HOLDOUT); the scene and material blocks at bindings
+    (HAS_OBJECT_POSITION), the mesh's second UV map as texcoord_second (HAS_SECOND_UV), the texture space's push
+    constants, the coverage and holdout (HAS_COVERAGE, HAS_HOLDOUT); the scene and material blocks at bindings
     0 and 1, `samplers` ((kind, name) in slot order), the technique's own push_constants ((type, name)) after
     the model matrix, the NodeConstants block of `node_constants` rows at binding 2 where there are any
     (techniques.material_textures.constant_rows), and the outputs of output_names."""
     vertex_colors = node_values is not None and node_values.vertex_colors
     object_position = node_values is not None and node_values.object_position
+    second_uv = node_values is not None and node_values.second_uv
     coverage = node_values is not None and node_values.coverage
     holdout = node_values is not None and node_values.holdout
     defines = {**LIMITS, **defines, **({"PER_VERTEX_ROWS": 1} if per_vertex else {}),
                **({"HAS_VERTEX_COLOR": 1} if vertex_colors else {}),
                **({"HAS_OBJECT_POSITION": 1} if object_position else {}),
-               **({"HAS_COVERAGE": 1} if coverage else {}), **({"HAS_HOLDOUT": 1} if holdout else {})}
+               **({"HAS_COVERAGE": 1} if coverage else {}), **({"HAS_HOLDOUT": 1} if holdout else {}),
+               **({"HAS_SECOND_UV": 1} if second_uv else {})}
     calls = [("define", (name, str(value))) for name, value in sorted(defines.items())]
     typedefs = typedef_source()
     if node_constants:
@@ -178,6 +180,8 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
         calls += [("vertex_in", (4, "INT", "vertex_index")), ("vertex_in", (5, "VEC3", "vertex_normal"))]
     if vertex_colors:
         calls.append(("vertex_in", (6, "VEC4", "color")))
+    if second_uv:
+        calls.append(("vertex_in", (7, "VEC2", "second_uv")))
     interface = [("smooth", ("VEC3", "world_position")), ("smooth", ("VEC3", "world_normal")),
                  ("smooth", ("VEC4", "world_tangent")), ("smooth", ("VEC2", "texcoord"))]
     if per_vertex:
@@ -188,8 +192,11 @@ def surface_calls(defines, fragment_source, samplers, gbuffer, per_vertex=(), pu
         interface.append(("smooth", ("VEC4", "vertex_color")))
     if object_position:
         interface.append(("smooth", ("VEC3", "object_position")))
+    if second_uv:
+        interface.append(("smooth", ("VEC2", "texcoord_second")))
     interface_name = "sgprt_surface_interface" + "".join(f"_{item.varying}{item.rows}" for item in per_vertex) \
-        + ("_color" if vertex_colors else "") + ("_object" if object_position else "")
+        + ("_color" if vertex_colors else "") + ("_object" if object_position else "") \
+        + ("_second_uv" if second_uv else "")
     calls.append(("vertex_out", (interface_name, tuple(interface))))
     calls.append(("push_constant", ("MAT4", "model_matrix")))
     calls += [("push_constant", constant) for constant in push_constants]

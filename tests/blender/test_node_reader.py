@@ -413,3 +413,29 @@ def test_a_bump_node_on_the_normal_is_a_computed_shading_normal(empty_file):
     normal = params.textures["shading_normal"]
     assert warnings == [] and normal.terms[0][1][0].function.name == "bump"
     assert set(normal.coordinate_names) == {"GENERATED", "POSITION", "WORLD_NORMAL"}
+
+
+def test_a_uv_map_node_naming_the_second_uv_map_reads_it(empty_file):
+    """A UV Map node naming each mesh's second UV map reads it (SECOND_UV coordinates, an image read there per
+    pixel), which the mesh export carries; one naming a map that is neither is named and reads the render UV map."""
+    from sg_prt_addon.blender import export
+
+    material, tree, output = _material("second_uv")
+    texture = _link_image(tree, _image("second_uv_image", np.ones((2, 2, 4), np.float32)),
+                          _principled(tree, output).inputs["Base Color"])
+    uv_map = tree.nodes.new("ShaderNodeUVMap")
+    tree.links.new(uv_map.outputs["UV"], texture.inputs["Vector"])
+    mesh = bpy.data.meshes.new("second_uv_mesh")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [], [(0, 1, 2, 3)])
+    first, second = mesh.uv_layers.new(name="First"), mesh.uv_layers.new(name="Second")
+    second.data.foreach_set("uv", [0.5, 0.25] * 4)
+    mesh.uv_layers.active = first
+    mesh.materials.append(material)
+    uv_map.uv_map = "Second"
+    params, warnings = _read(material)
+    assert warnings == [] and params.textures["diffuse_color"].coordinate_names == ("SECOND_UV",)
+    exported = export.export_mesh_data(mesh)
+    np.testing.assert_array_equal(exported.second_uvs, np.tile([0.5, 0.25], (4, 1)))
+    uv_map.uv_map = "Third"
+    params, warnings = _read(material)
+    assert params.textures["diffuse_color"] == "second_uv_image" and "UV map 'Third'" in warnings[0]

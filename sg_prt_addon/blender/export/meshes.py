@@ -4,6 +4,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...reflectance import models
+from .. import uv_maps
 from ..colour_attributes import default_color_attribute
 from .materials import TEXTURED_PARAMETERS
 from .messages import warn
@@ -18,7 +19,7 @@ class MeshExport:
     positions: np.ndarray          # (V, 3) corner positions
     normals: np.ndarray            # (V, 3) split (corner) normals, unit
     tangents: np.ndarray           # (V, 4) unit tangent xyz, bitangent sign w (+-1)
-    uvs: np.ndarray                # (V, 2) active UV map (zeros without one)
+    uvs: np.ndarray                # (V, 2) the UV map renders use (zeros without one: blender/uv_maps.py)
     triangles: np.ndarray          # (T, 3) uint32 corner indices, sorted by material index
     material_ranges: list          # [(material_index, first_triangle, triangle_count)]
     has_uv: bool = False
@@ -30,6 +31,8 @@ class MeshExport:
     vertex_normals: np.ndarray = None  # (vertex_count, 3) float32
     # the mesh's default colour attribute (what a node tree's Color Attribute reads), linear RGBA a corner
     colors: np.ndarray = None          # (V, 4) float32, or None without one
+    # the mesh's second UV map (blender/uv_maps.py) at every corner, or None without one
+    second_uvs: np.ndarray = None      # (V, 2) float32
     # the mesh's texture space (location, size): what Generated coordinates span ([0, 1] over location +- size)
     texture_space: tuple = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
 
@@ -112,8 +115,7 @@ def export_mesh_data(mesh, name=None):
         warn(f"object '{name or mesh.name}': {len(np.unique(vertex_index[~finite]))} vertices with NaN/Inf "
              f"coordinates (or beyond {MAX_COORDINATE:g}): their {int((~keep).sum())} triangle(s) left out")
 
-    # the UV map renders use (camera icon in the UI), else the active one
-    uv_layer = next((layer for layer in mesh.uv_layers if layer.active_render), mesh.uv_layers.active)
+    uv_layer = uv_maps.render_layer(mesh)
     uvs = np.zeros((loop_count, 2), np.float32)
     tangents = None
     if uv_layer is not None and loop_count:
@@ -160,7 +162,18 @@ def export_mesh_data(mesh, name=None):
         vertex_normals=_vertex_normals(mesh),
         texture_space=(tuple(mesh.texspace_location), tuple(mesh.texspace_size)),
         **_corner_colors(mesh, vertex_index, name),
+        **_second_uvs(mesh, loop_count),
     )
+
+
+def _second_uvs(mesh, loop_count):
+    """MeshExport's second_uvs: the mesh's second UV map (uv_maps.second_layer) at every corner."""
+    layer = uv_maps.second_layer(mesh)
+    if layer is None or not loop_count:
+        return {}
+    flat = np.empty(loop_count * 2, np.float32)
+    layer.data.foreach_get("uv", flat)
+    return {"second_uvs": np.ascontiguousarray(flat.reshape(-1, 2), np.float32)}
 
 
 def _corner_colors(mesh, vertex_index, name):
